@@ -1,0 +1,11 @@
+#include "apps/commands.h"
+#include "core/util/error.h"
+
+namespace pkslam::apps {
+
+void RegisterInfoCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("info", "(being implemented)");
+  cmd->callback([] { throw Error("not implemented yet"); });
+}
+
+}  // namespace pkslam::apps

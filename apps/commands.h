@@ -1,0 +1,12 @@
+// Each pkslam subcommand lives in its own cmd_*.cc and registers itself on the CLI11 app.
+// A command's callback throws on error; main() prints one line and exits non-zero.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace pkslam::apps {
+
+void RegisterEvalCommand(CLI::App& app);
+void RegisterInfoCommand(CLI::App& app);
+
+}  // namespace pkslam::apps

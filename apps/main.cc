@@ -1,0 +1,34 @@
+// pkslam: one executable, one subcommand per capability (see README.md).
+#include <exception>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "apps/commands.h"
+#include "core/util/error.h"
+#include "core/util/log.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"pkslam: keyframe SLAM with photogrammetric keyframe selection (PKS)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("pkslam ") + PKSLAM_VERSION);
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off")->capture_default_str();
+  app.parse_complete_callback([&log_level] { pkslam::SetLogLevel(log_level); });
+
+  pkslam::apps::RegisterEvalCommand(app);
+  pkslam::apps::RegisterInfoCommand(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const pkslam::Error& e) {
+    std::cerr << "pkslam: error: " << e.what() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "pkslam: error: " << e.what() << '\n';
+    return 2;
+  }
+  return 0;
+}

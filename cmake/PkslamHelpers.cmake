@@ -1,0 +1,50 @@
+# Shared compile settings and the folder-library / beside-the-code test helpers.
+
+add_library(pkslam_options INTERFACE)
+target_compile_options(pkslam_options INTERFACE -Wall -Wextra)
+if(PKSLAM_WERROR)
+  target_compile_options(pkslam_options INTERFACE -Werror)
+endif()
+if(PKSLAM_NATIVE)
+  target_compile_options(pkslam_options INTERFACE -march=native)
+endif()
+if(PKSLAM_SANITIZE STREQUAL "address")
+  target_compile_options(pkslam_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -g)
+  target_link_options(pkslam_options INTERFACE -fsanitize=address,undefined)
+elseif(PKSLAM_SANITIZE STREQUAL "thread")
+  target_compile_options(pkslam_options INTERFACE -fsanitize=thread -g)
+  target_link_options(pkslam_options INTERFACE -fsanitize=thread)
+elseif(NOT PKSLAM_SANITIZE STREQUAL "")
+  message(FATAL_ERROR "PKSLAM_SANITIZE must be '', 'address' or 'thread'")
+endif()
+target_compile_definitions(pkslam_options INTERFACE
+  PKSLAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}" PKSLAM_VERSION="${PROJECT_VERSION}")
+
+# pkslam_library(NAME SOURCES ... DEPS ... [TESTS ...] [TEST_DEPS ...] [BENCHMARKS ...])
+# One static library per folder; the folder's *_test.cc files form one gtest executable
+# NAME_test registered with CTest (label = folder name), *_benchmark.cc files one
+# Google Benchmark executable NAME_benchmark.
+function(pkslam_library NAME)
+  cmake_parse_arguments(ARG "" "LABEL" "SOURCES;DEPS;TESTS;TEST_DEPS;BENCHMARKS" ${ARGN})
+  add_library(${NAME} STATIC ${ARG_SOURCES})
+  target_include_directories(${NAME} PUBLIC ${PROJECT_SOURCE_DIR})
+  target_link_libraries(${NAME} PUBLIC ${ARG_DEPS} PRIVATE pkslam_options)
+  if(NOT ARG_LABEL)
+    get_filename_component(ARG_LABEL ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  endif()
+  if(ARG_TESTS AND PKSLAM_BUILD_TESTS)
+    add_executable(${NAME}_test ${ARG_TESTS})
+    target_link_libraries(${NAME}_test PRIVATE ${NAME} ${ARG_TEST_DEPS} pkslam_testsupport
+                          pkslam_options GTest::gtest GTest::gmock GTest::gtest_main)
+    set_target_properties(${NAME}_test PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
+    gtest_discover_tests(${NAME}_test DISCOVERY_MODE PRE_TEST
+                         PROPERTIES LABELS ${ARG_LABEL}
+                         WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
+  endif()
+  if(ARG_BENCHMARKS AND PKSLAM_BUILD_BENCHMARKS)
+    add_executable(${NAME}_benchmark ${ARG_BENCHMARKS})
+    target_link_libraries(${NAME}_benchmark PRIVATE ${NAME} ${ARG_TEST_DEPS} pkslam_testsupport
+                          pkslam_options benchmark::benchmark benchmark::benchmark_main)
+    set_target_properties(${NAME}_benchmark PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/benchmarks)
+  endif()
+endfunction()

@@ -1,0 +1,44 @@
+// Progress line for long work (simulation, runs, sweeps, training, fusion).
+// Prints "label  [#####.....]  42% 123/290  12.3/s  ETA 0:14" to stderr, redrawn in place
+// when stderr is a terminal and every ~5% as plain lines otherwise (logs stay readable).
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <string>
+
+namespace pkslam {
+
+class Progress {
+ public:
+  // total == 0 means unknown (shows count and rate only). quiet disables all output.
+  Progress(std::string label, std::size_t total, bool quiet = false);
+  ~Progress();
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+
+  // Advance by n and redraw if due. Not thread-safe: call from one thread.
+  void Add(std::size_t n = 1);
+  // Set an extra text shown after the bar (e.g. "ATE 0.012 m").
+  void SetSuffix(std::string suffix);
+  // Final redraw and newline (idempotent; the destructor calls it).
+  void Finish();
+
+  std::size_t done() const { return done_; }
+
+ private:
+  void Draw(bool force);
+
+  std::string label_;
+  std::string suffix_;
+  std::size_t total_ = 0;
+  std::size_t done_ = 0;
+  bool quiet_ = false;
+  bool tty_ = false;
+  bool finished_ = false;
+  int last_percent_printed_ = -1;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_draw_;
+};
+
+}  // namespace pkslam
