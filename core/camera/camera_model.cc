@@ -28,7 +28,7 @@ constexpr double kKbThetaTol = 1e-14;
 constexpr int kMaxKbIterations = 40;
 
 // Largest tan(angle) scanned when looking for the pinhole distortion fold (~87 degrees): no
-// real pinhole camera sees further, and a fold beyond it cannot reach the image.
+// real pinhole lens sees further, so a fold beyond it does not matter.
 constexpr double kMaxPinholeRadius = 20.0;
 
 // Smallest x in (0, x_max] with f(x) <= 0, given f(0) > 0, or nullopt: a coarse scan then
@@ -204,12 +204,7 @@ CameraModel CameraModel::KannalaBrandt8(int width, int height, double fx, double
   return cam;
 }
 
-bool CameraModel::HasDistortion() const {
-  for (const double d : distortion_) {
-    if (d != 0.0) return true;
-  }
-  return false;
-}
+bool CameraModel::HasDistortion() const { return distorted_; }
 
 std::optional<Eigen::Vector2d> CameraModel::Project(const Eigen::Vector3d& p_camera,
                                                     Matrix23d* d_uv_d_p) const {

@@ -46,6 +46,8 @@ class CameraModel {
   double cx() const { return cx_; }
   double cy() const { return cy_; }
   const std::vector<double>& distortion() const { return distortion_; }
+  // Whether pixels differ from an ideal pinhole's: a non-zero radtan coefficient, or KB8
+  // (always, even with zero coefficients: it is the equidistant mapping).
   bool HasDistortion() const;
   // Largest angle from the optical axis (rad) that Project accepts: for KB8 where theta_d(theta)
   // stops increasing (at most pi); for pinhole atan of the largest valid normalised radius

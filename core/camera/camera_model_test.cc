@@ -239,6 +239,10 @@ TEST(CameraModelTest, Kb8UndistortPixelIsThePerspectiveImageOfTheRay) {
 TEST(CameraModelTest, UndistortWithoutDistortionIsIdentity) {
   const CameraModel cam = CameraModel::Pinhole(640, 480, 500, 500, 320, 240);
   EXPECT_FALSE(cam.HasDistortion());
+  EXPECT_FALSE(CameraModel::Pinhole(640, 480, 500, 500, 320, 240, {0, 0, 0, 0}).HasDistortion());
+  EXPECT_TRUE(EurocCam0().HasDistortion());
+  EXPECT_TRUE(
+      CameraModel::KannalaBrandt8(640, 480, 500, 500, 320, 240, {0, 0, 0, 0}).HasDistortion());
   const std::vector<cv::Point2f> in = {{1.5f, 2.5f}, {600.f, 400.f}};
   std::vector<cv::Point2f> out;
   cam.UndistortPixels(in, &out);
