@@ -219,7 +219,8 @@ TrajectoryFormat DetectTrajectoryFormat(const std::filesystem::path& file) {
   return DetectFormat(SplitLines(content), file);
 }
 
-Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat format) {
+Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat format,
+                          DuplicateTimestamps duplicates) {
   const std::string content = ReadWholeFile(file);
   const std::vector<TextLine> lines = SplitLines(content);
   if (format == TrajectoryFormat::kAuto) format = DetectFormat(lines, file);
@@ -231,6 +232,8 @@ Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
   std::size_t far_from_unit = 0;
   std::size_t first_far_line = 0;
   double first_far_norm = 1.0;
+  std::size_t duplicates_dropped = 0;
+  std::size_t first_duplicate_line = 0;
   for (const TextLine& line : lines) {
     if (IsComment(line)) continue;
     bool comma = false;
@@ -269,13 +272,17 @@ Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
     stamped.pose = SE3d(q, Eigen::Vector3d(v[0], v[1], v[2]));  // SO3 normalises q
 
     if (!trajectory.poses.empty() && stamped.t_ns <= trajectory.poses.back().t_ns) {
+      const bool repeat = stamped.t_ns == trajectory.poses.back().t_ns;
+      if (repeat && duplicates == DuplicateTimestamps::kKeepFirst) {
+        if (duplicates_dropped++ == 0) first_duplicate_line = line.number;
+        continue;
+      }
       throw InputError(
           file, line.number,
-          fmt::format("timestamp {} s {} the previous one ({} s): poses must be sorted by time "
-                      "without duplicates",
-                      FormatSeconds(stamped.t_ns),
-                      stamped.t_ns == trajectory.poses.back().t_ns ? "repeats" : "is before",
-                      FormatSeconds(trajectory.poses.back().t_ns)));
+          fmt::format("timestamp {} s {} the previous one ({} s): poses must be sorted by time{}",
+                      FormatSeconds(stamped.t_ns), repeat ? "repeats" : "is before",
+                      FormatSeconds(trajectory.poses.back().t_ns),
+                      repeat ? " without duplicates" : ""));
     }
     trajectory.poses.push_back(stamped);
     if (fields.size() == 17) {
@@ -287,6 +294,10 @@ Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
     }
   }
   if (trajectory.poses.empty()) throw InputError(file, "empty trajectory file (no pose lines)");
+  if (duplicates_dropped > 0) {
+    PKSLAM_LOG_WARN("{}: dropped {} line(s) repeating the previous timestamp (first at line {})",
+                    file.string(), duplicates_dropped, first_duplicate_line);
+  }
   if (far_from_unit > 0) {
     PKSLAM_LOG_WARN(
         "{}: {} quaternion(s) far from unit norm (first at line {}, norm {:.4f}); "

@@ -25,8 +25,12 @@
 //
 // Errors: pkslam::InputError naming the file and line for a missing or empty file, a line that
 // is not numbers or has the wrong number of columns, a NaN/inf value, a zero quaternion,
-// timestamps that are not strictly increasing (the line that breaks the order) and a format
-// that cannot be detected.
+// a timestamp earlier than the one before it (the line that breaks the order) and a format
+// that cannot be detected. A timestamp equal to the previous one is an error too with
+// DuplicateTimestamps::kError; by default (kKeepFirst) the later line is dropped with a warning,
+// because real ground truth has them (TUM fr2_desk repeats 1311868229.5760 with two different
+// poses) and evo, whose nearest-time search takes the first of equal stamps, evaluates such
+// files as if the later line were absent.
 #pragma once
 
 #include <Eigen/Core>
@@ -75,9 +79,16 @@ std::string_view TrajectoryFormatName(TrajectoryFormat format);
 // missing, has no data line, or matches no format.
 TrajectoryFormat DetectTrajectoryFormat(const std::filesystem::path& file);
 
+// What to do with a line whose timestamp equals the previous line's.
+enum class DuplicateTimestamps {
+  kKeepFirst,  // drop the later line, warn once per file with the count and the first line
+  kError,      // throw InputError naming the line
+};
+
 // Reads a trajectory; kAuto detects the format. Throws InputError (see above).
 Trajectory ReadTrajectory(const std::filesystem::path& file,
-                          TrajectoryFormat format = TrajectoryFormat::kAuto);
+                          TrajectoryFormat format = TrajectoryFormat::kAuto,
+                          DuplicateTimestamps duplicates = DuplicateTimestamps::kKeepFirst);
 
 // Writers (kAuto is not allowed). tum: seconds with exactly 9 decimals, so nanosecond
 // timestamps survive a write/read round trip; positions and quaternions with 9 decimals.

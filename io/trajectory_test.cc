@@ -29,10 +29,11 @@ class TrajectoryFileTest : public ::testing::Test {
 
   // The InputError thrown by reading `content`; fails the test when nothing is thrown.
   InputError ReadError(const std::string& content,
-                       TrajectoryFormat format = TrajectoryFormat::kAuto) {
+                       TrajectoryFormat format = TrajectoryFormat::kAuto,
+                       DuplicateTimestamps duplicates = DuplicateTimestamps::kKeepFirst) {
     const fs::path file = Write("bad.txt", content);
     try {
-      ReadTrajectory(file, format);
+      ReadTrajectory(file, format, duplicates);
     } catch (const InputError& e) {
       return e;
     }
@@ -226,9 +227,20 @@ TEST_F(TrajectoryFileTest, UnsortedAndDuplicateTimestampsNameTheBreakingLine) {
       "1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n# comment\n1.5 0 0 0 0 0 0 1\n3 0 0 0 0 0 0 1\n");
   EXPECT_EQ(unsorted.line(), 4u);
   EXPECT_NE(std::string(unsorted.what()).find("is before"), std::string::npos) << unsorted.what();
-  const InputError duplicate = ReadError("1.0 0 0 0 0 0 0 1\n1.000000000 0 0 0 0 0 0 1\n");
+  const std::string repeated =
+      "1.0 0 0 0 0 0 0 1\n1.000000000 5 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n2 6 0 0 0 0 0 1\n";
+  const InputError duplicate =
+      ReadError(repeated, TrajectoryFormat::kAuto, DuplicateTimestamps::kError);
   EXPECT_EQ(duplicate.line(), 2u);
   EXPECT_NE(std::string(duplicate.what()).find("repeats"), std::string::npos) << duplicate.what();
+  // By default the first of equal stamps is kept (as evo's nearest-time search would use it).
+  const Trajectory kept = ReadTrajectory(Write("dup.txt", repeated));
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_EQ(kept.poses[0].pose.translation().x(), 0.0);
+  EXPECT_EQ(kept.poses[1].t_ns, 2000000000);
+  EXPECT_EQ(kept.poses[1].pose.translation().x(), 0.0);
+  // Going back in time after a repeat is still an error.
+  EXPECT_EQ(ReadError("1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n0.5 0 0 0 0 0 0 1\n").line(), 3u);
 }
 
 TEST_F(TrajectoryFileTest, UnknownFormatIsAnError) {
