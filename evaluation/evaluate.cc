@@ -59,12 +59,16 @@ EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& e
   result.alignment = options.alignment;
   result.pairs = AssociateTimestamps(ref.Timestamps(), est.Timestamps(), options.association);
   if (result.pairs.empty()) {
+    const std::int64_t offset_ns = std::llround(options.association.offset_s * 1e9);
+    const bool ranges_overlap = est.poses.front().t_ns + offset_ns <= ref.poses.back().t_ns &&
+                                ref.poses.front().t_ns <= est.poses.back().t_ns + offset_ns;
     throw InputError(
         est_name,
-        fmt::format("no pose within {} s of a pose of {} (no time overlap: ground truth {}, "
-                    "estimate {}{})",
-                    options.association.max_diff_s, ref_name.string(), TimeRange(ref),
-                    TimeRange(est),
+        fmt::format("no pose within {} s of a pose of {} ({}: ground truth {}, estimate {}{})",
+                    options.association.max_diff_s, ref_name.string(),
+                    ranges_overlap ? "the time ranges overlap but no stamps are that close"
+                                   : "no time overlap",
+                    TimeRange(ref), TimeRange(est),
                     options.association.offset_s != 0.0
                         ? fmt::format(", offset {} s", options.association.offset_s)
                         : std::string()));

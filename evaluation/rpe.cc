@@ -138,10 +138,15 @@ RpeResult ComputeRpe(const std::vector<SE3d>& ref, const std::vector<SE3d>& est,
   RpeResult result;
   result.pairs = SelectRpePairs(positions, options);
   if (result.pairs.empty()) {
-    throw OptionError(fmt::format(
-        "RPE delta {} {} selects no pose pair among {} poses ({} pairs); use a smaller delta",
-        options.delta, RpeUnitName(options.unit), est.size(),
-        options.all_pairs ? "all" : "consecutive"));
+    const std::string rule = options.unit == RpeUnit::kFrames
+                                 ? std::string("the trajectory is too short")
+                                 : fmt::format("no stretch of path is within {}% of it",
+                                               100.0 * options.relative_tolerance);
+    throw OptionError(
+        fmt::format("RPE delta {} {} selects no pose pair among {} associated poses ({} "
+                    "pairs): {}; choose another delta",
+                    options.delta, RpeUnitName(options.unit), est.size(),
+                    options.all_pairs ? "all" : "consecutive", rule));
   }
   for (const auto& [i, j] : result.pairs) {
     const SE3d ref_motion = ref[i].Inverse() * ref[j];
