@@ -33,8 +33,9 @@ void WriteStatistics(const ErrorStatistics& s, JsonWriter& json) {
 }
 
 std::string StatisticsRow(std::string_view label, const ErrorStatistics& s) {
-  return fmt::format("{:<16}{:>11.6f}{:>11.6f}{:>11.6f}{:>11.6f}{:>11.6f}{:>11.6f}{:>12.6f}\n",
-                     label, s.rmse, s.mean, s.median, s.std, s.min, s.max, s.sse);
+  return fmt::format(
+      "{:<14} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>11.6f}\n", label,
+      s.rmse, s.mean, s.median, s.std, s.min, s.max, s.sse);
 }
 
 }  // namespace
@@ -153,8 +154,8 @@ std::string FormatEvaluationTable(const EvaluationResult& result) {
       "alignment  {}, scale {:.6f}\n\n",
       result.pairs.size(), result.ref_poses, result.est_poses,
       result.options.association.max_diff_s, AlignmentMethodName(result.alignment), result.scale());
-  out += fmt::format("{:<16}{:>11}{:>11}{:>11}{:>11}{:>11}{:>11}{:>12}\n", "", "rmse", "mean",
-                     "median", "std", "min", "max", "sse");
+  out += fmt::format("{:<14} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>11}\n", "", "rmse",
+                     "mean", "median", "std", "min", "max", "sse");
   out += StatisticsRow("ATE [m]", result.ate_translation_m);
   out += StatisticsRow("ATE rot [deg]", result.ate_rotation_deg);
   if (result.rpe) {
