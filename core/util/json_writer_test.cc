@@ -1,9 +1,9 @@
 #include "core/util/json_writer.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdlib>
 #include <limits>
-
-#include <gtest/gtest.h>
 
 #include "core/util/error.h"
 
@@ -40,9 +40,8 @@ TEST(JsonWriter, CompactNestedDocument) {
       .BeginObject()
       .EndObject()
       .EndObject();
-  EXPECT_EQ(json.str(),
-            R"({"pairs":785,"alignment":"se3","ok":true,"ate":{"rmse":0.5},)"
-            R"("list":[1,2.25,null],"empty":{}})");
+  EXPECT_EQ(json.str(), R"({"pairs":785,"alignment":"se3","ok":true,"ate":{"rmse":0.5},)"
+                        R"("list":[1,2.25,null],"empty":{}})");
 }
 
 TEST(JsonWriter, PrettyPrintsWithIndent) {
@@ -96,8 +95,8 @@ TEST(JsonWriter, MisuseThrows) {
   {
     JsonWriter json;
     json.BeginObject().Key("k");
-    EXPECT_THROW(json.Key("k2"), Error);      // two keys in a row
-    EXPECT_THROW(json.EndObject(), Error);    // key without a value
+    EXPECT_THROW(json.Key("k2"), Error);    // two keys in a row
+    EXPECT_THROW(json.EndObject(), Error);  // key without a value
   }
   {
     JsonWriter json;
