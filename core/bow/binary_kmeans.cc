@@ -231,14 +231,19 @@ ClusterResult ClusterDescriptors(std::span<const Descriptor> points,
     });
   };
   assign();
+  result.converged = false;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    ++result.iterations;
     const std::vector<BitCounter> counters =
         CountBits(points, result.labels, k, options.parallel_min);
     for (std::size_t j = 0; j < k; ++j) {
       // An empty cluster keeps its centre (it may win points back next round).
       if (counters[j].total() > 0) result.centres[j] = counters[j].Majority();
     }
-    if (assign() == 0) break;
+    if (assign() == 0) {
+      result.converged = true;
+      break;
+    }
   }
   CompactClusters(&result);
   return result;

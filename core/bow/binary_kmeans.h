@@ -56,6 +56,8 @@ Descriptor MajorityCentre(std::span<const Descriptor> descriptors);
 struct ClusterResult {
   std::vector<Descriptor> centres;    // non-empty clusters only, at most k
   std::vector<std::uint32_t> labels;  // per descriptor: index into centres (its nearest)
+  int iterations = 0;                 // Lloyd iterations run
+  bool converged = true;              // false if stopped by max_iterations
 };
 
 struct ClusterOptions {

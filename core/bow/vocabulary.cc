@@ -125,36 +125,59 @@ std::vector<VocabularyNode> RenumberBreadthFirst(const std::vector<VocabularyNod
   return out;
 }
 
-// Greedy descent of each descriptor. Hot loop of Transform: the children of a node are read
-// as one contiguous block of 32-byte descriptors.
+// Issues prefetches for the `count` 32-byte descriptors starting at `p`.
+inline void PrefetchBlock(const Descriptor* p, std::uint32_t count) {
+  const char* begin = reinterpret_cast<const char*>(p);
+  const char* end = begin + std::size_t{count} * sizeof(Descriptor);
+  for (const char* q = begin; q < end; q += 64) __builtin_prefetch(q);
+  __builtin_prefetch(end - 1);
+}
+
+// Greedy descent of each descriptor: the hot loop of Transform. The children of a node are one
+// contiguous block of 32-byte descriptors; below the top levels every block is a cache miss,
+// so descriptors descend in batches, level by level, with each block prefetched for the whole
+// batch before any of them is scanned (the misses overlap instead of queueing).
 PKSLAM_POPCNT_CLONES
 void Descend(const Descriptor* descriptors, std::size_t count, const Descriptor* node_descriptors,
              const bow_detail::ChildSpan* children, int di_level, NodeId* leaves,
              NodeId* di_nodes) {
-  for (std::size_t i = 0; i < count; ++i) {
-    const Descriptor& d = descriptors[i];
-    NodeId node = 0;
-    NodeId di_node = 0;
-    int level = 0;
-    while (children[node].count != 0) {
-      const NodeId first = children[node].first;
-      const std::uint32_t n = children[node].count;
-      const Descriptor* c = node_descriptors + first;
-      std::uint32_t best = 0;
-      int best_distance = INT_MAX;
-      for (std::uint32_t j = 0; j < n; ++j) {
-        const int dist = HammingDistance(d, c[j]);
-        if (dist < best_distance) {
-          best_distance = dist;
-          best = j;
-        }
+  constexpr std::size_t kBatch = 16;
+  NodeId node[kBatch];
+  NodeId di_node[kBatch];
+  for (std::size_t base = 0; base < count; base += kBatch) {
+    const std::size_t m = std::min(kBatch, count - base);
+    for (std::size_t j = 0; j < m; ++j) node[j] = di_node[j] = 0;
+    for (int level = 1;; ++level) {
+      bool descending = false;
+      for (std::size_t j = 0; j < m; ++j) {
+        const bow_detail::ChildSpan span = children[node[j]];
+        if (span.count != 0) PrefetchBlock(node_descriptors + span.first, span.count);
       }
-      node = first + best;
-      ++level;
-      if (level <= di_level) di_node = node;
+      for (std::size_t j = 0; j < m; ++j) {
+        const bow_detail::ChildSpan span = children[node[j]];
+        if (span.count == 0) continue;
+        descending = true;
+        const Descriptor& d = descriptors[base + j];
+        const Descriptor* c = node_descriptors + span.first;
+        std::uint32_t best = 0;
+        int best_distance = INT_MAX;
+        for (std::uint32_t i = 0; i < span.count; ++i) {
+          const int dist = HammingDistance(d, c[i]);
+          if (dist < best_distance) {
+            best_distance = dist;
+            best = i;
+          }
+        }
+        node[j] = span.first + best;
+        if (level <= di_level) di_node[j] = node[j];
+        __builtin_prefetch(children + node[j]);
+      }
+      if (!descending) break;
     }
-    leaves[i] = node;
-    if (di_nodes != nullptr) di_nodes[i] = di_node;
+    for (std::size_t j = 0; j < m; ++j) {
+      leaves[base + j] = node[j];
+      if (di_nodes != nullptr) di_nodes[base + j] = di_node[j];
+    }
   }
 }
 

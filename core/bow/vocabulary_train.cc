@@ -38,6 +38,9 @@ struct TreeBuilder {
   const VocabularyTrainOptions& options;
   std::vector<Descriptor>& points;  // reordered in place: each node's points are contiguous
   std::atomic<std::size_t>& progress;
+  std::atomic<std::size_t>& clustered_nodes;    // nodes split by k-means (statistics)
+  std::atomic<std::size_t>& unconverged_nodes;  // of which stopped by max_iterations
+  std::atomic<std::size_t>& iterations;         // Lloyd iterations over all nodes
 
   // Clusters points [begin, end) of `node` (at `level`) and recurses into the children.
   void Build(TrainNode& node, std::size_t begin, std::size_t end, int level,
@@ -55,6 +58,11 @@ struct TreeBuilder {
     cluster_options.parallel_min = options.parallel_assign_min;
     const std::span<const Descriptor> slice(points.data() + begin, n);
     bow_internal::ClusterResult clusters = bow_internal::ClusterDescriptors(slice, cluster_options);
+    if (n > static_cast<std::size_t>(options.branching)) {
+      ++clustered_nodes;
+      iterations += static_cast<std::size_t>(clusters.iterations);
+      if (!clusters.converged) ++unconverged_nodes;
+    }
     if (clusters.centres.size() <= 1) {  // identical points: nothing to split
       progress += n * remaining;
       return;
@@ -150,10 +158,18 @@ Vocabulary Vocabulary::Train(const std::vector<std::vector<Descriptor>>& images,
   // 1. Hierarchical k-means.
   TrainNode root;
   std::atomic<std::size_t> progress{0};
-  const TreeBuilder builder{options, points, progress};
+  std::atomic<std::size_t> clustered{0};
+  std::atomic<std::size_t> unconverged{0};
+  std::atomic<std::size_t> iterations{0};
+  const TreeBuilder builder{options, points, progress, clustered, unconverged, iterations};
   RunWithProgress("vocab k-means", total * static_cast<std::size_t>(options.levels), options.quiet,
                   progress, [&] { builder.Build(root, 0, points.size(), 0, options.seed); });
   points = {};
+  PKSLAM_LOG_INFO(
+      "vocabulary: k-means on {} nodes, {:.1f} Lloyd iterations per node on average, {} stopped "
+      "at max_iterations {}",
+      clustered.load(), clustered > 0 ? static_cast<double>(iterations) / clustered : 0.0,
+      unconverged.load(), options.max_iterations);
 
   std::vector<VocabularyNode> nodes(1);
   EmitChildren(root, 0, &nodes);
