@@ -1,0 +1,67 @@
+#include "io/settings_euroc.h"
+
+#include <fmt/format.h>
+
+#include "core/util/error.h"
+
+namespace pkslam {
+namespace {
+
+CameraCalibration CalibrationOf(const EurocCameraSensor& sensor) {
+  CameraCalibration c;
+  c.type =
+      sensor.distortion_model == "equidistant" ? CameraType::kKannalaBrandt8 : CameraType::kPinhole;
+  c.width = sensor.width;
+  c.height = sensor.height;
+  c.fx = sensor.intrinsics[0];
+  c.fy = sensor.intrinsics[1];
+  c.cx = sensor.intrinsics[2];
+  c.cy = sensor.intrinsics[3];
+  c.distortion = sensor.distortion_coefficients;
+  return c;
+}
+
+}  // namespace
+
+Settings SettingsFromEuroc(const EurocDataset& dataset) {
+  Settings s;
+  const EurocCameraSensor& cam0 = dataset.cam0_sensor();
+  s.camera1 = CalibrationOf(cam0);
+  s.fps = cam0.rate_hz;
+  if (dataset.has_cam1()) {
+    const EurocCameraSensor& cam1 = dataset.cam1_sensor();
+    const std::filesystem::path cam1_yaml = dataset.mav0() / "cam1" / "sensor.yaml";
+    if (cam1.width != cam0.width || cam1.height != cam0.height) {
+      throw InputError(cam1_yaml, fmt::format("resolution {}x{} differs from cam0's {}x{}",
+                                              cam1.width, cam1.height, cam0.width, cam0.height));
+    }
+    if (cam1.rate_hz != cam0.rate_hz) {
+      throw InputError(
+          cam1_yaml, fmt::format("rate_hz {} differs from cam0's {}", cam1.rate_hz, cam0.rate_hz));
+    }
+    if (cam1.distortion_model != cam0.distortion_model) {
+      throw InputError(cam1_yaml, "distortion_model differs from cam0's");
+    }
+    s.camera2 = CalibrationOf(cam1);
+    // p_cam1 = T_BS1^-1 * T_BS0 * p_cam0.
+    s.right_from_left = cam1.body_from_camera.Inverse() * cam0.body_from_camera;
+  }
+  if (dataset.has_imu()) {
+    const EurocImuSensor& imu = dataset.imu_sensor();
+    ImuNoiseSettings noise;
+    noise.gyro_noise_density = imu.gyroscope_noise_density;
+    noise.accel_noise_density = imu.accelerometer_noise_density;
+    noise.gyro_random_walk = imu.gyroscope_random_walk;
+    noise.accel_random_walk = imu.accelerometer_random_walk;
+    noise.frequency_hz = imu.rate_hz;
+    s.imu = noise;
+    // The camera's T_BS is relative to the body frame; the IMU may be offset from it.
+    s.body_from_cam0 = imu.body_from_imu.Inverse() * cam0.body_from_camera;
+  }
+  s.th_depth = 60;
+  s.orb = OrbExtractorSettings{};  // 1200 features, 1.2, 8 levels, FAST 20 / 7
+  s.Check();
+  return s;
+}
+
+}  // namespace pkslam
