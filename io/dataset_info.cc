@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/util/error.h"
+#include "core/util/json_writer.h"
 #include "io/euroc_dataset.h"
 #include "io/tum_rgbd_dataset.h"
 
@@ -161,35 +162,6 @@ DatasetInfo TumInfo(const fs::path& dir) {
 
 std::string Hz(double hz) { return hz > 0 ? fmt::format("{:g} Hz", hz) : "unknown"; }
 
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += fmt::format("\\u{:04x}", static_cast<int>(c));
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
-std::string JsonNumber(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
-
 }  // namespace
 
 DatasetInfo ComputeDatasetInfo(const fs::path& dir) {
@@ -253,46 +225,61 @@ std::string FormatDatasetInfo(const DatasetInfo& info) {
 }
 
 std::string DatasetInfoToJson(const DatasetInfo& info) {
-  std::string out = "{\n";
-  out += fmt::format("  \"dataset\": {},\n  \"layout\": {},\n", JsonString(info.root.string()),
-                     JsonString(info.layout == DatasetLayout::kEuroc ? "euroc" : "tum_rgbd"));
-  out += fmt::format("  \"duration_s\": {},\n  \"total_duration_s\": {},\n",
-                     JsonNumber(info.ImageDurationS()), JsonNumber(info.TotalDurationS()));
-  out += "  \"streams\": [";
-  for (std::size_t k = 0; k < info.streams.size(); ++k) {
-    const StreamSummary& s = info.streams[k];
-    out += k ? ",\n    {" : "\n    {";
-    out += fmt::format(
-        "\"name\": {}, \"description\": {}, \"listed\": {}, \"count\": {}, \"missing\": {}, "
-        "\"nominal_rate_hz\": {}, \"measured_rate_hz\": {}, \"first_t_ns\": {}, "
-        "\"last_t_ns\": {}, \"span_s\": {}, \"gap_threshold_periods\": {}, ",
-        JsonString(s.name), JsonString(s.description), s.listed, s.count, s.missing_files.size(),
-        JsonNumber(s.nominal_rate_hz), JsonNumber(s.measured_rate_hz), s.first_ns, s.last_ns,
-        JsonNumber(s.SpanS()), JsonNumber(s.gap_threshold_periods));
-    out += "\"missing_files\": [";
-    for (std::size_t i = 0; i < s.missing_files.size(); ++i) {
-      out += (i ? ", " : "") + JsonString(s.missing_files[i]);
+  JsonWriter json;
+  json.BeginObject();
+  json.Member("dataset", info.root.string());
+  json.Member("layout", info.layout == DatasetLayout::kEuroc ? "euroc" : "tum_rgbd");
+  json.Member("duration_s", info.ImageDurationS());
+  json.Member("total_duration_s", info.TotalDurationS());
+  json.Key("streams").BeginArray();
+  for (const StreamSummary& s : info.streams) {
+    json.BeginObject();
+    json.Member("name", s.name);
+    json.Member("description", s.description);
+    json.Member("listed", static_cast<std::uint64_t>(s.listed));
+    json.Member("count", static_cast<std::uint64_t>(s.count));
+    json.Member("missing", static_cast<std::uint64_t>(s.missing_files.size()));
+    json.Member("nominal_rate_hz", s.nominal_rate_hz);
+    json.Member("measured_rate_hz", s.measured_rate_hz);
+    json.Member("first_t_ns", s.first_ns);
+    json.Member("last_t_ns", s.last_ns);
+    json.Member("span_s", s.SpanS());
+    json.Member("gap_threshold_periods", s.gap_threshold_periods);
+    json.Key("missing_files").BeginArray();
+    for (const std::string& f : s.missing_files) json.Value(f);
+    json.EndArray();
+    json.Key("gaps").BeginArray();
+    for (const TimeGap& g : s.gaps) {
+      json.BeginObject();
+      json.Member("begin_t_ns", g.begin_ns);
+      json.Member("end_t_ns", g.end_ns);
+      json.Member("periods", g.periods);
+      json.EndObject();
     }
-    out += "], \"gaps\": [";
-    for (std::size_t i = 0; i < s.gaps.size(); ++i) {
-      out +=
-          fmt::format("{}{{\"begin_t_ns\": {}, \"end_t_ns\": {}, \"periods\": {}}}", i ? ", " : "",
-                      s.gaps[i].begin_ns, s.gaps[i].end_ns, JsonNumber(s.gaps[i].periods));
-    }
-    out += "]}";
+    json.EndArray();
+    json.EndObject();
   }
-  out += "\n  ],\n";
-  const auto optional_count = [](const std::optional<std::size_t>& v) {
-    return v ? std::to_string(*v) : std::string("null");
+  json.EndArray();
+  const auto optional_count = [&json](const char* key, const std::optional<std::size_t>& v) {
+    json.Key(key);
+    if (v) {
+      json.Value(static_cast<std::uint64_t>(*v));
+    } else {
+      json.Null();
+    }
   };
-  out += fmt::format("  \"stereo_pairs\": {},\n  \"rgbd_pairs\": {},\n",
-                     optional_count(info.stereo_pairs), optional_count(info.rgbd_pairs));
-  if (info.depth_factor)
-    out += fmt::format("  \"depth_factor\": {},\n", JsonNumber(*info.depth_factor));
+  optional_count("stereo_pairs", info.stereo_pairs);
+  optional_count("rgbd_pairs", info.rgbd_pairs);
+  if (info.rgbd_pairs)
+    json.Member("association_max_difference_s", info.association_max_difference_s);
+  if (info.depth_factor) json.Member("depth_factor", *info.depth_factor);
   const StreamSummary* gt = info.Find("groundtruth");
-  out += fmt::format("  \"ground_truth\": {{\"present\": {}, \"count\": {}}}\n}}\n",
-                     info.has_ground_truth ? "true" : "false", gt ? gt->count : 0);
-  return out;
+  json.Key("ground_truth").BeginObject();
+  json.Member("present", info.has_ground_truth);
+  json.Member("count", static_cast<std::uint64_t>(gt ? gt->count : 0));
+  json.EndObject();
+  json.EndObject();
+  return json.str();
 }
 
 }  // namespace pkslam

@@ -90,7 +90,7 @@ void Settings::Check() const {
           std::pair{"imu.accel_noise_density", imu->accel_noise_density},
           std::pair{"imu.gyro_random_walk", imu->gyro_random_walk},
           std::pair{"imu.accel_random_walk", imu->accel_random_walk},
-          std::pair{"imu.frequency_hz", imu->frequency_hz}}) {
+          std::pair{"imu.rate_hz", imu->rate_hz}}) {
       PKSLAM_CHECK_OPTION(value > 0 && std::isfinite(value), name, "{}", value);
     }
   }
@@ -221,12 +221,12 @@ Settings ReadOrbSlam3Settings(const std::filesystem::path& file) {
   bool any_imu = false;
   for (const std::string& key : yaml.Keys()) any_imu = any_imu || key.rfind("IMU.", 0) == 0;
   if (any_imu) {
-    ImuNoiseSettings imu;
+    ImuNoise imu;
     imu.gyro_noise_density = Positive(yaml, "IMU.NoiseGyro");
     imu.accel_noise_density = Positive(yaml, "IMU.NoiseAcc");
     imu.gyro_random_walk = Positive(yaml, "IMU.GyroWalk");
     imu.accel_random_walk = Positive(yaml, "IMU.AccWalk");
-    imu.frequency_hz = Positive(yaml, "IMU.Frequency");
+    imu.rate_hz = Positive(yaml, "IMU.Frequency");
     s.imu = imu;
     s.body_from_cam0 = SE3d(yaml.RigidTransform("IMU.T_b_c1"));
   }

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/camera/camera_model.h"
+#include "core/frame/camera_rig.h"
 #include "core/geometry/se3.h"
 
 namespace pkslam {
@@ -35,16 +36,6 @@ struct CameraCalibration {
 
   bool operator==(const CameraCalibration&) const = default;
   void Check(const std::string& name) const;  // throws OptionError
-};
-
-struct ImuNoiseSettings {
-  double gyro_noise_density = 0;   // IMU.NoiseGyro [rad/s/sqrt(Hz)]
-  double accel_noise_density = 0;  // IMU.NoiseAcc [m/s^2/sqrt(Hz)]
-  double gyro_random_walk = 0;     // IMU.GyroWalk [rad/s^2/sqrt(Hz)]
-  double accel_random_walk = 0;    // IMU.AccWalk [m/s^3/sqrt(Hz)]
-  double frequency_hz = 0;         // IMU.Frequency [Hz]
-
-  bool operator==(const ImuNoiseSettings&) const = default;
 };
 
 // ORBextractor.* (ORB-SLAM3's names); the defaults are its EuRoC stereo-inertial values.
@@ -79,7 +70,9 @@ struct Settings {
   double th_depth = 60;
   // IMU.T_b_c1 (see the frame conventions above); set iff imu is set.
   std::optional<SE3d> body_from_cam0;
-  std::optional<ImuNoiseSettings> imu;  // IMU.NoiseGyro/NoiseAcc/GyroWalk/AccWalk/Frequency
+  // IMU.NoiseGyro -> gyro_noise_density, IMU.NoiseAcc -> accel_noise_density, IMU.GyroWalk
+  // -> gyro_random_walk, IMU.AccWalk -> accel_random_walk, IMU.Frequency -> rate_hz.
+  std::optional<ImuNoise> imu;
   // RGBD.DepthMapFactor: depth image value per metre (TUM: 5000). Optional.
   std::optional<double> depth_map_factor;
   OrbExtractorSettings orb;                // ORBextractor.*: optional, defaults above

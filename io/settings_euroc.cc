@@ -48,12 +48,12 @@ Settings SettingsFromEuroc(const EurocDataset& dataset) {
   }
   if (dataset.has_imu()) {
     const EurocImuSensor& imu = dataset.imu_sensor();
-    ImuNoiseSettings noise;
+    ImuNoise noise;
     noise.gyro_noise_density = imu.gyroscope_noise_density;
     noise.accel_noise_density = imu.accelerometer_noise_density;
     noise.gyro_random_walk = imu.gyroscope_random_walk;
     noise.accel_random_walk = imu.accelerometer_random_walk;
-    noise.frequency_hz = imu.rate_hz;
+    noise.rate_hz = imu.rate_hz;
     s.imu = noise;
     // The camera's T_BS is relative to the body frame; the IMU may be offset from it.
     s.body_from_cam0 = imu.body_from_imu.Inverse() * cam0.body_from_camera;

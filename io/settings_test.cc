@@ -37,7 +37,14 @@ void ExpectSettingsNear(const Settings& a, const Settings& b, double tol) {
   EXPECT_EQ(a.th_depth, b.th_depth);
   ExpectTransformNear(a.right_from_left, b.right_from_left, tol, "right_from_left");
   ExpectTransformNear(a.body_from_cam0, b.body_from_cam0, tol, "body_from_cam0");
-  EXPECT_EQ(a.imu, b.imu);
+  ASSERT_EQ(a.imu.has_value(), b.imu.has_value());
+  if (a.imu) {
+    EXPECT_EQ(a.imu->gyro_noise_density, b.imu->gyro_noise_density);
+    EXPECT_EQ(a.imu->accel_noise_density, b.imu->accel_noise_density);
+    EXPECT_EQ(a.imu->gyro_random_walk, b.imu->gyro_random_walk);
+    EXPECT_EQ(a.imu->accel_random_walk, b.imu->accel_random_walk);
+    EXPECT_EQ(a.imu->rate_hz, b.imu->rate_hz);
+  }
   EXPECT_EQ(a.depth_map_factor, b.depth_map_factor);
   EXPECT_EQ(a.orb, b.orb);
   EXPECT_EQ(a.keyframe, b.keyframe);
@@ -66,7 +73,7 @@ TEST(Settings, ReadsEurocStereoInertialFile) {
   ASSERT_TRUE(s.imu.has_value());
   EXPECT_EQ(s.imu->gyro_noise_density, 1.6968e-04);
   EXPECT_EQ(s.imu->accel_random_walk, 3.0e-3);
-  EXPECT_EQ(s.imu->frequency_hz, 200);
+  EXPECT_EQ(s.imu->rate_hz, 200);
   EXPECT_FALSE(s.depth_map_factor.has_value());
   EXPECT_EQ(s.orb, OrbExtractorSettings{});
   EXPECT_TRUE(s.keyframe.empty());
@@ -159,7 +166,7 @@ TEST_F(SettingsFiles, RoundTripKannalaBrandtAndRectified) {
       SE3d(SO3d::Exp(Eigen::Vector3d(0.01, -0.02, 0.003)), Eigen::Vector3d(-0.101, 0.002, -0.0004));
   kb.body_from_cam0 =
       SE3d(SO3d::Exp(Eigen::Vector3d(1.2, 0.1, -0.4)), Eigen::Vector3d(0.04, -0.03, 0.02));
-  kb.imu = ImuNoiseSettings{0.004, 0.05, 4.4e-5, 0.00172, 200};
+  kb.imu = ImuNoise{0.004, 0.05, 4.4e-5, 0.00172, 200};
   kb.orb = {1500, 1.25, 9, 19, 6};
   WriteOrbSlam3Settings(kb, dir_ / "kb.yaml");
   ExpectSettingsNear(ReadOrbSlam3Settings(dir_ / "kb.yaml"), kb, 1e-15);

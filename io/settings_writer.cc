@@ -111,7 +111,7 @@ void WriteOrbSlam3Settings(const Settings& s, const std::filesystem::path& file)
     w.RealKey("IMU.NoiseAcc", s.imu->accel_noise_density);
     w.RealKey("IMU.GyroWalk", s.imu->gyro_random_walk);
     w.RealKey("IMU.AccWalk", s.imu->accel_random_walk);
-    w.RealKey("IMU.Frequency", s.imu->frequency_hz);
+    w.RealKey("IMU.Frequency", s.imu->rate_hz);
     w.Blank();
   }
   if (s.depth_map_factor) {
