@@ -96,10 +96,10 @@ struct Settings {
 // Camera.height, Camera.fps; PinHole distortion Camera1.k1, k2, p1, p2 (all or none; k3
 // optional); KannalaBrandt8 Camera1.k1..k4; Camera2.* and Stereo.T_c1_c2 together (stereo);
 // Stereo.b for Rectified (optional otherwise: RGB-D virtual baseline); if any IMU.* key is
-// present: IMU.NoiseGyro, NoiseAcc, GyroWalk,
-// AccWalk, Frequency, T_b_c1. Optional keys default as documented on Settings. Unknown keys
-// (Viewer.*, System.*, ...) are ignored; Camera.newWidth/newHeight (resizing) is rejected.
-// Throws InputError naming the file, the key and its line.
+// present: IMU.NoiseGyro, NoiseAcc, GyroWalk, AccWalk, Frequency, T_b_c1. Optional keys
+// default as documented on Settings. Unknown keys (Viewer.*, System.*, ...) are ignored;
+// Camera.newWidth/newHeight (resizing) is rejected. Throws InputError naming the file, the
+// key and its line.
 Settings ReadOrbSlam3Settings(const std::filesystem::path& file);
 
 // Writes `settings` (after Check()) in the same format. Matrices are written with dt: f, as

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <opencv2/core/persistence.hpp>
 #include <regex>
 
 #include "core/util/error.h"
@@ -147,6 +148,23 @@ TEST_F(SettingsFiles, RoundTripEurocAndTum) {
     WriteOrbSlam3Settings(s, out);
     ExpectSettingsNear(ReadOrbSlam3Settings(out), s, 1e-15);
   }
+  // What ORB-SLAM3 itself needs from the written file: reals where it reads floats, ints where
+  // it reads ints, and float matrices.
+  cv::FileStorage fs((dir_ / "euroc_stereo_inertial.yaml").string(), cv::FileStorage::READ);
+  ASSERT_TRUE(fs.isOpened());
+  EXPECT_TRUE(fs["Camera1.fx"].isReal());
+  EXPECT_TRUE(fs["Stereo.ThDepth"].isReal());
+  EXPECT_TRUE(fs["IMU.Frequency"].isReal());
+  EXPECT_TRUE(fs["Camera.width"].isInt());
+  EXPECT_TRUE(fs["Camera.fps"].isInt());
+  EXPECT_TRUE(fs["ORBextractor.nFeatures"].isInt());
+  EXPECT_EQ(fs["Camera.type"].string(), "PinHole");
+  EXPECT_EQ(fs["File.version"].string(), "1.0");
+  cv::Mat t_c1_c2;
+  fs["Stereo.T_c1_c2"] >> t_c1_c2;
+  ASSERT_EQ(t_c1_c2.type(), CV_32F);
+  ASSERT_EQ(t_c1_c2.rows, 4);
+  EXPECT_NEAR(t_c1_c2.at<float>(0, 3), 0.1100741378, 1e-7);
 }
 
 TEST_F(SettingsFiles, RoundTripKannalaBrandtAndRectified) {
