@@ -103,7 +103,9 @@ StreamSummary SummariseSeries(const std::string& name, const std::string& descri
 }
 
 std::string CameraDescription(const EurocCameraSensor& c) {
-  return fmt::format("camera {}x{} {} {}", c.width, c.height, c.camera_model, c.distortion_model);
+  return fmt::format("camera {}x{} {} {}, fu fv cu cv = {} {} {} {}", c.width, c.height,
+                     c.camera_model, c.distortion_model, c.intrinsics[0], c.intrinsics[1],
+                     c.intrinsics[2], c.intrinsics[3]);
 }
 
 DatasetInfo EurocInfo(const fs::path& dir) {
@@ -118,6 +120,10 @@ DatasetInfo EurocInfo(const fs::path& dir) {
     info.streams.push_back(SummariseImages(d.cam1(), CameraDescription(d.cam1_sensor()),
                                            options.frame_gap_periods, dir));
     info.stereo_pairs = d.stereo_pairs().size();
+    info.stereo_baseline_m =
+        (d.cam1_sensor().body_from_camera.Inverse() * d.cam0_sensor().body_from_camera)
+            .translation()
+            .norm();
   }
   if (d.has_imu()) {
     const EurocImuSensor& imu = d.imu_sensor();
@@ -186,8 +192,8 @@ std::string FormatDatasetInfo(const DatasetInfo& info) {
                        Hz(s.nominal_rate_hz), s.measured_rate_hz, s.SpanS());
   }
   if (info.stereo_pairs) {
-    out += fmt::format("stereo pairs {} (cam0/cam1 with identical timestamps)\n",
-                       GroupThousands(*info.stereo_pairs));
+    out += fmt::format("stereo pairs {} (cam0/cam1 with identical timestamps), baseline {:.6f} m\n",
+                       GroupThousands(*info.stereo_pairs), info.stereo_baseline_m.value_or(0.0));
   }
   if (info.rgbd_pairs) {
     out += fmt::format("rgbd pairs   {} (rgb/depth associated within {:g} s)\n",
@@ -270,6 +276,7 @@ std::string DatasetInfoToJson(const DatasetInfo& info) {
   };
   optional_count("stereo_pairs", info.stereo_pairs);
   optional_count("rgbd_pairs", info.rgbd_pairs);
+  if (info.stereo_baseline_m) json.Member("stereo_baseline_m", *info.stereo_baseline_m);
   if (info.rgbd_pairs)
     json.Member("association_max_difference_s", info.association_max_difference_s);
   if (info.depth_factor) json.Member("depth_factor", *info.depth_factor);

@@ -41,6 +41,7 @@ struct DatasetInfo {
   DatasetLayout layout = DatasetLayout::kEuroc;
   std::vector<StreamSummary> streams;       // cameras first, then IMU, then ground truth
   std::optional<std::size_t> stereo_pairs;  // EuRoC with cam1: exact timestamp matches
+  std::optional<double> stereo_baseline_m;  // EuRoC with cam1: |T_BS1^-1 T_BS0| translation
   std::optional<std::size_t> rgbd_pairs;    // TUM: associated rgb/depth pairs
   double association_max_difference_s = 0;  // TUM association tolerance
   std::optional<double> depth_factor;       // TUM depth value per metre

@@ -13,10 +13,6 @@ namespace pkslam {
 
 namespace {
 
-std::string CameraTypeName(CameraType type) {
-  return type == CameraType::kPinhole ? "pinhole" : "Kannala-Brandt 8";
-}
-
 void CheckRigid(const SE3d& transform, const std::string& name) {
   PKSLAM_CHECK_OPTION(
       transform.translation().allFinite() && transform.quaternion().coeffs().allFinite(), name,
@@ -25,22 +21,10 @@ void CheckRigid(const SE3d& transform, const std::string& name) {
 
 }  // namespace
 
-void CameraCalibration::Check(const std::string& name) const {
-  PKSLAM_CHECK_OPTION(width > 0 && height > 0, name + ".width/height", "{}x{}", width, height);
-  PKSLAM_CHECK_OPTION(fx > 0 && fy > 0 && std::isfinite(fx) && std::isfinite(fy), name + ".fx/fy",
-                      "{}, {}", fx, fy);
-  PKSLAM_CHECK_OPTION(std::isfinite(cx) && std::isfinite(cy), name + ".cx/cy", "{}, {}", cx, cy);
-  const std::size_t n = distortion.size();
-  if (type == CameraType::kPinhole) {
-    PKSLAM_CHECK_OPTION(n == 0 || n == 4 || n == 5, name + ".distortion",
-                        "{} pinhole coefficients (want 0, 4 or 5)", n);
-  } else {
-    PKSLAM_CHECK_OPTION(n == 4, name + ".distortion", "{} {} coefficients (want 4)", n,
-                        CameraTypeName(type));
-  }
-  for (double k : distortion) {
-    PKSLAM_CHECK_OPTION(std::isfinite(k), name + ".distortion", "non-finite coefficient");
-  }
+bool SameCalibration(const CameraModel& a, const CameraModel& b) {
+  return a.type() == b.type() && a.width() == b.width() && a.height() == b.height() &&
+         a.fx() == b.fx() && a.fy() == b.fy() && a.cx() == b.cx() && a.cy() == b.cy() &&
+         a.distortion() == b.distortion();
 }
 
 double Settings::BaselineM() const {
@@ -49,19 +33,24 @@ double Settings::BaselineM() const {
   return 0.0;
 }
 
-double Settings::Bf() const { return BaselineM() * camera1.fx; }
+double Settings::Bf() const { return BaselineM() * camera1.fx(); }
 
 void Settings::Check() const {
-  camera1.Check("camera1");
+  // CameraModel's factories validate intrinsics; a default-constructed model is not set.
+  PKSLAM_CHECK_OPTION(camera1.width() > 0 && camera1.fx() > 0, "camera1", "not set");
   if (camera2) {
-    camera2->Check("camera2");
-    PKSLAM_CHECK_OPTION(camera2->type == camera1.type, "camera2.type", "differs from camera1");
+    PKSLAM_CHECK_OPTION(camera2->width() > 0 && camera2->fx() > 0, "camera2", "not set");
+    PKSLAM_CHECK_OPTION(camera2->type() == camera1.type(), "camera2.type", "differs from camera1");
+    PKSLAM_CHECK_OPTION(
+        camera2->width() == camera1.width() && camera2->height() == camera1.height(),
+        "camera2 size", "{}x{} differs from camera1's {}x{}", camera2->width(), camera2->height(),
+        camera1.width(), camera1.height());
     PKSLAM_CHECK_OPTION(right_from_left.has_value(), "right_from_left", "required with camera2");
   }
   PKSLAM_CHECK_OPTION(fps > 0 && std::isfinite(fps), "fps", "{}", fps);
   if (rectified_stereo) {
     PKSLAM_CHECK_OPTION(!camera2, "camera2", "a rectified rig has no camera2");
-    PKSLAM_CHECK_OPTION(camera1.distortion.empty() && camera1.type == CameraType::kPinhole,
+    PKSLAM_CHECK_OPTION(camera1.distortion().empty() && camera1.type() == CameraType::kPinhole,
                         "camera1", "a rectified rig is an undistorted pinhole");
     PKSLAM_CHECK_OPTION(stereo_baseline_m && *stereo_baseline_m > 0, "stereo_baseline_m",
                         "required and positive for a rectified rig");
@@ -123,26 +112,32 @@ int PositiveInt(const OpenCvYamlFile& yaml, const std::string& key) {
   return value;
 }
 
-CameraCalibration ReadCamera(const OpenCvYamlFile& yaml, const std::string& prefix, CameraType type,
-                             int width, int height) {
-  CameraCalibration c;
-  c.type = type;
-  c.width = width;
-  c.height = height;
-  c.fx = Positive(yaml, prefix + ".fx");
-  c.fy = Positive(yaml, prefix + ".fy");
-  c.cx = yaml.Double(prefix + ".cx");
-  c.cy = yaml.Double(prefix + ".cy");
+CameraModel ReadCamera(const OpenCvYamlFile& yaml, const std::string& prefix, CameraType type,
+                       int width, int height) {
+  const double fx = Positive(yaml, prefix + ".fx");
+  const double fy = Positive(yaml, prefix + ".fy");
+  const double cx = yaml.Double(prefix + ".cx");
+  const double cy = yaml.Double(prefix + ".cy");
+  std::vector<double> distortion;
   if (type == CameraType::kKannalaBrandt8) {
     for (const char* k : {".k1", ".k2", ".k3", ".k4"})
-      c.distortion.push_back(yaml.Double(prefix + k));
+      distortion.push_back(yaml.Double(prefix + k));
   } else if (yaml.Has(prefix + ".k1") || yaml.Has(prefix + ".p1")) {
     // ORB-SLAM3: k1 k2 p1 p2 come together; k3 is optional.
     for (const char* k : {".k1", ".k2", ".p1", ".p2"})
-      c.distortion.push_back(yaml.Double(prefix + k));
-    if (const auto k3 = yaml.OptionalDouble(prefix + ".k3")) c.distortion.push_back(*k3);
+      distortion.push_back(yaml.Double(prefix + k));
+    if (const auto k3 = yaml.OptionalDouble(prefix + ".k3")) distortion.push_back(*k3);
   }
-  return c;
+  try {
+    if (type == CameraType::kKannalaBrandt8) {
+      return CameraModel::KannalaBrandt8(
+          width, height, fx, fy, cx, cy,
+          {distortion[0], distortion[1], distortion[2], distortion[3]});
+    }
+    return CameraModel::Pinhole(width, height, fx, fy, cx, cy, std::move(distortion));
+  } catch (const OptionError& e) {
+    yaml.Fail(prefix + ".fx", fmt::format("invalid {} camera: {}", prefix, e.what()));
+  }
 }
 
 }  // namespace
@@ -187,7 +182,7 @@ Settings ReadOrbSlam3Settings(const std::filesystem::path& file) {
   }
 
   if (s.rectified_stereo) {
-    if (!s.camera1.distortion.empty()) {
+    if (!s.camera1.distortion().empty()) {
       yaml.Fail("Camera1.k1", "a Rectified camera has no distortion coefficients");
     }
     s.stereo_baseline_m = Positive(yaml, "Stereo.b");

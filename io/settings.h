@@ -25,18 +25,8 @@
 
 namespace pkslam {
 
-// Intrinsic calibration of one camera (mirrors CameraModel's parameters).
-struct CameraCalibration {
-  CameraType type = CameraType::kPinhole;
-  int width = 0;                          // Camera.width [px]
-  int height = 0;                         // Camera.height [px]
-  double fx = 0, fy = 0, cx = 0, cy = 0;  // CameraN.fx/fy/cx/cy [px]
-  // Pinhole: {} or {k1, k2, p1, p2[, k3]}; Kannala-Brandt: {k1, k2, k3, k4}.
-  std::vector<double> distortion;
-
-  bool operator==(const CameraCalibration&) const = default;
-  void Check(const std::string& name) const;  // throws OptionError
-};
+// Whether two camera models have the same type, size, intrinsics and distortion (exactly).
+bool SameCalibration(const CameraModel& a, const CameraModel& b);
 
 // ORBextractor.* (ORB-SLAM3's names); the defaults are its EuRoC stereo-inertial values.
 struct OrbExtractorSettings {
@@ -53,9 +43,12 @@ struct Settings {
   // Camera.type "Rectified": images are already rectified and undistorted; camera1 has no
   // distortion, there is no camera2, and the baseline is Stereo.b.
   bool rectified_stereo = false;
-  CameraCalibration camera1;                 // Camera1.*: left or only camera
-  std::optional<CameraCalibration> camera2;  // Camera2.*: right camera of an unrectified rig
-  double fps = 0;                            // Camera.fps [Hz]
+  // Camera1.*: the left or only camera, as calibrated (raw, possibly distorted), with
+  // Camera.width/height. Pinhole (radial-tangential) or Kannala-Brandt 8 per Camera.type.
+  CameraModel camera1;
+  // Camera2.*: the right camera of an unrectified stereo rig (same type and size).
+  std::optional<CameraModel> camera2;
+  double fps = 0;  // Camera.fps [Hz]
   // Camera.RGB: 1 = colour images are RGB ordered, 0 = BGR (ignored for grey images).
   // Optional, default 1.
   bool rgb_order = true;
@@ -83,9 +76,6 @@ struct Settings {
   double BaselineM() const;
   // baseline * camera1.fx [px*m] (ORB-SLAM3's bf; after rectification use the rectified fx).
   double Bf() const;
-  // The camera models (pinhole radial-tangential or Kannala-Brandt 8).
-  CameraModel Camera1Model() const;
-  CameraModel Camera2Model() const;  // requires camera2
 
   // Throws OptionError naming the offending field.
   void Check() const;

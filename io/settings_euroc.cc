@@ -7,18 +7,18 @@
 namespace pkslam {
 namespace {
 
-CameraCalibration CalibrationOf(const EurocCameraSensor& sensor) {
-  CameraCalibration c;
-  c.type =
-      sensor.distortion_model == "equidistant" ? CameraType::kKannalaBrandt8 : CameraType::kPinhole;
-  c.width = sensor.width;
-  c.height = sensor.height;
-  c.fx = sensor.intrinsics[0];
-  c.fy = sensor.intrinsics[1];
-  c.cx = sensor.intrinsics[2];
-  c.cy = sensor.intrinsics[3];
-  c.distortion = sensor.distortion_coefficients;
-  return c;
+CameraModel CameraOf(const EurocCameraSensor& sensor, const std::filesystem::path& yaml) {
+  const auto& k = sensor.intrinsics;
+  const auto& d = sensor.distortion_coefficients;
+  try {
+    if (sensor.distortion_model == "equidistant") {
+      return CameraModel::KannalaBrandt8(sensor.width, sensor.height, k[0], k[1], k[2], k[3],
+                                         {d[0], d[1], d[2], d[3]});
+    }
+    return CameraModel::Pinhole(sensor.width, sensor.height, k[0], k[1], k[2], k[3], d);
+  } catch (const OptionError& e) {
+    throw InputError(yaml, fmt::format("invalid camera calibration: {}", e.what()));
+  }
 }
 
 }  // namespace
@@ -26,7 +26,7 @@ CameraCalibration CalibrationOf(const EurocCameraSensor& sensor) {
 Settings SettingsFromEuroc(const EurocDataset& dataset) {
   Settings s;
   const EurocCameraSensor& cam0 = dataset.cam0_sensor();
-  s.camera1 = CalibrationOf(cam0);
+  s.camera1 = CameraOf(cam0, dataset.mav0() / "cam0" / "sensor.yaml");
   s.fps = cam0.rate_hz;
   if (dataset.has_cam1()) {
     const EurocCameraSensor& cam1 = dataset.cam1_sensor();
@@ -42,7 +42,7 @@ Settings SettingsFromEuroc(const EurocDataset& dataset) {
     if (cam1.distortion_model != cam0.distortion_model) {
       throw InputError(cam1_yaml, "distortion_model differs from cam0's");
     }
-    s.camera2 = CalibrationOf(cam1);
+    s.camera2 = CameraOf(cam1, cam1_yaml);
     // p_cam1 = T_BS1^-1 * T_BS0 * p_cam0.
     s.right_from_left = cam1.body_from_camera.Inverse() * cam0.body_from_camera;
   }

@@ -30,8 +30,13 @@ void ExpectTransformNear(const std::optional<SE3d>& a, const std::optional<SE3d>
 
 void ExpectSettingsNear(const Settings& a, const Settings& b, double tol) {
   EXPECT_EQ(a.rectified_stereo, b.rectified_stereo);
-  EXPECT_EQ(a.camera1, b.camera1);
-  EXPECT_EQ(a.camera2, b.camera2);
+  EXPECT_TRUE(SameCalibration(a.camera1, b.camera1))
+      << a.camera1.ToString() << " vs " << b.camera1.ToString();
+  ASSERT_EQ(a.camera2.has_value(), b.camera2.has_value());
+  if (a.camera2) {
+    EXPECT_TRUE(SameCalibration(*a.camera2, *b.camera2))
+        << a.camera2->ToString() << " vs " << b.camera2->ToString();
+  }
   EXPECT_EQ(a.fps, b.fps);
   EXPECT_EQ(a.rgb_order, b.rgb_order);
   EXPECT_EQ(a.stereo_baseline_m, b.stereo_baseline_m);
@@ -53,14 +58,14 @@ void ExpectSettingsNear(const Settings& a, const Settings& b, double tol) {
 
 TEST(Settings, ReadsEurocStereoInertialFile) {
   const Settings s = ReadOrbSlam3Settings(kTestData / "euroc_stereo_inertial.yaml");
-  EXPECT_EQ(s.camera1.type, CameraType::kPinhole);
-  EXPECT_EQ(s.camera1.width, 752);
-  EXPECT_EQ(s.camera1.height, 480);
-  EXPECT_DOUBLE_EQ(s.camera1.fx, 458.654);
-  EXPECT_EQ(s.camera1.distortion,
+  EXPECT_EQ(s.camera1.type(), CameraType::kPinhole);
+  EXPECT_EQ(s.camera1.width(), 752);
+  EXPECT_EQ(s.camera1.height(), 480);
+  EXPECT_DOUBLE_EQ(s.camera1.fx(), 458.654);
+  EXPECT_EQ(s.camera1.distortion(),
             (std::vector<double>{-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05}));
   ASSERT_TRUE(s.camera2.has_value());
-  EXPECT_DOUBLE_EQ(s.camera2->cy, 255.238);
+  EXPECT_DOUBLE_EQ(s.camera2->cy(), 255.238);
   EXPECT_EQ(s.fps, 20);
   EXPECT_TRUE(s.IsStereo());
   // Stereo.T_c1_c2 is left_from_right: the right camera is +0.110 m along left x, so a point
@@ -82,8 +87,8 @@ TEST(Settings, ReadsEurocStereoInertialFile) {
 
 TEST(Settings, ReadsTumFr1RgbdFile) {
   const Settings s = ReadOrbSlam3Settings(kTestData / "tum_fr1_rgbd.yaml");
-  EXPECT_EQ(s.camera1.distortion.size(), 5u);
-  EXPECT_DOUBLE_EQ(s.camera1.distortion[4], 1.163314);
+  EXPECT_EQ(s.camera1.distortion().size(), 5u);
+  EXPECT_DOUBLE_EQ(s.camera1.distortion()[4], 1.163314);
   EXPECT_FALSE(s.camera2.has_value());
   EXPECT_FALSE(s.IsStereo());
   EXPECT_EQ(s.depth_map_factor, 5000.0);
@@ -169,16 +174,10 @@ TEST_F(SettingsFiles, RoundTripEurocAndTum) {
 
 TEST_F(SettingsFiles, RoundTripKannalaBrandtAndRectified) {
   Settings kb;
-  kb.camera1 = {CameraType::kKannalaBrandt8,
-                512,
-                512,
-                190.978,
-                190.973,
-                254.932,
-                256.897,
-                {0.00348238, 0.000715034, -0.00205323, 0.000202936}};
-  kb.camera2 = kb.camera1;
-  kb.camera2->fx = 190.44;
+  kb.camera1 = CameraModel::KannalaBrandt8(512, 512, 190.978, 190.973, 254.932, 256.897,
+                                           {0.00348238, 0.000715034, -0.00205323, 0.000202936});
+  kb.camera2 = CameraModel::KannalaBrandt8(512, 512, 190.44, 190.45, 255.0, 256.2,
+                                           {0.0034, 0.0007, -0.0020, 0.0002});
   kb.fps = 20.5;
   kb.right_from_left =
       SE3d(SO3d::Exp(Eigen::Vector3d(0.01, -0.02, 0.003)), Eigen::Vector3d(-0.101, 0.002, -0.0004));
@@ -191,7 +190,7 @@ TEST_F(SettingsFiles, RoundTripKannalaBrandtAndRectified) {
 
   Settings rectified;
   rectified.rectified_stereo = true;
-  rectified.camera1 = {CameraType::kPinhole, 640, 480, 400, 400, 320, 240, {}};
+  rectified.camera1 = CameraModel::Pinhole(640, 480, 400, 400, 320, 240);
   rectified.fps = 10;
   rectified.stereo_baseline_m = 0.12;
   rectified.right_from_left = SE3d(SO3d(), Eigen::Vector3d(-0.12, 0, 0));
@@ -212,6 +211,8 @@ TEST_F(SettingsFiles, MissingOrMalformedKeysNameKeyFileAndLine) {
               HasSubstr("key 'File.version': unsupported version '0.9'"));
   EXPECT_THAT(ReadError(Edited("\"PinHole\"", "\"Pinhole\"")),
               HasSubstr("key 'Camera.type': unknown camera type 'Pinhole'"));
+  EXPECT_THAT(ReadError(Edited("Camera1.k2: 0.07395907", "Camera1.k2: nan")),
+              HasSubstr("key 'Camera1.k2': expected a number"));
   EXPECT_THAT(ReadError(Edited("Camera.width: 752", "Camera.width: 752.5")),
               HasSubstr("key 'Camera.width': expected an integer"));
   EXPECT_THAT(ReadError(Edited("Camera.width: 752", "Camera.width: -752")),
@@ -243,7 +244,7 @@ TEST_F(SettingsFiles, KeyframeParametersAndOptionalDefaults) {
                      "Camera.width: 640\nCamera.height: 480\nCamera.fps: 30\n"
                      "Keyframe.cone_threshold: 0.4\nKeyframe.max_gap_s: 2\n");
   const Settings s = ReadOrbSlam3Settings(file);
-  EXPECT_TRUE(s.camera1.distortion.empty());
+  EXPECT_TRUE(s.camera1.distortion().empty());
   EXPECT_TRUE(s.rgb_order);
   EXPECT_EQ(s.th_depth, 60);
   EXPECT_EQ(s.orb, OrbExtractorSettings{});
@@ -256,13 +257,16 @@ TEST(SettingsCheck, RejectsInconsistentValues) {
   Settings s = ReadOrbSlam3Settings(kTestData / "euroc_stereo_inertial.yaml");
   EXPECT_NO_THROW(s.Check());
   Settings bad = s;
-  bad.camera2->type = CameraType::kKannalaBrandt8;
+  bad.camera2 = CameraModel::KannalaBrandt8(752, 480, 457, 456, 380, 255, {0, 0, 0, 0});
   EXPECT_THROW(bad.Check(), OptionError);
   bad = s;
   bad.body_from_cam0.reset();
   EXPECT_THROW(bad.Check(), OptionError);
   bad = s;
-  bad.camera1.distortion = {0.1, 0.2, 0.3};
+  bad.camera2 = CameraModel::Pinhole(640, 480, 457, 456, 380, 255);
+  EXPECT_THROW(bad.Check(), OptionError);
+  bad = s;
+  bad.camera1 = CameraModel();
   EXPECT_THROW(bad.Check(), OptionError);
   bad = s;
   bad.orb.scale_factor = 1.0;

@@ -48,13 +48,13 @@ class Writer {
   std::string out_;
 };
 
-void WriteCamera(const CameraCalibration& camera, const std::string& prefix, Writer* w) {
-  w->RealKey(prefix + ".fx", camera.fx);
-  w->RealKey(prefix + ".fy", camera.fy);
-  w->RealKey(prefix + ".cx", camera.cx);
-  w->RealKey(prefix + ".cy", camera.cy);
-  const auto& d = camera.distortion;
-  if (camera.type == CameraType::kKannalaBrandt8) {
+void WriteCamera(const CameraModel& camera, const std::string& prefix, Writer* w) {
+  w->RealKey(prefix + ".fx", camera.fx());
+  w->RealKey(prefix + ".fy", camera.fy());
+  w->RealKey(prefix + ".cx", camera.cx());
+  w->RealKey(prefix + ".cy", camera.cy());
+  const auto& d = camera.distortion();
+  if (camera.type() == CameraType::kKannalaBrandt8) {
     for (int i = 0; i < 4; ++i) w->RealKey(fmt::format("{}.k{}", prefix, i + 1), d[i]);
   } else if (!d.empty()) {
     w->RealKey(prefix + ".k1", d[0]);
@@ -85,13 +85,13 @@ void WriteOrbSlam3Settings(const Settings& s, const std::filesystem::path& file)
   w.Blank();
   w.StringKey("File.version", "1.0");
   w.Blank();
-  const bool kb = s.camera1.type == CameraType::kKannalaBrandt8;
+  const bool kb = s.camera1.type() == CameraType::kKannalaBrandt8;
   w.StringKey("Camera.type", s.rectified_stereo ? "Rectified" : kb ? "KannalaBrandt8" : "PinHole");
   w.Blank();
   WriteCamera(s.camera1, "Camera1", &w);
   if (s.camera2) WriteCamera(*s.camera2, "Camera2", &w);
-  w.IntKey("Camera.width", s.camera1.width);
-  w.IntKey("Camera.height", s.camera1.height);
+  w.IntKey("Camera.width", s.camera1.width());
+  w.IntKey("Camera.height", s.camera1.height());
   if (s.fps == static_cast<int>(s.fps)) {
     w.IntKey("Camera.fps", static_cast<int>(s.fps));  // ORB-SLAM3 reads fps as an integer
   } else {
