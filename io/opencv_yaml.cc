@@ -159,7 +159,7 @@ Eigen::MatrixXd OpenCvYamlFile::Matrix(const std::string& key, int rows, int col
   if (!dt.empty() && !dt.isString()) Fail(key, "matrix 'dt' must be a type letter (f, d)");
   const cv::FileNode data = node["data"];
   if (data.empty() || !data.isSeq()) Fail(key, "matrix needs a 'data' sequence");
-  if (data.size() != static_cast<std::size_t>(rows * cols)) {
+  if (data.size() != static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols)) {
     Fail(key, fmt::format("matrix data has {} numbers, expected {}", data.size(), rows * cols));
   }
   Eigen::MatrixXd m(rows, cols);
@@ -172,7 +172,7 @@ Eigen::MatrixXd OpenCvYamlFile::Matrix(const std::string& key, int rows, int col
 }
 
 Eigen::Matrix4d OpenCvYamlFile::RigidTransform(const std::string& key) const {
-  const Eigen::Matrix4d m = Matrix(key, 4, 4);
+  Eigen::Matrix4d m = Matrix(key, 4, 4);
   if (!m.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1), 1e-9)) {
     Fail(key, "not a rigid transform: the last row must be 0 0 0 1");
   }

@@ -127,7 +127,7 @@ class SettingsFiles : public ::testing::Test {
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const std::string edited = std::regex_replace(text, std::regex(pattern), replacement);
     EXPECT_NE(edited, text) << "pattern did not match: " << pattern;
-    const fs::path file = dir_ / "edited.yaml";
+    fs::path file = dir_ / "edited.yaml";
     testing::WriteText(file, edited);
     return file;
   }

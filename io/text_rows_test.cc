@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 fs::path WriteFile(const fs::path& dir, const std::string& name, const std::string& text) {
-  const fs::path p = dir / name;
+  fs::path p = dir / name;
   std::ofstream(p, std::ios::binary) << text;
   return p;
 }
