@@ -11,11 +11,11 @@
 
 #include <opencv2/core.hpp>
 
-#include "core/features/orb_extractor.h"
 #include "core/frame/frame.h"
 #include "core/map/atlas.h"
 #include "core/map/mapping_backend.h"
 #include "keyframe/keyframe_selector.h"
+#include "tracking/frame_builder.h"
 #include "tracking/tracking_options.h"
 
 namespace pkslam {
@@ -90,7 +90,11 @@ class Tracker {
   int SearchLocalPoints();
   SelectorInput BuildSelectorInput() const;
   void CreateNewKeyFrame(const SelectorInput& input);
+  // Issue 6 brings relocalisation; until then a lost camera cannot relocalise.
+  bool Relocalize();
   void HandleLost();
+  // Back to NOT_INITIALIZED on the current (new or cleared) map.
+  void StartOver();
   void RecordFrame(bool keyframe, double ms);
 
   Atlas* atlas_;
@@ -99,8 +103,7 @@ class Tracker {
   std::unique_ptr<KeyframeSelector> selector_;
   MappingBackend* mapping_;
   TrackingOptions options_;
-  OrbExtractor extractor_;
-  OrbExtractor init_extractor_;  // monocular initialisation uses 2x features (ORB-SLAM)
+  FrameBuilder builder_;
   std::vector<cv::Point2f> init_prev_matched_;  // monocular: where init keypoints were seen
   std::vector<int> init_matches_;
 

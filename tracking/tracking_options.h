@@ -38,6 +38,8 @@ struct TrackingOptions {
   double recently_lost_timeout_s = 5.0;
   // A lost map with at most this many keyframes is reset instead of kept in the Atlas.
   int min_keyframes_to_keep_map = 10;
+  // Deterministic mode: wait for local mapping to finish each keyframe before going on.
+  bool lockstep = false;
   PoseOptimizerOptions pose;
 
   void Check() const;
