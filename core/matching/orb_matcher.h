@@ -34,6 +34,7 @@ struct ProjectedPoint {
   double depth = 0;     // depth in the frame's camera
 };
 
+// Holds only its two settings: one instance may be used from several threads at once.
 class OrbMatcher {
  public:
   // nn_ratio: Lowe ratio between best and second-best distance (1 disables the test).

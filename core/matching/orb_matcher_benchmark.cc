@@ -10,6 +10,7 @@
 
 #include "core/matching/matching_test_utils.h"
 #include "core/matching/orb_matcher.h"
+#include "core/util/log.h"
 
 namespace pkslam {
 namespace {
@@ -88,6 +89,25 @@ void BM_SearchByProjectionLocalMap(benchmark::State& state) {
 }
 BENCHMARK(BM_SearchByProjectionLocalMap)->Unit(benchmark::kMicrosecond);
 
+// The grid queries alone of the local-map search (one allocated vector per point): the share
+// of BM_SearchByProjectionLocalMap spent in Frame::FeaturesInArea.
+void BM_FeaturesInAreaLocalMap(benchmark::State& state) {
+  Fixture fx;
+  const auto& scale = fx.rig->pyramid.scale;
+  std::size_t found = 0;
+  for (auto _ : state) {
+    found = 0;
+    for (const ProjectedPoint& p : fx.projected) {
+      const double r = OrbMatcher::RadiusByViewingCos(p.view_cos) * scale[p.predicted_level];
+      found +=
+          fx.frame.FeaturesInArea(p.u, p.v, r, p.predicted_level - 1, p.predicted_level).size();
+    }
+    benchmark::DoNotOptimize(found);
+  }
+  state.counters["candidates"] = static_cast<double>(found);
+}
+BENCHMARK(BM_FeaturesInAreaLocalMap)->Unit(benchmark::kMicrosecond);
+
 void BM_SearchByProjectionMotionModel(benchmark::State& state) {
   Fixture fx;  // rebuilt per run (no statics); not timed
   std::shared_lock lock(fx.atlas.mutex());
@@ -113,6 +133,7 @@ struct BowFixture {
   Frame frame;
 
   explicit BowFixture(Fixture& fx) {
+    SetLogLevel("warn");  // vocabulary training reports at info level on every rebuild
     std::vector<std::vector<Descriptor>> images;
     for (const auto& kf : fx.map.keyframes) images.push_back(kf->descriptors());
     VocabularyTrainOptions options;
