@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "core/features/orb_extractor.h"
@@ -12,12 +13,27 @@
 namespace pkslam {
 namespace {
 
-// Sum over the window of |(L(p) - L(c)) - (R(p + s) - R(c + s))|: SAD after removing each
-// window's centre intensity, which tolerates a brightness offset between the cameras.
-int CenteredSad(const cv::Mat& left, cv::Point cl, const cv::Mat& right, cv::Point cr, int w) {
-  const int left_centre = left.at<std::uint8_t>(cl);
-  const int right_centre = right.at<std::uint8_t>(cr);
-  const int offset = right_centre - left_centre;
+// Sum of absolute differences over the (2w+1)^2 windows centred at `cl` (left) and `cr`
+// (right), after adding to the left window the brightness offset `normalization` asks for.
+int WindowSad(const cv::Mat& left, cv::Point cl, const cv::Mat& right, cv::Point cr, int w,
+              SadNormalization normalization) {
+  int offset = 0;
+  if (normalization == SadNormalization::kCentrePixel) {
+    offset = int(right.at<std::uint8_t>(cr)) - int(left.at<std::uint8_t>(cl));
+  } else if (normalization == SadNormalization::kWindowMean) {
+    int sum_left = 0;
+    int sum_right = 0;
+    for (int dy = -w; dy <= w; ++dy) {
+      const std::uint8_t* l = left.ptr<std::uint8_t>(cl.y + dy) + cl.x;
+      const std::uint8_t* r = right.ptr<std::uint8_t>(cr.y + dy) + cr.x;
+      for (int dx = -w; dx <= w; ++dx) {
+        sum_left += l[dx];
+        sum_right += r[dx];
+      }
+    }
+    offset =
+        static_cast<int>(std::lround(double(sum_right - sum_left) / ((2 * w + 1) * (2 * w + 1))));
+  }
   int sad = 0;
   for (int dy = -w; dy <= w; ++dy) {
     const std::uint8_t* l = left.ptr<std::uint8_t>(cl.y + dy) + cl.x;
@@ -25,6 +41,20 @@ int CenteredSad(const cv::Mat& left, cv::Point cl, const cv::Mat& right, cv::Poi
     for (int dx = -w; dx <= w; ++dx) sad += std::abs(int(l[dx]) + offset - int(r[dx]));
   }
   return sad;
+}
+
+// Sub-pixel offset of the minimum from the costs at -1, 0, +1 (c0 the smallest), or nullopt
+// when the costs are flat.
+std::optional<double> SubpixelOffset(double c_minus, double c0, double c_plus, SubpixelFit fit) {
+  if (fit == SubpixelFit::kParabola) {
+    const double curvature = c_minus + c_plus - 2.0 * c0;
+    if (curvature <= 0.0) return std::nullopt;
+    return (c_minus - c_plus) / (2.0 * curvature);
+  }
+  // Two lines of opposite slope through the three costs (the shape of a SAD minimum).
+  const double slope = std::max(c_minus, c_plus) - c0;
+  if (slope <= 0.0) return std::nullopt;
+  return (c_minus - c_plus) / (2.0 * slope);
 }
 
 }  // namespace
@@ -125,7 +155,8 @@ StereoMatches MatchStereo(std::span<const cv::KeyPoint> left_keypoints,
     int best_cost = std::numeric_limits<int>::max();
     int best_shift = 0;
     for (int shift = -radius; shift <= radius; ++shift) {
-      const int cost = CenteredSad(left_image, {xl, yl}, right_image, {xr0 + shift, yl}, w);
+      const int cost = WindowSad(left_image, {xl, yl}, right_image, {xr0 + shift, yl}, w,
+                                 options.sad_normalization);
       costs[shift + radius] = cost;
       if (cost < best_cost) {
         best_cost = cost;
@@ -134,16 +165,12 @@ StereoMatches MatchStereo(std::span<const cv::KeyPoint> left_keypoints,
     }
     if (best_shift == -radius || best_shift == radius) continue;  // minimum not bracketed
 
-    // Parabola through the costs at best_shift - 1, best_shift, best_shift + 1.
-    const double c1 = costs[best_shift + radius - 1];
-    const double c2 = costs[best_shift + radius];
-    const double c3 = costs[best_shift + radius + 1];
-    const double curvature = c1 + c3 - 2.0 * c2;
-    if (curvature <= 0.0) continue;  // flat: no sub-pixel information
-    const double delta = (c1 - c3) / (2.0 * curvature);
-    if (delta < -1.0 || delta > 1.0) continue;
+    const std::optional<double> delta =
+        SubpixelOffset(costs[best_shift + radius - 1], costs[best_shift + radius],
+                       costs[best_shift + radius + 1], options.subpixel_fit);
+    if (!delta || *delta < -1.0 || *delta > 1.0) continue;
 
-    double u_right = right_pyramid.ToBaseX(level, xr0 + best_shift + delta);
+    double u_right = right_pyramid.ToBaseX(level, xr0 + best_shift + *delta);
     double disparity = u_left - u_right;
     if (disparity < min_disparity || disparity >= max_disparity) continue;
     if (disparity <= 0.0) {  // at infinity: keep a tiny disparity so depth stays finite
