@@ -3,7 +3,8 @@
 //
 // Time: wall-clock of the extraction call only (manual timing; both extractors may use both
 // cores: pkslam through its level tasks, OpenCV through its own TBB-backed internals).
-// Counters: median_ms = median per-image extraction time; features = mean keypoint count;
+// Counters: median_ms = median per-image extraction time (wall); cpu_ms = median CPU time of
+// the whole process (all threads) per extraction; features = mean keypoint count;
 // spread_8x8grid = mean share of the 64 cells of an 8 x 8 grid laid over the image that hold
 // a keypoint; spread_8px = mean share of the 8 x 8-pixel cells (94 x 60 for 752 x 480) that
 // hold a keypoint.
@@ -11,6 +12,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -49,8 +51,15 @@ std::vector<std::filesystem::path> EurocFiles(const std::string& cam) {
 
 std::vector<cv::Mat> LoadGrey(const std::vector<std::filesystem::path>& files) {
   std::vector<cv::Mat> images;
+  images.reserve(files.size());
   for (const auto& f : files) images.push_back(cv::imread(f.string(), cv::IMREAD_GRAYSCALE));
   return images;
+}
+
+double ProcessCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
 double Median(std::vector<double> v) {
@@ -66,14 +75,17 @@ void RunExtraction(benchmark::State& state, const std::vector<cv::Mat>& images, 
     return;
   }
   std::vector<double> times_ms;
+  std::vector<double> cpu_ms;
   double grid = 0.0;
   double px8 = 0.0;
   double count = 0.0;
   std::size_t i = 0;
   for (auto _ : state) {
     const cv::Mat& image = images[i % images.size()];
+    const double c0 = ProcessCpuMs();
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<cv::KeyPoint> keypoints = extract(image);
+    cpu_ms.push_back(ProcessCpuMs() - c0);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     state.SetIterationTime(seconds);
@@ -85,6 +97,7 @@ void RunExtraction(benchmark::State& state, const std::vector<cv::Mat>& images, 
   }
   const double n = static_cast<double>(i);
   state.counters["median_ms"] = Median(times_ms);
+  state.counters["cpu_ms"] = Median(cpu_ms);
   state.counters["features"] = count / n;
   state.counters["spread_8x8grid"] = grid / n;
   state.counters["spread_8px"] = px8 / n;
@@ -137,6 +150,48 @@ void BM_PkslamOrbSequential_Synthetic(benchmark::State& state) {
   RunPkslam(state, SyntheticImages(), false);
 }
 void BM_OpenCvOrb_Synthetic(benchmark::State& state) { RunOpenCv(state, SyntheticImages()); }
+
+// pkslam and cv::ORB alternating on the same image, so that both see the same machine load
+// (this machine is shared): medians of each and of the per-image time ratio.
+void BM_PairedPkslamVsOpenCv_Euroc(benchmark::State& state) {
+  const std::vector<cv::Mat> images = LoadGrey(EurocFiles("cam0"));
+  if (images.empty()) {
+    state.SkipWithError("EuRoC images not found (../shared/data/euroc/V1_01_easy_static)");
+    return;
+  }
+  const OrbExtractor extractor(PkslamOptions(true));
+  const cv::Ptr<cv::ORB> orb = OpenCvOrb();
+  OrbFeatures features;
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  std::vector<double> ours, theirs, ratio;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const cv::Mat& image = images[i % images.size()];
+    double t_ours = 0.0;
+    double t_theirs = 0.0;
+    for (int k = 0; k < 2; ++k) {
+      const bool ours_now = (k == 0) == (i % 2 == 0);  // alternate who goes first
+      const auto t0 = std::chrono::steady_clock::now();
+      if (ours_now) {
+        extractor.Extract(image, &features);
+      } else {
+        orb->detectAndCompute(image, cv::noArray(), keypoints, descriptors);
+      }
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      (ours_now ? t_ours : t_theirs) = ms;
+    }
+    state.SetIterationTime((t_ours + t_theirs) * 1e-3);
+    ours.push_back(t_ours);
+    theirs.push_back(t_theirs);
+    ratio.push_back(t_ours / t_theirs);
+    ++i;
+  }
+  state.counters["pkslam_median_ms"] = Median(ours);
+  state.counters["opencv_median_ms"] = Median(theirs);
+  state.counters["median_ratio"] = Median(ratio);
+}
 
 // First stereo pair present in both cameras (cam1 lacks a few frames).
 bool LoadEurocPair(cv::Mat* left, cv::Mat* right) {
@@ -205,6 +260,10 @@ BENCHMARK(BM_PkslamOrbSequential_Euroc)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(285);
 BENCHMARK(BM_OpenCvOrb_Euroc)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(285);
+BENCHMARK(BM_PairedPkslamVsOpenCv_Euroc)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(285);
 BENCHMARK(BM_PkslamOrb_Synthetic)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PkslamOrbSequential_Synthetic)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OpenCvOrb_Synthetic)->UseManualTime()->Unit(benchmark::kMillisecond);

@@ -98,6 +98,7 @@ TEST(RbriefPattern, EqualsOpenCvOrbForSameKeypointsAndAngles) {
   const cv::Mat image = SyntheticTexture(cv::Size(320, 240), 11);
   std::vector<cv::KeyPoint> keypoints;
   cv::RNG rng(5);
+  keypoints.reserve(410);
   for (int i = 0; i < 400; ++i) {
     keypoints.emplace_back(static_cast<float>(rng.uniform(19, 320 - 19)),
                            static_cast<float>(rng.uniform(19, 240 - 19)), 31.0f,
@@ -162,6 +163,7 @@ TEST(RbriefPattern, SteeredDescriptorFollowsA90DegreeRotation) {
 
 TEST(DistributeQuadtree, KeepsAllWhenFewerThanTarget) {
   std::vector<cv::KeyPoint> kps;
+  kps.reserve(5);
   for (int i = 0; i < 5; ++i) kps.emplace_back(10.0f * i + 1, 7.0f, 7.0f, -1.0f, float(i));
   const std::vector<int> keep = DistributeQuadtree(kps, cv::Size(100, 60), 10);
   EXPECT_EQ(keep, (std::vector<int>{0, 1, 2, 3, 4}));
@@ -173,6 +175,7 @@ TEST(DistributeQuadtree, KeepsIsolatedPointsAndSamplesTheDenseCluster) {
   // their nodes and are always kept; the rest of the quota goes to the cluster.
   std::vector<cv::KeyPoint> kps;
   cv::RNG rng(1);
+  kps.reserve(404);
   for (int i = 0; i < 400; ++i) {
     kps.emplace_back(rng.uniform(0.0f, 40.0f), rng.uniform(0.0f, 40.0f), 7.0f, -1.0f,
                      rng.uniform(1.0f, 50.0f));

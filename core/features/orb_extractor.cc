@@ -126,7 +126,7 @@ std::vector<cv::KeyPoint> OrbExtractor::DetectCandidates(const cv::Mat& level_im
   const int n_rows = std::max(1, height / options_.cell_size);
   const int cell_w = (width + n_cols - 1) / n_cols;
   const int cell_h = (height + n_rows - 1) / n_rows;
-  std::vector<int> count(n_cols * n_rows, 0);
+  std::vector<int> count(static_cast<std::size_t>(n_cols) * n_rows, 0);
   for (const cv::KeyPoint& kp : keypoints) {
     const int j = std::min((static_cast<int>(kp.pt.x) - kFastRadius) / cell_w, n_cols - 1);
     const int i = std::min((static_cast<int>(kp.pt.y) - kFastRadius) / cell_h, n_rows - 1);

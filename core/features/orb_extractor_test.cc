@@ -292,6 +292,7 @@ TEST(OrbThreaded, ConcurrentCallsAndStereoGiveTheSameAsAlone) {
 
   std::vector<OrbFeatures> results(4);
   std::vector<std::thread> threads;
+  threads.reserve(4);
   for (int t = 0; t < 4; ++t) {
     threads.emplace_back([&, t] {
       for (int rep = 0; rep < 3; ++rep) extractor.Extract(t % 2 ? right : left, &results[t]);

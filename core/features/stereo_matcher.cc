@@ -188,7 +188,7 @@ StereoMatches MatchStereo(std::span<const cv::KeyPoint> left_keypoints,
   // so that a median of 0 on noise-free images does not reject everything).
   if (!sad_and_index.empty()) {
     std::sort(sad_and_index.begin(), sad_and_index.end());
-    const double median = sad_and_index[sad_and_index.size() / 2].first;
+    const int median = sad_and_index[sad_and_index.size() / 2].first;
     const double threshold = options.sad_outlier_factor * median;
     for (const auto& [cost, il] : sad_and_index) {
       if (cost <= threshold) continue;
