@@ -34,24 +34,97 @@ std::vector<int> CircularPatchHalfWidths(int half_patch) {
   return u_max;
 }
 
-float IntensityCentroidAngle(const cv::Mat& image, cv::Point center, std::span<const int> u_max) {
-  const int half = static_cast<int>(u_max.size()) - 1;
+OrientationDisc::OrientationDisc(int half_patch)
+    : half_(half_patch), u_max_(CircularPatchHalfWidths(half_patch)) {
+  // The disc rows in chunks of 16 pixels starting at -half, the last one moved back to end at
+  // +half (never reading beyond the disc's square) with its overlap weighted 0.
+  const int width = 2 * half_ + 1;
+  if (width >= kChunk) {
+    for (int start = -half_; start <= half_; start += kChunk) {
+      chunk_start_.push_back(std::min(start, half_ + 1 - kChunk));
+    }
+  }
+  const std::size_t n_chunks = chunk_start_.size();
+  u_weight_.assign((half_ + 1) * n_chunks * kChunk, 0);
+  v_weight_.assign(u_weight_.size(), 0);
+  for (int v = 0; v <= half_; ++v) {
+    int covered = -half_;  // first u not yet weighted in this row
+    for (std::size_t k = 0; k < n_chunks; ++k) {
+      for (int lane = 0; lane < kChunk; ++lane) {
+        const int u = chunk_start_[k] + lane;
+        if (u < covered || std::abs(u) > u_max_[v]) continue;
+        const std::size_t index = (v * n_chunks + k) * kChunk + lane;
+        u_weight_[index] = static_cast<std::int16_t>(u);
+        v_weight_[index] = static_cast<std::int16_t>(v);
+      }
+      covered = chunk_start_[k] + kChunk;
+    }
+  }
+}
+
+float OrientationDisc::Angle(const cv::Mat& image, cv::Point center) const {
   const std::ptrdiff_t step = static_cast<std::ptrdiff_t>(image.step1());
   const std::uint8_t* c = image.ptr<std::uint8_t>(center.y) + center.x;
   int m_10 = 0;
   int m_01 = 0;
-  for (int u = -half; u <= half; ++u) m_10 += u * c[u];
-  // Rows v and -v together: their sum feeds m_10, their difference m_01.
-  for (int v = 1; v <= half; ++v) {
-    const std::uint8_t* below = c + v * step;
-    const std::uint8_t* above = c - v * step;
-    const int d = u_max[v];
-    int diff_sum = 0;
-    for (int u = -d; u <= d; ++u) {
-      diff_sum += below[u] - above[u];
-      m_10 += u * (below[u] + above[u]);
+#if defined(__SSE2__)
+  if (!chunk_start_.empty()) {
+    // Rows v and -v together: u * (below + above) feeds m_10, v * (below - above) m_01;
+    // pmaddwd multiplies the 16-bit lanes by the weights and sums pairs into 32 bits.
+    const std::size_t n_chunks = chunk_start_.size();
+    const __m128i zero = _mm_setzero_si128();
+    __m128i acc_10 = zero;
+    __m128i acc_01 = zero;
+    auto weights = [&](const std::vector<std::int16_t>& w, int v, std::size_t k, int half) {
+      return _mm_loadu_si128(
+          reinterpret_cast<const __m128i*>(w.data() + (v * n_chunks + k) * kChunk + 8 * half));
+    };
+    for (int v = 0; v <= half_; ++v) {
+      const std::uint8_t* below = c + v * step;
+      const std::uint8_t* above = c - v * step;
+      for (std::size_t k = 0; k < n_chunks; ++k) {
+        const __m128i bb =
+            _mm_loadu_si128(reinterpret_cast<const __m128i*>(below + chunk_start_[k]));
+        const __m128i aa =
+            _mm_loadu_si128(reinterpret_cast<const __m128i*>(above + chunk_start_[k]));
+        const __m128i b_lo = _mm_unpacklo_epi8(bb, zero);
+        const __m128i b_hi = _mm_unpackhi_epi8(bb, zero);
+        if (v == 0) {  // the centre row counts once
+          acc_10 = _mm_add_epi32(acc_10, _mm_madd_epi16(b_lo, weights(u_weight_, 0, k, 0)));
+          acc_10 = _mm_add_epi32(acc_10, _mm_madd_epi16(b_hi, weights(u_weight_, 0, k, 1)));
+          continue;
+        }
+        const __m128i a_lo = _mm_unpacklo_epi8(aa, zero);
+        const __m128i a_hi = _mm_unpackhi_epi8(aa, zero);
+        acc_10 = _mm_add_epi32(
+            acc_10, _mm_madd_epi16(_mm_add_epi16(b_lo, a_lo), weights(u_weight_, v, k, 0)));
+        acc_10 = _mm_add_epi32(
+            acc_10, _mm_madd_epi16(_mm_add_epi16(b_hi, a_hi), weights(u_weight_, v, k, 1)));
+        acc_01 = _mm_add_epi32(
+            acc_01, _mm_madd_epi16(_mm_sub_epi16(b_lo, a_lo), weights(v_weight_, v, k, 0)));
+        acc_01 = _mm_add_epi32(
+            acc_01, _mm_madd_epi16(_mm_sub_epi16(b_hi, a_hi), weights(v_weight_, v, k, 1)));
+      }
     }
-    m_01 += v * diff_sum;
+    alignas(16) std::array<int, 4> lanes{};
+    _mm_store_si128(reinterpret_cast<__m128i*>(lanes.data()), acc_10);
+    m_10 = lanes[0] + lanes[1] + lanes[2] + lanes[3];
+    _mm_store_si128(reinterpret_cast<__m128i*>(lanes.data()), acc_01);
+    m_01 = lanes[0] + lanes[1] + lanes[2] + lanes[3];
+  } else
+#endif
+  {
+    for (int u = -half_; u <= half_; ++u) m_10 += u * c[u];
+    for (int v = 1; v <= half_; ++v) {
+      const std::uint8_t* below = c + v * step;
+      const std::uint8_t* above = c - v * step;
+      int diff_sum = 0;
+      for (int u = -u_max_[v]; u <= u_max_[v]; ++u) {
+        diff_sum += below[u] - above[u];
+        m_10 += u * (below[u] + above[u]);
+      }
+      m_01 += v * diff_sum;
+    }
   }
   float angle =
       static_cast<float>(std::atan2(double(m_01), double(m_10)) * 180.0 / std::numbers::pi);
@@ -65,11 +138,13 @@ namespace {
 // ORB's smoothing is OpenCV's bit-exact 8-bit Gaussian (7 taps, sigma 2): fixed-point taps
 // {18, 34, 48, 56, 48, 34, 18} / 256 per axis, then (sum + 2^15) >> 16. All taps are even, so
 // halving them keeps the row sums in int16 and the result is (sum' + 2^13) >> 14. The loops
-// are written for the auto-vectoriser and cloned for AVX2.
+// are written for the auto-vectoriser and compiled twice, for AVX2 and for the baseline,
+// chosen at run time (explicit dispatch rather than ifunc target_clones, whose resolvers run
+// before sanitizer runtimes are initialised).
 constexpr int kTap0 = 9, kTap1 = 17, kTap2 = 24, kTap3 = 28;
 
-[[gnu::target_clones("avx2", "default")]] void SmoothRow(const std::uint8_t* padded, int width,
-                                                         std::int16_t* out) {
+[[gnu::always_inline]] inline void SmoothRowBody(const std::uint8_t* padded, int width,
+                                                 std::int16_t* out) {
   const std::uint8_t* p = padded + 3;
   for (int x = 0; x < width; ++x) {
     out[x] =
@@ -78,16 +153,52 @@ constexpr int kTap0 = 9, kTap1 = 17, kTap2 = 24, kTap3 = 28;
   }
 }
 
-[[gnu::target_clones("avx2", "default")]] void SmoothColumn(
-    const std::int16_t* r0, const std::int16_t* r1, const std::int16_t* r2, const std::int16_t* r3,
-    const std::int16_t* r4, const std::int16_t* r5, const std::int16_t* r6, int width,
-    std::uint8_t* out) {
+// rows[0..6]: the smoothed rows y-3 .. y+3.
+[[gnu::always_inline]] inline void SmoothColumnBody(const std::int16_t* const* rows, int width,
+                                                    std::uint8_t* out) {
+  const std::int16_t* r0 = rows[0];
+  const std::int16_t* r1 = rows[1];
+  const std::int16_t* r2 = rows[2];
+  const std::int16_t* r3 = rows[3];
+  const std::int16_t* r4 = rows[4];
+  const std::int16_t* r5 = rows[5];
+  const std::int16_t* r6 = rows[6];
   for (int x = 0; x < width; ++x) {
     const int sum =
         kTap0 * (r0[x] + r6[x]) + kTap1 * (r1[x] + r5[x]) + kTap2 * (r2[x] + r4[x]) + kTap3 * r3[x];
     out[x] = static_cast<std::uint8_t>((sum + (1 << 13)) >> 14);
   }
 }
+
+using SmoothRowFn = void (*)(const std::uint8_t*, int, std::int16_t*);
+using SmoothColumnFn = void (*)(const std::int16_t* const*, int, std::uint8_t*);
+
+void SmoothRowBaseline(const std::uint8_t* padded, int width, std::int16_t* out) {
+  SmoothRowBody(padded, width, out);
+}
+void SmoothColumnBaseline(const std::int16_t* const* rows, int width, std::uint8_t* out) {
+  SmoothColumnBody(rows, width, out);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+[[gnu::target("avx2")]] void SmoothRowAvx2(const std::uint8_t* padded, int width,
+                                           std::int16_t* out) {
+  SmoothRowBody(padded, width, out);
+}
+[[gnu::target("avx2")]] void SmoothColumnAvx2(const std::int16_t* const* rows, int width,
+                                              std::uint8_t* out) {
+  SmoothColumnBody(rows, width, out);
+}
+bool HasAvx2() { return __builtin_cpu_supports("avx2"); }
+#else
+void SmoothRowAvx2(const std::uint8_t* padded, int width, std::int16_t* out) {
+  SmoothRowBody(padded, width, out);
+}
+void SmoothColumnAvx2(const std::int16_t* const* rows, int width, std::uint8_t* out) {
+  SmoothColumnBody(rows, width, out);
+}
+bool HasAvx2() { return false; }
+#endif
 
 int Reflect101(int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); }
 
@@ -102,6 +213,9 @@ void SmoothForDescriptor(const cv::Mat& image, cv::Mat* smoothed) {
     return;
   }
   smoothed->create(image.size(), CV_8UC1);
+  const bool avx2 = HasAvx2();
+  const SmoothRowFn smooth_row_fn = avx2 ? SmoothRowAvx2 : SmoothRowBaseline;
+  const SmoothColumnFn smooth_column = avx2 ? SmoothColumnAvx2 : SmoothColumnBaseline;
   std::vector<std::uint8_t> padded(width + 6);
   std::vector<std::int16_t> ring(7 * static_cast<std::size_t>(width));
   auto row_of = [&](int y) { return ring.data() + static_cast<std::size_t>((y + 7) % 7) * width; };
@@ -112,13 +226,14 @@ void SmoothForDescriptor(const cv::Mat& image, cv::Mat* smoothed) {
       padded[3 - i] = src[i];
       padded[width + 2 + i] = src[width - 1 - i];
     }
-    SmoothRow(padded.data(), width, row_of(y));
+    smooth_row_fn(padded.data(), width, row_of(y));
   };
   for (int y = -3; y < 3; ++y) smooth_row(y);
   for (int y = 0; y < height; ++y) {
     smooth_row(y + 3);
-    SmoothColumn(row_of(y - 3), row_of(y - 2), row_of(y - 1), row_of(y), row_of(y + 1),
-                 row_of(y + 2), row_of(y + 3), width, smoothed->ptr<std::uint8_t>(y));
+    const std::int16_t* rows[7];
+    for (int k = 0; k < 7; ++k) rows[k] = row_of(y - 3 + k);
+    smooth_column(rows, width, smoothed->ptr<std::uint8_t>(y));
   }
 }
 
@@ -144,39 +259,62 @@ Descriptor RbriefPattern::Compute(const cv::Mat& smoothed, cv::Point center,
   const float a = static_cast<float>(std::cos(static_cast<double>(angle)));
   const float b = static_cast<float>(std::sin(static_cast<double>(angle)));
   const int n = static_cast<int>(xs_.size());
-  std::array<int, 2 * kOrbDescriptorBits> ix;
-  std::array<int, 2 * kOrbDescriptorBits> iy;
+  const std::ptrdiff_t step = static_cast<std::ptrdiff_t>(smoothed.step1());
+  // Memory offset of every rotated test point from the centre.
+  std::array<int, 2 * kOrbDescriptorBits> offset;
   int i = 0;
 #if defined(__SSE2__)
-  const __m128 va = _mm_set1_ps(a);
-  const __m128 vb = _mm_set1_ps(b);
-  for (; i + 4 <= n; i += 4) {
-    const __m128 px = _mm_loadu_ps(xs_.data() + i);
-    const __m128 py = _mm_loadu_ps(ys_.data() + i);
-    const __m128 rx = _mm_sub_ps(_mm_mul_ps(px, va), _mm_mul_ps(py, vb));
-    const __m128 ry = _mm_add_ps(_mm_mul_ps(px, vb), _mm_mul_ps(py, va));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(ix.data() + i), _mm_cvtps_epi32(rx));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(iy.data() + i), _mm_cvtps_epi32(ry));
+  // round(y) * step + round(x) in float is exact while |offset| < 2^24.
+  if (step < (1 << 19)) {
+    const __m128 va = _mm_set1_ps(a);
+    const __m128 vb = _mm_set1_ps(b);
+    const __m128 vstep = _mm_set1_ps(static_cast<float>(step));
+    for (; i + 4 <= n; i += 4) {
+      const __m128 px = _mm_loadu_ps(xs_.data() + i);
+      const __m128 py = _mm_loadu_ps(ys_.data() + i);
+      const __m128 rx = _mm_sub_ps(_mm_mul_ps(px, va), _mm_mul_ps(py, vb));
+      const __m128 ry = _mm_add_ps(_mm_mul_ps(px, vb), _mm_mul_ps(py, va));
+      const __m128 ix = _mm_cvtepi32_ps(_mm_cvtps_epi32(rx));
+      const __m128 iy = _mm_cvtepi32_ps(_mm_cvtps_epi32(ry));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(offset.data() + i),
+                       _mm_cvtps_epi32(_mm_add_ps(_mm_mul_ps(iy, vstep), ix)));
+    }
   }
 #endif
   for (; i < n; ++i) {
     const float rx = xs_[i] * a - ys_[i] * b;
     const float ry = xs_[i] * b + ys_[i] * a;
-    ix[i] = cvRound(rx);
-    iy[i] = cvRound(ry);
+    offset[i] = static_cast<int>(cvRound(ry) * step + cvRound(rx));
   }
-  const std::ptrdiff_t step = static_cast<std::ptrdiff_t>(smoothed.step1());
   const std::uint8_t* c = smoothed.ptr<std::uint8_t>(center.y) + center.x;
-  auto sample = [&](int k) { return c[iy[k] * step + ix[k]]; };
+  // Gather both samples of every test, then compare them 16 tests at a time.
+  std::array<std::uint8_t, kOrbDescriptorBits> first;
+  std::array<std::uint8_t, kOrbDescriptorBits> second;
+  for (std::size_t t = 0; t < kOrbDescriptorBits; ++t) {
+    first[t] = c[offset[2 * t]];
+    second[t] = c[offset[2 * t + 1]];
+  }
   Descriptor desc;
-  for (int byte = 0; byte < 32; ++byte) {
+#if defined(__SSE2__)
+  const __m128i flip = _mm_set1_epi8(static_cast<char>(0x80));  // unsigned -> signed order
+  for (std::size_t t = 0; t < kOrbDescriptorBits; t += 16) {
+    const __m128i f =
+        _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(first.data() + t)), flip);
+    const __m128i g =
+        _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(second.data() + t)), flip);
+    const int bits = _mm_movemask_epi8(_mm_cmplt_epi8(f, g));  // bit i: test t + i
+    desc.bytes[t / 8] = static_cast<std::uint8_t>(bits & 0xff);
+    desc.bytes[t / 8 + 1] = static_cast<std::uint8_t>(bits >> 8);
+  }
+#else
+  for (std::size_t byte = 0; byte < 32; ++byte) {
     int value = 0;
     for (int bit = 0; bit < 8; ++bit) {
-      const int k = 2 * (8 * byte + bit);
-      value |= (sample(k) < sample(k + 1) ? 1 : 0) << bit;
+      value |= (first[8 * byte + bit] < second[8 * byte + bit] ? 1 : 0) << bit;
     }
     desc.bytes[byte] = static_cast<std::uint8_t>(value);
   }
+#endif
   return desc;
 }
 

@@ -3,8 +3,8 @@
 // same smoothed image, position and angle).
 #pragma once
 
+#include <cstdint>
 #include <opencv2/core.hpp>
-#include <span>
 #include <vector>
 
 #include "core/features/descriptor.h"
@@ -15,9 +15,25 @@ namespace pkslam {
 // the orientation moments; symmetric under x <-> y so the disc is the same after rotation.
 std::vector<int> CircularPatchHalfWidths(int half_patch);
 
-// Orientation (degrees, [0, 360), x right / y down) of the intensity centroid of the disc
-// around `center` (which must be >= half_patch pixels from every border of `image`).
-float IntensityCentroidAngle(const cv::Mat& image, cv::Point center, std::span<const int> u_max);
+// Orientation by the intensity centroid of a disc of radius half_patch (ORB's u_max disc).
+class OrientationDisc {
+ public:
+  explicit OrientationDisc(int half_patch = 15);
+
+  // Angle (degrees, [0, 360), x right / y down) from `center` to the intensity centroid of
+  // the disc around it; `center` must be >= half_patch pixels from every border of `image`.
+  float Angle(const cv::Mat& image, cv::Point center) const;
+
+ private:
+  static constexpr int kChunk = 16;  // pixels per SIMD step
+  int half_;
+  std::vector<int> u_max_;
+  // Row chunks [start, start + 16) relative to the centre, and per (row v, chunk, lane) the
+  // weights u and v (0 outside the disc and where an earlier chunk already counted).
+  std::vector<int> chunk_start_;
+  std::vector<std::int16_t> u_weight_;
+  std::vector<std::int16_t> v_weight_;
+};
 
 // The smoothing ORB applies before the binary tests: Gaussian 7x7, sigma 2, reflect-101 border.
 void SmoothForDescriptor(const cv::Mat& image, cv::Mat* smoothed);

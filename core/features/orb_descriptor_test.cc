@@ -30,6 +30,27 @@ TEST(CircularPatch, HalfWidthsOfRadius15AreTheDiscAndSymmetric) {
   }
 }
 
+TEST(OrientationDisc, EqualsTheMomentDefinition) {
+  const cv::Mat image = SyntheticTexture(cv::Size(120, 90), 8);
+  const std::vector<int> u_max = CircularPatchHalfWidths(15);
+  const OrientationDisc disc(15);
+  for (int y = 15; y < 75; y += 7) {
+    for (int x = 15; x < 105; x += 9) {
+      double m10 = 0.0;
+      double m01 = 0.0;
+      for (int v = -15; v <= 15; ++v) {
+        for (int u = -u_max[std::abs(v)]; u <= u_max[std::abs(v)]; ++u) {
+          m10 += u * image.at<std::uint8_t>(y + v, x + u);
+          m01 += v * image.at<std::uint8_t>(y + v, x + u);
+        }
+      }
+      double expected = std::atan2(m01, m10) * 180.0 / std::numbers::pi;
+      if (expected < 0.0) expected += 360.0;
+      EXPECT_NEAR(std::remainder(disc.Angle(image, {x, y}) - expected, 360.0), 0.0, 1e-3);
+    }
+  }
+}
+
 TEST(SmoothForDescriptor, BitExactWithOpenCvGaussian7x7Sigma2) {
   cv::RNG rng(3);
   for (const cv::Size size : {cv::Size(4, 4), cv::Size(5, 9), cv::Size(37, 41), cv::Size(3, 8),
@@ -52,8 +73,8 @@ TEST(SmoothForDescriptor, BitExactWithOpenCvGaussian7x7Sigma2) {
   EXPECT_EQ(cv::countNonZero(smoothed != expected), 0);
 }
 
-TEST(IntensityCentroidAngle, PointsUpTheIntensityRamp) {
-  const std::vector<int> u_max = CircularPatchHalfWidths(15);
+TEST(OrientationDisc, PointsUpTheIntensityRamp) {
+  const OrientationDisc disc(15);
   for (int deg = 0; deg < 360; deg += 15) {
     const double a = deg * std::numbers::pi / 180.0;
     cv::Mat image(41, 41, CV_8UC1);
@@ -63,7 +84,7 @@ TEST(IntensityCentroidAngle, PointsUpTheIntensityRamp) {
             128.0 + 4.0 * ((x - 20) * std::cos(a) + (y - 20) * std::sin(a)));
       }
     }
-    const float angle = IntensityCentroidAngle(image, {20, 20}, u_max);
+    const float angle = disc.Angle(image, {20, 20});
     EXPECT_GE(angle, 0.0f);
     EXPECT_LT(angle, 360.0f);
     const double diff = std::remainder(angle - deg, 360.0);
@@ -147,14 +168,14 @@ TEST(RbriefPattern, SteeredDescriptorFollowsA90DegreeRotation) {
   cv::Mat s0, s1;
   SmoothForDescriptor(image, &s0);
   SmoothForDescriptor(rotated, &s1);
-  const std::vector<int> u_max = CircularPatchHalfWidths(15);
+  const OrientationDisc disc(15);
   const RbriefPattern pattern(31);
   for (int y = 30; y < 130; y += 17) {
     for (int x = 30; x < 170; x += 23) {
       const cv::Point p(x, y);
       const cv::Point q(image.rows - 1 - y, x);
-      const float a0 = IntensityCentroidAngle(image, p, u_max);
-      const float a1 = IntensityCentroidAngle(rotated, q, u_max);
+      const float a0 = disc.Angle(image, p);
+      const float a1 = disc.Angle(rotated, q);
       EXPECT_NEAR(std::remainder(a1 - a0 - 90.0, 360.0), 0.0, 1e-3);
       EXPECT_EQ(pattern.Compute(s0, p, 0.0f), pattern.Compute(s1, q, 90.0f));
     }

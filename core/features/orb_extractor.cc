@@ -1,12 +1,12 @@
 #include "core/features/orb_extractor.h"
 
-#include <tbb/task_group.h>
-
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <exception>
 #include <opencv2/features2d.hpp>
+#include <thread>
 
 #include "core/features/quadtree_distribution.h"
 #include "core/util/error.h"
@@ -73,7 +73,7 @@ void OrbOptions::Check() const {
 }
 
 OrbExtractor::OrbExtractor(const OrbOptions& options)
-    : options_(options), pattern_(options.patch_size) {
+    : options_(options), orientation_(options.patch_size / 2), pattern_(options.patch_size) {
   options_.Check();
   const int n = options_.n_levels;
   scale_.resize(n);
@@ -98,7 +98,6 @@ OrbExtractor::OrbExtractor(const OrbOptions& options)
     wanted *= f;
   }
   quota_[n - 1] = std::max(options_.n_features - assigned, 0);
-  u_max_ = CircularPatchHalfWidths(options_.patch_size / 2);
 }
 
 std::vector<cv::KeyPoint> OrbExtractor::DetectCandidates(const cv::Mat& level_image, int level,
@@ -179,7 +178,7 @@ void OrbExtractor::ExtractLevel(int level, const ImagePyramid& pyramid, const cv
     const cv::KeyPoint& candidate = candidates[index];
     const cv::Point p(static_cast<int>(candidate.pt.x) + border,
                       static_cast<int>(candidate.pt.y) + border);
-    const float angle = IntensityCentroidAngle(image, p, u_max_);
+    const float angle = orientation_.Angle(image, p);
     out->descriptors.push_back(pattern_.Compute(*smoothed, p, angle));
     out->keypoints.emplace_back(BasePoint(pyramid, level, p.x, p.y), size, angle,
                                 candidate.response, level);
@@ -187,36 +186,68 @@ void OrbExtractor::ExtractLevel(int level, const ImagePyramid& pyramid, const cv
 }
 
 void OrbExtractor::Extract(const cv::Mat& image, OrbFeatures* features, const cv::Mat& mask) const {
+  ExtractImpl(image, mask, options_.parallel, features);
+}
+
+void OrbExtractor::ExtractImpl(const cv::Mat& image, const cv::Mat& mask, bool with_helper,
+                               OrbFeatures* features) const {
   PKSLAM_CHECK(!image.empty() && image.type() == CV_8UC1,
                "ORB extraction needs a non-empty CV_8UC1 image (type {}, {}x{})", image.type(),
                image.cols, image.rows);
   PKSLAM_CHECK(mask.empty() || (mask.type() == CV_8UC1 && mask.size() == image.size()),
                "ORB mask must be CV_8UC1 of the image size");
+  internal::CheckPyramidInput(image, options_.scale_factor, options_.n_levels);
   const int n = options_.n_levels;
   std::vector<LevelResult> results(n);
   ImagePyramid& pyramid = features->pyramid;
   std::vector<cv::Mat>& smoothed = features->smoothed;
   smoothed.resize(n);
-  if (options_.parallel) {
-    // Each level starts as soon as it is resized; the calling thread builds the rest of the
-    // pyramid meanwhile and then helps with the remaining levels in wait().
-    tbb::task_group group;
+  auto extract_level = [&](int level) {
+    ExtractLevel(level, pyramid, mask, &smoothed[level], &results[level]);
+  };
+
+  if (!with_helper) {
+    BuildImagePyramid(image, options_.scale_factor, n, &pyramid);
+    for (int level = 0; level < n; ++level) extract_level(level);
+  } else {
+    // One helper thread and the caller take levels in order (largest first) from a shared
+    // counter; a level is processed once the caller has resized it. `ready` (levels built,
+    // or n + 1 after a failure) publishes the pyramid with release/acquire ordering.
+    std::atomic<int> next{0};
+    std::atomic<int> ready{0};
+    auto take_levels = [&]() -> std::exception_ptr {
+      try {
+        for (int level = next.fetch_add(1); level < n; level = next.fetch_add(1)) {
+          int built = ready.load(std::memory_order_acquire);
+          while (built <= level) {
+            ready.wait(built, std::memory_order_acquire);
+            built = ready.load(std::memory_order_acquire);
+          }
+          if (built > n) return nullptr;  // the caller failed and will report it
+          extract_level(level);
+        }
+      } catch (...) {
+        return std::current_exception();
+      }
+      return nullptr;
+    };
+    std::exception_ptr helper_error;
+    std::thread helper([&] { helper_error = take_levels(); });
+    std::exception_ptr caller_error;
     try {
       BuildImagePyramid(image, options_.scale_factor, n, &pyramid, [&](int level) {
-        group.run([this, level, &pyramid, &mask, &smoothed, &results] {
-          ExtractLevel(level, pyramid, mask, &smoothed[level], &results[level]);
-        });
+        ready.store(level + 1, std::memory_order_release);
+        ready.notify_all();
       });
     } catch (...) {
-      group.wait();
-      throw;
+      caller_error = std::current_exception();
+      ready.store(n + 1, std::memory_order_release);
+      ready.notify_all();
     }
-    group.wait();
-  } else {
-    BuildImagePyramid(image, options_.scale_factor, n, &pyramid);
-    for (int level = 0; level < n; ++level) {
-      ExtractLevel(level, pyramid, mask, &smoothed[level], &results[level]);
-    }
+    if (!caller_error) caller_error = take_levels();
+    helper.join();
+    if (caller_error) std::rethrow_exception(caller_error);
+    if (helper_error) std::rethrow_exception(helper_error);
   }
 
   std::size_t total = 0;
@@ -245,16 +276,24 @@ void OrbExtractor::ExtractStereo(const cv::Mat& left, const cv::Mat& right,
     Extract(right, right_features);
     return;
   }
-  tbb::task_group group;
-  group.run([&] { Extract(right, right_features); });
+  // One thread per image, each doing its levels in turn: two busy threads, as many as cores.
+  std::exception_ptr right_error;
+  std::thread right_thread([&] {
+    try {
+      ExtractImpl(right, cv::Mat(), /*with_helper=*/false, right_features);
+    } catch (...) {
+      right_error = std::current_exception();
+    }
+  });
   std::exception_ptr left_error;
   try {
-    Extract(left, left_features);
+    ExtractImpl(left, cv::Mat(), /*with_helper=*/false, left_features);
   } catch (...) {
     left_error = std::current_exception();
   }
-  group.wait();  // rethrows the right image's error, if any
+  right_thread.join();
   if (left_error) std::rethrow_exception(left_error);
+  if (right_error) std::rethrow_exception(right_error);
 }
 
 }  // namespace pkslam

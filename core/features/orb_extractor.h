@@ -29,7 +29,8 @@ struct OrbOptions {
   int patch_size = 31;
   // Nominal side of the FAST cells in pixels (cells are stretched to tile each level).
   int cell_size = 35;
-  // Process pyramid levels as concurrent tasks (TBB); the output does not depend on it.
+  // Share the levels between the caller and one helper thread (ExtractStereo: one thread per
+  // image); the output does not depend on it.
   bool parallel = true;
 
   void Check() const;
@@ -48,7 +49,9 @@ struct OrbFeatures {
 };
 
 // Immutable after construction; Extract* are const and keep no state between calls, so one
-// extractor may be used from several threads at once (each call with its own output).
+// extractor may be used from several threads at once (each call with its own output). With
+// options.parallel a call starts one short-lived helper thread (two for ExtractStereo's pair)
+// and joins it before returning; the output is written only by the call's threads.
 class OrbExtractor {
  public:
   explicit OrbExtractor(const OrbOptions& options = {});
@@ -79,6 +82,8 @@ class OrbExtractor {
     std::vector<Descriptor> descriptors;
   };
 
+  void ExtractImpl(const cv::Mat& image, const cv::Mat& mask, bool with_helper,
+                   OrbFeatures* features) const;
   void ExtractLevel(int level, const ImagePyramid& pyramid, const cv::Mat& mask, cv::Mat* smoothed,
                     LevelResult* out) const;
   std::vector<cv::KeyPoint> DetectCandidates(const cv::Mat& level_image, int level,
@@ -88,7 +93,7 @@ class OrbExtractor {
   OrbOptions options_;
   std::vector<float> scale_, inv_scale_, sigma2_, inv_sigma2_;
   std::vector<int> quota_;
-  std::vector<int> u_max_;
+  OrientationDisc orientation_;
   RbriefPattern pattern_;
 };
 
