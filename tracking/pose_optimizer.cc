@@ -146,7 +146,8 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
     }
   }
 
-  if (frame->outliers.size() != static_cast<std::size_t>(n)) frame->outliers.assign(n, 0);
+  // Every slot is rewritten: no stale flag survives on a slot matched later.
+  frame->outliers.assign(static_cast<std::size_t>(n), 0);
   int num_outliers = 0;
   for (const Correspondence& c : corrs) {
     const bool outlier = c.block == nullptr;
