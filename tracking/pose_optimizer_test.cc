@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/map/map_point.h"
@@ -184,6 +186,11 @@ TEST(PoseOptimizer, SingleThreadedIsBitIdentical) {
   const Eigen::Matrix4d ma = a.camera_from_world().Matrix();
   const Eigen::Matrix4d mb = b.camera_from_world().Matrix();
   EXPECT_EQ(std::memcmp(ma.data(), mb.data(), sizeof(double) * 16), 0);
+  // Across processes: compare this between two runs with --gtest_output=xml.
+  std::uint64_t hash = 1469598103934665603ull;  // FNV-1a
+  const auto* bytes = reinterpret_cast<const unsigned char*>(ma.data());
+  for (std::size_t i = 0; i < sizeof(double) * 16; ++i) hash = (hash ^ bytes[i]) * 1099511628211ull;
+  RecordProperty("pose_fnv1a", std::to_string(hash));
 }
 
 TEST(PoseOptimizer, RejectsBadOptionsAndMissingPose) {

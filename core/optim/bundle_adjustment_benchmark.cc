@@ -6,6 +6,7 @@
 // pts = map points, obs = observations, it = solver iterations of both passes.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <atomic>
 #include <memory>
 #include <mutex>
@@ -30,8 +31,13 @@ struct LocalMap {
 std::unique_ptr<LocalMap> BuildMap(int keyframes, int points, bool stereo) {
   auto m = std::make_unique<LocalMap>();
   auto rig = testing::MakeStereoRig(stereo ? Sensor::kStereo : Sensor::kMonocular);
-  // A wide scene so that each point is seen by about half of the keyframes.
-  const auto scene = testing::MakeScene(points, 31, 6.0, 3.0, 3.0, 9.0);
+  // A wide scene so that each point is seen by about half of the keyframes (for up to 20
+  // keyframes); longer paths get a scene stretched along them.
+  const double half_path = 0.5 * 0.45 * keyframes;
+  auto scene = testing::MakeScene(points, 31, std::max(6.0, half_path + 3.0), 3.0, 3.0, 9.0);
+  if (keyframes > 20) {
+    for (auto& p : scene.points_world) p.x() += half_path;
+  }
   const auto poses = testing::MakeForwardPath(keyframes, 0.45, 32);
   testing::FrameOptions o;
   o.stereo = stereo;
@@ -92,8 +98,33 @@ BENCHMARK(BM_SolveLocalBundle)
     ->Args({10, 2000, 1, 1})
     ->Args({20, 6500, 1, 0})
     ->Args({20, 6500, 1, 1})
-    ->Args({40, 8000, 1, 0})
-    ->Args({40, 8000, 1, 1})
+    ->Unit(benchmark::kMillisecond);
+
+// Global BA (every keyframe free but the origin), where the reduced camera system grows.
+// Args: keyframes, scene points, solver (0 = SPARSE_SCHUR, 1 = DENSE_SCHUR).
+void BM_SolveGlobalBundle(benchmark::State& state) {
+  const auto m = BuildMap(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), true);
+  BundleProblem problem;
+  {
+    std::shared_lock lock(m->atlas.mutex());
+    problem = Perturbed(CollectGlobalBundle(*m->atlas.current_map()));
+  }
+  internal::BundleSolverOverrides overrides;
+  overrides.linear_solver = state.range(2) == 0 ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
+  int iterations = 0;
+  for (auto _ : state) {
+    const BundleResult r = internal::SolveBundle(problem, {}, nullptr, overrides);
+    iterations = r.iterations;
+    benchmark::DoNotOptimize(r.final_cost);
+  }
+  SetCounters(state, problem, iterations);
+}
+BENCHMARK(BM_SolveGlobalBundle)
+    ->ArgNames({"kf", "scene", "dense"})
+    ->Args({40, 8000, 0})
+    ->Args({40, 8000, 1})
+    ->Args({80, 12000, 0})
+    ->Args({80, 12000, 1})
     ->Unit(benchmark::kMillisecond);
 
 void BM_CollectLocalBundle(benchmark::State& state) {

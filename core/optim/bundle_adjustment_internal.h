@@ -6,14 +6,16 @@
 #include <ceres/types.h>
 
 #include <atomic>
+#include <optional>
 
 #include "core/optim/bundle_adjustment.h"
 
 namespace pkslam::internal {
 
 struct BundleSolverOverrides {
-  // The linear solver of both passes (SPARSE_SCHUR or DENSE_SCHUR; see bundle_adjustment.cc).
-  ceres::LinearSolverType linear_solver = ceres::SPARSE_SCHUR;
+  // The linear solver of both passes (SPARSE_SCHUR or DENSE_SCHUR); unset: chosen by the
+  // number of free keyframes (see bundle_solve.cc).
+  std::optional<ceres::LinearSolverType> linear_solver;
   // Called after every solver iteration, before the abort flag is polled (may be null).
   ceres::IterationCallback* callback = nullptr;
 };

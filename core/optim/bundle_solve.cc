@@ -38,6 +38,12 @@ class AbortCallback final : public ceres::IterationCallback {
   bool fired_ = false;
 };
 
+// Reduced camera systems up to this many free poses are solved densely. Measured with
+// bundle_adjustment_benchmark.cc: DENSE_SCHUR executes 2-3% fewer instructions (callgrind)
+// than SPARSE_SCHUR at 10-20 free keyframes; CPU time is about equal at 40 and DENSE_SCHUR is
+// ~14% slower at 80 (global BA).
+constexpr int kMaxFreePosesForDenseSchur = 40;
+
 // The solver's working copy of the problem state.
 struct State {
   std::vector<double> poses;   // 7 per keyframe
@@ -148,7 +154,12 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
   }
 
   ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = overrides.linear_solver;
+  int free_poses = 0;
+  for (int i = 0; i < num_keyframes; ++i) {
+    free_poses += pose_added[i] && !problem.keyframes[i].fixed ? 1 : 0;
+  }
+  solver_options.linear_solver_type = overrides.linear_solver.value_or(
+      free_poses <= kMaxFreePosesForDenseSchur ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR);
   solver_options.num_threads = options.num_threads;
   solver_options.logging_type = ceres::SILENT;
   // Schur complement: eliminate the points (group 0), then solve for the poses.
