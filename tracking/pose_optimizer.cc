@@ -75,8 +75,9 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
 
   // One problem for all rounds: outliers are removed from / re-inliers re-added to it, and the
   // Huber losses sit in wrappers that are switched to plain least squares after robust_rounds.
-  const double delta_mono = std::sqrt(options.chi2_mono);
-  const double delta_stereo = std::sqrt(options.chi2_stereo);
+  // Declared before the wrappers and the problem that point at them (destroyed after them).
+  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
+  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
   ceres::LossFunctionWrapper loss_mono(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
   ceres::LossFunctionWrapper loss_stereo(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
   SE3LeftManifold manifold;
@@ -120,8 +121,6 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
   solver_options.num_threads = options.num_threads;
   solver_options.logging_type = ceres::SILENT;
 
-  ceres::HuberLoss huber_mono(delta_mono);
-  ceres::HuberLoss huber_stereo(delta_stereo);
   SE3d camera_from_world = frame->camera_from_world();
   for (int round = 0; round < options.rounds; ++round) {
     if (num_active == 0) break;
