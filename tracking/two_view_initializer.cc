@@ -281,11 +281,17 @@ std::optional<TwoViewResult> ReconstructTwoView(const Frame& first, const Frame&
     const two_view::MotionRefinement refined =
         two_view::RefineMotion(first_pass.motion, normalized,
                                two_view::SampsonInliers(first_pass.motion, normalized, gate));
-    report->sampson_rms_before = first_pass.initial_rms;
-    report->sampson_rms_after = refined.final_rms;
-    best = refined.motion;
-    check = two_view::CheckMotion(best, pixels, normalized, model.inliers, camera1, camera2,
-                                  kReprojectionGateSigmas2 * options.sigma * options.sigma);
+    MotionCheck refined_check =
+        two_view::CheckMotion(refined.motion, pixels, normalized, model.inliers, camera1, camera2,
+                              kReprojectionGateSigmas2 * options.sigma * options.sigma);
+    // Guard against a refinement that went astray (not seen in the sweeps): it must keep
+    // the accepted hypothesis' support.
+    if (refined_check.num_good >= kMinGoodShareOfInliers * check.num_good) {
+      report->sampson_rms_before = first_pass.initial_rms;
+      report->sampson_rms_after = refined.final_rms;
+      best = refined.motion;
+      check = std::move(refined_check);
+    }
   }
   TwoViewResult result;
   result.camera2_from_camera1 = SE3d(best.rotation, best.translation);

@@ -99,7 +99,8 @@ struct TwoViewReport {
   std::vector<int> hypothesis_good;         // good points per motion hypothesis
   std::vector<double> hypothesis_parallax;  // parallax (deg) per motion hypothesis
   int best_hypothesis = -1;
-  // Sampson error (normalised image units) of the accepted motion before / after refinement.
+  // RMS Sampson error (normalised image units) of the accepted motion before refinement (on
+  // its triangulated points) and after (on the 99%-gate matches); 0 when not refined.
   double sampson_rms_before = 0, sampson_rms_after = 0;
   TwoViewRejection rejection = TwoViewRejection::kNone;
 };
