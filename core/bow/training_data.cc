@@ -1,7 +1,5 @@
 #include "core/bow/training_data.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cstring>
@@ -12,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "core/bow/parallel.h"
 #include "core/util/error.h"
 #include "core/util/progress.h"
 
@@ -75,7 +74,7 @@ std::vector<std::filesystem::path> ListTrainingImages(
 
 std::vector<std::vector<Descriptor>> ExtractTrainingSet(
     const std::vector<std::filesystem::path>& images, const TrainingFeatureOptions& options,
-    bool quiet) {
+    bool quiet, int threads) {
   options.Check();
   std::vector<std::vector<Descriptor>> out(images.size());
   // One slot per image, so the error reported (the first bad image in list order) does not
@@ -83,17 +82,18 @@ std::vector<std::vector<Descriptor>> ExtractTrainingSet(
   std::vector<std::exception_ptr> errors(images.size());
   std::mutex progress_mutex;  // Progress is single-threaded: serialise its updates
   Progress progress("vocab features", images.size(), quiet);
-  tbb::parallel_for(std::size_t{0}, images.size(), [&](std::size_t i) {
-    try {
-      const cv::Mat gray = cv::imread(images[i].string(), cv::IMREAD_GRAYSCALE);
-      if (gray.empty()) throw InputError(images[i], "cannot read image");
-      out[i] = ExtractTrainingDescriptors(gray, options);
-    } catch (...) {
-      errors[i] = std::current_exception();
-    }
-    std::lock_guard lock(progress_mutex);
-    progress.Add();
-  });
+  bow_internal::ParallelFor(
+      images.size(), bow_internal::ResolveThreadCount(threads), [&](std::size_t i) {
+        try {
+          const cv::Mat gray = cv::imread(images[i].string(), cv::IMREAD_GRAYSCALE);
+          if (gray.empty()) throw InputError(images[i], "cannot read image");
+          out[i] = ExtractTrainingDescriptors(gray, options);
+        } catch (...) {
+          errors[i] = std::current_exception();
+        }
+        std::lock_guard lock(progress_mutex);
+        progress.Add();
+      });
   progress.Finish();
   for (const auto& error : errors) {
     if (error) std::rethrow_exception(error);

@@ -82,6 +82,8 @@ struct VocabularyTrainOptions {
   std::uint64_t seed = 1;
   // Nodes with more descriptors than this split their assignment step across threads.
   std::size_t parallel_assign_min = 50000;
+  // Worker threads (0 = one per hardware thread). The result does not depend on it.
+  int threads = 0;
   // No progress bar.
   bool quiet = false;
 
