@@ -148,6 +148,7 @@ Vocabulary Vocabulary::LoadBinary(const std::filesystem::path& file) {
 }
 
 void Vocabulary::SaveBinary(const std::filesystem::path& file) const {
+  PKSLAM_CHECK(!empty(), "cannot save an empty vocabulary to {}", file.string());
   std::string out;
   const std::size_t count = node_count() - (node_count() > 0 ? 1 : 0);
   out.reserve(kHeaderSize + count * kRecordSize + kChecksumSize);

@@ -176,6 +176,7 @@ Vocabulary Vocabulary::LoadText(const std::filesystem::path& file) {
 }
 
 void Vocabulary::SaveText(const std::filesystem::path& file) const {
+  PKSLAM_CHECK(!empty(), "cannot save an empty vocabulary to {}", file.string());
   std::string out;
   out.reserve(node_count() * 120 + 32);
   out += fmt::format("{} {}  {} {}\n", params_.branching, params_.levels,
