@@ -61,9 +61,9 @@ BENCHMARK(BM_VocabularyTransform1200_K10L6)->Unit(benchmark::kMicrosecond);
 
 // The vocabulary shipped in Vocabulary/ (trained), when present.
 void BM_VocabularyTransform1200_Shipped(benchmark::State& state) {
-  const fs::path file = fs::path(PKSLAM_SOURCE_DIR) / "Vocabulary/pkslam_k10_l6.pkvoc";
+  const fs::path file = fs::path(PKSLAM_SOURCE_DIR) / "Vocabulary/pkslam_orb_k10_L6.bin";
   if (!fs::exists(file)) {
-    state.SkipWithError("Vocabulary/pkslam_k10_l6.pkvoc not found");
+    state.SkipWithError("Vocabulary/pkslam_orb_k10_L6.bin not found");
     return;
   }
   RunTransform(state, Vocabulary::Load(file));
