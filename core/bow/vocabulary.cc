@@ -189,6 +189,11 @@ Vocabulary Vocabulary::FromNodes(const VocabularyParams& params,
   if (auto problem = bow_internal::FindTreeProblem(params, nodes)) {
     throw Error(fmt::format("vocabulary node {}: {}", problem->node, problem->message));
   }
+  return FromValidNodes(params, std::move(nodes));
+}
+
+Vocabulary Vocabulary::FromValidNodes(const VocabularyParams& params,
+                                      std::vector<VocabularyNode> nodes) {
   if (!ChildrenContiguous(nodes)) nodes = RenumberBreadthFirst(nodes);
   Vocabulary v;
   v.params_ = params;

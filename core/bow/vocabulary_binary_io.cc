@@ -144,7 +144,7 @@ Vocabulary Vocabulary::LoadBinary(const std::filesystem::path& file) {
     const std::size_t at = problem->node == 0 ? 0 : kHeaderSize + (problem->node - 1) * kRecordSize;
     throw AtOffset(file, at, fmt::format("node {}: {}", problem->node, problem->message));
   }
-  return FromNodes(params, std::move(nodes));
+  return FromValidNodes(params, std::move(nodes));
 }
 
 void Vocabulary::SaveBinary(const std::filesystem::path& file) const {
