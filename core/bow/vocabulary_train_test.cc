@@ -150,6 +150,29 @@ TEST(VocabularyTrain, DeterministicForSeedAndThreadCount) {
   EXPECT_NE(Vocabulary::Train(images, options).Nodes(), a.Nodes());
 }
 
+// Descriptor sets, not hand-made vectors: the same set scores 1; sets drawn from disjoint
+// prototype pools score near 0; two sets from the same pool in between.
+TEST(VocabularyTrain, IdenticalSetsScoreOneDisjointNearZero) {
+  std::mt19937_64 rng(4);
+  std::vector<Descriptor> pool_a, pool_b;
+  for (int i = 0; i < 100; ++i) pool_a.push_back(RandomDescriptor(rng));
+  for (int i = 0; i < 100; ++i) pool_b.push_back(RandomDescriptor(rng));
+  const auto draw = [&](const std::vector<Descriptor>& pool) {
+    std::vector<Descriptor> image;
+    for (int i = 0; i < 300; ++i) image.push_back(FlipBits(pool[rng() % pool.size()], 15, rng));
+    return image;
+  };
+  std::vector<std::vector<Descriptor>> images;
+  for (int i = 0; i < 10; ++i) images.push_back(draw(i % 2 == 0 ? pool_a : pool_b));
+  const Vocabulary v = Vocabulary::Train(images, Quiet(10, 3));
+  const BowVector a1 = v.Transform(draw(pool_a));
+  const BowVector a2 = v.Transform(draw(pool_a));
+  const BowVector b1 = v.Transform(draw(pool_b));
+  EXPECT_NEAR(v.Score(a1, a1), 1.0, 1e-12);
+  EXPECT_LT(v.Score(a1, b1), 0.05);
+  EXPECT_GT(v.Score(a1, a2), 0.2);
+}
+
 TEST(VocabularyTrain, IdenticalDescriptorsGiveOneWord) {
   const Descriptor d = Prototypes()[1];
   const Vocabulary v = Vocabulary::Train({{d, d, d}, {d}}, Quiet(10, 6));
