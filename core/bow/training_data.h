@@ -20,8 +20,8 @@ struct TrainingFeatureOptions {
   void Check() const;
 };
 
-// ORB descriptors of one 8-bit grey image, as the vocabulary will later see them.
-// The single place that chooses the extractor (cv::ORB until pkslam's OrbExtractor is on main).
+// ORB descriptors of one 8-bit grey image, as the vocabulary will later see them: pkslam's
+// OrbExtractor (ORB-SLAM's quadtree-distributed ORB), the extractor tracking uses.
 std::vector<Descriptor> ExtractTrainingDescriptors(const cv::Mat& gray,
                                                    const TrainingFeatureOptions& options);
 

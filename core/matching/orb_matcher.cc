@@ -61,13 +61,15 @@ int OrbMatcher::SearchByProjection(Frame* frame, const std::vector<ProjectedPoin
   // Slots filled by this call: a later point must not steal them (the previous content may
   // be a point without observations, which matching is allowed to overwrite).
   std::vector<std::uint8_t> claimed(slots.size(), 0);
+  std::vector<int> candidates;
+  candidates.reserve(64);
   int matches = 0;
   for (const ProjectedPoint& p : points) {
     if (!p.point || p.point->IsBad()) continue;
     if (far_points_th > 0 && p.depth > far_points_th) continue;
     const int level = std::clamp(p.predicted_level, 0, n_levels - 1);
     const double radius = RadiusByViewingCos(p.view_cos) * th * scale[level];
-    const std::vector<int> candidates = frame->FeaturesInArea(p.u, p.v, radius, level - 1, level);
+    frame->FeaturesInArea(p.u, p.v, radius, level - 1, level, &candidates);
     if (candidates.empty()) continue;
     const Descriptor& descriptor = p.point->descriptor();
     BestTwo best;
@@ -112,6 +114,8 @@ int OrbMatcher::SearchByProjection(Frame* current, const Frame& last_frame, doub
   PKSLAM_CHECK(static_cast<int>(slots.size()) == current->size(),
                "frame {}: {} slots, {} keypoints", current->id(), slots.size(), current->size());
   std::vector<std::uint8_t> claimed(slots.size(), 0);
+  std::vector<int> candidates;
+  candidates.reserve(64);
   RotationHistogram histogram;
   int matches = 0;
   for (std::size_t i = 0; i < last_frame.map_points.size(); ++i) {
@@ -125,13 +129,12 @@ int OrbMatcher::SearchByProjection(Frame* current, const Frame& last_frame, doub
     if (!rig.bounds.Contains(u, v)) continue;
     const int last_octave = last_keypoints[i].octave;
     const double radius = th * scale[last_octave];
-    std::vector<int> candidates;
     if (forward) {
-      candidates = current->FeaturesInArea(u, v, radius, last_octave);
+      current->FeaturesInArea(u, v, radius, last_octave, -1, &candidates);
     } else if (backward) {
-      candidates = current->FeaturesInArea(u, v, radius, 0, last_octave);
+      current->FeaturesInArea(u, v, radius, 0, last_octave, &candidates);
     } else {
-      candidates = current->FeaturesInArea(u, v, radius, last_octave - 1, last_octave + 1);
+      current->FeaturesInArea(u, v, radius, last_octave - 1, last_octave + 1, &candidates);
     }
     if (candidates.empty()) continue;
     const double u_right = u - view.bf / pc.z();
