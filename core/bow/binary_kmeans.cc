@@ -25,9 +25,10 @@ constexpr std::array<std::uint64_t, 256> MakeByteLanes() {
 constexpr std::array<std::uint64_t, 256> kByteLanes = MakeByteLanes();
 
 // Nearest centre of each point in [begin, end); returns how many labels changed.
-PKSLAM_POPCNT_CLONES
-std::size_t AssignRange(const Descriptor* points, std::size_t begin, std::size_t end,
-                        const Descriptor* centres, std::size_t k, std::uint32_t* labels) {
+[[gnu::always_inline]] inline std::size_t AssignRangeBody(const Descriptor* points,
+                                                          std::size_t begin, std::size_t end,
+                                                          const Descriptor* centres, std::size_t k,
+                                                          std::uint32_t* labels) {
   std::size_t changed = 0;
   for (std::size_t i = begin; i < end; ++i) {
     std::uint32_t best = 0;
@@ -47,10 +48,27 @@ std::size_t AssignRange(const Descriptor* points, std::size_t begin, std::size_t
   return changed;
 }
 
+PKSLAM_TARGET_POPCNT std::size_t AssignRangePopcnt(const Descriptor* points, std::size_t begin,
+                                                   std::size_t end, const Descriptor* centres,
+                                                   std::size_t k, std::uint32_t* labels) {
+  return AssignRangeBody(points, begin, end, centres, k, labels);
+}
+std::size_t AssignRangeBaseline(const Descriptor* points, std::size_t begin, std::size_t end,
+                                const Descriptor* centres, std::size_t k, std::uint32_t* labels) {
+  return AssignRangeBody(points, begin, end, centres, k, labels);
+}
+std::size_t AssignRange(const Descriptor* points, std::size_t begin, std::size_t end,
+                        const Descriptor* centres, std::size_t k, std::uint32_t* labels) {
+  return (CpuHasPopcnt() ? AssignRangePopcnt : AssignRangeBaseline)(points, begin, end, centres, k,
+                                                                    labels);
+}
+
 // min_d2[i] = min(min_d2[i], d(points[i], centre)^2) over [begin, end); returns their sum.
-PKSLAM_POPCNT_CLONES
-std::uint64_t UpdateMinDistances(const Descriptor* points, std::size_t begin, std::size_t end,
-                                 const Descriptor& centre, std::uint64_t* min_d2) {
+[[gnu::always_inline]] inline std::uint64_t UpdateMinDistancesBody(const Descriptor* points,
+                                                                   std::size_t begin,
+                                                                   std::size_t end,
+                                                                   const Descriptor& centre,
+                                                                   std::uint64_t* min_d2) {
   std::uint64_t sum = 0;
   for (std::size_t i = begin; i < end; ++i) {
     const auto d = static_cast<std::uint64_t>(HammingDistance(points[i], centre));
@@ -58,6 +76,22 @@ std::uint64_t UpdateMinDistances(const Descriptor* points, std::size_t begin, st
     sum += min_d2[i];
   }
   return sum;
+}
+PKSLAM_TARGET_POPCNT std::uint64_t UpdateMinDistancesPopcnt(const Descriptor* points,
+                                                            std::size_t begin, std::size_t end,
+                                                            const Descriptor& centre,
+                                                            std::uint64_t* min_d2) {
+  return UpdateMinDistancesBody(points, begin, end, centre, min_d2);
+}
+std::uint64_t UpdateMinDistancesBaseline(const Descriptor* points, std::size_t begin,
+                                         std::size_t end, const Descriptor& centre,
+                                         std::uint64_t* min_d2) {
+  return UpdateMinDistancesBody(points, begin, end, centre, min_d2);
+}
+std::uint64_t UpdateMinDistances(const Descriptor* points, std::size_t begin, std::size_t end,
+                                 const Descriptor& centre, std::uint64_t* min_d2) {
+  return (CpuHasPopcnt() ? UpdateMinDistancesPopcnt : UpdateMinDistancesBaseline)(
+      points, begin, end, centre, min_d2);
 }
 
 // Splits [0, n) into contiguous chunks, one task each: serial below options.parallel_min

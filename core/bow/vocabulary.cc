@@ -137,10 +137,10 @@ inline void PrefetchBlock(const Descriptor* p, std::uint32_t count) {
 // contiguous block of 32-byte descriptors; below the top levels every block is a cache miss,
 // so descriptors descend in batches, level by level, with each block prefetched for the whole
 // batch before any of them is scanned (the misses overlap instead of queueing).
-PKSLAM_POPCNT_CLONES
-void Descend(const Descriptor* descriptors, std::size_t count, const Descriptor* node_descriptors,
-             const bow_detail::ChildSpan* children, int di_level, NodeId* leaves,
-             NodeId* di_nodes) {
+[[gnu::always_inline]] inline void DescendBody(const Descriptor* descriptors, std::size_t count,
+                                               const Descriptor* node_descriptors,
+                                               const bow_detail::ChildSpan* children, int di_level,
+                                               NodeId* leaves, NodeId* di_nodes) {
   constexpr std::size_t kBatch = 16;
   NodeId node[kBatch];
   NodeId di_node[kBatch];
@@ -179,6 +179,26 @@ void Descend(const Descriptor* descriptors, std::size_t count, const Descriptor*
       if (di_nodes != nullptr) di_nodes[base + j] = di_node[j];
     }
   }
+}
+
+PKSLAM_TARGET_POPCNT void DescendPopcnt(const Descriptor* descriptors, std::size_t count,
+                                        const Descriptor* node_descriptors,
+                                        const bow_detail::ChildSpan* children, int di_level,
+                                        NodeId* leaves, NodeId* di_nodes) {
+  DescendBody(descriptors, count, node_descriptors, children, di_level, leaves, di_nodes);
+}
+
+void DescendBaseline(const Descriptor* descriptors, std::size_t count,
+                     const Descriptor* node_descriptors, const bow_detail::ChildSpan* children,
+                     int di_level, NodeId* leaves, NodeId* di_nodes) {
+  DescendBody(descriptors, count, node_descriptors, children, di_level, leaves, di_nodes);
+}
+
+void Descend(const Descriptor* descriptors, std::size_t count, const Descriptor* node_descriptors,
+             const bow_detail::ChildSpan* children, int di_level, NodeId* leaves,
+             NodeId* di_nodes) {
+  (bow_internal::CpuHasPopcnt() ? DescendPopcnt : DescendBaseline)(
+      descriptors, count, node_descriptors, children, di_level, leaves, di_nodes);
 }
 
 }  // namespace
