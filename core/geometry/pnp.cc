@@ -5,7 +5,6 @@
 #include <functional>
 #include <limits>
 #include <numeric>
-
 #include <opengv/absolute_pose/CentralAbsoluteAdapter.hpp>
 #include <opengv/absolute_pose/methods.hpp>
 #include <opengv/sac/Ransac.hpp>
@@ -109,21 +108,21 @@ PnpRansac::PnpRansac(std::vector<PnpCorrespondence> correspondences,
       rng_(options.seed) {
   options_.Check();
   const auto n = static_cast<int>(correspondences_.size());
-  required_inliers_ = std::max(
-      options_.min_inliers, static_cast<int>(std::ceil(options_.min_inlier_ratio * n)));
+  required_inliers_ =
+      std::max(options_.min_inliers, static_cast<int>(std::ceil(options_.min_inlier_ratio * n)));
   if (n < required_inliers_) return;  // budget 0: nothing to try
   FillOpenGv(correspondences_, camera_, &opengv_->bearings, &opengv_->points);
   opengv_->adapter = std::make_unique<CentralAbsoluteAdapter>(opengv_->bearings, opengv_->points);
   // randomSeed = false: OpenGV's own generator is never used here (we draw the samples).
-  opengv_->problem = std::make_unique<AbsolutePoseSacProblem>(
-      *opengv_->adapter, AbsolutePoseSacProblem::KNEIP, false);
+  opengv_->problem = std::make_unique<AbsolutePoseSacProblem>(*opengv_->adapter,
+                                                              AbsolutePoseSacProblem::KNEIP, false);
   // Iterations to draw one all-inlier 4-sample with `probability` at the acceptance ratio.
   const double ratio = static_cast<double>(required_inliers_) / n;
   const double p_good = std::pow(ratio, 4);
   const int needed =
       p_good >= 1.0 ? 1
-                    : static_cast<int>(std::ceil(std::log(1.0 - options_.probability) /
-                                                 std::log(1.0 - p_good)));
+                    : static_cast<int>(
+                          std::ceil(std::log(1.0 - options_.probability) / std::log(1.0 - p_good)));
   budget_ = std::max(1, std::min(needed, options_.max_iterations));
 }
 
@@ -138,7 +137,8 @@ std::optional<SE3d> PnpRansac::Refine(const std::vector<bool>& inliers, int coun
                                       std::vector<bool>* refined_inliers) const {
   const std::vector<int> indices = IndicesOf(inliers);
   if (indices.size() < 6) return std::nullopt;  // EPnP needs 6 points
-  opengv::transformation_t world_from_camera = opengv::absolute_pose::epnp(*opengv_->adapter, indices);
+  opengv::transformation_t world_from_camera =
+      opengv::absolute_pose::epnp(*opengv_->adapter, indices);
   if (!IsFinite(world_from_camera)) return std::nullopt;
   opengv_->adapter->setR(world_from_camera.block<3, 3>(0, 0));
   opengv_->adapter->sett(world_from_camera.col(3));
@@ -211,8 +211,8 @@ PnpResult SolvePnpOpenGvRansac(const std::vector<PnpCorrespondence>& corresponde
       std::make_shared<AbsolutePoseSacProblem>(adapter, AbsolutePoseSacProblem::KNEIP, false);
   // Re-seed: the problem samples through rng_gen_, a copy of rng_alg_ bound at construction.
   problem->rng_alg_.seed(static_cast<std::mt19937::result_type>(options.seed));
-  problem->rng_gen_ = std::make_shared<std::function<int()>>(
-      std::bind(*problem->rng_dist_, problem->rng_alg_));
+  problem->rng_gen_ =
+      std::make_shared<std::function<int()>>(std::bind(*problem->rng_dist_, problem->rng_alg_));
   opengv::sac::Ransac<AbsolutePoseSacProblem> ransac;
   ransac.sac_model_ = problem;
   ransac.threshold_ = AngularThreshold(threshold_pixels, 0.5 * (camera.fx + camera.fy));

@@ -12,13 +12,12 @@
 // a missing `break` in OpenGV 1.0, so the minimal solver here is always KNEIP.)
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <random>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/geometry/pinhole_intrinsics.h"
 #include "core/geometry/se3.h"

@@ -1,11 +1,10 @@
 #include "core/geometry/sim3_solver.h"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
-
-#include <Eigen/SVD>
 
 #include "core/map/keyframe.h"
 #include "core/map/map_point.h"
@@ -120,8 +119,8 @@ Sim3Solver::Sim3Solver(std::vector<Sim3Match> matches, const PinholeIntrinsics& 
   if (p_good >= 1.0) {
     needed = 1;
   } else {
-    needed = static_cast<int>(
-        std::ceil(std::log(1.0 - options_.probability) / std::log(1.0 - p_good)));
+    needed =
+        static_cast<int>(std::ceil(std::log(1.0 - options_.probability) / std::log(1.0 - p_good)));
   }
   budget_ = std::max(1, std::min(needed, options_.max_iterations));
 }

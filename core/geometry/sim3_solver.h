@@ -7,12 +7,11 @@
 // samples.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <optional>
 #include <random>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/geometry/pinhole_intrinsics.h"
 #include "core/geometry/sim3.h"

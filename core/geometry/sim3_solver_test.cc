@@ -73,9 +73,9 @@ TEST(Sim3SolverTest, MonocularLoopWithOutliersRecoversScaleAndPose) {
   ASSERT_TRUE(result.found);
   EXPECT_NEAR(result.camera1_from_camera2.scale(), 1.35, 0.02);
   EXPECT_LT(RotationErrorDeg(result.camera1_from_camera2, p.camera1_from_camera2), 0.5);
-  EXPECT_LT((result.camera1_from_camera2.translation() - p.camera1_from_camera2.translation())
-                .norm(),
-            0.05 * p.camera1_from_camera2.translation().norm());
+  EXPECT_LT(
+      (result.camera1_from_camera2.translation() - p.camera1_from_camera2.translation()).norm(),
+      0.05 * p.camera1_from_camera2.translation().norm());
   int true_positive = 0, false_positive = 0, true_inliers = 0;
   for (std::size_t i = 0; i < p.matches.size(); ++i) {
     true_inliers += p.is_inlier[i] ? 1 : 0;

@@ -34,8 +34,7 @@ inline Sim3Problem MakeSim3Problem(const Sim3ProblemOptions& o) {
   const SyntheticScene scene = MakeScene(o.num_points, o.seed);
   const SE3d camera1_from_world;
   const SE3d camera2_from_world =
-      SE3d(SO3d::Exp(Eigen::Vector3d(0.02, -0.08, 0.03)), Eigen::Vector3d(0.6, 0.1, 0.3))
-          .Inverse();
+      SE3d(SO3d::Exp(Eigen::Vector3d(0.02, -0.08, 0.03)), Eigen::Vector3d(0.6, 0.1, 0.3)).Inverse();
   FrameOptions fo;
   fo.pixel_noise = o.pixel_noise;
   fo.stereo = false;
@@ -44,7 +43,8 @@ inline Sim3Problem MakeSim3Problem(const Sim3ProblemOptions& o) {
   const Frame f1 = MakeFrame(scene, rig, camera1_from_world, 0, 0, fo, &scene_of1);
   const Frame f2 = MakeFrame(scene, rig, camera2_from_world, 1, 0, fo, &scene_of2);
   std::unordered_map<int, int> keypoint_of2;
-  for (std::size_t i = 0; i < scene_of2.size(); ++i) keypoint_of2[scene_of2[i]] = static_cast<int>(i);
+  for (std::size_t i = 0; i < scene_of2.size(); ++i)
+    keypoint_of2[scene_of2[i]] = static_cast<int>(i);
 
   std::mt19937_64 rng(o.seed * 31 + 7);
   std::normal_distribution<double> ray(0.0, o.depth_noise);
@@ -52,9 +52,8 @@ inline Sim3Problem MakeSim3Problem(const Sim3ProblemOptions& o) {
   std::uniform_int_distribution<int> any2(0, f2.size() - 1);
   Sim3Problem p;
   p.camera = {rig->fx, rig->fy, rig->cx, rig->cy};
-  p.camera1_from_camera2 =
-      Sim3d(camera1_from_world * camera2_from_world.Inverse()) * Sim3d(o.scale, SO3d(),
-                                                                       Eigen::Vector3d::Zero());
+  p.camera1_from_camera2 = Sim3d(camera1_from_world * camera2_from_world.Inverse()) *
+                           Sim3d(o.scale, SO3d(), Eigen::Vector3d::Zero());
   for (std::size_t i1 = 0; i1 < scene_of1.size(); ++i1) {
     auto it = keypoint_of2.find(scene_of1[i1]);
     if (it == keypoint_of2.end()) continue;
@@ -66,7 +65,8 @@ inline Sim3Problem MakeSim3Problem(const Sim3ProblemOptions& o) {
       } while (i2 == it->second);
     }
     const auto& x1 = scene.points_world[static_cast<std::size_t>(scene_of1[i1])];
-    const auto& x2 = scene.points_world[static_cast<std::size_t>(scene_of2[static_cast<std::size_t>(i2)])];
+    const auto& x2 =
+        scene.points_world[static_cast<std::size_t>(scene_of2[static_cast<std::size_t>(i2)])];
     const auto& kp1 = f1.keypoints_undistorted()[i1];
     const auto& kp2 = f2.keypoints_undistorted()[static_cast<std::size_t>(i2)];
     Sim3Match m;

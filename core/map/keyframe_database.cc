@@ -124,8 +124,8 @@ std::vector<PlaceCandidate> KeyFrameDatabase::ScoreGroups(
   return groups;
 }
 
-std::vector<PlaceCandidate> KeyFrameDatabase::DetectRelocalisationCandidates(
-    const Frame& frame, const Map* map) const {
+std::vector<PlaceCandidate> KeyFrameDatabase::DetectRelocalisationCandidates(const Frame& frame,
+                                                                             const Map* map) const {
   PKSLAM_CHECK(frame.HasBoW(), "frame {} has no BoW vector", frame.id());
   const auto counts = CountCommonWords(
       frame.bow(), [map](const KeyFrame* kf) { return map == nullptr || kf->map() == map; });

@@ -7,6 +7,7 @@
 
 #include "core/bow/bow_test_utils.h"
 #include "core/map/keyframe.h"
+#include "core/map/keyframe_database_test_utils.h"
 #include "core/map/map_point.h"
 #include "core/testing/synthetic_map.h"
 #include "core/util/error.h"
@@ -14,61 +15,11 @@
 namespace pkslam {
 namespace {
 
+using testing::AddKeyFrames;
 using testing::MakeFrame;
 using testing::MakeScene;
 using testing::MakeStereoRig;
-
-// Keyframes (with BoW) at `poses` in `map`, with map points for the scene points that at least
-// two of them see. Points are shared only among the keyframes of one call, so two calls over
-// the same place make two unconnected keyframe groups (a revisit before loop closure).
-std::vector<KeyFramePtr> AddKeyFrames(Atlas* atlas, Map* map, const testing::SyntheticScene& scene,
-                                      const std::shared_ptr<const CameraRig>& rig,
-                                      const std::vector<SE3d>& poses, const Vocabulary& vocabulary,
-                                      std::uint64_t seed) {
-  std::unique_lock lock(atlas->mutex());
-  std::vector<KeyFramePtr> kfs;
-  std::vector<std::vector<int>> keypoint_points;
-  std::vector<int> seen(scene.points_world.size(), 0);
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    testing::FrameOptions options;
-    options.descriptor_bit_flips = 2;
-    options.seed = seed + k;
-    std::vector<int> kp_points;
-    Frame f = MakeFrame(scene, rig, poses[k], atlas->NextFrameId(), 0, options, &kp_points);
-    f.ComputeBoW(vocabulary);
-    f.SetPose(poses[k]);
-    auto kf = std::make_shared<KeyFrame>(atlas->NextKeyFrameId(), f, map);
-    map->AddKeyFrame(kf);
-    kfs.push_back(kf);
-    for (int p : kp_points) ++seen[p];
-    keypoint_points.push_back(std::move(kp_points));
-  }
-  std::vector<MapPointPtr> points(scene.points_world.size());
-  for (std::size_t k = 0; k < kfs.size(); ++k) {
-    for (std::size_t i = 0; i < keypoint_points[k].size(); ++i) {
-      const int p = keypoint_points[k][i];
-      if (seen[p] < 2) continue;
-      if (!points[p]) {
-        points[p] = std::make_shared<MapPoint>(atlas->NextMapPointId(), scene.points_world[p],
-                                               kfs[k].get(), map);
-        map->AddMapPoint(points[p]);
-      }
-      points[p]->AddObservation(kfs[k].get(), static_cast<int>(i));
-      kfs[k]->AddMapPoint(points[p], static_cast<int>(i));
-    }
-  }
-  for (const auto& kf : kfs) kf->UpdateConnections();
-  return kfs;
-}
-
-// Camera poses along +x (looking along +z) from x0 in steps of `step`.
-std::vector<SE3d> Strip(double x0, double step, int n, double y = 0) {
-  std::vector<SE3d> out;
-  for (int i = 0; i < n; ++i) {
-    out.push_back(SE3d(SO3d(), Eigen::Vector3d(x0 + step * i, y, 0)).Inverse());
-  }
-  return out;
-}
+using testing::Strip;
 
 class KeyFrameDatabaseTest : public ::testing::Test {
  protected:
@@ -110,8 +61,8 @@ TEST_F(KeyFrameDatabaseTest, RelocalisationFindsTheKeyFramesOfThePlace) {
   for (const auto& kf : kfs) db.Add(kf.get());
   ASSERT_EQ(db.size(), 20u);
 
-  const Frame query = QueryFrame(SE3d(SO3d(), Eigen::Vector3d(-24.0 + 1.2 * 12 + 0.1, 0.05, 0))
-                                     .Inverse());
+  const Frame query =
+      QueryFrame(SE3d(SO3d(), Eigen::Vector3d(-24.0 + 1.2 * 12 + 0.1, 0.05, 0)).Inverse());
   const auto candidates = db.DetectRelocalisationCandidates(query, map_a_);
   ASSERT_FALSE(candidates.empty());
   EXPECT_EQ(candidates.front().keyframe, kfs[12].get());
@@ -132,12 +83,12 @@ TEST_F(KeyFrameDatabaseTest, RelocalisationFindsTheKeyFramesOfThePlace) {
 TEST_F(KeyFrameDatabaseTest, LoopAndMergeCandidatesExcludeConnectedKeyFrames) {
   // Map A: a first pass along the wall and a later revisit of its middle (its own points, so
   // not connected to the first pass). Map B: another session over the same middle part.
-  const auto first = AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 20),
-                                  vocabulary_, 1);
-  const auto revisit = AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-10.0, 1.2, 6, 0.1),
-                                    vocabulary_, 100);
-  const auto other = AddKeyFrames(&atlas_, map_b_, scene_, rig_, Strip(-10.5, 1.2, 6, -0.1),
-                                  vocabulary_, 200);
+  const auto first =
+      AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 20), vocabulary_, 1);
+  const auto revisit =
+      AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-10.0, 1.2, 6, 0.1), vocabulary_, 100);
+  const auto other =
+      AddKeyFrames(&atlas_, map_b_, scene_, rig_, Strip(-10.5, 1.2, 6, -0.1), vocabulary_, 200);
   KeyFrameDatabase db(vocabulary_);
   std::shared_lock lock(atlas_.mutex());
   for (const auto* list : {&first, &revisit, &other}) {
@@ -159,8 +110,8 @@ TEST_F(KeyFrameDatabaseTest, LoopAndMergeCandidatesExcludeConnectedKeyFrames) {
     EXPECT_GE(index, 12);
     EXPECT_LE(index, 17);
   }
-  EXPECT_NEAR(static_cast<double>(result.loop.front().keyframe->id() - first.front()->id()),
-              14.7, 1.0);
+  EXPECT_NEAR(static_cast<double>(result.loop.front().keyframe->id() - first.front()->id()), 14.7,
+              1.0);
   for (const auto& c : result.merge) EXPECT_EQ(c.keyframe->map(), map_b_);
   // Every revisit keyframe is connected to the query: none of them is a candidate.
   for (const auto& kf : revisit) {
@@ -203,8 +154,8 @@ TEST_F(KeyFrameDatabaseTest, EraseWorksAfterRetirementAndClearIsPerMap) {
 }
 
 TEST_F(KeyFrameDatabaseTest, ResultsDoNotDependOnInsertionOrder) {
-  const auto kfs = AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 20), vocabulary_,
-                                1);
+  const auto kfs =
+      AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 20), vocabulary_, 1);
   KeyFrameDatabase forward(vocabulary_);
   KeyFrameDatabase backward(vocabulary_);
   std::shared_lock lock(atlas_.mutex());
@@ -220,17 +171,20 @@ TEST_F(KeyFrameDatabaseTest, ResultsDoNotDependOnInsertionOrder) {
       EXPECT_EQ(f[i].keyframe, b[i].keyframe);
       EXPECT_EQ(f[i].group_score, b[i].group_score);
     }
-    const auto lf = forward.DetectLoopAndMergeCandidates(kfs[static_cast<std::size_t>(place)].get());
-    const auto lb = backward.DetectLoopAndMergeCandidates(kfs[static_cast<std::size_t>(place)].get());
+    const auto lf =
+        forward.DetectLoopAndMergeCandidates(kfs[static_cast<std::size_t>(place)].get());
+    const auto lb =
+        backward.DetectLoopAndMergeCandidates(kfs[static_cast<std::size_t>(place)].get());
     ASSERT_EQ(lf.loop.size(), lb.loop.size());
-    for (std::size_t i = 0; i < lf.loop.size(); ++i) EXPECT_EQ(lf.loop[i].keyframe, lb.loop[i].keyframe);
+    for (std::size_t i = 0; i < lf.loop.size(); ++i)
+      EXPECT_EQ(lf.loop[i].keyframe, lb.loop[i].keyframe);
   }
 }
 
 TEST_F(KeyFrameDatabaseTest, RejectsWordsOutsideTheVocabularyAndBadOptions) {
   Vocabulary small = testing::MakeRandomVocabulary(2, 2, 3);  // 4 words
-  const auto kfs = AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 2), vocabulary_,
-                                1);
+  const auto kfs =
+      AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 2), vocabulary_, 1);
   KeyFrameDatabase db(small);
   std::unique_lock lock(atlas_.mutex());
   EXPECT_THROW(db.Add(kfs[0].get()), Error);

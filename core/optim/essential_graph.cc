@@ -1,11 +1,11 @@
 #include "core/optim/essential_graph.h"
 
+#include <ceres/ceres.h>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
 #include <utility>
-
-#include <ceres/ceres.h>
 
 #include "core/map/keyframe.h"
 #include "core/map/map.h"
@@ -31,21 +31,35 @@ Sim3<T> VertexSim3(const T* q, const T* t, const T* log_s) {
 
 // ORB-SLAM's EdgeSim3 error: log(S_ji * S_iw * S_jw^-1), zero when the two vertices keep the
 // relative pose they had before the correction. Identity information, as ORB-SLAM.
+// With exact_log = false the error is [t; Log(R); log s] of the same transform, which agrees
+// with the logarithm to first order and skips the series of Sim3's V-matrix.
 struct RelativeSim3Cost {
-  explicit RelativeSim3Cost(const Sim3d& j_from_i) : j_from_i(j_from_i) {}
+  RelativeSim3Cost(const Sim3d& j_from_i, bool exact_log)
+      : j_from_i(j_from_i), exact_log(exact_log) {}
 
   template <typename T>
   bool operator()(const T* qi, const T* ti, const T* si, const T* qj, const T* tj, const T* sj,
                   T* residual) const {
+    using std::log;
     const Sim3<T> i_from_world = VertexSim3(qi, ti, si);
     const Sim3<T> j_from_world = VertexSim3(qj, tj, sj);
     const Sim3<T> error = j_from_i.cast<T>() * i_from_world * j_from_world.Inverse();
-    const typename Sim3<T>::Tangent xi = error.Log();
-    for (int k = 0; k < 7; ++k) residual[k] = xi(k);
+    if (exact_log) {
+      const typename Sim3<T>::Tangent xi = error.Log();
+      for (int k = 0; k < 7; ++k) residual[k] = xi(k);
+    } else {
+      const Eigen::Matrix<T, 3, 1> phi = error.so3().Log();
+      for (int k = 0; k < 3; ++k) {
+        residual[k] = error.translation()(k);
+        residual[3 + k] = phi(k);
+      }
+      residual[6] = log(error.scale());
+    }
     return true;
   }
 
   Sim3d j_from_i;
+  bool exact_log;
 };
 
 std::pair<KeyFrameId, KeyFrameId> Ordered(KeyFrameId a, KeyFrameId b) {
@@ -79,8 +93,9 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
     EssentialGraphProblem::Vertex v;
     v.keyframe = kf;
     auto it = correction.corrected_camera_from_world.find(id);
-    v.camera_from_world =
-        it != correction.corrected_camera_from_world.end() ? it->second : Sim3d(kf->camera_from_world());
+    v.camera_from_world = it != correction.corrected_camera_from_world.end()
+                              ? it->second
+                              : Sim3d(kf->camera_from_world());
     if (options.dof == PoseGraphDof::kSE3) v.camera_from_world.set_scale(1.0);
     v.fixed = kf.get() == map->origin();
     problem.vertex_of[id] = static_cast<int>(problem.vertices.size());
@@ -122,9 +137,10 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
           kf_i->Weight(problem.vertices[j].keyframe.get()) < options.min_covisibility_weight) {
         continue;
       }
-      add_edge(i, j,
-               problem.vertices[j].camera_from_world * problem.vertices[i].camera_from_world.Inverse(),
-               EssentialGraphProblem::EdgeKind::kNewLoop);
+      add_edge(
+          i, j,
+          problem.vertices[j].camera_from_world * problem.vertices[i].camera_from_world.Inverse(),
+          EssentialGraphProblem::EdgeKind::kNewLoop);
       inserted.insert(Ordered(id_i, id_j));
     }
   }
@@ -222,7 +238,7 @@ EssentialGraphResult SolveEssentialGraph(const EssentialGraphProblem& problem,
     double* pi = &params[static_cast<std::size_t>(e.i) * kVertexSize];
     double* pj = &params[static_cast<std::size_t>(e.j) * kVertexSize];
     auto* cost = new ceres::AutoDiffCostFunction<RelativeSim3Cost, 7, 4, 3, 1, 4, 3, 1>(
-        new RelativeSim3Cost(e.j_from_i));
+        new RelativeSim3Cost(e.j_from_i, options.exact_log));
     ceres_problem.AddResidualBlock(cost, nullptr, pi + kQ, pi + kT, pi + kS, pj + kQ, pj + kT,
                                    pj + kS);
   }

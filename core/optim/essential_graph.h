@@ -13,13 +13,16 @@
 // log-scale block of its camera_from_world Sim3; the Dof switch decides which blocks move
 // (SE3 keeps every log-scale at 0). The 4-DoF inertial variant (issue 7) adds a value here:
 // its rotation block gets a manifold that only turns about the world's gravity axis (yaw)
-// and its scale stays fixed; edges and Apply are shared.
+// and its scale stays fixed; edges and Apply are shared (ORB-SLAM3 also adds an edge to the
+// previous keyframe for inertial maps: one more EdgeKind).
+//
+// Cost (loop_closing_benchmark, Release, 1 thread): 40 keyframes / 188 edges ~10 ms; 184
+// keyframes / 4465 edges ~0.3 s CPU, about 2/3 autodiff Jacobians and 1/3 sparse Cholesky.
 #pragma once
 
+#include <Eigen/Core>
 #include <map>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/geometry/sim3.h"
 #include "core/map/ids.h"
@@ -40,6 +43,9 @@ struct EssentialGraphOptions {
   int iterations = 20;
   // Ceres threads (1 in deterministic mode).
   int num_threads = 1;
+  // Edge error: the Sim3 logarithm of S_ji * S_iw * S_jw^-1 (ORB-SLAM's EdgeSim3), or, when
+  // false, its translation, rotation log and log-scale (equal to first order, cheaper).
+  bool exact_log = true;
 
   void Check() const;
 };

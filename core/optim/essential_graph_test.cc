@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 #include <mutex>
 
 #include "core/optim/loop_scenario.h"
@@ -75,9 +74,6 @@ TEST(EssentialGraphTest, MonocularLoopSpreadsTheSim3CorrectionOverTheMap) {
     max_log_scale = std::max(max_log_scale, std::abs(std::log(sim.scale())));
   }
   EXPECT_GT(max_log_scale, 0.01);
-  std::printf("sim3 loop: keyframe RMSE %.3f -> %.3f m, points %.3f -> %.3f m, %zu edges\n",
-              o.kf_rmse_before, o.kf_rmse_after, o.point_rmse_before, o.point_rmse_after,
-              o.problem.edges.size());
 }
 
 TEST(EssentialGraphTest, StereoLoopKeepsScalesAtOne) {
@@ -91,8 +87,6 @@ TEST(EssentialGraphTest, StereoLoopKeepsScalesAtOne) {
   EXPECT_GT(o.kf_rmse_before, 0.1);
   EXPECT_LT(o.kf_rmse_after, 0.2 * o.kf_rmse_before);
   EXPECT_LT(o.point_rmse_after, 0.3 * o.point_rmse_before);
-  std::printf("se3 loop: keyframe RMSE %.3f -> %.3f m, points %.3f -> %.3f m\n",
-              o.kf_rmse_before, o.kf_rmse_after, o.point_rmse_before, o.point_rmse_after);
 }
 
 TEST(EssentialGraphTest, KeyFramesAndPointsAddedAfterCollectFollowTheirAncestor) {
@@ -136,9 +130,10 @@ TEST(EssentialGraphTest, KeyFramesAndPointsAddedAfterCollectFollowTheirAncestor)
   EXPECT_LT((late->camera_from_world() * late_point->position() - Eigen::Vector3d(0, 0, 5)).norm(),
             1e-9);
   // The anchor did move (the correction is not the identity there).
-  EXPECT_GT((anchor->CameraCenter() - problem.vertices[20].camera_from_world.Inverse().translation())
-                .norm(),
-            0.01);
+  EXPECT_GT(
+      (anchor->CameraCenter() - problem.vertices[20].camera_from_world.Inverse().translation())
+          .norm(),
+      0.01);
 }
 
 TEST(EssentialGraphTest, IsDeterministic) {

@@ -126,7 +126,8 @@ inline void BuildLoopScenario(const LoopScenarioOptions& o, const SyntheticScene
   std::vector<Sim3d> drift(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) {
     const Sim3d world_from_camera(s->true_camera_from_world[k].Inverse());
-    drift[k] = k == 0 ? Sim3d() : drift[k - 1] * world_from_camera * delta * world_from_camera.Inverse();
+    drift[k] =
+        k == 0 ? Sim3d() : drift[k - 1] * world_from_camera * delta * world_from_camera.Inverse();
   }
   for (const auto& [id, mp] : s->map->map_points()) {
     const KeyFrameId ref = mp->reference_keyframe()->id() - kfs[0]->id();

@@ -1,9 +1,9 @@
 #include "core/optim/sim3_optimization.h"
 
+#include <ceres/ceres.h>
+
 #include <cmath>
 #include <limits>
-
-#include <ceres/ceres.h>
 
 #include "core/util/error.h"
 
@@ -106,11 +106,10 @@ Sim3OptimizationResult OptimizeSim3(const std::vector<Sim3Match>& matches,
         new PairReprojection(m.point2, m.uv1, 1.0 / std::sqrt(m.sigma2_1), camera1, true));
     auto* backward = new ceres::AutoDiffCostFunction<PairReprojection, 2, 4, 3, 1>(
         new PairReprojection(m.point1, m.uv2, 1.0 / std::sqrt(m.sigma2_2), camera2, false));
-    blocks.emplace_back(
-        problem.AddResidualBlock(forward, &huber, state.q.coeffs().data(), state.t.data(),
-                                 &state.log_s),
-        problem.AddResidualBlock(backward, &huber, state.q.coeffs().data(), state.t.data(),
-                                 &state.log_s));
+    blocks.emplace_back(problem.AddResidualBlock(forward, &huber, state.q.coeffs().data(),
+                                                 state.t.data(), &state.log_s),
+                        problem.AddResidualBlock(backward, &huber, state.q.coeffs().data(),
+                                                 state.t.data(), &state.log_s));
   }
 
   ceres::Solver::Options solver_options;
@@ -141,7 +140,8 @@ Sim3OptimizationResult OptimizeSim3(const std::vector<Sim3Match>& matches,
     return result;
   }
 
-  solver_options.max_num_iterations = bad > 0 ? options.iterations_second : options.iterations_first;
+  solver_options.max_num_iterations =
+      bad > 0 ? options.iterations_second : options.iterations_first;
   if (solver_options.max_num_iterations > 0) {
     ceres::Solve(solver_options, &problem, &summary);
     result.final_cost = summary.final_cost;
