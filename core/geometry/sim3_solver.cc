@@ -80,7 +80,7 @@ std::optional<Sim3d> AlignPoints(const std::vector<Eigen::Vector3d>& source,
   }
   if (var_s <= 1e-18) return std::nullopt;
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::Vector3d sv = svd.singularValues();
+  const Eigen::Vector3d& sv = svd.singularValues();
   // Collinear sources (or targets) leave the rotation about the line free.
   if (sv(1) <= 1e-9 * sv(0) || sv(0) <= 0) return std::nullopt;
   Eigen::Vector3d d(1, 1, 1);

@@ -47,8 +47,8 @@ TEST(AlignPointsTest, RecoversAnExactSimilarityAndRejectsDegenerateSets) {
 
   // Fixed scale: a rigid transform of rigid data is exact too.
   const Sim3d rigid(1.0, truth.so3(), truth.translation());
-  std::vector<Eigen::Vector3d> rigid_target;
-  for (const auto& p : source) rigid_target.push_back(rigid * p);
+  std::vector<Eigen::Vector3d> rigid_target(source.size());
+  for (std::size_t i = 0; i < source.size(); ++i) rigid_target[i] = rigid * source[i];
   const auto se3 = AlignPoints(source, rigid_target, true);
   ASSERT_TRUE(se3.has_value());
   EXPECT_EQ(se3->scale(), 1.0);

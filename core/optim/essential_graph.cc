@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <set>
 #include <utility>
 
@@ -61,6 +62,14 @@ struct RelativeSim3Cost {
   Sim3d j_from_i;
   bool exact_log;
 };
+
+// Ceres takes ownership of cost functions and their functors through raw pointers.
+template <typename Functor, int... kDims>
+ceres::CostFunction* MakeAutoDiff(Functor functor) {
+  auto owned = std::make_unique<Functor>(std::move(functor));
+  return std::make_unique<ceres::AutoDiffCostFunction<Functor, kDims...>>(owned.release())
+      .release();
+}
 
 std::pair<KeyFrameId, KeyFrameId> Ordered(KeyFrameId a, KeyFrameId b) {
   return {std::min(a, b), std::max(a, b)};
@@ -220,11 +229,12 @@ EssentialGraphResult SolveEssentialGraph(const EssentialGraphProblem& problem,
   }
 
   ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::EigenQuaternionManifold quaternion_manifold;  // shared by all rotation blocks
   ceres::Problem ceres_problem(problem_options);
   for (std::size_t v = 0; v < n; ++v) {
     double* p = &params[v * kVertexSize];
-    ceres_problem.AddParameterBlock(p + kQ, 4, new ceres::EigenQuaternionManifold());
+    ceres_problem.AddParameterBlock(p + kQ, 4, &quaternion_manifold);
     ceres_problem.AddParameterBlock(p + kT, 3);
     ceres_problem.AddParameterBlock(p + kS, 1);
     const bool fixed = problem.vertices[v].fixed;
@@ -237,8 +247,8 @@ EssentialGraphResult SolveEssentialGraph(const EssentialGraphProblem& problem,
   for (const auto& e : problem.edges) {
     double* pi = &params[static_cast<std::size_t>(e.i) * kVertexSize];
     double* pj = &params[static_cast<std::size_t>(e.j) * kVertexSize];
-    auto* cost = new ceres::AutoDiffCostFunction<RelativeSim3Cost, 7, 4, 3, 1, 4, 3, 1>(
-        new RelativeSim3Cost(e.j_from_i, options.exact_log));
+    ceres::CostFunction* cost = MakeAutoDiff<RelativeSim3Cost, 7, 4, 3, 1, 4, 3, 1>(
+        RelativeSim3Cost(e.j_from_i, options.exact_log));
     ceres_problem.AddResidualBlock(cost, nullptr, pi + kQ, pi + kT, pi + kS, pj + kQ, pj + kT,
                                    pj + kS);
   }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "core/util/error.h"
 
@@ -47,6 +48,14 @@ struct PairReprojection {
   bool forward;
 };
 
+// Ceres takes ownership of cost functions and their functors through raw pointers.
+template <typename Functor, int... kDims>
+ceres::CostFunction* MakeAutoDiff(Functor functor) {
+  auto owned = std::make_unique<Functor>(std::move(functor));
+  return std::make_unique<ceres::AutoDiffCostFunction<Functor, kDims...>>(owned.release())
+      .release();
+}
+
 struct State {
   Eigen::Quaterniond q;
   Eigen::Vector3d t;
@@ -89,11 +98,13 @@ Sim3OptimizationResult OptimizeSim3(const std::vector<Sim3Match>& matches,
 
   State state{initial.so3().quaternion(), initial.translation(), std::log(initial.scale())};
   ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
+  // Declared before the problem so they outlive it.
+  ceres::EigenQuaternionManifold quaternion_manifold;
   ceres::HuberLoss huber(std::sqrt(options.chi2));
-  problem.AddParameterBlock(state.q.coeffs().data(), 4, new ceres::EigenQuaternionManifold());
+  ceres::Problem problem(problem_options);
+  problem.AddParameterBlock(state.q.coeffs().data(), 4, &quaternion_manifold);
   problem.AddParameterBlock(state.t.data(), 3);
   problem.AddParameterBlock(&state.log_s, 1);
   if (options.fix_scale) problem.SetParameterBlockConstant(&state.log_s);
@@ -102,10 +113,10 @@ Sim3OptimizationResult OptimizeSim3(const std::vector<Sim3Match>& matches,
   std::vector<std::pair<ceres::ResidualBlockId, ceres::ResidualBlockId>> blocks;
   blocks.reserve(matches.size());
   for (const Sim3Match& m : matches) {
-    auto* forward = new ceres::AutoDiffCostFunction<PairReprojection, 2, 4, 3, 1>(
-        new PairReprojection(m.point2, m.uv1, 1.0 / std::sqrt(m.sigma2_1), camera1, true));
-    auto* backward = new ceres::AutoDiffCostFunction<PairReprojection, 2, 4, 3, 1>(
-        new PairReprojection(m.point1, m.uv2, 1.0 / std::sqrt(m.sigma2_2), camera2, false));
+    ceres::CostFunction* forward = MakeAutoDiff<PairReprojection, 2, 4, 3, 1>(
+        PairReprojection(m.point2, m.uv1, 1.0 / std::sqrt(m.sigma2_1), camera1, true));
+    ceres::CostFunction* backward = MakeAutoDiff<PairReprojection, 2, 4, 3, 1>(
+        PairReprojection(m.point1, m.uv2, 1.0 / std::sqrt(m.sigma2_2), camera2, false));
     blocks.emplace_back(problem.AddResidualBlock(forward, &huber, state.q.coeffs().data(),
                                                  state.t.data(), &state.log_s),
                         problem.AddResidualBlock(backward, &huber, state.q.coeffs().data(),
