@@ -9,6 +9,8 @@ namespace pkslam {
 
 struct PinholeIntrinsics {
   double fx = 1, fy = 1, cx = 0, cy = 0;
+  // Stereo (or RGB-D virtual) baseline times fx; used by stereo residuals only.
+  double bf = 0;
 
   // uv of a camera-frame point (no check of z: callers reject z <= 0 themselves).
   template <typename T>
