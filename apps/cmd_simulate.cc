@@ -25,6 +25,7 @@ struct SimulateArgs {
   std::string trajectory;
   bool no_imu_noise = false;
   bool no_cloud = false;
+  bool no_images = false;
   bool no_auto_exposure = false;
   bool list_scenes = false;
 };
@@ -52,7 +53,8 @@ void Run(SimulateArgs& a) {
   o.imu.initial_gyro_bias = ToVector(a.gyro_bias, "--gyro-bias");
   o.imu.initial_accel_bias = ToVector(a.accel_bias, "--accel-bias");
   o.imu.noise = !a.no_imu_noise;
-  o.write_cloud = !a.no_cloud;
+  o.write_cloud = !a.no_cloud && !a.no_images;
+  o.write_images = !a.no_images;
   o.sensor.auto_exposure = !a.no_auto_exposure;
   const sim::SimulationSummary s = sim::RunSimulation(o);
   const double duration = 1e-9 * static_cast<double>(s.end_ns - s.begin_ns);
@@ -134,6 +136,7 @@ void RegisterSimulateCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--quality", args->quality, "fast|default|high")->capture_default_str();
   cmd->add_flag("--no-cloud", args->no_cloud, "Do not write reference_cloud.ply");
+  cmd->add_flag("--no-images", args->no_images, "IMU and ground truth only (no rendering)");
   cmd->add_option("--cloud-spacing", o.cloud_spacing_m, "Reference cloud point spacing (m)")
       ->capture_default_str();
   cmd->add_flag("--bench", o.bench, "Only render (no files) and report frames/s");

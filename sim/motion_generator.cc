@@ -161,7 +161,9 @@ SplineTrajectory GenerateMotion(const Scene& scene, const MotionOptions& options
     }
     const int moving = j - (rest_knots + kPositionOrder - 1);
     const double ramp = std::min(1.0, (moving + 1) / 4.0);  // smooth take-off
-    const double step = level.speed_mps * h * ramp * rng.Uniform(0.75, 1.25);
+    // 1.17: the spline cuts the random walk's corners, losing ~15% of the control polygon's
+    // length (measured over 60 s flights at every level).
+    const double step = 1.17 * level.speed_mps * h * ramp * rng.Uniform(0.75, 1.25);
     bool placed = false;
     for (int attempt = 0; attempt < 40 && !placed; ++attempt) {
       // Small turns first; widen the search when blocked, biased to the room centre.
@@ -215,7 +217,7 @@ SplineTrajectory GenerateMotion(const Scene& scene, const MotionOptions& options
     const Eigen::Vector3d pj = position.Evaluate(std::clamp(tj, grid.t0_ns, grid.end_ns()));
     if (j >= rest_knots + kRotationOrder - 1) {
       // Yaw rate: a mean-reverting random process with spread ~ the level's angular rate.
-      yaw_rate = 0.6 * yaw_rate + rng.Normal(0.0, 1.1 * rate);
+      yaw_rate = 0.6 * yaw_rate + rng.Normal(0.0, 1.25 * rate);
       yaw_rate = std::clamp(yaw_rate, -2.0 * rate, 2.0 * rate);
       double cand_yaw = yaw + yaw_rate * h;
       const double cand_pitch =

@@ -26,16 +26,8 @@ static_assert(sizeof(PlyVertex) == 25);
 float Albedo(const Scene& scene, const Shape& shape, int face, const Eigen::Vector2f& uv) {
   const Material& m = scene.materials[shape.material[face]];
   const MipTexture& tex = scene.textures[m.texture];
-  float s = 0.0f;
-  float t = 0.0f;
-  if (m.stretch) {
-    s = uv.x() / (2.0f * shape.half.x());
-    t = 1.0f - uv.y() / (2.0f * shape.half.y());
-  } else {
-    s = (uv.x() + shape.uv_offset.x()) / m.tile_m;
-    t = -(uv.y() + shape.uv_offset.y()) / m.tile_m;
-  }
-  return std::min(1.0f, m.albedo * tex.SampleGrey(s, t, 0.0f));
+  const Eigen::Vector2f st = TextureCoords(shape, m, uv);
+  return std::min(1.0f, m.albedo * tex.SampleGrey(st.x(), st.y(), 0.0f));
 }
 
 }  // namespace

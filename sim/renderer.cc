@@ -29,16 +29,27 @@ CameraRays::CameraRays(const CameraModel& camera, int supersample)
       }
     }
   }
-  // Pixel angular size from the centre rays of neighbours (one-sided at the border).
-  pixel_angle_.resize(static_cast<std::size_t>(width_) * height_);
-  auto centre = [&](int x, int y) -> Eigen::Vector3f {
-    return camera.Unproject(Eigen::Vector2d(x, y)).normalized().cast<float>();
+  // Pixel angular size from the centre rays of neighbours (one-sided at the border). With one
+  // sample per pixel the centre rays are the rays already computed.
+  std::vector<Eigen::Vector3f> centres;
+  if (samples_ > 1) {
+    centres.resize(static_cast<std::size_t>(width_) * height_);
+    for (int y = 0; y < height_; ++y) {
+      for (int x = 0; x < width_; ++x) {
+        centres[static_cast<std::size_t>(y) * width_ + x] =
+            camera.Unproject(Eigen::Vector2d(x, y)).normalized().cast<float>();
+      }
+    }
+  }
+  auto centre = [&](int x, int y) -> const Eigen::Vector3f& {
+    return samples_ > 1 ? centres[static_cast<std::size_t>(y) * width_ + x] : Ray(x, y, 0);
   };
+  pixel_angle_.resize(static_cast<std::size_t>(width_) * height_);
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x) {
-      const Eigen::Vector3f c = centre(x, y);
-      const Eigen::Vector3f rx = centre(x + 1 < width_ ? x + 1 : x - 1, y);
-      const Eigen::Vector3f ry = centre(x, y + 1 < height_ ? y + 1 : y - 1);
+      const Eigen::Vector3f& c = centre(x, y);
+      const Eigen::Vector3f& rx = centre(x + 1 < width_ ? x + 1 : x - 1, y);
+      const Eigen::Vector3f& ry = centre(x, y + 1 < height_ ? y + 1 : y - 1);
       pixel_angle_[y * width_ + x] = std::sqrt((rx - c).norm() * (ry - c).norm());
     }
   }
@@ -122,7 +133,7 @@ bool SurfaceVisibility::Seen(int shape, int face, const Eigen::Vector2f& uv) con
 }
 
 void RenderOptions::Check() const {
-  PKSLAM_CHECK_OPTION(std::abs(lod_bias) <= 4.0f, "render.lod_bias", "{}", lod_bias);
+  PKSLAM_CHECK_OPTION(lod_bias >= -10.0f && lod_bias <= 4.0f, "render.lod_bias", "{}", lod_bias);
   PKSLAM_CHECK_OPTION(max_distance > 0.0f, "render.max_distance", "{}", max_distance);
 }
 
@@ -254,20 +265,9 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
                 const MipTexture& tex = scene_.textures[mat.texture];
                 const float cos_inc = std::max(std::abs(n_local.dot(d_best)), 0.05f);
                 const float footprint = t * pixel_angle / std::sqrt(cos_inc);
-                float s_coord;
-                float t_coord;
-                float texels;
-                if (mat.stretch) {
-                  const Eigen::Vector2f size(2.0f * shape.half.x(), 2.0f * shape.half.y());
-                  s_coord = uv.x() / size.x();
-                  t_coord = 1.0f - uv.y() / size.y();
-                  texels = footprint / size.x() * static_cast<float>(tex.width());
-                } else {
-                  const float inv_tile = 1.0f / mat.tile_m;
-                  s_coord = (uv.x() + shape.uv_offset.x()) * inv_tile;
-                  t_coord = -(uv.y() + shape.uv_offset.y()) * inv_tile;
-                  texels = footprint * inv_tile * static_cast<float>(tex.width());
-                }
+                const Eigen::Vector2f st = TextureCoords(shape, mat, uv);
+                const float texels = footprint * static_cast<float>(tex.width()) /
+                                     (mat.stretch ? 2.0f * shape.half.x() : mat.tile_m);
                 const float lod = FastLog2(std::max(texels, 1e-6f)) + options_.lod_bias;
                 float albedo_scale = mat.albedo;
                 if (mat.macro_texture >= 0) {
@@ -293,9 +293,9 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
                 }
                 const float shade = albedo_scale * light;
                 if (channels == 1) {
-                  acc[0] += shade * tex.SampleGrey(s_coord, t_coord, lod);
+                  acc[0] += shade * tex.SampleGrey(st.x(), st.y(), lod);
                 } else {
-                  const Eigen::Vector3f c = tex.SampleColour(s_coord, t_coord, lod);
+                  const Eigen::Vector3f c = tex.SampleColour(st.x(), st.y(), lod);
                   for (int ch = 0; ch < 3; ++ch) acc[ch] += shade * c[ch];
                 }
                 depth_acc += t * rc.z();

@@ -6,8 +6,10 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/texture.h"
@@ -25,6 +27,10 @@ struct Material {
   int macro_texture = -1;       // large-scale albedo variation (-1: none)
   float macro_tile_m = 8.0f;    // metres per macro texture repeat
   float macro_strength = 0.0f;  // albedo *= 1 + strength * (macro - 0.5) * 2
+  // Each tile shows the texture shifted by a random offset and turned/mirrored by one of
+  // the 8 square symmetries (hash of the tile index), so a wall is not a visible grid of
+  // identical copies. Off for repetitive textures (the repetition is the point).
+  bool shuffle_tiles = true;
 };
 
 struct Shape {
@@ -59,6 +65,32 @@ struct Hit {
   Eigen::Vector2f uv = Eigen::Vector2f::Zero();      // metres on the face
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // world, facing the ray origin
 };
+
+// Texture coordinates (one unit = one texture) of face point uv (metres) with `material`.
+inline Eigen::Vector2f TextureCoords(const Shape& shape, const Material& m,
+                                     const Eigen::Vector2f& uv) {
+  if (m.stretch) {
+    return {uv.x() / (2.0f * shape.half.x()), 1.0f - uv.y() / (2.0f * shape.half.y())};
+  }
+  const float inv_tile = 1.0f / m.tile_m;
+  float s = (uv.x() + shape.uv_offset.x()) * inv_tile;
+  float t = -(uv.y() + shape.uv_offset.y()) * inv_tile;
+  if (!m.shuffle_tiles) return {s, t};
+  const float fs = std::floor(s);
+  const float ft = std::floor(t);
+  float ls = s - fs;
+  float lt = t - ft;
+  std::uint32_t h = static_cast<std::uint32_t>(static_cast<std::int32_t>(fs)) * 0x9E3779B1u ^
+                    static_cast<std::uint32_t>(static_cast<std::int32_t>(ft)) * 0x85EBCA77u;
+  h ^= h >> 15;
+  h *= 0x2C1B3C6Du;
+  h ^= h >> 12;
+  if (h & 1u) std::swap(ls, lt);
+  if (h & 2u) ls = 1.0f - ls;
+  if (h & 4u) lt = 1.0f - lt;
+  return {ls + static_cast<float>((h >> 8) & 0xFFFu) * (1.0f / 4096.0f),
+          lt + static_cast<float>((h >> 20) & 0xFFFu) * (1.0f / 4096.0f)};
+}
 
 // Ray/shape tests in the shape's local frame. origin/dir are local; dir need not be unit
 // (t is in units of dir). Return false on a miss or a hit not in (t_min, *t).

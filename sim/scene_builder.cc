@@ -280,6 +280,8 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
     mat.stretch = m.stretch;
     mat.albedo = static_cast<float>(m.albedo);
     mat.macro_strength = static_cast<float>(m.macro_strength);
+    // Procedural noise is seamless and has no recognisable motif: shuffling would only add seams.
+    mat.shuffle_tiles = spec.kind == TextureKind::kPhoto;
     scene.materials.push_back(mat);
   }
   TextureSpec macro;

@@ -148,6 +148,7 @@ void WriteSimYaml(const std::filesystem::path& file, const SimulationOptions& o,
   e << YAML::Key << "depth_noise" << YAML::Value << o.depth_noise;
   e << YAML::Key << "blackout_s" << YAML::Value << YAML::Flow << YAML::BeginSeq
     << o.blackout_begin_s << o.blackout_end_s << YAML::EndSeq;
+  e << YAML::Key << "images_written" << YAML::Value << o.write_images;
   e << YAML::Key << "frames" << YAML::Value << s.frames;
   e << YAML::EndMap;
 

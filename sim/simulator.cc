@@ -225,7 +225,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     period = (period + 500) / 1000 * 1000;  // TUM timestamps are whole microseconds
     first = (begin_ns + 999) / 1000 * 1000;
   }
-  int frames = static_cast<int>((end_ns - first) / period) + 1;
+  int frames = o.write_images ? static_cast<int>((end_ns - first) / period) + 1 : 0;
   if (o.bench && o.bench_frames > 0) frames = std::min(frames, o.bench_frames);
   RenderOptions render_options;
   render_options.colour = o.rgbd;
@@ -233,14 +233,14 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   const Renderer renderer(scene, render_options);
   std::vector<CameraRays> rays;
   std::vector<SensorModel> sensors;
-  for (std::size_t c = 0; c < cameras.size(); ++c) {
+  for (std::size_t c = 0; c < cameras.size() && frames > 0; ++c) {
     rays.emplace_back(cameras[c].camera, quality.supersample);
   }
-  for (std::size_t c = 0; c < cameras.size(); ++c) {
+  for (std::size_t c = 0; c < rays.size(); ++c) {
     sensors.emplace_back(o.sensor, rays[c], DeriveSeed(o.seed, 0x43414D00 + c));
   }
   std::unique_ptr<SurfaceVisibility> visibility;
-  if (o.write_cloud && !o.bench) {
+  if (o.write_cloud && !o.bench && frames > 0) {
     visibility =
         std::make_unique<SurfaceVisibility>(scene, static_cast<float>(o.visibility_cell_m));
   }

@@ -38,6 +38,7 @@ struct SimulationOptions {
   SceneBuildOptions scene_build;  // texture_size and colour follow quality / rgbd
   ImuOptions imu;
   bool write_imu = true;
+  bool write_images = true;      // false: IMU + ground truth only (no rendering)
   double camera_rate_hz = 20.0;  // stereo cameras (EuRoC: 20)
   SensorOptions sensor;
   double motion_blur_exposure_s = 0.0;  // > 0: average sub-renders over this exposure
