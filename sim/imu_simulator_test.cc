@@ -5,9 +5,9 @@
 #include <cmath>
 #include <cstdio>
 
+#include "io/trajectory.h"
 #include "sim/euroc_writer.h"
 #include "sim/motion_generator.h"
-#include "sim/pose_file.h"
 #include "sim/scene_builder.h"
 #include "tests/support/test_data.h"
 
@@ -119,7 +119,7 @@ void CheckIntegration(const SplineTrajectory& traj, std::int64_t t0, const char*
 
 TEST(ImuSimulator, NoiseFreeImuIntegratesToTheGroundTruthReplay) {
   PKSLAM_REQUIRE_SHARED_DATA(shared);
-  const auto poses = ReadPoseFile(shared / "euroc/groundtruth/V1_02_medium.txt");
+  const auto poses = ReadTrajectory(shared / "euroc/groundtruth/V1_02_medium.txt").poses;
   const std::int64_t t0 = poses.front().t_ns + 20'000'000'000;
   const SplineTrajectory traj = FitTrajectory(poses, t0, t0 + 10'000'000'000, ReplayOptions());
   CheckIntegration(traj, t0, "V1_02_medium replay");

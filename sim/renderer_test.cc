@@ -7,6 +7,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/camera/stereo_rectification.h"
 #include "sim/euroc_writer.h"
 #include "sim/scene_builder.h"
 #include "sim/sensor_model.h"
@@ -153,27 +154,27 @@ TEST(Renderer, RectifiedStereoCorrespondencesShareRows) {
   const auto corners_r = Detect(img_r);
   ASSERT_EQ(corners_l.size(), 48u);
   ASSERT_EQ(corners_r.size(), 48u);
-  // Rectify (OpenCV's Bouguet rectification of the EuRoC calibration) and compare rows.
+  // Rectify the detected raw corners with the project's stereo rectification and compare rows.
   const SE3d right_from_left = right.body_from_camera.Inverse() * left.body_from_camera;
-  cv::Mat r_rl(3, 3, CV_64F), t_rl(3, 1, CV_64F);
-  for (int i = 0; i < 3; ++i) {
-    t_rl.at<double>(i) = right_from_left.translation()[i];
-    for (int j = 0; j < 3; ++j) r_rl.at<double>(i, j) = right_from_left.RotationMatrix()(i, j);
+  const StereoRectification rectification(left.camera, right.camera, right_from_left);
+  std::vector<Eigen::Vector2d> rect_l, rect_r;
+  for (std::size_t i = 0; i < corners_l.size(); ++i) {
+    const auto l = rectification.RectifyLeftPixel(Eigen::Vector2d(corners_l[i].x, corners_l[i].y));
+    const auto r = rectification.RectifyRightPixel(Eigen::Vector2d(corners_r[i].x, corners_r[i].y));
+    ASSERT_TRUE(l && r);
+    rect_l.push_back(*l);
+    rect_r.push_back(*r);
   }
-  cv::Mat r1, r2, p1, p2, q;
-  cv::stereoRectify(left.camera.CvK(), left.camera.CvDistortion(), right.camera.CvK(),
-                    right.camera.CvDistortion(), cv::Size(752, 480), r_rl, t_rl, r1, r2, p1, p2, q,
-                    cv::CALIB_ZERO_DISPARITY, 0);
-  std::vector<cv::Point2f> rect_l, rect_r;
-  cv::undistortPoints(corners_l, rect_l, left.camera.CvK(), left.camera.CvDistortion(), r1, p1);
-  cv::undistortPoints(corners_r, rect_r, right.camera.CvK(), right.camera.CvDistortion(), r2, p2);
   // Both detections start from the same board corner (same orientation in both views).
   double mean = 0, max = 0;
   for (std::size_t i = 0; i < rect_l.size(); ++i) {
-    const double dy = std::abs(rect_l[i].y - rect_r[i].y);
+    const double dy = std::abs(rect_l[i].y() - rect_r[i].y());
     mean += dy / rect_l.size();
     max = std::max(max, dy);
-    EXPECT_GT(rect_l[i].x - rect_r[i].x, 0.0);  // positive disparity
+    // Positive disparity matching the board's depth (about 1.3 m): bf / z.
+    const double disparity = rect_l[i].x() - rect_r[i].x();
+    EXPECT_GT(disparity, rectification.bf() / 2.0);
+    EXPECT_LT(disparity, rectification.bf() / 0.8);
   }
   std::printf("rectified stereo: row difference mean %.3f px, max %.3f px\n", mean, max);
   EXPECT_LT(mean, 0.2);

@@ -9,11 +9,11 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/progress.h"
+#include "io/settings.h"
+#include "io/trajectory.h"
 #include "sim/euroc_writer.h"
-#include "sim/pose_file.h"
 #include "sim/random.h"
 #include "sim/reference_cloud.h"
-#include "sim/settings_writer.h"
 #include "sim/tum_rgbd_writer.h"
 
 namespace pkslam::sim {
@@ -75,6 +75,33 @@ void RenderFrame(const Renderer& renderer, const CameraRays& rays, const SplineT
     if (centre && !sub.depth.empty()) out->depth = sub.depth.clone();
   }
   out->radiance = sum / samples;
+}
+
+// ORB-SLAM3-format settings of the simulated rig (io/settings.h writes the file).
+void WriteSettings(const std::filesystem::path& file, const std::vector<CameraRig>& cameras,
+                   const SimulationOptions& o) {
+  Settings settings;
+  settings.camera1 = cameras[0].camera;
+  settings.fps = cameras[0].rate_hz;
+  if (o.rgbd) {
+    settings.depth_map_factor = 5000.0;
+    settings.stereo_baseline_m = 0.07;  // ORB-SLAM3's virtual RGB-D baseline (TUM files)
+    settings.th_depth = 40.0;
+  } else {
+    settings.camera2 = cameras[1].camera;
+    settings.right_from_left = cameras[1].body_from_camera.Inverse() * cameras[0].body_from_camera;
+    if (o.write_imu) {
+      settings.body_from_cam0 = cameras[0].body_from_camera;
+      ImuNoise noise;
+      noise.gyro_noise_density = o.imu.gyro_noise_density;
+      noise.accel_noise_density = o.imu.accel_noise_density;
+      noise.gyro_random_walk = o.imu.gyro_random_walk;
+      noise.accel_random_walk = o.imu.accel_random_walk;
+      noise.rate_hz = o.imu.rate_hz;
+      settings.imu = noise;
+    }
+  }
+  WriteOrbSlam3Settings(settings, file);
 }
 
 bool InBlackout(const SimulationOptions& o, std::int64_t t_ns, std::int64_t begin_ns) {
@@ -152,7 +179,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   std::int64_t begin_ns = 0;
   std::int64_t end_ns = 0;
   if (!o.trajectory.empty()) {
-    const std::vector<PoseSample> samples = ReadPoseFile(o.trajectory);
+    const std::vector<StampedPose> samples = ReadTrajectory(o.trajectory).poses;
     begin_ns = samples.front().t_ns + Ns(o.start_s);
     end_ns = o.duration_s > 0.0 ? begin_ns + Ns(o.duration_s) : samples.back().t_ns;
     if (end_ns > samples.back().t_ns || begin_ns >= end_ns) {
@@ -201,7 +228,9 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     if (o.rgbd) {
       tum = std::make_unique<TumRgbdWriter>(o.output_dir);
     } else {
-      euroc = std::make_unique<EurocWriter>(o.output_dir, cameras, o.imu, o.write_imu);
+      // Without images (IMU + ground truth only) there are no camera folders at all.
+      euroc = std::make_unique<EurocWriter>(
+          o.output_dir, o.write_images ? cameras : std::vector<CameraRig>{}, o.imu, o.write_imu);
     }
   }
   if (!o.rgbd) {
@@ -303,12 +332,11 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
       tum->WriteGroundTruth(t, traj.WorldFromBody(t) * cameras[0].body_from_camera);
     }
     tum->Close();
-    WriteRgbdSettings(o.output_dir / "settings.yaml", cameras[0], 5000.0);
+    WriteSettings(o.output_dir / "settings.yaml", cameras, o);
     summary.layout = "tum_rgbd";
   } else {
     euroc->Close();
-    WriteStereoSettings(o.output_dir / "settings.yaml", cameras[0], cameras[1],
-                        o.write_imu ? &o.imu : nullptr);
+    WriteSettings(o.output_dir / "settings.yaml", cameras, o);
     summary.layout = "euroc";
   }
   if (o.write_cloud) {

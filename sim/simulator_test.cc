@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "core/util/error.h"
-#include "sim/pose_file.h"
+#include "io/dataset_info.h"
+#include "io/settings.h"
+#include "io/trajectory.h"
 #include "tests/support/test_data.h"
 
 namespace pkslam::sim {
@@ -157,13 +159,20 @@ TEST(Simulator, ReplayWritesEurocFormatLikeTheRealDataset) {
   EXPECT_EQ(*imu_times.begin(), std::stoll(ts.at(0)));
 
   // Settings (ORB-SLAM3 format) and the record of options.
-  cv::FileStorage settings((out / "settings.yaml").string(), cv::FileStorage::READ);
-  ASSERT_TRUE(settings.isOpened());
-  EXPECT_DOUBLE_EQ(static_cast<double>(settings["Camera1.fx"]), 458.654);
-  EXPECT_DOUBLE_EQ(static_cast<double>(settings["IMU.NoiseGyro"]), 1.6968e-4);
-  cv::Mat t_c1_c2;
-  settings["Stereo.T_c1_c2"] >> t_c1_c2;
-  EXPECT_NEAR(t_c1_c2.at<float>(0, 3), 0.110074, 1e-5);  // EuRoC's baseline
+  const Settings settings = ReadOrbSlam3Settings(out / "settings.yaml");
+  EXPECT_DOUBLE_EQ(settings.camera1.fx(), 458.654);
+  ASSERT_TRUE(settings.imu.has_value());
+  EXPECT_DOUBLE_EQ(settings.imu->gyro_noise_density, 1.6968e-4);
+  EXPECT_NEAR(settings.BaselineM(), 0.110078, 1e-5);  // EuRoC's baseline
+  // `pkslam info` reads the sequence: 11 stereo pairs over the 0.5 s window, IMU at 200 Hz.
+  const DatasetInfo info = ComputeDatasetInfo(out);
+  EXPECT_EQ(info.layout, DatasetLayout::kEuroc);
+  ASSERT_TRUE(info.stereo_pairs.has_value());
+  EXPECT_EQ(*info.stereo_pairs, 11u);
+  EXPECT_NEAR(info.ImageDurationS(), 0.5, 1e-9);
+  ASSERT_NE(info.Find("imu0"), nullptr);
+  EXPECT_NEAR(info.Find("imu0")->measured_rate_hz, 200.0, 1e-6);
+  EXPECT_TRUE(info.Find("cam0")->missing_files.empty());
   EXPECT_NE(Bytes(out / "sim.yaml").find("seed: 1"), std::string::npos);
   EXPECT_GT(s.cloud_points, 100u);
   EXPECT_EQ(Bytes(out / "reference_cloud.ply").rfind("ply\nformat binary_little_endian 1.0", 0),
@@ -196,10 +205,10 @@ TEST(Simulator, SameSeedGivesIdenticalBytes) {
   EXPECT_GT(files, 20);
   EXPECT_GT(differ_c, 10);  // images, IMU, biases, sim.yaml change with the seed
   // The motion does not depend on the seed: same ground-truth poses.
-  const auto ga = ReadPoseFile(a / "mav0/state_groundtruth_estimate0/data.csv");
-  const auto gc = ReadPoseFile(c / "mav0/state_groundtruth_estimate0/data.csv");
+  const auto ga = ReadTrajectory(a / "mav0/state_groundtruth_estimate0/data.csv").poses;
+  const auto gc = ReadTrajectory(c / "mav0/state_groundtruth_estimate0/data.csv").poses;
   ASSERT_EQ(ga.size(), gc.size());
-  EXPECT_EQ(ga.back().world_from_body.translation(), gc.back().world_from_body.translation());
+  EXPECT_EQ(ga.back().pose.translation(), gc.back().pose.translation());
 }
 
 TEST(Simulator, FullV102ReplayKeepsDurationAndPathLength) {
@@ -214,28 +223,27 @@ TEST(Simulator, FullV102ReplayKeepsDurationAndPathLength) {
   o.quality = Quality::kFast;
   o.quiet = true;
   RunSimulation(o);
-  const auto src = ReadPoseFile(source);
-  const auto sim = ReadPoseFile(out / "mav0/state_groundtruth_estimate0/data.csv");
-  auto length = [](const std::vector<PoseSample>& p) {
-    std::vector<Eigen::Vector3d> x;
-    for (const auto& s : p) x.push_back(s.world_from_body.translation());
-    return PathLength(x);
-  };
-  const double src_s = 1e-9 * static_cast<double>(src.back().t_ns - src.front().t_ns);
-  const double sim_s = 1e-9 * static_cast<double>(sim.back().t_ns - sim.front().t_ns);
-  std::printf("V1_02 source %.3f s %.3f m; simulated %.3f s %.3f m\n", src_s, length(src), sim_s,
-              length(sim));
+  const Trajectory src_traj = ReadTrajectory(source);
+  const Trajectory sim_traj = ReadTrajectory(out / "mav0/state_groundtruth_estimate0/data.csv");
+  const auto& src = src_traj.poses;
+  const auto& sim = sim_traj.poses;
+  const double src_s = DurationSeconds(src_traj);
+  const double sim_s = DurationSeconds(sim_traj);
+  const double src_m = PathLengthMeters(src_traj);
+  const double sim_m = PathLengthMeters(sim_traj);
+  std::printf("V1_02 source %.3f s %.3f m; simulated %.3f s %.3f m\n", src_s, src_m, sim_s, sim_m);
   EXPECT_EQ(sim.front().t_ns, src.front().t_ns);
   EXPECT_NEAR(sim_s, src_s, 0.005);
-  EXPECT_NEAR(length(sim), length(src), 0.01 * length(src));
+  EXPECT_NEAR(sim_m, src_m, 0.01 * src_m);
+  EXPECT_TRUE(sim_traj.has_extras());           // 17-column EuRoC ground truth
+  EXPECT_FALSE(fs::exists(out / "mav0/cam0"));  // --no-images: IMU and ground truth only
   // The replay follows the source closely (not just in length).
   double max_err = 0;
   std::size_t j = 0;
   for (const auto& s : src) {
     while (j + 1 < sim.size() && sim[j].t_ns < s.t_ns) ++j;
     if (std::llabs(sim[j].t_ns - s.t_ns) > 100'000) continue;  // 10 us source rounding
-    max_err = std::max(
-        max_err, (sim[j].world_from_body.translation() - s.world_from_body.translation()).norm());
+    max_err = std::max(max_err, (sim[j].pose.translation() - s.pose.translation()).norm());
   }
   EXPECT_LT(max_err, 0.01);
 }
@@ -265,8 +273,12 @@ TEST(Simulator, RgbdWritesTumLayout) {
   EXPECT_GT(hi / 5000.0, 0.5);
   EXPECT_LT(hi / 5000.0, 8.01);
   EXPECT_GT(Lines(out / "groundtruth.txt").size(), 20u);
-  cv::FileStorage settings((out / "settings.yaml").string(), cv::FileStorage::READ);
-  EXPECT_DOUBLE_EQ(static_cast<double>(settings["RGBD.DepthMapFactor"]), 5000.0);
+  const Settings settings = ReadOrbSlam3Settings(out / "settings.yaml");
+  EXPECT_EQ(settings.depth_map_factor, 5000.0);
+  const DatasetInfo info = ComputeDatasetInfo(out);
+  EXPECT_EQ(info.layout, DatasetLayout::kTumRgbd);
+  ASSERT_TRUE(info.rgbd_pairs.has_value());
+  EXPECT_EQ(*info.rgbd_pairs, 7u);
 }
 
 TEST(Simulator, BadInputsAreReportedWithFileAndLine) {

@@ -35,7 +35,7 @@ void ReplayOptions::Check() const {
   PKSLAM_CHECK_OPTION(padding_s >= 0.0, "padding_s", "{}", padding_s);
 }
 
-SplineTrajectory FitTrajectory(const std::vector<PoseSample>& samples, std::int64_t begin_ns,
+SplineTrajectory FitTrajectory(const std::vector<StampedPose>& samples, std::int64_t begin_ns,
                                std::int64_t end_ns, const ReplayOptions& options) {
   options.Check();
   PKSLAM_CHECK(samples.size() >= 2, "trajectory has {} poses", samples.size());
@@ -52,8 +52,8 @@ SplineTrajectory FitTrajectory(const std::vector<PoseSample>& samples, std::int6
   for (const auto& s : samples) {
     if (s.t_ns < lo || s.t_ns > hi) continue;
     t.push_back(s.t_ns);
-    p.push_back(s.world_from_body.translation());
-    r.push_back(s.world_from_body.so3());
+    p.push_back(s.pose.translation());
+    r.push_back(s.pose.so3());
   }
   auto knot = [](double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); };
   const KnotGrid pgrid = KnotGrid::Covering(t.front(), t.back(), knot(options.position_knot_s));

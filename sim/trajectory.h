@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/geometry/se3.h"
+#include "io/trajectory.h"
 #include "sim/bspline.h"
 
 namespace pkslam::sim {
@@ -45,12 +46,6 @@ class SplineTrajectory {
   std::int64_t end_ns_ = 0;
 };
 
-// A time-stamped pose from a trajectory file.
-struct PoseSample {
-  std::int64_t t_ns = 0;
-  SE3d world_from_body;
-};
-
 // Smoothing options for replaying recorded (motion-capture) poses.
 struct ReplayOptions {
   double position_knot_s = 0.05;    // knot spacing of the quintic position spline
@@ -62,12 +57,12 @@ struct ReplayOptions {
   void Check() const;
 };
 
-// Fits the samples around [begin_ns, end_ns] (plus padding where data exists). Throws
-// InputError-free Error when the window holds too few samples.
-SplineTrajectory FitTrajectory(const std::vector<PoseSample>& samples, std::int64_t begin_ns,
+// Fits the poses (world_from_body, e.g. from io/trajectory.h) around [begin_ns, end_ns] plus
+// padding where data exists. Throws Error when the window holds too few samples.
+SplineTrajectory FitTrajectory(const std::vector<StampedPose>& samples, std::int64_t begin_ns,
                                std::int64_t end_ns, const ReplayOptions& options);
 
-// Path length (m) and duration (s) of sampled positions; shared by tests and the report.
+// Path length (m) of sampled positions.
 double PathLength(const std::vector<Eigen::Vector3d>& positions);
 
 }  // namespace pkslam::sim
