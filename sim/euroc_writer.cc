@@ -153,14 +153,17 @@ EurocWriter::EurocWriter(const std::filesystem::path& dir, const std::vector<Cam
 }
 
 void EurocWriter::WriteImage(int camera, std::int64_t t_ns, const cv::Mat& image) {
+  WritePng(AddImage(camera, t_ns), image);
+}
+
+std::filesystem::path EurocWriter::AddImage(int camera, std::int64_t t_ns) {
   const std::string name = fmt::format("{}.png", t_ns);
-  const std::filesystem::path cam_dir = dir_ / "mav0" / fmt::format("cam{}", camera);
-  WritePng(cam_dir / "data" / name, image);
   camera_csv_.at(camera) << t_ns << ',' << name << '\n';
   if (t_ns != last_timestamp_) {
     timestamps_ << t_ns << '\n';
     last_timestamp_ = t_ns;
   }
+  return dir_ / "mav0" / fmt::format("cam{}", camera) / "data" / name;
 }
 
 void EurocWriter::WriteImu(const ImuSample& s) {

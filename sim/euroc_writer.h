@@ -5,6 +5,7 @@
 //   DIR/mav0/imu0/{sensor.yaml, data.csv}
 //   DIR/mav0/state_groundtruth_estimate0/{sensor.yaml, data.csv}   (17 columns)
 // plus DIR/timestamps.txt (image timestamps, one per line, as ORB-SLAM3's EuRoC examples use).
+// Threads: an EurocWriter is used by one thread; only WritePng may run elsewhere.
 #pragma once
 
 #include <cstdint>
@@ -53,6 +54,9 @@ class EurocWriter {
 
   // Writes camK/data/<t_ns>.png and its data.csv row. Rows must come in time order.
   void WriteImage(int camera, std::int64_t t_ns, const cv::Mat& image);
+  // The same in two steps, so PNG encoding can run on another thread: AddImage writes the
+  // csv rows (in order, on the owning thread) and returns the file to WritePng() into.
+  std::filesystem::path AddImage(int camera, std::int64_t t_ns);
   void WriteImu(const ImuSample& sample);
   void WriteGroundTruth(const GroundTruthRow& row);
   // Flushes and closes all files; throws Error on a write failure. Called by the destructor
@@ -73,7 +77,7 @@ class EurocWriter {
 };
 
 // Writes `image` as PNG (compression level fixed so the bytes are reproducible); throws
-// Error on failure.
+// Error on failure. Thread-safe (no shared state).
 void WritePng(const std::filesystem::path& file, const cv::Mat& image);
 
 }  // namespace pkslam::sim

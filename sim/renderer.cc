@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/util/error.h"
+#include "sim/intersect.h"
 
 namespace pkslam::sim {
 

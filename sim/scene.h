@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "sim/texture.h"
+#include "sim/texture.h"  // FloorToInt
 
 namespace pkslam::sim {
 
@@ -76,8 +76,8 @@ inline Eigen::Vector2f TextureCoords(const Shape& shape, const Material& m,
   float s = (uv.x() + shape.uv_offset.x()) * inv_tile;
   float t = -(uv.y() + shape.uv_offset.y()) * inv_tile;
   if (!m.shuffle_tiles) return {s, t};
-  const float fs = std::floor(s);
-  const float ft = std::floor(t);
+  const float fs = static_cast<float>(FloorToInt(s));
+  const float ft = static_cast<float>(FloorToInt(t));
   float ls = s - fs;
   float lt = t - ft;
   std::uint32_t h = static_cast<std::uint32_t>(static_cast<std::int32_t>(fs)) * 0x9E3779B1u ^
@@ -92,11 +92,7 @@ inline Eigen::Vector2f TextureCoords(const Shape& shape, const Material& m,
           lt + static_cast<float>((h >> 20) & 0xFFFu) * (1.0f / 4096.0f)};
 }
 
-// Ray/shape tests in the shape's local frame. origin/dir are local; dir need not be unit
-// (t is in units of dir). Return false on a miss or a hit not in (t_min, *t).
-bool IntersectLocal(const Shape& shape, const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
-                    float t_min, float* t, int* face, Eigen::Vector2f* uv,
-                    Eigen::Vector3f* normal_local);
+// Ray/shape tests in a shape's local frame: IntersectLocal in sim/intersect.h (inline).
 
 // Signed distance from a world point to the shape's surface (negative inside solids; for the
 // room, distance to the nearest wall, negative outside the room).

@@ -1,5 +1,7 @@
 #include "sim/simulator.h"
 
+#include <tbb/task_group.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -279,6 +281,18 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   double render_seconds = 0.0;
   double render_cpu = 0.0;
   std::vector<RenderBuffers> buffers(cameras.size());
+  tbb::task_group writers;
+  // On an exception below, let running PNG tasks finish before the group goes away.
+  struct WaitOnExit {
+    tbb::task_group& group;
+    ~WaitOnExit() {
+      try {
+        group.wait();
+      } catch (...) {  // the first error is already propagating
+      }
+    }
+  } wait_on_exit{writers};
+  const auto loop_start = std::chrono::steady_clock::now();
   for (int k = 0; k < frames; ++k) {
     const std::int64_t t = first + k * period;
     const bool black = InBlackout(o, t, begin_ns);
@@ -304,20 +318,31 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     }
     render_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     render_cpu += static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+    // PNG encoding of this frame overlaps the rendering of the next one (a second core's
+    // worth of work); list files are written here, in order.
+    writers.wait();
     if (euroc) {
-      for (std::size_t c = 0; c < cameras.size(); ++c)
-        euroc->WriteImage(static_cast<int>(c), t, images[c]);
+      for (std::size_t c = 0; c < cameras.size(); ++c) {
+        const std::filesystem::path file = euroc->AddImage(static_cast<int>(c), t);
+        writers.run([file, image = images[c]] { WritePng(file, image); });
+      }
     }
     if (tum) {
       const cv::Mat depth = black ? cv::Mat::zeros(images[0].size(), CV_16U)
                                   : DepthImage(buffers[0].depth, o.depth_noise, depth_noise,
                                                DeriveSeed(o.seed, 0x44455054 + k), 5000.0);
-      tum->WriteFrame(t, images[0], depth);
+      const auto files = tum->AddFrame(t);
+      writers.run([files, colour = images[0], depth] {
+        TumRgbdWriter::WriteImages(files.first, files.second, colour, depth);
+      });
     }
     progress.Add();
   }
+  writers.wait();
   progress.Finish();
   summary.frames = frames;
+  summary.total_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   summary.render_seconds = render_seconds;
   summary.render_cpu_seconds = render_cpu;
   summary.frames_per_second = render_seconds > 0.0 ? frames / render_seconds : 0.0;

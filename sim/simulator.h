@@ -70,7 +70,9 @@ struct SimulationSummary {
   double max_angular_rate_dps = 0.0;
   double render_seconds = 0.0;      // rendering + image formation only
   double frames_per_second = 0.0;   // frames / render_seconds
-  double render_cpu_seconds = 0.0;  // process CPU time (all threads) of the same work
+  double render_cpu_seconds = 0.0;  // process CPU time (all threads) of the same work; in
+                                    // file-writing runs it includes overlapping PNG encoding
+  double total_seconds = 0.0;       // wall time of the frame loop including image files
   std::size_t cloud_points = 0;
   SceneBuildReport scene;
 };

@@ -42,15 +42,26 @@ TumRgbdWriter::TumRgbdWriter(const std::filesystem::path& dir) : dir_(dir) {
 }
 
 void TumRgbdWriter::WriteFrame(std::int64_t t_ns, const cv::Mat& colour_rgb, const cv::Mat& depth) {
-  PKSLAM_CHECK(colour_rgb.type() == CV_8UC3 && depth.type() == CV_16U, "bad RGB-D image types");
+  const auto [colour_file, depth_file] = AddFrame(t_ns);
+  WriteImages(colour_file, depth_file, colour_rgb, depth);
+}
+
+std::pair<std::filesystem::path, std::filesystem::path> TumRgbdWriter::AddFrame(std::int64_t t_ns) {
   const std::string ts = TumTimestamp(t_ns);
-  cv::Mat bgr;
-  cv::cvtColor(colour_rgb, bgr, cv::COLOR_RGB2BGR);
-  WritePng(dir_ / "rgb" / (ts + ".png"), bgr);
-  WritePng(dir_ / "depth" / (ts + ".png"), depth);
   rgb_txt_ << ts << " rgb/" << ts << ".png\n";
   depth_txt_ << ts << " depth/" << ts << ".png\n";
   assoc_txt_ << ts << " rgb/" << ts << ".png " << ts << " depth/" << ts << ".png\n";
+  return {dir_ / "rgb" / (ts + ".png"), dir_ / "depth" / (ts + ".png")};
+}
+
+void TumRgbdWriter::WriteImages(const std::filesystem::path& colour_file,
+                                const std::filesystem::path& depth_file, const cv::Mat& colour_rgb,
+                                const cv::Mat& depth) {
+  PKSLAM_CHECK(colour_rgb.type() == CV_8UC3 && depth.type() == CV_16U, "bad RGB-D image types");
+  cv::Mat bgr;
+  cv::cvtColor(colour_rgb, bgr, cv::COLOR_RGB2BGR);
+  WritePng(colour_file, bgr);
+  WritePng(depth_file, depth);
 }
 
 void TumRgbdWriter::WriteGroundTruth(std::int64_t t_ns, const SE3d& world_from_camera) {

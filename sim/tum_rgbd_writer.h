@@ -10,6 +10,7 @@
 #include <fstream>
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 
 #include "core/geometry/se3.h"
 
@@ -23,6 +24,12 @@ class TumRgbdWriter {
   explicit TumRgbdWriter(const std::filesystem::path& dir);
   // colour: CV_8UC3 in RGB order; depth: CV_16U.
   void WriteFrame(std::int64_t t_ns, const cv::Mat& colour_rgb, const cv::Mat& depth);
+  // The same in two steps (PNG encoding on another thread): AddFrame writes the list rows and
+  // returns the colour and depth files for WriteImages (thread-safe, no shared state).
+  std::pair<std::filesystem::path, std::filesystem::path> AddFrame(std::int64_t t_ns);
+  static void WriteImages(const std::filesystem::path& colour_file,
+                          const std::filesystem::path& depth_file, const cv::Mat& colour_rgb,
+                          const cv::Mat& depth);
   void WriteGroundTruth(std::int64_t t_ns, const SE3d& world_from_camera);
   void Close();  // throws Error on a failed write
   ~TumRgbdWriter();
