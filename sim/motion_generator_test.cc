@@ -23,6 +23,7 @@ struct Stats {
   double min_view = 1e9;
   double max_view = 0;
   double start_speed = 0;
+  double rms_jerk = 0;
 };
 
 Stats Measure(const Scene& scene, const SplineTrajectory& traj, const SE3d& body_from_camera,
@@ -40,6 +41,9 @@ Stats Measure(const Scene& scene, const SplineTrajectory& traj, const SE3d& body
       continue;
     }
     s.mean_speed += st.velocity_world.norm();
+    Eigen::Vector3d jerk;
+    traj.position().Evaluate(t, nullptr, nullptr, &jerk);
+    s.rms_jerk += jerk.squaredNorm();
     s.mean_rate_dps += st.omega_body.norm() * 180 / M_PI;
     ++n;
     const SE3d cam = st.world_from_body * body_from_camera;
@@ -56,12 +60,14 @@ Stats Measure(const Scene& scene, const SplineTrajectory& traj, const SE3d& body
   }
   s.mean_speed /= n;
   s.mean_rate_dps /= n;
+  s.rms_jerk = std::sqrt(s.rms_jerk / n);
   return s;
 }
 
 TEST(MotionGenerator, LevelsHitTheirSpeedAndRateTargetsAndStayClear) {
   const Scene scene = TinyScene("vicon_room");
   const SE3d body_from_camera = EurocCam0().body_from_camera;
+  double previous_jerk = 0.0;
   for (MotionLevel level : {MotionLevel::kEasy, MotionLevel::kMedium, MotionLevel::kDifficult}) {
     MotionOptions o;
     o.level = level;
@@ -70,10 +76,12 @@ TEST(MotionGenerator, LevelsHitTheirSpeedAndRateTargetsAndStayClear) {
     const Stats s = Measure(scene, traj, body_from_camera, o.rest_s);
     const MotionLevelParams target = ParamsFor(level);
     std::printf(
-        "%s: speed %.2f m/s (target %.2f), angular rate %.1f deg/s (target %.1f), "
-        "min clearance %.2f m, view distance %.2f..%.2f m\n",
+        "%s: speed %.2f m/s (target %.2f), angular rate %.1f deg/s (target %.1f), rms jerk "
+        "%.2f m/s^3, min clearance %.2f m, view distance %.2f..%.2f m\n",
         MotionLevelName(level).c_str(), s.mean_speed, target.speed_mps, s.mean_rate_dps,
-        target.angular_rate_dps, s.min_clearance, s.min_view, s.max_view);
+        target.angular_rate_dps, s.rms_jerk, s.min_clearance, s.min_view, s.max_view);
+    EXPECT_GT(s.rms_jerk, previous_jerk);  // harder levels are jerkier
+    previous_jerk = s.rms_jerk;
     EXPECT_NEAR(s.mean_speed, target.speed_mps, 0.2 * target.speed_mps);
     EXPECT_NEAR(s.mean_rate_dps, target.angular_rate_dps, 0.25 * target.angular_rate_dps);
     EXPECT_GT(s.min_clearance, 0.5);

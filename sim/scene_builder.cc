@@ -262,6 +262,9 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
     const MaterialDesc& m = d.materials[i];
     TextureSpec spec = m.texture;
     if (spec.size == 0) spec.size = options.texture_size;
+    // Small (fast/test) textures cannot hold the finest octaves a scene asks for.
+    spec.base_cells = std::min(spec.base_cells, spec.size);
+    if (spec.max_cells > 0) spec.max_cells = std::min(spec.max_cells, spec.size);
     spec.seed = DeriveSeed(options.seed, 0x54455800 + i);
     const bool tiled = !m.stretch && spec.kind != TextureKind::kChecker;
     if (tiled && options.texture_mode == TextureMode::kWeak) {

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
 
@@ -279,6 +280,39 @@ TEST(Simulator, RgbdWritesTumLayout) {
   EXPECT_EQ(info.layout, DatasetLayout::kTumRgbd);
   ASSERT_TRUE(info.rgbd_pairs.has_value());
   EXPECT_EQ(*info.rgbd_pairs, 7u);
+}
+
+// Sharpness: variance of the Laplacian.
+double Sharpness(const cv::Mat& image) {
+  cv::Mat lap;
+  cv::Laplacian(image, lap, CV_64F);
+  cv::Scalar mean, sd;
+  cv::meanStdDev(lap, mean, sd);
+  return sd[0] * sd[0];
+}
+
+TEST(Simulator, MotionBlurSoftensMovingFrames) {
+  PKSLAM_REQUIRE_SHARED_DATA(shared);
+  const fs::path sharp_dir = testing::MakeTempDir("sim_sharp");
+  const fs::path blur_dir = testing::MakeTempDir("sim_blur");
+  SimulationOptions o = ShortReplay(shared, sharp_dir);
+  o.duration_s = 0.1;
+  o.write_cloud = false;
+  o.sensor.read_noise_dn = 0.0;
+  o.sensor.shot_noise_gain = 0.0;
+  RunSimulation(o);
+  o.output_dir = blur_dir;
+  o.motion_blur_exposure_s = 0.03;  // 30 ms at ~1 m/s and ~30 deg/s: several pixels
+  RunSimulation(o);
+  const std::string name = Split(Lines(sharp_dir / "mav0/cam0/data.csv").at(2), ',')[1];
+  const cv::Mat sharp =
+      cv::imread((sharp_dir / "mav0/cam0/data" / name).string(), cv::IMREAD_GRAYSCALE);
+  const cv::Mat blurred =
+      cv::imread((blur_dir / "mav0/cam0/data" / name).string(), cv::IMREAD_GRAYSCALE);
+  std::printf("Laplacian variance: sharp %.1f, motion-blurred %.1f\n", Sharpness(sharp),
+              Sharpness(blurred));
+  EXPECT_LT(Sharpness(blurred), 0.8 * Sharpness(sharp));
+  EXPECT_NEAR(cv::mean(blurred)[0], cv::mean(sharp)[0], 8.0);  // same exposure
 }
 
 TEST(Simulator, BadInputsAreReportedWithFileAndLine) {
