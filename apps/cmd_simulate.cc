@@ -72,13 +72,16 @@ void Run(SimulateArgs& a) {
   std::cout << fmt::format(
       "simulate: {} -> {} ({})\n  {} frames, {} IMU samples, {:.3f} s, path {:.3f} m, "
       "mean speed {:.2f} m/s, angular rate mean {:.1f} / max {:.1f} deg/s\n"
-      "  scene: {} objects ({} removed near the path), cloud {} points\n"
-      "  {:.1f} frames/s end to end (rendering, image formation and PNG files)\n",
+      "  scene: {} objects ({} removed near the path), cloud {} points\n",
       o.trajectory.empty() ? "random " + a.motion : o.trajectory.string(), o.output_dir.string(),
       s.layout, s.frames, s.imu_samples, duration, s.path_length_m, s.mean_speed_mps,
       s.mean_angular_rate_dps, s.max_angular_rate_dps,
-      s.scene.objects_placed - s.scene.objects_removed, s.scene.objects_removed, s.cloud_points,
-      s.total_seconds > 0.0 ? s.frames / s.total_seconds : 0.0);
+      s.scene.objects_placed - s.scene.objects_removed, s.scene.objects_removed, s.cloud_points);
+  if (s.frames > 0 && s.total_seconds > 0.0) {
+    std::cout << fmt::format(
+        "  {:.1f} frames/s end to end (rendering, image formation and PNG files)\n",
+        s.frames / s.total_seconds);
+  }
 }
 
 }  // namespace

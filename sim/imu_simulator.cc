@@ -53,7 +53,9 @@ std::vector<Tone> MakeTones(Rng* rng, int count, double rms) {
     Tone t;
     t.frequency_hz = rng->Uniform(35.0, 90.0);
     t.phase = rng->Uniform(0.0, 2.0 * std::numbers::pi);
-    Eigen::Vector3d dir(rng->Normal(), rng->Normal(), rng->Normal());
+    // One draw per statement: argument evaluation order is unspecified in C++.
+    Eigen::Vector3d dir;
+    for (int k = 0; k < 3; ++k) dir[k] = rng->Normal();
     t.amplitude = amplitude * dir.normalized();
     tones.push_back(t);
   }

@@ -90,8 +90,8 @@ class Planner {
 
   Eigen::Vector3d RandomFreePoint() const {
     for (int attempt = 0; attempt < 5000; ++attempt) {
-      const Eigen::Vector3d p(rng_->Uniform(lo_.x(), hi_.x()), rng_->Uniform(lo_.y(), hi_.y()),
-                              rng_->Uniform(lo_.z(), hi_.z()));
+      Eigen::Vector3d p;  // one draw per statement (argument order is unspecified)
+      for (int k = 0; k < 3; ++k) p[k] = rng_->Uniform(lo_[k], hi_[k]);
       if (Free(p)) return p;
     }
     throw Error("no free space for the camera in the scene (reduce the clearance)");

@@ -22,8 +22,10 @@ CameraRays::CameraRays(const CameraModel& camera, int supersample)
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x) {
       for (int k = 0; k < samples_; ++k) {
-        const double ox = ((k % supersample) + 0.5) / supersample - 0.5;
-        const double oy = ((k / supersample) + 0.5) / supersample - 0.5;
+        const int sx = k % supersample;
+        const int sy = k / supersample;
+        const double ox = (sx + 0.5) / supersample - 0.5;
+        const double oy = (sy + 0.5) / supersample - 0.5;
         const Eigen::Vector3d r = camera.Unproject(Eigen::Vector2d(x + ox, y + oy));
         rays_[(static_cast<std::size_t>(y) * width_ + x) * samples_ + k] =
             r.normalized().cast<float>();

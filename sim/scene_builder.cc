@@ -63,8 +63,8 @@ Eigen::Matrix3f Yaw(double deg) {
 
 class Builder {
  public:
-  Builder(const SceneDescription& d, const SceneBuildOptions& o, Scene* scene)
-      : d_(d), o_(o), scene_(scene), rng_(DeriveSeed(o.seed, 0x5343454E45)) {}
+  Builder(const SceneDescription& d, const SceneBuildOptions& o)
+      : d_(d), rng_(DeriveSeed(o.seed, 0x5343454E45)) {}
 
   int Material(const std::string& name) const { return d_.MaterialIndex(name); }
 
@@ -73,8 +73,8 @@ class Builder {
     s.type = type;
     s.name = name;
     s.group = group;
-    s.uv_offset = Eigen::Vector2f(static_cast<float>(rng_.Uniform(0.0, 10.0)),
-                                  static_cast<float>(rng_.Uniform(0.0, 10.0)));
+    s.uv_offset.x() = static_cast<float>(rng_.Uniform(0.0, 10.0));
+    s.uv_offset.y() = static_cast<float>(rng_.Uniform(0.0, 10.0));
     return s;
   }
 
@@ -103,7 +103,7 @@ class Builder {
     const float w = size.x();
     const float dpt = size.y();
     const float h = size.z();
-    auto part = [&](Eigen::Vector3f local_base, Eigen::Vector3f part_size,
+    auto part = [&](const Eigen::Vector3f& local_base, const Eigen::Vector3f& part_size,
                     const std::vector<std::string>& mats) {
       AddBox(base + rot * local_base, part_size, rot, mats, name, group, out);
     };
@@ -192,8 +192,6 @@ class Builder {
 
  private:
   const SceneDescription& d_;
-  const SceneBuildOptions& o_;
-  Scene* scene_;
   Rng rng_;
 };
 
@@ -302,7 +300,7 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
     }
   }
 
-  Builder builder(d, options, &scene);
+  Builder builder(d, options);
   Shape room_shape = builder.NewShape(ShapeType::kRoom, "room", 0);
   room_shape.center = (0.5 * (room.min + room.max)).cast<float>();
   room_shape.half = (0.5 * (room.max - room.min)).cast<float>();

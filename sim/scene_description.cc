@@ -62,7 +62,6 @@ class Parser {
   TextureSpec Texture(const YAML::Node& node) const {
     TextureSpec t;
     const std::string kind = Get<std::string>(node, "kind", "noise");
-    static_assert(sizeof(TextureKind) > 0);
     if (kind == "photo") {
       t.kind = TextureKind::kPhoto;
     } else if (kind == "noise") {

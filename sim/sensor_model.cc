@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/util/error.h"
+#include "sim/texture.h"  // FloorToInt
 
 namespace pkslam::sim {
 
@@ -85,25 +86,25 @@ cv::Mat SensorModel::Develop(const cv::Mat& radiance, double gain, std::uint64_t
   const float scale = static_cast<float>(255.0 * gain);
   const float read = static_cast<float>(options_.read_noise_dn);
   const float shot = static_cast<float>(options_.shot_noise_gain);
-  tbb::parallel_for(tbb::blocked_range<int>(0, radiance.rows),
-                    [&](const tbb::blocked_range<int>& r) {
-                      for (int y = r.begin(); y != r.end(); ++y) {
-                        const float* in = blurred.ptr<float>(y);
-                        const float* vig = vignette_.ptr<float>(y);
-                        std::uint8_t* dst = out.ptr<std::uint8_t>(y);
-                        for (int x = 0; x < radiance.cols; ++x) {
-                          for (int c = 0; c < channels; ++c) {
-                            const int i = x * channels + c;
-                            const float level = std::max(in[i] * vig[x] * scale, 0.0f);
-                            const float sigma = std::sqrt(read * read + shot * level);
-                            const std::uint64_t index =
-                                static_cast<std::uint64_t>(y) * radiance.cols * channels + i;
-                            const float v = level + sigma * noise_.Sample(key, index);
-                            dst[i] = static_cast<std::uint8_t>(std::clamp(v, 0.0f, 255.0f) + 0.5f);
-                          }
-                        }
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, radiance.rows), [&](const tbb::blocked_range<int>& r) {
+        for (int y = r.begin(); y != r.end(); ++y) {
+          const float* in = blurred.ptr<float>(y);
+          const float* vig = vignette_.ptr<float>(y);
+          std::uint8_t* dst = out.ptr<std::uint8_t>(y);
+          for (int x = 0; x < radiance.cols; ++x) {
+            for (int c = 0; c < channels; ++c) {
+              const int i = x * channels + c;
+              const float level = std::max(in[i] * vig[x] * scale, 0.0f);
+              const float sigma = std::sqrt(read * read + shot * level);
+              const std::uint64_t index =
+                  static_cast<std::uint64_t>(y) * radiance.cols * channels + i;
+              const float v = level + sigma * noise_.Sample(key, index);
+              dst[i] = static_cast<std::uint8_t>(FloorToInt(std::clamp(v, 0.0f, 255.0f) + 0.5f));
+            }
+          }
+        }
+      });
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "core/util/error.h"
@@ -158,10 +159,14 @@ RotationSpline4 FitRotationSpline(const std::vector<std::int64_t>& t_ns,
     int seg = 0;
     double u = 0.0;
     grid.Locate(t_ns[k], &seg, &u);
-    auto* cost = new ceres::AutoDiffCostFunction<RotationSampleCost, 3, 4, 4, 4, 4>(
-        new RotationSampleCost{rotations[k].Inverse(), basis.Weights(u, 1.0, 0, true)});
-    problem.AddResidualBlock(cost, nullptr, q[seg].coeffs().data(), q[seg + 1].coeffs().data(),
-                             q[seg + 2].coeffs().data(), q[seg + 3].coeffs().data());
+    // The problem owns cost functions (and they their functors): hand over released pointers.
+    auto cost = std::make_unique<ceres::AutoDiffCostFunction<RotationSampleCost, 3, 4, 4, 4, 4>>(
+        std::make_unique<RotationSampleCost>(
+            RotationSampleCost{rotations[k].Inverse(), basis.Weights(u, 1.0, 0, true)})
+            .release());
+    problem.AddResidualBlock(cost.release(), nullptr, q[seg].coeffs().data(),
+                             q[seg + 1].coeffs().data(), q[seg + 2].coeffs().data(),
+                             q[seg + 3].coeffs().data());
   }
   if (cutoff_hz > 0.0) {
     // integral |theta''|^2 dt ~ sum |second difference|^2 / dt^3; lambda as for positions
@@ -170,10 +175,10 @@ RotationSpline4 FitRotationSpline(const std::vector<std::int64_t>& t_ns,
     const double lambda = SampleRate(t_ns) / std::pow(2.0 * std::numbers::pi * cutoff_hz, 4);
     const double weight = std::sqrt(lambda / (dt * dt * dt));
     for (int j = 1; j + 1 < n; ++j) {
-      auto* cost = new ceres::AutoDiffCostFunction<RotationSmoothnessCost, 3, 4, 4, 4>(
-          new RotationSmoothnessCost{weight});
-      problem.AddResidualBlock(cost, nullptr, q[j - 1].coeffs().data(), q[j].coeffs().data(),
-                               q[j + 1].coeffs().data());
+      auto cost = std::make_unique<ceres::AutoDiffCostFunction<RotationSmoothnessCost, 3, 4, 4, 4>>(
+          std::make_unique<RotationSmoothnessCost>(RotationSmoothnessCost{weight}).release());
+      problem.AddResidualBlock(cost.release(), nullptr, q[j - 1].coeffs().data(),
+                               q[j].coeffs().data(), q[j + 1].coeffs().data());
     }
   }
   for (int j = 0; j < n; ++j) {

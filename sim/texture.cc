@@ -23,13 +23,14 @@ MipTexture::MipTexture(const cv::Mat& grey, const cv::Mat& colour, bool repeat)
   base.height = grey.rows;
   base.grey.resize(static_cast<std::size_t>(grey.total()));
   for (int y = 0; y < grey.rows; ++y) {
-    std::copy_n(grey.ptr<std::uint8_t>(y), grey.cols, base.grey.data() + y * grey.cols);
+    std::copy_n(grey.ptr<std::uint8_t>(y), grey.cols,
+                base.grey.data() + static_cast<std::ptrdiff_t>(y) * grey.cols);
   }
   if (has_colour_) {
     base.rgb.resize(static_cast<std::size_t>(grey.total()) * 3);
     for (int y = 0; y < colour.rows; ++y) {
       std::copy_n(colour.ptr<std::uint8_t>(y), colour.cols * 3,
-                  base.rgb.data() + y * colour.cols * 3);
+                  base.rgb.data() + static_cast<std::ptrdiff_t>(y) * colour.cols * 3);
     }
   }
   levels_.push_back(std::move(base));

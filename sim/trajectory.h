@@ -48,11 +48,11 @@ class SplineTrajectory {
 
 // Smoothing options for replaying recorded (motion-capture) poses.
 struct ReplayOptions {
-  double position_knot_s = 0.05;    // knot spacing of the quintic position spline
-  double rotation_knot_s = 0.05;    // knot spacing of the cubic rotation spline
-  double position_cutoff_hz = 6.0;  // low-pass cutoff of the jerk penalty (<= 0: none)
-  double rotation_cutoff_hz = 6.0;  // same for angular acceleration (<= 0: none)
-  double padding_s = 1.0;           // extra data fitted beyond the window on each side
+  double position_knot_s = 0.05;     // knot spacing of the quintic position spline
+  double rotation_knot_s = 0.05;     // knot spacing of the cubic rotation spline
+  double position_cutoff_hz = 10.0;  // low-pass cutoff of the jerk penalty (<= 0: none)
+  double rotation_cutoff_hz = 10.0;  // same for angular acceleration (<= 0: none)
+  double padding_s = 1.0;            // extra data fitted beyond the window on each side
 
   void Check() const;
 };
