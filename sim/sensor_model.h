@@ -28,6 +28,8 @@ struct SensorOptions {
   void Check() const;
 };
 
+// Threads: NextGain() updates the exposure state and belongs to the one thread driving the
+// frame loop; Develop() is const (it parallelises rows internally with TBB).
 class SensorModel {
  public:
   // Precomputes the vignetting map of the camera.

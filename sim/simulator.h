@@ -5,6 +5,10 @@
 //     groundtruth.txt of the colour camera), DIR/settings.yaml.
 //   Both: DIR/reference_cloud.ply (seen surfaces), DIR/sim.yaml (every option + seed).
 // Same options and seed -> identical bytes.
+//
+// Threads: RunSimulation drives frames sequentially on the calling thread; rendering and
+// image formation use TBB inside each frame, and the PNG files of frame k are encoded by a
+// TBB task while frame k+1 renders (list files are written in order by the calling thread).
 #pragma once
 
 #include <cstdint>
