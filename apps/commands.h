@@ -10,5 +10,6 @@ void RegisterEvalCommand(CLI::App& app);
 void RegisterInfoCommand(CLI::App& app);
 void RegisterRunCommand(CLI::App& app);
 void RegisterVocabCommand(CLI::App& app);
+void RegisterSimulateCommand(CLI::App& app);
 
 }  // namespace pkslam::apps

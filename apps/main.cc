@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterInfoCommand(app);
   pkslam::apps::RegisterRunCommand(app);
   pkslam::apps::RegisterVocabCommand(app);
+  pkslam::apps::RegisterSimulateCommand(app);
 
   try {
     app.parse(argc, argv);
