@@ -1,11 +1,50 @@
+// pkslam info DATASET [--json OUT]: what a dataset holds and what is wrong with it.
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <string>
+
 #include "apps/commands.h"
 #include "core/util/error.h"
+#include "io/dataset_info.h"
 
 namespace pkslam::apps {
 
+namespace {
+
+struct InfoArgs {
+  std::string dataset;
+  std::string json_out;
+};
+
+void RunInfo(const InfoArgs& args) {
+  const DatasetInfo info = ComputeDatasetInfo(args.dataset);
+  std::cout << FormatDatasetInfo(info) << std::flush;
+  if (!args.json_out.empty()) {
+    std::ofstream out(args.json_out, std::ios::trunc);
+    if (!out) throw Error(args.json_out + ": cannot open for writing");
+    out << DatasetInfoToJson(info);
+    out.close();
+    if (!out) throw Error(args.json_out + ": write failed");
+  }
+}
+
+}  // namespace
+
 void RegisterInfoCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("info", "(being implemented)");
-  cmd->callback([] { throw Error("not implemented yet"); });
+  auto args = std::make_shared<InfoArgs>();
+  auto* cmd = app.add_subcommand(
+      "info",
+      "Summarise a dataset (EuRoC ASL or TUM RGB-D, auto-detected): sensors, resolutions, "
+      "nominal and measured rates, time spans, frame / stereo pair / rgb-depth pair / IMU / "
+      "ground-truth counts, frame and IMU gaps, missing image files");
+  cmd->add_option("DATASET", args->dataset,
+                  "dataset directory (EuRoC: the sequence dir holding mav0/; TUM: the dir "
+                  "holding rgb.txt)")
+      ->required();
+  cmd->add_option("--json", args->json_out, "also write the summary as JSON to this file");
+  cmd->footer("Example: pkslam info ../shared/data/euroc/V1_01_easy_static --json info.json");
+  cmd->callback([args] { RunInfo(*args); });
 }
 
 }  // namespace pkslam::apps

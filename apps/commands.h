@@ -8,5 +8,6 @@ namespace pkslam::apps {
 
 void RegisterEvalCommand(CLI::App& app);
 void RegisterInfoCommand(CLI::App& app);
+void RegisterVocabCommand(CLI::App& app);
 
 }  // namespace pkslam::apps

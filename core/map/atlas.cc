@@ -1,0 +1,33 @@
+#include "core/map/atlas.h"
+
+#include <algorithm>
+
+namespace pkslam {
+
+Atlas::Atlas() { CreateNewMap(); }
+
+Map* Atlas::CreateNewMap() {
+  maps_.push_back(std::make_unique<Map>(next_map_id_++));
+  current_ = maps_.back().get();
+  return current_;
+}
+
+void Atlas::SetCurrentMap(Map* map) { current_ = map; }
+
+void Atlas::RemoveMap(const Map* map) {
+  std::erase_if(maps_, [map](const std::unique_ptr<Map>& m) { return m.get() == map; });
+  if (current_ == map) current_ = maps_.empty() ? nullptr : maps_.back().get();
+}
+
+void Atlas::ResetCurrentMap() {
+  if (current_ != nullptr) current_->Clear();
+}
+
+std::vector<Map*> Atlas::maps() const {
+  std::vector<Map*> out;
+  out.reserve(maps_.size());
+  for (const auto& m : maps_) out.push_back(m.get());
+  return out;
+}
+
+}  // namespace pkslam

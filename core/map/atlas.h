@@ -1,0 +1,53 @@
+// The Atlas: all maps of a session, the current (active) map, the id counters and the mutex
+// that guards the whole map model (see docs/architecture.md for the locking rules).
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <vector>
+
+#include "core/map/ids.h"
+#include "core/map/map.h"
+
+namespace pkslam {
+
+class Atlas {
+ public:
+  Atlas();
+  Atlas(const Atlas&) = delete;
+  Atlas& operator=(const Atlas&) = delete;
+
+  // Shared: read the map model. Exclusive: change it.
+  std::shared_mutex& mutex() const { return mutex_; }
+
+  // Requires the exclusive lock.
+  Map* CreateNewMap();
+  void SetCurrentMap(Map* map);
+  // Removes an (empty or merged) map; requires the exclusive lock.
+  void RemoveMap(const Map* map);
+  // Clears the current map's content (a reset) keeping the map object.
+  void ResetCurrentMap();
+
+  // Requires at least the shared lock.
+  Map* current_map() const { return current_; }
+  std::vector<Map*> maps() const;
+  int NumMaps() const { return static_cast<int>(maps_.size()); }
+
+  // Id counters (thread-safe, deterministic: ids increase by one per call).
+  FrameId NextFrameId() { return next_frame_id_.fetch_add(1); }
+  KeyFrameId NextKeyFrameId() { return next_kf_id_.fetch_add(1); }
+  MapPointId NextMapPointId() { return next_point_id_.fetch_add(1); }
+
+ private:
+  mutable std::shared_mutex mutex_;
+  std::vector<std::unique_ptr<Map>> maps_;
+  Map* current_ = nullptr;
+  MapId next_map_id_ = 0;
+  std::atomic<FrameId> next_frame_id_{0};
+  std::atomic<KeyFrameId> next_kf_id_{0};
+  std::atomic<MapPointId> next_point_id_{0};
+};
+
+}  // namespace pkslam

@@ -1,0 +1,71 @@
+// One map of the Atlas: its live keyframes and map points (owned, id-ordered), its retired
+// keyframes (kept for trajectory reconstruction), and per-map state (IMU initialisation,
+// change counter for loop corrections). Guarded by the Atlas mutex.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "core/map/ids.h"
+
+namespace pkslam {
+
+class Map {
+ public:
+  explicit Map(MapId id) : id_(id) {}
+  Map(const Map&) = delete;
+  Map& operator=(const Map&) = delete;
+  ~Map();
+
+  MapId id() const { return id_; }
+
+  void AddKeyFrame(const KeyFramePtr& kf);
+  void AddMapPoint(const MapPointPtr& point);
+  // Removes the point from the live set (callers mark it bad first).
+  void EraseMapPoint(const MapPoint* point);
+  // Moves a keyframe from the live set to the retired set (KeyFrame::SetBad calls this).
+  void RetireKeyFrame(const KeyFrame* kf);
+  // Moves a keyframe out of this map entirely (map merging); returns the owning pointer.
+  KeyFramePtr TakeKeyFrame(const KeyFrame* kf);
+  MapPointPtr TakeMapPoint(const MapPoint* point);
+
+  const std::map<KeyFrameId, KeyFramePtr>& keyframes() const { return keyframes_; }
+  const std::map<KeyFrameId, KeyFramePtr>& retired_keyframes() const { return retired_; }
+  const std::map<MapPointId, MapPointPtr>& map_points() const { return map_points_; }
+  int NumKeyFrames() const { return static_cast<int>(keyframes_.size()); }
+  int NumMapPoints() const { return static_cast<int>(map_points_.size()); }
+  // Live or retired keyframe by id, or nullptr.
+  KeyFramePtr FindKeyFrame(KeyFrameId id) const;
+  // The owning pointer of a live keyframe / map point (nullptr if not live here).
+  KeyFramePtr Share(const KeyFrame* kf) const;
+  MapPointPtr Share(const MapPoint* point) const;
+
+  // The first keyframe of the map (never retired), or nullptr.
+  KeyFrame* origin() const { return origin_; }
+  KeyFrameId max_keyframe_id() const { return max_kf_id_; }
+
+  // Bumped by loop closing / global BA so tracking knows poses moved under it.
+  int change_index() const { return change_index_; }
+  void IncreaseChangeIndex() { ++change_index_; }
+
+  // Inertial state of the map.
+  bool imu_initialized = false;
+  bool inertial_ba1_done = false;
+  bool inertial_ba2_done = false;
+
+  // Drops everything (used on reset). Breaks every keyframe<->point link first.
+  void Clear();
+
+ private:
+  MapId id_;
+  std::map<KeyFrameId, KeyFramePtr> keyframes_;
+  std::map<KeyFrameId, KeyFramePtr> retired_;
+  std::map<MapPointId, MapPointPtr> map_points_;
+  KeyFrame* origin_ = nullptr;
+  KeyFrameId max_kf_id_ = kInvalidId;
+  int change_index_ = 0;
+};
+
+}  // namespace pkslam

@@ -1,0 +1,67 @@
+// Trajectory evaluation: associate by time, align, then absolute (ATE) and relative (RPE)
+// errors, reproducing evo_ape / evo_rpe (see association.h, alignment.h, rpe.h for the rules).
+//
+// ATE translation error of pair k: |p_ref_k - T p_est_k| with T = ref_from_est (evo_ape's
+// trans_part); ATE rotation error: the angle of R_ref_k^T (R_T R_est_k) in degrees (evo_ape's
+// angle_deg). A sim3 alignment also scales the estimate's positions before RPE, as evo does.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/geometry/sim3.h"
+#include "core/util/json_writer.h"
+#include "evaluation/alignment.h"
+#include "evaluation/association.h"
+#include "evaluation/rpe.h"
+#include "evaluation/statistics.h"
+#include "io/trajectory.h"
+
+namespace pkslam {
+
+struct EvaluationOptions {
+  // How estimate poses are paired with reference poses.
+  AssociationOptions association;
+  // How the estimate is aligned to the reference before measuring errors.
+  AlignmentMethod alignment = AlignmentMethod::kSE3;
+  // Whether to compute the RPE, and how.
+  bool compute_rpe = true;
+  RpeOptions rpe;
+
+  void Check() const;
+};
+
+struct EvaluationResult {
+  std::size_t ref_poses = 0;  // poses in the reference trajectory
+  std::size_t est_poses = 0;  // poses in the estimated trajectory
+  std::vector<IndexPair> pairs;
+  AlignmentMethod alignment = AlignmentMethod::kSE3;
+  Sim3d ref_from_est;  // the alignment applied to the estimate (identity for none)
+  std::vector<double> ate_translation_errors_m;  // one per pair
+  std::vector<double> ate_rotation_errors_deg;   // one per pair
+  ErrorStatistics ate_translation_m;
+  ErrorStatistics ate_rotation_deg;
+  std::optional<RpeResult> rpe;  // when options.compute_rpe
+  EvaluationOptions options;     // as used
+
+  double scale() const { return ref_from_est.scale(); }
+};
+
+// Throws InputError naming the estimate's file when no pose pair falls within max_diff (the
+// message gives both time ranges) or when there are too few pairs for the alignment;
+// OptionError for bad options.
+EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& est,
+                                      const EvaluationOptions& options);
+
+// The result as one JSON object: {"pairs", "gt_poses", "est_poses", "max_diff_s",
+// "alignment", "scale", "ate": stats, "ate_rot_deg": stats, "rpe": {"delta", "unit",
+// "all_pairs", "pairs", "trans_m": stats, "rot_deg": stats} or null}; stats = {"rmse", "mean",
+// "median", "std", "min", "max", "sse"}.
+void WriteEvaluationJson(const EvaluationResult& result, JsonWriter& json);
+std::string EvaluationJson(const EvaluationResult& result);
+
+// A readable multi-line table of the same numbers.
+std::string FormatEvaluationTable(const EvaluationResult& result);
+
+}  // namespace pkslam

@@ -1,0 +1,91 @@
+#include "io/dataset_common.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/util/error.h"
+#include "core/util/log.h"
+
+namespace pkslam {
+
+std::vector<TimeGap> FindTimeGaps(const std::vector<std::int64_t>& t_ns, double nominal_period_ns,
+                                  double max_periods) {
+  std::vector<TimeGap> gaps;
+  if (t_ns.size() < 2) return gaps;
+  if (nominal_period_ns <= 0) {
+    std::vector<std::int64_t> dt(t_ns.size() - 1);
+    for (std::size_t i = 1; i < t_ns.size(); ++i) dt[i - 1] = t_ns[i] - t_ns[i - 1];
+    std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+    nominal_period_ns = static_cast<double>(dt[dt.size() / 2]);
+    if (nominal_period_ns <= 0) return gaps;
+  }
+  for (std::size_t i = 1; i < t_ns.size(); ++i) {
+    const double periods = static_cast<double>(t_ns[i] - t_ns[i - 1]) / nominal_period_ns;
+    if (periods > max_periods) gaps.push_back({t_ns[i - 1], t_ns[i], periods});
+  }
+  return gaps;
+}
+
+double MeasuredRateHz(std::int64_t first_ns, std::int64_t last_ns, std::size_t count) {
+  if (count < 2 || last_ns <= first_ns) return 0.0;
+  return static_cast<double>(count - 1) * 1e9 / static_cast<double>(last_ns - first_ns);
+}
+
+void FillImageStream(const std::vector<ImageEntry>& listed, double frame_gap_periods,
+                     ImageStream* stream) {
+  stream->listed = listed.size();
+  stream->images.clear();
+  stream->missing.clear();
+  for (const ImageEntry& entry : listed) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(entry.path, ec)) {
+      stream->images.push_back(entry);
+    } else {
+      stream->missing.push_back(entry.path);
+    }
+  }
+  if (!stream->missing.empty()) {
+    std::string first;
+    const std::size_t shown = std::min<std::size_t>(stream->missing.size(), 3);
+    for (std::size_t i = 0; i < shown; ++i) {
+      first += (i ? ", " : "") + stream->missing[i].filename().string();
+    }
+    PKSLAM_LOG_WARN("{}: {} of {} images listed in {} are missing and skipped (first: {}{})",
+                    stream->name, stream->missing.size(), stream->listed,
+                    stream->list_file.string(), first,
+                    stream->missing.size() > shown ? ", ..." : "");
+  }
+  std::vector<std::int64_t> t_ns;
+  t_ns.reserve(stream->images.size());
+  for (const ImageEntry& entry : stream->images) t_ns.push_back(entry.t_ns);
+  const double period_ns = stream->nominal_rate_hz > 0 ? 1e9 / stream->nominal_rate_hz : 0.0;
+  stream->gaps = FindTimeGaps(t_ns, period_ns, frame_gap_periods);
+}
+
+namespace {
+
+cv::Mat LoadImage(const std::filesystem::path& path, int flags) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "image file not found");
+  cv::Mat image = cv::imread(path.string(), flags);
+  if (image.empty()) throw InputError(path, "cannot decode image (corrupt or unsupported)");
+  return image;
+}
+
+}  // namespace
+
+cv::Mat LoadGreyImage(const std::filesystem::path& path) {
+  return LoadImage(path, cv::IMREAD_GRAYSCALE);
+}
+
+cv::Mat LoadColourImage(const std::filesystem::path& path) {
+  return LoadImage(path, cv::IMREAD_COLOR);
+}
+
+cv::Mat LoadUnchangedImage(const std::filesystem::path& path) {
+  return LoadImage(path, cv::IMREAD_UNCHANGED);
+}
+
+}  // namespace pkslam

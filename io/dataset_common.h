@@ -1,0 +1,65 @@
+// Types shared by the dataset readers: image lists with their missing files and time gaps,
+// IMU samples, and lazy image loading that turns unreadable files into InputError.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace pkslam {
+
+// One image of a sequence: its timestamp and the absolute path of its file.
+struct ImageEntry {
+  std::int64_t t_ns = 0;
+  std::filesystem::path path;
+};
+
+// An interval between consecutive samples longer than the gap threshold.
+struct TimeGap {
+  std::int64_t begin_ns = 0;  // the sample before the gap
+  std::int64_t end_ns = 0;    // the sample after the gap
+  double periods = 0;         // (end - begin) / nominal period
+};
+
+// A list of images as the dataset describes it, after the up-front existence check.
+struct ImageStream {
+  std::string name;                            // "cam0", "cam1", "rgb", "depth"
+  std::filesystem::path list_file;             // data.csv / rgb.txt the list came from
+  double nominal_rate_hz = 0;                  // from the sensor description; 0 = unknown
+  std::size_t listed = 0;                      // rows in the list file
+  std::vector<ImageEntry> images;              // rows whose file exists, time-ordered
+  std::vector<std::filesystem::path> missing;  // rows whose file does not exist
+  std::vector<TimeGap> gaps;                   // between consecutive usable images
+};
+
+// One IMU reading, in the IMU sensor frame.
+struct ImuSample {
+  std::int64_t t_ns = 0;
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   // angular velocity [rad/s]
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // specific force [m/s^2]
+};
+
+// Gaps of a strictly increasing time series: intervals > max_periods * nominal period.
+// nominal_period_ns <= 0 uses the median interval. Fewer than 2 samples: no gaps.
+std::vector<TimeGap> FindTimeGaps(const std::vector<std::int64_t>& t_ns, double nominal_period_ns,
+                                  double max_periods);
+
+// (n - 1) / (last - first) in Hz; 0 when fewer than 2 samples or zero span.
+double MeasuredRateHz(std::int64_t first_ns, std::int64_t last_ns, std::size_t count);
+
+// Splits `listed` into stream->images (file exists) and stream->missing, keeping order,
+// and fills stream->gaps (intervals > frame_gap_periods nominal periods among usable images).
+// Logs one warning with the count and the first few names when files are missing.
+void FillImageStream(const std::vector<ImageEntry>& listed, double frame_gap_periods,
+                     ImageStream* stream);
+
+// Loads an image lazily. Throws InputError(path) if the file is missing or cannot be decoded.
+cv::Mat LoadGreyImage(const std::filesystem::path& path);       // CV_8UC1
+cv::Mat LoadColourImage(const std::filesystem::path& path);     // CV_8UC3, BGR
+cv::Mat LoadUnchangedImage(const std::filesystem::path& path);  // as stored (e.g. CV_16UC1)
+
+}  // namespace pkslam

@@ -1,0 +1,39 @@
+// EuRoC ASL sensor descriptions (mav0/<sensor>/sensor.yaml). T_BS maps sensor coordinates to
+// body (IMU) coordinates: p_body = T_BS * p_sensor, i.e. body_from_sensor.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/geometry/se3.h"
+
+namespace pkslam {
+
+struct EurocCameraSensor {
+  SE3d body_from_camera;                        // T_BS
+  double rate_hz = 0;                           // rate_hz
+  int width = 0;                                // resolution[0]
+  int height = 0;                               // resolution[1]
+  std::string camera_model;                     // "pinhole" (the only model EuRoC/TUM-VI use)
+  std::array<double, 4> intrinsics{};           // fu, fv, cu, cv
+  std::string distortion_model;                 // "radial-tangential" | "equidistant"
+  std::vector<double> distortion_coefficients;  // radtan: k1 k2 p1 p2 [k3]; equidistant: k1..k4
+};
+
+struct EurocImuSensor {
+  SE3d body_from_imu;                      // T_BS (identity on EuRoC: the IMU is the body)
+  double rate_hz = 0;                      // rate_hz
+  double gyroscope_noise_density = 0;      // [rad/s/sqrt(Hz)]
+  double gyroscope_random_walk = 0;        // [rad/s^2/sqrt(Hz)]
+  double accelerometer_noise_density = 0;  // [m/s^2/sqrt(Hz)]
+  double accelerometer_random_walk = 0;    // [m/s^3/sqrt(Hz)]
+};
+
+// Parse and validate (positive rate and size, known models, coefficient counts, rigid T_BS).
+// Throws InputError naming the file and key.
+EurocCameraSensor ReadEurocCameraSensor(const std::filesystem::path& sensor_yaml);
+EurocImuSensor ReadEurocImuSensor(const std::filesystem::path& sensor_yaml);
+
+}  // namespace pkslam

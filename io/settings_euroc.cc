@@ -1,0 +1,67 @@
+#include "io/settings_euroc.h"
+
+#include <fmt/format.h>
+
+#include "core/util/error.h"
+
+namespace pkslam {
+namespace {
+
+CameraModel CameraOf(const EurocCameraSensor& sensor, const std::filesystem::path& yaml) {
+  const auto& k = sensor.intrinsics;
+  const auto& d = sensor.distortion_coefficients;
+  try {
+    if (sensor.distortion_model == "equidistant") {
+      return CameraModel::KannalaBrandt8(sensor.width, sensor.height, k[0], k[1], k[2], k[3],
+                                         {d[0], d[1], d[2], d[3]});
+    }
+    return CameraModel::Pinhole(sensor.width, sensor.height, k[0], k[1], k[2], k[3], d);
+  } catch (const OptionError& e) {
+    throw InputError(yaml, fmt::format("invalid camera calibration: {}", e.what()));
+  }
+}
+
+}  // namespace
+
+Settings SettingsFromEuroc(const EurocDataset& dataset) {
+  Settings s;
+  const EurocCameraSensor& cam0 = dataset.cam0_sensor();
+  s.camera1 = CameraOf(cam0, dataset.mav0() / "cam0" / "sensor.yaml");
+  s.fps = cam0.rate_hz;
+  if (dataset.has_cam1()) {
+    const EurocCameraSensor& cam1 = dataset.cam1_sensor();
+    const std::filesystem::path cam1_yaml = dataset.mav0() / "cam1" / "sensor.yaml";
+    if (cam1.width != cam0.width || cam1.height != cam0.height) {
+      throw InputError(cam1_yaml, fmt::format("resolution {}x{} differs from cam0's {}x{}",
+                                              cam1.width, cam1.height, cam0.width, cam0.height));
+    }
+    if (cam1.rate_hz != cam0.rate_hz) {
+      throw InputError(
+          cam1_yaml, fmt::format("rate_hz {} differs from cam0's {}", cam1.rate_hz, cam0.rate_hz));
+    }
+    if (cam1.distortion_model != cam0.distortion_model) {
+      throw InputError(cam1_yaml, "distortion_model differs from cam0's");
+    }
+    s.camera2 = CameraOf(cam1, cam1_yaml);
+    // p_cam1 = T_BS1^-1 * T_BS0 * p_cam0.
+    s.right_from_left = cam1.body_from_camera.Inverse() * cam0.body_from_camera;
+  }
+  if (dataset.has_imu()) {
+    const EurocImuSensor& imu = dataset.imu_sensor();
+    ImuNoise noise;
+    noise.gyro_noise_density = imu.gyroscope_noise_density;
+    noise.accel_noise_density = imu.accelerometer_noise_density;
+    noise.gyro_random_walk = imu.gyroscope_random_walk;
+    noise.accel_random_walk = imu.accelerometer_random_walk;
+    noise.rate_hz = imu.rate_hz;
+    s.imu = noise;
+    // The camera's T_BS is relative to the body frame; the IMU may be offset from it.
+    s.body_from_cam0 = imu.body_from_imu.Inverse() * cam0.body_from_camera;
+  }
+  s.th_depth = 60;
+  s.orb = OrbExtractorSettings{};  // 1200 features, 1.2, 8 levels, FAST 20 / 7
+  s.Check();
+  return s;
+}
+
+}  // namespace pkslam

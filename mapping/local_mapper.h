@@ -1,0 +1,121 @@
+// The LocalMapping thread (ORB-SLAM3's LocalMapping): for each new keyframe it completes the
+// point associations, culls recent points, triangulates new points with covisible keyframes,
+// fuses duplicates, runs local bundle adjustment and culls redundant keyframes, then hands the
+// keyframe on (to loop closing).
+//
+// Threads: the queue and flags are guarded by `mutex_` (plus atomics for flags read on hot
+// paths); the map model by the Atlas mutex, taken shared for computation and exclusive for
+// the short apply steps (docs/architecture.md). Owned by System; Stop() joins the thread.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "core/frame/camera_rig.h"
+#include "core/map/atlas.h"
+#include "core/map/mapping_backend.h"
+#include "core/optim/bundle_adjustment.h"
+
+namespace pkslam {
+
+struct LocalMappingOptions {
+  // Covisible keyframes used for triangulation (stereo/RGB-D, monocular).
+  int triangulation_neighbours_stereo = 10;
+  int triangulation_neighbours_mono = 20;
+  // Keyframe culling: a keyframe is redundant when this share of its (close) points is seen
+  // by at least `culling_observers` other keyframes at the same or a finer scale.
+  double culling_redundancy = 0.9;
+  int culling_observers = 3;
+  bool cull_keyframes = true;
+  // Recent points: culled when found/visible < this ratio.
+  double min_found_ratio = 0.25;
+  BundleAdjustmentOptions ba;
+
+  void Check() const;
+};
+
+struct LocalMappingStats {
+  std::vector<double> keyframe_ms;  // processing time per keyframe
+  std::vector<double> ba_ms;        // local BA time per keyframe (0 when skipped)
+  int ba_aborted = 0;
+  int keyframes_culled = 0;
+  int points_created = 0;
+  int points_culled = 0;
+};
+
+class LocalMapper : public MappingBackend {
+ public:
+  LocalMapper(Atlas* atlas, std::shared_ptr<const CameraRig> rig, LocalMappingOptions options);
+  ~LocalMapper() override;
+  LocalMapper(const LocalMapper&) = delete;
+  LocalMapper& operator=(const LocalMapper&) = delete;
+
+  // Starts the thread. Without Start(), WaitUntilIdle() processes the queue inline.
+  void Start();
+  // Processes what is queued, then stops and joins the thread.
+  void Finish();
+
+  // Where processed keyframes go (loop closing); set before Start().
+  void SetKeyFrameConsumer(std::function<void(const KeyFramePtr&)> consumer);
+
+  // MappingBackend.
+  void InsertKeyFrame(const KeyFramePtr& kf) override;
+  bool AcceptsKeyFrames() const override { return accept_keyframes_.load(); }
+  bool IsStoppedOrStopRequested() const override;
+  bool IsInitializingImu() const override { return initializing_imu_.load(); }
+  int QueueSize() const override;
+  void InterruptBundleAdjustment() override { abort_ba_.store(true); }
+  void WaitUntilIdle() override;
+  void ResetQueue() override;
+
+  // Loop closing pauses local mapping while it corrects the map.
+  void RequestStop();
+  bool IsStopped() const;
+  void Release();
+
+  LocalMappingStats stats() const;
+
+ private:
+  void Run();
+  bool HasQueued() const;
+  void ProcessNext();
+  void ProcessNewKeyFrame(const KeyFramePtr& kf);
+  void CullRecentPoints(const KeyFramePtr& kf);
+  void CreateNewMapPoints(const KeyFramePtr& kf);
+  void SearchInNeighbours(const KeyFramePtr& kf);
+  void LocalBundleAdjustment(const KeyFramePtr& kf);
+  void CullKeyFrames(const KeyFramePtr& kf);
+
+  Atlas* atlas_;
+  std::shared_ptr<const CameraRig> rig_;
+  LocalMappingOptions options_;
+  std::function<void(const KeyFramePtr&)> consumer_;
+
+  mutable std::mutex mutex_;  // guards queue_, busy_, stop/reset/finish requests, stats_
+  std::condition_variable wake_;
+  std::condition_variable idle_;
+  std::deque<KeyFramePtr> queue_;
+  bool busy_ = false;
+  bool finish_requested_ = false;
+  bool stop_requested_ = false;
+  bool stopped_ = false;
+  bool reset_requested_ = false;
+  LocalMappingStats stats_;
+
+  std::atomic<bool> accept_keyframes_{true};
+  std::atomic<bool> abort_ba_{false};
+  std::atomic<bool> initializing_imu_{false};
+
+  // Owned by the mapping thread: points created recently, checked by CullRecentPoints.
+  std::vector<MapPointPtr> recent_points_;
+
+  std::thread thread_;
+};
+
+}  // namespace pkslam

@@ -1,0 +1,260 @@
+// LocalMapper: the per-keyframe steps (ORB-SLAM3's LocalMapping::Run body).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <shared_mutex>
+#include <unordered_set>
+
+#include "core/map/keyframe.h"
+#include "core/map/map_point.h"
+#include "core/matching/orb_matcher.h"
+#include "core/util/log.h"
+#include "mapping/local_mapper.h"
+#include "mapping/triangulation.h"
+
+namespace pkslam {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+void LocalMapper::ProcessNext() {
+  KeyFramePtr kf;
+  {
+    std::lock_guard lock(mutex_);
+    if (queue_.empty()) return;
+    kf = queue_.front();
+    queue_.pop_front();
+  }
+  const auto start = std::chrono::steady_clock::now();
+  abort_ba_.store(false);
+  ProcessNewKeyFrame(kf);
+  CullRecentPoints(kf);
+  CreateNewMapPoints(kf);
+  double ba_ms = 0;
+  if (!HasQueued()) {
+    SearchInNeighbours(kf);
+  }
+  if (!HasQueued() && !IsStoppedOrStopRequested()) {
+    int keyframes = 0;
+    {
+      std::shared_lock lock(atlas_->mutex());
+      keyframes = kf->map() != nullptr ? kf->map()->NumKeyFrames() : 0;
+    }
+    if (keyframes > 2) {
+      const auto ba_start = std::chrono::steady_clock::now();
+      LocalBundleAdjustment(kf);
+      ba_ms = MsSince(ba_start);
+    }
+    if (options_.cull_keyframes) CullKeyFrames(kf);
+  }
+  {
+    std::lock_guard lock(mutex_);
+    stats_.keyframe_ms.push_back(MsSince(start));
+    stats_.ba_ms.push_back(ba_ms);
+  }
+  if (consumer_) consumer_(kf);
+}
+
+void LocalMapper::ProcessNewKeyFrame(const KeyFramePtr& kf) {
+  std::unique_lock lock(atlas_->mutex());
+  if (kf->IsBad() || kf->map() == nullptr) return;
+  const auto& points = kf->map_points();
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+    const MapPointPtr mp = points[i];
+    if (!mp || mp->IsBad()) continue;
+    if (!mp->IsInKeyFrame(kf.get())) {
+      // A point tracked by the frame: the keyframe becomes one of its observers.
+      mp->AddObservation(kf.get(), i);
+      mp->UpdateNormalAndDepth();
+      mp->ComputeDistinctiveDescriptor();
+    } else {
+      // Created by tracking for this keyframe (stereo/RGB-D): watch it for a while.
+      recent_points_.push_back(mp);
+    }
+  }
+  kf->UpdateConnections();
+}
+
+void LocalMapper::CullRecentPoints(const KeyFramePtr& kf) {
+  std::unique_lock lock(atlas_->mutex());
+  const int min_observations = IsMonocular(rig_->sensor) ? 2 : 3;
+  int culled = 0;
+  std::erase_if(recent_points_, [&](const MapPointPtr& mp) {
+    if (mp->IsBad()) return true;
+    const KeyFrameId age = kf->id() - mp->first_keyframe_id();
+    if (mp->FoundRatio() < options_.min_found_ratio) {
+      mp->SetBad();
+      ++culled;
+      return true;
+    }
+    if (age >= 2 && mp->NumObservations() <= min_observations) {
+      mp->SetBad();
+      ++culled;
+      return true;
+    }
+    return age >= 3;  // survived its probation
+  });
+  lock.unlock();
+  std::lock_guard stats_lock(mutex_);
+  stats_.points_culled += culled;
+}
+
+void LocalMapper::CreateNewMapPoints(const KeyFramePtr& kf) {
+  const bool mono = IsMonocular(rig_->sensor);
+  const int n_neighbours =
+      mono ? options_.triangulation_neighbours_mono : options_.triangulation_neighbours_stereo;
+  std::vector<TriangulatedPoint> created;
+  std::vector<KeyFrame*> neighbours;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    if (kf->IsBad() || kf->map() == nullptr) return;
+    neighbours = kf->BestCovisibles(n_neighbours);
+    const OrbMatcher matcher(0.6, false);
+    std::unordered_set<int> claimed;  // keypoints of kf already given a point this round
+    for (std::size_t n = 0; n < neighbours.size(); ++n) {
+      if (n > 0 && HasQueued()) break;
+      KeyFrame* other = neighbours[n];
+      if (!HasTriangulationBaseline(*kf, *other, mono)) continue;
+      const auto pairs = matcher.SearchForTriangulation(*kf, *other);
+      for (const auto& [i1, i2] : pairs) {
+        if (claimed.count(i1) > 0) continue;
+        if (auto p = TriangulatePair(*kf, i1, *other, i2, mono)) {
+          claimed.insert(i1);
+          created.push_back({*p, other, i1, i2});
+        }
+      }
+    }
+  }
+  if (created.empty()) return;
+  std::unique_lock lock(atlas_->mutex());
+  Map* map = kf->map();
+  if (kf->IsBad() || map == nullptr) return;
+  int added = 0;
+  for (const auto& c : created) {
+    // Tracking never fills existing keyframes' slots and we are the only other writer, but a
+    // neighbour may have been retired by loop closing's fusion meanwhile.
+    if (c.other->IsBad() || kf->map_point(c.index1) || c.other->map_point(c.index2)) continue;
+    auto mp = std::make_shared<MapPoint>(atlas_->NextMapPointId(), c.position, kf.get(), map);
+    mp->AddObservation(kf.get(), c.index1);
+    mp->AddObservation(c.other, c.index2);
+    kf->AddMapPoint(mp, c.index1);
+    c.other->AddMapPoint(mp, c.index2);
+    mp->ComputeDistinctiveDescriptor();
+    mp->UpdateNormalAndDepth();
+    map->AddMapPoint(mp);
+    recent_points_.push_back(mp);
+    ++added;
+  }
+  lock.unlock();
+  std::lock_guard stats_lock(mutex_);
+  stats_.points_created += added;
+}
+
+void LocalMapper::SearchInNeighbours(const KeyFramePtr& kf) {
+  std::unique_lock lock(atlas_->mutex());
+  if (kf->IsBad() || kf->map() == nullptr) return;
+  const int n = IsMonocular(rig_->sensor) ? 30 : 10;
+  std::vector<KeyFrame*> targets;
+  std::unordered_set<KeyFrameId> in_targets{kf->id()};
+  for (KeyFrame* neighbour : kf->BestCovisibles(n)) {
+    if (neighbour->IsBad() || !in_targets.insert(neighbour->id()).second) continue;
+    targets.push_back(neighbour);
+  }
+  const std::size_t first_ring = targets.size();
+  for (std::size_t i = 0; i < first_ring; ++i) {
+    for (KeyFrame* second : targets[i]->BestCovisibles(20)) {
+      if (second->IsBad() || !in_targets.insert(second->id()).second) continue;
+      targets.push_back(second);
+    }
+  }
+  const OrbMatcher matcher;
+  // Our points into the neighbours...
+  const std::vector<MapPointPtr> ours = kf->GoodMapPoints();
+  for (KeyFrame* target : targets) matcher.Fuse(target, ours);
+  // ...and the neighbours' points into us.
+  std::vector<MapPointPtr> candidates;
+  std::unordered_set<MapPointId> seen;
+  for (const auto& mp : kf->GoodMapPoints()) seen.insert(mp->id());
+  for (KeyFrame* target : targets) {
+    for (const auto& mp : target->map_points()) {
+      if (!mp || mp->IsBad() || !seen.insert(mp->id()).second) continue;
+      candidates.push_back(mp);
+    }
+  }
+  matcher.Fuse(kf.get(), candidates);
+  for (const auto& mp : kf->GoodMapPoints()) {
+    mp->ComputeDistinctiveDescriptor();
+    mp->UpdateNormalAndDepth();
+  }
+  kf->UpdateConnections();
+}
+
+void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
+  BundleProblem problem;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    if (kf->IsBad() || kf->map() == nullptr) return;
+    problem = CollectLocalBundle(kf.get(), options_.ba);
+  }
+  if (problem.empty()) return;
+  const BundleResult result = SolveBundle(problem, options_.ba, &abort_ba_);
+  std::unique_lock lock(atlas_->mutex());
+  ApplyBundle(problem, result);
+  if (result.aborted) {
+    lock.unlock();
+    std::lock_guard stats_lock(mutex_);
+    ++stats_.ba_aborted;
+  }
+}
+
+void LocalMapper::CullKeyFrames(const KeyFramePtr& kf) {
+  std::unique_lock lock(atlas_->mutex());
+  if (kf->IsBad() || kf->map() == nullptr) return;
+  const bool mono = IsMonocular(rig_->sensor);
+  const int observers = options_.culling_observers;
+  const KeyFrame* origin = kf->map()->origin();
+  int culled = 0;
+  int examined = 0;
+  for (KeyFrame* candidate : std::vector<KeyFrame*>(kf->CovisiblesByWeight())) {
+    if (candidate == origin || candidate->IsBad()) continue;
+    if (++examined > 100) break;
+    const auto& kps = candidate->keypoints_undistorted();
+    int points = 0;
+    int redundant = 0;
+    const auto& slots = candidate->map_points();
+    for (int i = 0; i < static_cast<int>(slots.size()); ++i) {
+      const auto& mp = slots[i];
+      if (!mp || mp->IsBad()) continue;
+      if (!mono) {
+        // Only close points count for stereo: far ones are weakly constrained anyway.
+        const float depth = candidate->depth()[i];
+        if (depth < 0 || depth > rig_->th_depth) continue;
+      }
+      ++points;
+      if (mp->NumObservations() <= observers) continue;
+      const int level = kps[i].octave;
+      int seen_by = 0;
+      for (const auto& [id, obs] : mp->observations()) {
+        if (obs.keyframe == candidate) continue;
+        if (obs.keyframe->keypoints_undistorted()[obs.index].octave <= level + 1) {
+          if (++seen_by >= observers) break;
+        }
+      }
+      if (seen_by >= observers) ++redundant;
+    }
+    if (points > 0 && redundant > options_.culling_redundancy * points) {
+      candidate->SetBad();
+      ++culled;
+    }
+  }
+  lock.unlock();
+  std::lock_guard stats_lock(mutex_);
+  stats_.keyframes_culled += culled;
+}
+
+}  // namespace pkslam

@@ -1,0 +1,167 @@
+#include "system/run_dataset.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include "core/util/error.h"
+#include "core/util/json_writer.h"
+#include "core/util/log.h"
+#include "core/util/progress.h"
+#include "io/euroc_dataset.h"
+#include "io/settings_euroc.h"
+#include "io/tum_rgbd_dataset.h"
+#include "system/run_outputs.h"
+
+namespace pkslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+// One input frame, however the dataset stores it.
+struct FrameSource {
+  std::int64_t t_ns;
+  std::size_t a;  // left / rgb index
+  std::size_t b;  // right / depth index
+};
+
+}  // namespace
+
+void RunOptions::Check() const {
+  if (dataset.empty()) throw OptionError("--dataset is required");
+  if (max_frames < 0) throw OptionError(fmt::format("--max-frames {} < 0", max_frames));
+  system.Check();
+}
+
+fs::path DefaultVocabularyPath() {
+  const fs::path name = "Vocabulary/pkslam_orb_k10_L6.bin";
+  // Next to the executable's build tree first (build/bin/pkslam -> source/Vocabulary), then the
+  // source tree this binary was built from.
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path();
+         dir = dir.parent_path()) {
+      if (fs::exists(dir / name)) return dir / name;
+    }
+  }
+  return fs::path(PKSLAM_SOURCE_DIR) / name;
+}
+
+RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interrupt) {
+  options.Check();
+  const Sensor sensor = options.system.sensor;
+  if (!fs::is_directory(options.dataset)) {
+    throw InputError(options.dataset, "dataset directory does not exist");
+  }
+  fs::create_directories(options.out);
+  AddLogFile(options.out / "run.log");
+  struct LogGuard {
+    ~LogGuard() { RemoveLogFiles(); }
+  } log_guard;
+
+  // --- dataset and settings ---
+  std::optional<EurocDataset> euroc;
+  std::optional<TumRgbdDataset> tum;
+  std::vector<FrameSource> sources;
+  Settings settings;
+  if (EurocDataset::LooksLikeEuroc(options.dataset)) {
+    EurocOptions eo;
+    eo.read_imu = IsInertial(sensor);
+    euroc = EurocDataset::Open(options.dataset, eo);
+    if (IsRgbd(sensor)) throw OptionError("an EuRoC dataset has no depth: use stereo or mono");
+    if (IsStereo(sensor)) {
+      for (const auto& p : euroc->stereo_pairs()) sources.push_back({p.t_ns, p.left, p.right});
+    } else {
+      const auto& images = euroc->cam0().images;
+      for (std::size_t i = 0; i < images.size(); ++i) sources.push_back({images[i].t_ns, i, 0});
+    }
+    settings = options.settings ? ReadOrbSlam3Settings(*options.settings) : SettingsFromEuroc(*euroc);
+  } else if (TumRgbdDataset::LooksLikeTumRgbd(options.dataset)) {
+    tum = TumRgbdDataset::Open(options.dataset);
+    if (IsStereo(sensor)) throw OptionError("a TUM RGB-D dataset has no stereo pair");
+    if (IsRgbd(sensor)) {
+      for (const auto& a : tum->associations()) {
+        sources.push_back({tum->rgb().images[a.rgb].t_ns, a.rgb, a.depth});
+      }
+    } else {
+      const auto& images = tum->rgb().images;
+      for (std::size_t i = 0; i < images.size(); ++i) sources.push_back({images[i].t_ns, i, 0});
+    }
+    const fs::path fallback = options.dataset / "settings.yaml";
+    if (!options.settings && !fs::exists(fallback)) {
+      throw InputError(options.dataset,
+                       "TUM RGB-D layout needs --settings (or settings.yaml in the dataset)");
+    }
+    settings = ReadOrbSlam3Settings(options.settings.value_or(fallback));
+    if (!settings.depth_map_factor) settings.depth_map_factor = tum->depth_factor();
+  } else {
+    throw InputError(options.dataset,
+                     "not a EuRoC (mav0/cam0/data.csv) or TUM RGB-D (rgb.txt, depth.txt) dataset");
+  }
+  if (sources.empty()) throw InputError(options.dataset, "no frames to process");
+  if (options.max_frames > 0 && static_cast<int>(sources.size()) > options.max_frames) {
+    sources.resize(options.max_frames);
+  }
+
+  const fs::path vocabulary_path = options.vocabulary.value_or(DefaultVocabularyPath());
+  if (!fs::exists(vocabulary_path)) {
+    throw InputError(vocabulary_path, "vocabulary not found (pass --vocabulary)");
+  }
+  PKSLAM_LOG_INFO("loading vocabulary {}", vocabulary_path.string());
+  auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary_path));
+
+  SlamSystem system(settings, vocabulary, options.system);
+
+  // --- the frame loop ---
+  RunSummary summary;
+  Progress progress("tracking", sources.size(), options.quiet);
+  const auto wall_start = std::chrono::steady_clock::now();
+  const std::int64_t t0 = sources.front().t_ns;
+  for (const FrameSource& s : sources) {
+    if (interrupt != nullptr && interrupt->load()) {
+      summary.interrupted = true;
+      PKSLAM_LOG_WARN("interrupted after {} frames; writing what exists", summary.frames);
+      break;
+    }
+    if (options.realtime) {
+      const auto due = wall_start + std::chrono::nanoseconds(s.t_ns - t0);
+      std::this_thread::sleep_until(due);
+    }
+    TrackResult r;
+    if (euroc) {
+      const cv::Mat left = euroc->LoadCam0(s.a);
+      if (IsStereo(sensor)) {
+        r = system.TrackStereo(left, euroc->LoadCam1(s.b), s.t_ns);
+      } else {
+        r = system.TrackMonocular(left, s.t_ns);
+      }
+    } else if (IsRgbd(sensor)) {
+      r = system.TrackRgbd(tum->LoadRgbGrey(s.a), tum->LoadDepthRaw(s.b), s.t_ns);
+    } else {
+      r = system.TrackMonocular(tum->LoadRgbGrey(s.a), s.t_ns);
+    }
+    ++summary.frames;
+    if (r.state == TrackingState::kOk) ++summary.tracked;
+    progress.SetSuffix(fmt::format("{} KFs {}", TrackingStateName(r.state), system.NumKeyFrames()));
+    progress.Add();
+  }
+  progress.Finish();
+  system.Shutdown();
+  summary.wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  summary.sequence_s =
+      static_cast<double>(sources[std::max(0, summary.frames - 1)].t_ns - t0) * 1e-9;
+  WriteRunOutputs(system, options, &summary);
+  PKSLAM_LOG_INFO("{} frames ({} tracked), {} keyframes, {} map points, {} map(s); "
+                  "{:.1f} s wall for {:.1f} s of data; outputs in {}",
+                  summary.frames, summary.tracked, summary.keyframes, summary.map_points,
+                  summary.maps, summary.wall_s, summary.sequence_s, options.out.string());
+  return summary;
+}
+
+}  // namespace pkslam

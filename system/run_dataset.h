@@ -1,0 +1,60 @@
+// Runs the SLAM system over a dataset on disk (EuRoC ASL or TUM RGB-D layout) and writes the
+// run's outputs. Used by `pkslam run` and `pkslam bench`.
+//
+// OUT/trajectory.txt   every tracked frame, TUM format (seconds), camera pose world_from_camera
+// OUT/keyframes.txt    keyframes of the final map, same format
+// OUT/map_points.ply   map points (binary PLY)
+// OUT/stats.json       timings, counts, tracking states, memory
+// OUT/run.log          the log of the run
+// OUT/keyframe_trace.csv  per-frame keyframe decisions (with trace enabled)
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "system/slam_system.h"
+
+namespace pkslam {
+
+struct RunOptions {
+  std::filesystem::path dataset;
+  // ORB-SLAM3 settings file; when absent: EuRoC datasets use their sensor.yaml files, other
+  // layouts look for settings.yaml in the dataset directory.
+  std::optional<std::filesystem::path> settings;
+  // Vocabulary (DBoW2 text or pkslam binary); default: the one shipped in Vocabulary/.
+  std::optional<std::filesystem::path> vocabulary;
+  std::filesystem::path out = "out";
+  // Pace frames to their timestamps instead of running as fast as possible.
+  bool realtime = false;
+  // Stop after this many frames (0: all).
+  int max_frames = 0;
+  // No progress line.
+  bool quiet = false;
+  SystemOptions system;
+
+  void Check() const;
+};
+
+struct RunSummary {
+  int frames = 0;
+  int tracked = 0;
+  int lost = 0;  // frames without a pose after initialisation
+  int keyframes = 0;
+  int map_points = 0;
+  int maps = 0;
+  double wall_s = 0;
+  double sequence_s = 0;
+  double median_tracking_ms = 0;
+  bool interrupted = false;
+};
+
+// The vocabulary shipped with pkslam (Vocabulary/ in the source tree or next to the binary).
+std::filesystem::path DefaultVocabularyPath();
+
+// Throws InputError / OptionError on bad input. `interrupt` (may be null) stops the run
+// early; outputs are still written for the frames processed so far.
+RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interrupt = nullptr);
+
+}  // namespace pkslam

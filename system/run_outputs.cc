@@ -1,0 +1,124 @@
+#include "system/run_outputs.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <fstream>
+#include <set>
+
+#include "core/util/error.h"
+#include "core/util/json_writer.h"
+
+namespace pkslam {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const std::size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(mid), v.end());
+  return v[mid];
+}
+
+void WriteArray(JsonWriter* json, std::string_view key, const std::vector<double>& values) {
+  json->Key(key).BeginArray();
+  for (double v : values) json->Value(std::round(v * 1000.0) / 1000.0);
+  json->EndArray();
+}
+
+void WriteTrace(const Tracker& tracker, const std::filesystem::path& file) {
+  // Fixed leading columns, then every trace key any selector produced (sorted, stable).
+  std::set<std::string> keys;
+  for (const auto& row : tracker.trace()) {
+    for (const auto& [k, v] : row.decision.trace) keys.insert(k);
+  }
+  std::ofstream out(file);
+  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  out << "time,frame,selector,decision,reason,frames_since_keyframe";
+  for (const auto& k : keys) out << ',' << k;
+  out << '\n';
+  const std::string selector(tracker.selector().name());
+  for (const auto& row : tracker.trace()) {
+    out << fmt::format("{:.9f},{},{},{},{},{}", static_cast<double>(row.t_ns) * 1e-9,
+                       row.frame_id, selector, row.decision.insert ? 1 : 0, row.decision.reason,
+                       row.frames_since_keyframe);
+    for (const auto& k : keys) {
+      out << ',';
+      if (auto it = row.decision.trace.find(k); it != row.decision.trace.end()) {
+        out << fmt::format("{:.6g}", it->second);
+      }
+    }
+    out << '\n';
+  }
+}
+
+}  // namespace
+
+double PeakMemoryMiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSummary* summary) {
+  const auto& out = options.out;
+  const Trajectory frames = system.FrameTrajectory();
+  WriteTrajectory(frames, out / "trajectory.txt", TrajectoryFormat::kTum);
+  WriteTrajectory(system.KeyFrameTrajectory(), out / "keyframes.txt", TrajectoryFormat::kTum);
+  system.WriteMapPly(out / "map_points.ply");
+  if (options.system.trace) WriteTrace(system.tracker(), out / "keyframe_trace.csv");
+
+  const auto& records = system.tracker().records();
+  std::vector<double> tracking_ms;
+  std::map<std::string, int> states;
+  bool initialised = false;
+  int lost = 0;
+  for (const FrameRecord& r : records) {
+    tracking_ms.push_back(r.tracking_ms);
+    ++states[TrackingStateName(r.state)];
+    if (r.state != TrackingState::kNotInitialized) initialised = true;
+    if (initialised && r.state != TrackingState::kOk) ++lost;
+  }
+  const LocalMappingStats mapping = system.mapping_stats();
+  summary->keyframes = system.NumKeyFrames();
+  summary->map_points = system.NumMapPoints();
+  summary->maps = system.NumMaps();
+  summary->lost = lost;
+  summary->median_tracking_ms = Median(tracking_ms);
+
+  JsonWriter json;
+  json.BeginObject();
+  json.Member("dataset", options.dataset.string());
+  json.Member("sensor", SensorName(options.system.sensor));
+  json.Member("selector", options.system.selector);
+  json.Member("deterministic", options.system.deterministic);
+  json.Member("interrupted", summary->interrupted);
+  json.Member("frames", summary->frames);
+  json.Member("frames_in_trajectory", static_cast<int>(frames.poses.size()));
+  json.Member("lost_frames", lost);
+  json.Member("keyframes", summary->keyframes);
+  json.Member("keyframes_created",
+              static_cast<int>(std::count_if(records.begin(), records.end(),
+                                             [](const FrameRecord& r) { return r.keyframe; })));
+  json.Member("keyframes_culled", mapping.keyframes_culled);
+  json.Member("map_points", summary->map_points);
+  json.Member("maps", summary->maps);
+  json.Key("tracking_states").BeginObject();
+  for (const auto& [name, count] : states) json.Member(name, count);
+  json.EndObject();
+  json.Member("wall_time_s", summary->wall_s);
+  json.Member("sequence_duration_s", summary->sequence_s);
+  json.Member("realtime_factor", summary->wall_s > 0 ? summary->sequence_s / summary->wall_s : 0.0);
+  json.Member("median_tracking_ms", summary->median_tracking_ms);
+  json.Member("median_local_mapping_ms", Median(mapping.keyframe_ms));
+  json.Member("local_ba_aborted", mapping.ba_aborted);
+  json.Member("peak_memory_mib", PeakMemoryMiB());
+  WriteArray(&json, "tracking_ms", tracking_ms);
+  WriteArray(&json, "local_mapping_ms", mapping.keyframe_ms);
+  WriteArray(&json, "local_ba_ms", mapping.ba_ms);
+  json.EndObject();
+  std::ofstream file(out / "stats.json");
+  if (!file) throw Error(fmt::format("cannot write {}", (out / "stats.json").string()));
+  file << json.str() << '\n';
+}
+
+}  // namespace pkslam

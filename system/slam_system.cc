@@ -1,0 +1,165 @@
+#include "system/slam_system.h"
+
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+#include <shared_mutex>
+
+#include "core/map/keyframe.h"
+#include "core/map/map_point.h"
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "keyframe/selector_factory.h"
+
+namespace pkslam {
+
+void SystemOptions::Check() const {
+  tracking.Check();
+  mapping.Check();
+}
+
+SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabulary> vocabulary,
+                       SystemOptions options)
+    : options_(std::move(options)),
+      setup_(MakeRig(settings, options_.sensor)),
+      vocabulary_(std::move(vocabulary)) {
+  PKSLAM_CHECK(vocabulary_ != nullptr, "no vocabulary");
+  if (options_.deterministic) {
+    options_.tracking.lockstep = true;
+    options_.tracking.pose.num_threads = 1;
+    options_.mapping.ba.num_threads = 1;
+  }
+  options_.Check();
+  std::map<std::string, double> selector_parameters = settings.keyframe;
+  for (const auto& [k, v] : options_.selector_parameters) selector_parameters[k] = v;
+  auto selector = MakeKeyframeSelector(options_.selector, selector_parameters);
+
+  mapper_ = std::make_unique<LocalMapper>(&atlas_, setup_.rig, options_.mapping);
+  OrbOptions orb;
+  orb.n_features = settings.orb.n_features;
+  orb.scale_factor = settings.orb.scale_factor;
+  orb.n_levels = settings.orb.n_levels;
+  orb.ini_th_fast = settings.orb.ini_th_fast;
+  orb.min_th_fast = settings.orb.min_th_fast;
+  tracker_ = std::make_unique<Tracker>(&atlas_, vocabulary_.get(), setup_.rig,
+                                       std::move(selector), mapper_.get(), options_.tracking, orb);
+  tracker_->EnableTrace(options_.trace);
+  mapper_->Start();
+  PKSLAM_LOG_INFO("sensor {}, camera {}, baseline {:.4f} m, selector {}{}",
+                  SensorName(options_.sensor), setup_.rig->camera.ToString(),
+                  setup_.rig->baseline, options_.selector,
+                  options_.deterministic ? ", deterministic" : "");
+}
+
+SlamSystem::~SlamSystem() { Shutdown(); }
+
+void SlamSystem::Shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  mapper_->Finish();
+}
+
+TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right,
+                                    std::int64_t t_ns) {
+  if (setup_.rectification) {
+    const auto [l, r] = setup_.rectification->Rectify(left, right);
+    return tracker_->TrackStereo(l, r, t_ns);
+  }
+  return tracker_->TrackStereo(left, right, t_ns);
+}
+
+TrackResult SlamSystem::TrackRgbd(const cv::Mat& image, const cv::Mat& depth,
+                                  std::int64_t t_ns) {
+  return tracker_->TrackRgbd(image, depth, t_ns);
+}
+
+TrackResult SlamSystem::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
+  return tracker_->TrackMonocular(image, t_ns);
+}
+
+const Map* SlamSystem::LargestMap() const {
+  const Map* best = nullptr;
+  for (const Map* m : atlas_.maps()) {
+    if (best == nullptr || m->NumKeyFrames() > best->NumKeyFrames()) best = m;
+  }
+  return best;
+}
+
+namespace {
+
+// camera_from_world of a (possibly retired) keyframe through its parent chain.
+SE3d CameraFromWorld(const KeyFrame* kf) {
+  SE3d camera_from_kf;
+  while (kf->IsBad() && kf->parent() != nullptr) {
+    camera_from_kf = camera_from_kf * kf->camera_from_parent();
+    kf = kf->parent();
+  }
+  return camera_from_kf * kf->camera_from_world();
+}
+
+}  // namespace
+
+Trajectory SlamSystem::FrameTrajectory() const {
+  std::shared_lock lock(atlas_.mutex());
+  Trajectory out;
+  const Map* map = LargestMap();
+  for (const FrameRecord& r : tracker_->records()) {
+    if (!r.reference || r.reference->map() != map) continue;
+    const SE3d camera_from_world = r.camera_from_reference * CameraFromWorld(r.reference.get());
+    out.poses.push_back({r.t_ns, camera_from_world.Inverse()});
+  }
+  return out;
+}
+
+Trajectory SlamSystem::KeyFrameTrajectory() const {
+  std::shared_lock lock(atlas_.mutex());
+  Trajectory out;
+  const Map* map = LargestMap();
+  if (map == nullptr) return out;
+  for (const auto& [id, kf] : map->keyframes()) {
+    out.poses.push_back({kf->t_ns(), kf->world_from_camera()});
+  }
+  std::sort(out.poses.begin(), out.poses.end(),
+            [](const StampedPose& a, const StampedPose& b) { return a.t_ns < b.t_ns; });
+  return out;
+}
+
+void SlamSystem::WriteMapPly(const std::filesystem::path& file) const {
+  std::shared_lock lock(atlas_.mutex());
+  const Map* map = LargestMap();
+  std::ofstream out(file, std::ios::binary);
+  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  const std::size_t n = map != nullptr ? map->map_points().size() : 0;
+  out << "ply\nformat binary_little_endian 1.0\ncomment pkslam map points (world frame)\n"
+      << "element vertex " << n
+      << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << "property uchar observations\nend_header\n";
+  if (map == nullptr) return;
+  for (const auto& [id, mp] : map->map_points()) {
+    const float xyz[3] = {static_cast<float>(mp->position().x()),
+                          static_cast<float>(mp->position().y()),
+                          static_cast<float>(mp->position().z())};
+    out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
+    const auto obs = static_cast<unsigned char>(std::min<std::size_t>(255, mp->observations().size()));
+    out.put(static_cast<char>(obs));
+  }
+}
+
+int SlamSystem::NumKeyFrames() const {
+  std::shared_lock lock(atlas_.mutex());
+  const Map* map = LargestMap();
+  return map != nullptr ? map->NumKeyFrames() : 0;
+}
+
+int SlamSystem::NumMapPoints() const {
+  std::shared_lock lock(atlas_.mutex());
+  const Map* map = LargestMap();
+  return map != nullptr ? map->NumMapPoints() : 0;
+}
+
+int SlamSystem::NumMaps() const {
+  std::shared_lock lock(atlas_.mutex());
+  return atlas_.NumMaps();
+}
+
+}  // namespace pkslam

@@ -1,0 +1,82 @@
+// The SLAM system: owns the Atlas, the tracker (caller's thread), the LocalMapping thread and
+// (later) loop closing, and turns the map into outputs. One instance per run.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "core/bow/vocabulary.h"
+#include "core/map/atlas.h"
+#include "io/settings.h"
+#include "io/trajectory.h"
+#include "mapping/local_mapper.h"
+#include "system/rig_factory.h"
+#include "tracking/tracker.h"
+
+namespace pkslam {
+
+struct SystemOptions {
+  Sensor sensor = Sensor::kStereo;
+  // Keyframe selector name and parameters (merged over the settings' Keyframe.* values).
+  std::string selector = "orbslam3";
+  std::map<std::string, double> selector_parameters;
+  // Fixed seeds, local mapping in lock-step with tracking, single-threaded solvers.
+  bool deterministic = false;
+  // Record per-frame keyframe decisions (keyframe_trace.csv).
+  bool trace = false;
+  TrackingOptions tracking;
+  LocalMappingOptions mapping;
+
+  void Check() const;
+};
+
+class SlamSystem {
+ public:
+  SlamSystem(const Settings& settings, std::shared_ptr<const Vocabulary> vocabulary,
+             SystemOptions options);
+  ~SlamSystem();
+  SlamSystem(const SlamSystem&) = delete;
+  SlamSystem& operator=(const SlamSystem&) = delete;
+
+  // Raw (unrectified) or rectified stereo pair, as the settings describe the rig.
+  TrackResult TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns);
+  TrackResult TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns);
+  TrackResult TrackMonocular(const cv::Mat& image, std::int64_t t_ns);
+
+  // Lets local mapping finish its queue and stops the threads (idempotent).
+  void Shutdown();
+
+  // Camera poses (world_from_camera) of every tracked frame whose map is the largest map
+  // (ORB-SLAM3's choice when saving), with poses re-expressed through their reference
+  // keyframes' final poses. Frames without a pose are left out.
+  Trajectory FrameTrajectory() const;
+  Trajectory KeyFrameTrajectory() const;
+  // Binary little-endian PLY of the largest map's points (x, y, z float; observations uchar).
+  void WriteMapPly(const std::filesystem::path& file) const;
+
+  const CameraRig& rig() const { return *setup_.rig; }
+  const Tracker& tracker() const { return *tracker_; }
+  LocalMappingStats mapping_stats() const { return mapper_->stats(); }
+  // Keyframes and map points in the largest map; number of maps.
+  int NumKeyFrames() const;
+  int NumMapPoints() const;
+  int NumMaps() const;
+
+ private:
+  const Map* LargestMap() const;  // requires the Atlas lock
+
+  SystemOptions options_;
+  RigSetup setup_;
+  std::shared_ptr<const Vocabulary> vocabulary_;
+  Atlas atlas_;
+  std::unique_ptr<LocalMapper> mapper_;
+  std::unique_ptr<Tracker> tracker_;
+  bool shut_down_ = false;
+};
+
+}  // namespace pkslam

@@ -1,0 +1,156 @@
+// End-to-end tests of `pkslam eval`: the published evo numbers through the real binary, and one
+// clear error line with a non-zero exit for each kind of bad input.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "tests/support/test_data.h"
+
+namespace pkslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ReadFile(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+// The number after `"key": ` following the first occurrence of `section` in a JSON text.
+double JsonNumber(const std::string& json, const std::string& section, const std::string& key) {
+  const std::size_t start = json.find(section);
+  if (start == std::string::npos) return -1.0;
+  const std::size_t at = json.find("\"" + key + "\": ", start);
+  if (at == std::string::npos) return -1.0;
+  return std::stod(json.substr(at + key.size() + 4));
+}
+
+testing::CommandResult Eval(const std::string& arguments) {
+  return testing::RunCommand(
+      fmt::format("'{}' eval {}", testing::PkslamExecutable().string(), arguments));
+}
+
+class EvalCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = testing::MakeTempDir("eval_cli_test"); }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Write(const std::string& name, const std::string& content) {
+    const fs::path file = dir_ / name;
+    std::ofstream(file) << content;
+    return file.string();
+  }
+
+  // Runs eval expecting failure: non-zero exit and a single line "pkslam: error: ...".
+  std::string ExpectOneLineError(const std::string& arguments) {
+    const testing::CommandResult r = Eval(arguments);
+    EXPECT_NE(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.rfind("pkslam: error: ", 0), 0u) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    return r.output;
+  }
+
+  fs::path dir_;
+};
+
+const char* const kGood =
+    "1.00 0 0 0 0 0 0 1\n1.05 1 0 0 0 0 0 1\n1.10 2 0 0 0 0 0 1\n1.15 3 1 0 0 0 0 1\n";
+
+TEST_F(EvalCliTest, ReproducesEvoOnFr2Desk) {
+  PKSLAM_REQUIRE_SHARED_DATA(shared);
+  const fs::path json = dir_ / "fr2.json";
+  const testing::CommandResult r =
+      Eval(fmt::format("--gt '{}' --est '{}' --align se3 --json '{}'",
+                       (shared / "evo" / "fr2_desk_groundtruth.txt").string(),
+                       (shared / "evo" / "fr2_desk_ORB.txt").string(), json.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("ATE [m]"), std::string::npos) << r.output;
+  const std::string text = ReadFile(json);
+  EXPECT_NE(text.find("\"alignment\": \"se3\""), std::string::npos) << text;
+  EXPECT_NEAR(JsonNumber(text, "\"ate\"", "rmse"), 0.008119, 5e-7);
+  EXPECT_NEAR(JsonNumber(text, "\"ate\"", "mean"), 0.007492, 5e-7);
+  EXPECT_NEAR(JsonNumber(text, "\"ate\"", "max"), 0.024300, 5e-7);
+  EXPECT_NEAR(JsonNumber(text, "\"ate\"", "sse"), 0.143305, 5e-7);
+  EXPECT_EQ(JsonNumber(text, "{", "scale"), 1.0);
+  EXPECT_GT(JsonNumber(text, "\"ate_rot_deg\"", "rmse"), 0.0);
+  EXPECT_GT(JsonNumber(text, "\"rpe\"", "rmse"), 0.0);
+}
+
+TEST_F(EvalCliTest, ReproducesEvoOnFr1XyzRgbdslam) {
+  PKSLAM_REQUIRE_SHARED_DATA(shared);
+  const fs::path json = dir_ / "fr1.json";
+  const testing::CommandResult r =
+      Eval(fmt::format("--gt '{}' --est '{}' --json '{}'",
+                       (shared / "evo" / "freiburg1_xyz-groundtruth.txt").string(),
+                       (shared / "evo" / "freiburg1_xyz-rgbdslam.txt").string(), json.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string text = ReadFile(json);
+  EXPECT_EQ(JsonNumber(text, "{", "pairs"), 785.0);
+  EXPECT_NEAR(JsonNumber(text, "\"ate\"", "rmse"), 0.013470, 5e-7);
+}
+
+TEST_F(EvalCliTest, SyntheticRunWithEveryAlignmentAndRpeUnit) {
+  const std::string gt = Write("gt.txt", kGood);
+  for (const char* align : {"se3", "sim3", "posyaw", "none"}) {
+    const testing::CommandResult r =
+        Eval(fmt::format("--gt {} --est {} --align {} --rpe-delta 1 --rpe-unit m", gt, gt, align));
+    EXPECT_EQ(r.exit_code, 0) << align << "\n" << r.output;
+    EXPECT_NE(r.output.find("pairs      4"), std::string::npos) << r.output;
+  }
+}
+
+TEST_F(EvalCliTest, BadInputsGiveOneLineErrors) {
+  const std::string good = Write("good.txt", kGood);
+  const std::string empty = Write("empty.txt", "");
+  std::string out = ExpectOneLineError(fmt::format("--gt {} --est {}", good, empty));
+  EXPECT_NE(out.find("empty.txt: empty trajectory file"), std::string::npos) << out;
+
+  const std::string garbage = Write("garbage.txt", "1.0 0 0 0 0 0 0 1\n1.1 0 0 oops 0 0 0 1\n");
+  out = ExpectOneLineError(fmt::format("--gt {} --est {}", good, garbage));
+  EXPECT_NE(out.find("garbage.txt:2: column 4: 'oops' is not a number"), std::string::npos) << out;
+
+  const std::string unsorted =
+      Write("unsorted.txt", "1.0 0 0 0 0 0 0 1\n1.1 0 0 0 0 0 0 1\n1.05 0 0 0 0 0 0 1\n");
+  out = ExpectOneLineError(fmt::format("--gt {} --est {}", unsorted, good));
+  EXPECT_NE(out.find("unsorted.txt:3: timestamp 1.050000000 s is before"), std::string::npos)
+      << out;
+
+  const std::string later = Write("later.txt",
+                                  "100.00 0 0 0 0 0 0 1\n100.05 1 0 0 0 0 0 1\n"
+                                  "100.10 2 0 0 0 0 0 1\n");
+  out = ExpectOneLineError(fmt::format("--gt {} --est {}", good, later));
+  EXPECT_NE(out.find("later.txt: no pose within 0.01 s"), std::string::npos) << out;
+  EXPECT_NE(out.find("no time overlap"), std::string::npos) << out;
+
+  const std::string five = Write("five.txt", "1 2 3 4 5\n");
+  out = ExpectOneLineError(fmt::format("--gt {} --est {}", good, five));
+  EXPECT_NE(out.find("five.txt:1: unknown trajectory format"), std::string::npos) << out;
+  out = ExpectOneLineError(fmt::format("--gt {} --est {} --est-format kitti", good, good));
+  EXPECT_NE(out.find("unknown trajectory format 'kitti'"), std::string::npos) << out;
+  out = ExpectOneLineError(fmt::format("--gt {} --est {} --align affine", good, good));
+  EXPECT_NE(out.find("unknown alignment 'affine'"), std::string::npos) << out;
+
+  out = ExpectOneLineError(fmt::format("--gt {} --est {}", good, (dir_ / "missing.txt").string()));
+  EXPECT_NE(out.find("missing.txt: trajectory file not found"), std::string::npos) << out;
+  out = ExpectOneLineError(fmt::format("--gt {} --est {} --max-diff -1", good, good));
+  EXPECT_NE(out.find("max_diff_s"), std::string::npos) << out;
+  out = ExpectOneLineError(fmt::format("--gt {} --est {} --rpe-delta 50", good, good));
+  EXPECT_NE(out.find("RPE delta 50 frames selects no pose pair"), std::string::npos) << out;
+}
+
+TEST_F(EvalCliTest, MissingRequiredOptionFails) {
+  const testing::CommandResult r = Eval("--gt x.txt");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--est"), std::string::npos) << r.output;
+  const testing::CommandResult help = Eval("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.output.find("--rpe-unit"), std::string::npos) << help.output;
+}
+
+}  // namespace
+}  // namespace pkslam

@@ -1,0 +1,290 @@
+#include "tracking/tracker.h"
+
+#include <chrono>
+#include <mutex>
+#include <shared_mutex>
+
+#include "core/bow/vocabulary.h"
+#include "core/map/keyframe.h"
+#include "core/map/map_point.h"
+#include "core/matching/orb_matcher.h"
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "tracking/pose_optimizer.h"
+
+namespace pkslam {
+
+const char* TrackingStateName(TrackingState s) {
+  switch (s) {
+    case TrackingState::kNotInitialized:
+      return "NOT_INITIALIZED";
+    case TrackingState::kOk:
+      return "OK";
+    case TrackingState::kRecentlyLost:
+      return "RECENTLY_LOST";
+    case TrackingState::kLost:
+      return "LOST";
+  }
+  return "?";
+}
+
+void TrackingOptions::Check() const {
+  PKSLAM_CHECK_OPTION(min_features_stereo_init > 0, "Tracking.min_features_stereo_init", "{}",
+                      min_features_stereo_init);
+  PKSLAM_CHECK_OPTION(max_local_keyframes > 0, "Tracking.max_local_keyframes", "{}",
+                      max_local_keyframes);
+  PKSLAM_CHECK_OPTION(min_inliers > 0 && min_inliers_after_reloc > 0, "Tracking.min_inliers",
+                      "{} / {}", min_inliers, min_inliers_after_reloc);
+  PKSLAM_CHECK_OPTION(motion_model_radius_stereo > 0 && motion_model_radius_mono > 0,
+                      "Tracking.motion_model_radius", "{} / {}", motion_model_radius_stereo,
+                      motion_model_radius_mono);
+  pose.Check();
+}
+
+Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<const CameraRig> rig,
+                 std::unique_ptr<KeyframeSelector> selector, MappingBackend* mapping,
+                 TrackingOptions options, OrbOptions orb_options)
+    : atlas_(atlas),
+      vocabulary_(vocabulary),
+      rig_(std::move(rig)),
+      selector_(std::move(selector)),
+      mapping_(mapping),
+      options_(options),
+      builder_(rig_, orb_options) {
+  options_.Check();
+  PKSLAM_CHECK(atlas_ != nullptr && vocabulary_ != nullptr && selector_ != nullptr &&
+                   mapping_ != nullptr,
+               "tracker needs an atlas, a vocabulary, a selector and local mapping");
+}
+
+Tracker::~Tracker() = default;
+
+TrackResult Tracker::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
+  PKSLAM_CHECK(IsStereo(rig_->sensor), "TrackStereo with a {} rig", SensorName(rig_->sensor));
+  return Track(builder_.BuildStereo(atlas_->NextFrameId(), t_ns, left, right));
+}
+
+TrackResult Tracker::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns) {
+  PKSLAM_CHECK(IsRgbd(rig_->sensor), "TrackRgbd with a {} rig", SensorName(rig_->sensor));
+  return Track(builder_.BuildRgbd(atlas_->NextFrameId(), t_ns, image, depth));
+}
+
+TrackResult Tracker::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
+  PKSLAM_CHECK(IsMonocular(rig_->sensor), "TrackMonocular with a {} rig",
+               SensorName(rig_->sensor));
+  const bool initialising = state_ == TrackingState::kNotInitialized;
+  return Track(builder_.BuildMonocular(atlas_->NextFrameId(), t_ns, image, initialising));
+}
+
+TrackResult Tracker::Track(Frame frame) {
+  const auto start = std::chrono::steady_clock::now();
+  current_ = std::move(frame);
+  TrackResult result;
+  bool new_keyframe = false;
+
+  if (state_ == TrackingState::kNotInitialized) {
+    if (IsMonocular(rig_->sensor)) {
+      MonocularInitialization();
+    } else {
+      StereoInitialization();
+    }
+    new_keyframe = state_ == TrackingState::kOk;
+  } else {
+    bool ok = false;
+    SelectorInput selector_input;
+    {
+      std::shared_lock lock(atlas_->mutex());
+      // Local mapping may have fused points of the last frame into others meanwhile.
+      for (auto& mp : last_.map_points) {
+        while (mp && mp->replaced_by()) mp = mp->replaced_by();
+      }
+      if (state_ == TrackingState::kOk) {
+        if (!velocity_ || current_.id() < last_reloc_frame_id_ + 2) {
+          ok = TrackReferenceKeyFrame();
+        } else {
+          ok = TrackWithMotionModel();
+          if (!ok) ok = TrackReferenceKeyFrame();
+        }
+      } else if (state_ == TrackingState::kRecentlyLost) {
+        ok = Relocalize();
+      }
+      if (ok) ok = TrackLocalMap();
+
+      if (ok) {
+        state_ = TrackingState::kOk;
+      } else if (state_ == TrackingState::kOk) {
+        const bool keep = atlas_->current_map()->NumKeyFrames() > options_.min_keyframes_to_keep_map;
+        state_ = keep ? TrackingState::kRecentlyLost : TrackingState::kLost;
+        lost_since_t_ns_ = current_.t_ns();
+      } else if (state_ == TrackingState::kRecentlyLost &&
+                 (current_.t_ns() - lost_since_t_ns_) * 1e-9 > options_.recently_lost_timeout_s) {
+        state_ = TrackingState::kLost;
+      }
+
+      if (ok) {
+        velocity_ = current_.camera_from_world() * last_.world_from_camera();
+        // Matches to points that are not in the map (no observations) are dropped.
+        for (int i = 0; i < current_.size(); ++i) {
+          const auto& mp = current_.map_points[i];
+          if (mp && mp->NumObservations() < 1) {
+            current_.map_points[i].reset();
+            current_.outliers[i] = 0;
+          }
+        }
+        selector_input = BuildSelectorInput();
+        last_decision_ = selector_->Decide(selector_input);
+        if (trace_enabled_) {
+          trace_.push_back({current_.t_ns(), current_.id(), last_decision_,
+                            selector_input.FramesSinceLastKeyFrame()});
+        }
+      }
+    }
+    if (ok) {
+      if (last_decision_.interrupt_local_ba) mapping_->InterruptBundleAdjustment();
+      if (last_decision_.insert) {
+        CreateNewKeyFrame(selector_input);
+        new_keyframe = true;
+      }
+      // Outliers went into the keyframe (BA decides on them); the next frame must not use
+      // them for its pose.
+      for (int i = 0; i < current_.size(); ++i) {
+        if (current_.map_points[i] && current_.outliers[i]) current_.map_points[i].reset();
+      }
+      result.keyframe_reason = last_decision_.reason;
+    } else {
+      velocity_.reset();
+    }
+  }
+
+  if (state_ == TrackingState::kLost) HandleLost();
+
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  RecordFrame(new_keyframe, ms);
+  result.state = state_;
+  result.new_keyframe = new_keyframe;
+  result.inliers = inliers_;
+  if (current_.HasPose() && state_ == TrackingState::kOk) {
+    result.camera_from_world = current_.camera_from_world();
+  }
+  if (state_ != TrackingState::kNotInitialized) {
+    if (!current_.reference_kf) current_.reference_kf = reference_kf_;
+    last_ = std::move(current_);
+  }
+  return result;
+}
+
+void Tracker::RecordFrame(bool keyframe, double ms) {
+  FrameRecord r;
+  r.t_ns = current_.t_ns();
+  r.frame_id = current_.id();
+  r.state = state_;
+  r.keyframe = keyframe;
+  r.tracking_ms = ms;
+  r.inliers = inliers_;
+  const KeyFramePtr& ref = current_.reference_kf ? current_.reference_kf : reference_kf_;
+  if (state_ == TrackingState::kOk && current_.HasPose() && ref) {
+    std::shared_lock lock(atlas_->mutex());
+    r.reference = ref;
+    r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
+  }
+  records_.push_back(std::move(r));
+}
+
+void Tracker::StereoInitialization() {
+  if (current_.size() <= options_.min_features_stereo_init) return;
+  KeyFramePtr kf;
+  int points = 0;
+  {
+    std::unique_lock lock(atlas_->mutex());
+    Map* map = atlas_->current_map();
+    current_.SetPose(SE3d());
+    current_.ComputeBoW(*vocabulary_);
+    kf = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
+    map->AddKeyFrame(kf);
+    for (int i = 0; i < current_.size(); ++i) {
+      const auto p = current_.UnprojectStereo(i);
+      if (!p) continue;
+      auto mp = std::make_shared<MapPoint>(atlas_->NextMapPointId(), *p, kf.get(), map);
+      mp->AddObservation(kf.get(), i);
+      kf->AddMapPoint(mp, i);
+      mp->ComputeDistinctiveDescriptor();
+      mp->UpdateNormalAndDepth();
+      map->AddMapPoint(mp);
+      current_.map_points[i] = mp;
+      ++points;
+    }
+    local_keyframes_ = {kf.get()};
+    local_points_ = kf->GoodMapPoints();
+  }
+  PKSLAM_LOG_INFO("new map {} initialised from stereo/depth with {} points",
+                  atlas_->current_map()->id(), points);
+  mapping_->InsertKeyFrame(kf);
+  if (options_.lockstep) mapping_->WaitUntilIdle();
+  last_kf_ = kf;
+  reference_kf_ = kf;
+  current_.reference_kf = kf;
+  inliers_ = points;
+  selector_->Reset();
+  SelectorInput input;
+  input.frame_id = current_.id();
+  input.t_ns = current_.t_ns();
+  selector_->OnKeyFrameInserted(input);
+  state_ = TrackingState::kOk;
+}
+
+void Tracker::HandleLost() {
+  int keyframes = 0;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    keyframes = atlas_->current_map()->NumKeyFrames();
+  }
+  if (keyframes <= options_.min_keyframes_to_keep_map) {
+    PKSLAM_LOG_WARN("tracking lost at t = {:.3f} s with {} keyframes: resetting the map",
+                    current_.t_s(), keyframes);
+    Reset();
+    return;
+  }
+  PKSLAM_LOG_WARN("tracking lost at t = {:.3f} s: starting a new map", current_.t_s());
+  mapping_->ResetQueue();
+  {
+    std::unique_lock lock(atlas_->mutex());
+    atlas_->CreateNewMap();
+  }
+  StartOver();
+}
+
+void Tracker::Reset() {
+  mapping_->ResetQueue();
+  {
+    std::unique_lock lock(atlas_->mutex());
+    // Records of the dropped map lose their reference (those frames end up without pose).
+    Map* map = atlas_->current_map();
+    for (auto& r : records_) {
+      if (r.reference && r.reference->map() == map) r.reference.reset();
+    }
+    last_.map_points.assign(last_.map_points.size(), nullptr);
+    current_.map_points.assign(current_.map_points.size(), nullptr);
+    local_points_.clear();
+    local_keyframes_.clear();
+    reference_kf_.reset();
+    last_kf_.reset();
+    current_.reference_kf.reset();
+    last_.reference_kf.reset();
+    atlas_->ResetCurrentMap();
+  }
+  StartOver();
+}
+
+void Tracker::StartOver() {
+  state_ = TrackingState::kNotInitialized;
+  velocity_.reset();
+  init_frame_.reset();
+  reference_kf_.reset();
+  last_kf_.reset();
+  local_points_.clear();
+  local_keyframes_.clear();
+  selector_->Reset();
+}
+
+}  // namespace pkslam

@@ -1,0 +1,133 @@
+// The tracking thread's logic (runs in the caller's thread, as in ORB-SLAM3): builds a Frame
+// from the images, initialises a map, tracks the camera against the last frame / reference
+// keyframe and the local map, asks the KeyframeSelector for keyframes and hands them to local
+// mapping. Owns its frames; touches the map model only under the Atlas mutex.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/frame/frame.h"
+#include "core/map/atlas.h"
+#include "core/map/mapping_backend.h"
+#include "keyframe/keyframe_selector.h"
+#include "tracking/frame_builder.h"
+#include "tracking/tracking_options.h"
+
+namespace pkslam {
+
+class Vocabulary;
+
+enum class TrackingState { kNotInitialized, kOk, kRecentlyLost, kLost };
+const char* TrackingStateName(TrackingState s);
+
+// One processed frame, kept for the trajectory: its pose relative to a reference keyframe so
+// later map optimisation moves it along (ORB-SLAM's mlRelativeFramePoses).
+struct FrameRecord {
+  std::int64_t t_ns = 0;
+  FrameId frame_id = kInvalidId;
+  TrackingState state = TrackingState::kNotInitialized;
+  KeyFramePtr reference;  // null when the frame has no pose
+  SE3d camera_from_reference;
+  bool keyframe = false;
+  double tracking_ms = 0;
+  int inliers = 0;
+};
+
+struct TrackResult {
+  TrackingState state = TrackingState::kNotInitialized;
+  std::optional<SE3d> camera_from_world;
+  bool new_keyframe = false;
+  int inliers = 0;
+  std::string keyframe_reason;
+};
+
+class Tracker {
+ public:
+  Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<const CameraRig> rig,
+          std::unique_ptr<KeyframeSelector> selector, MappingBackend* mapping,
+          TrackingOptions options, OrbOptions orb_options);
+  ~Tracker();
+  Tracker(const Tracker&) = delete;
+  Tracker& operator=(const Tracker&) = delete;
+
+  // Rectified stereo pair (grey).
+  TrackResult TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns);
+  // Registered RGB-D pair: grey (or colour) image and depth (CV_16U raw or CV_32F metres).
+  TrackResult TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns);
+  TrackResult TrackMonocular(const cv::Mat& image, std::int64_t t_ns);
+
+  TrackingState state() const { return state_; }
+  const std::vector<FrameRecord>& records() const { return records_; }
+  const KeyframeSelector& selector() const { return *selector_; }
+  // Keyframe-decision traces (one per tracked frame), for --trace.
+  struct TraceRow {
+    std::int64_t t_ns;
+    FrameId frame_id;
+    SelectorDecision decision;
+    int frames_since_keyframe;
+  };
+  const std::vector<TraceRow>& trace() const { return trace_; }
+  void EnableTrace(bool on) { trace_enabled_ = on; }
+
+  // Drops the current map (a reset) and starts again from NOT_INITIALIZED.
+  void Reset();
+
+ private:
+  TrackResult Track(Frame frame);
+  void StereoInitialization();
+  void MonocularInitialization();
+  bool TrackReferenceKeyFrame();
+  bool TrackWithMotionModel();
+  bool TrackLocalMap();
+  void UpdateLastFrame();
+  void UpdateLocalKeyFrames();
+  void UpdateLocalPoints();
+  int SearchLocalPoints();
+  SelectorInput BuildSelectorInput() const;
+  void CreateNewKeyFrame(const SelectorInput& input);
+  // Issue 6 brings relocalisation; until then a lost camera cannot relocalise.
+  bool Relocalize();
+  void HandleLost();
+  // Back to NOT_INITIALIZED on the current (new or cleared) map.
+  void StartOver();
+  void RecordFrame(bool keyframe, double ms);
+
+  Atlas* atlas_;
+  const Vocabulary* vocabulary_;
+  std::shared_ptr<const CameraRig> rig_;
+  std::unique_ptr<KeyframeSelector> selector_;
+  MappingBackend* mapping_;
+  TrackingOptions options_;
+  FrameBuilder builder_;
+  std::vector<cv::Point2f> init_prev_matched_;  // monocular: where init keypoints were seen
+  std::vector<int> init_matches_;
+
+  TrackingState state_ = TrackingState::kNotInitialized;
+  Frame current_;
+  Frame last_;
+  std::optional<Frame> init_frame_;  // monocular: first frame of the initial pair
+  std::optional<SE3d> velocity_;     // camera_from_world(current) * world_from_camera(last)
+  KeyFramePtr reference_kf_;
+  KeyFramePtr last_kf_;
+  FrameId last_reloc_frame_id_ = -1000000;
+  int inliers_ = 0;
+  std::int64_t lost_since_t_ns_ = 0;
+
+  // Local map (rebuilt every frame).
+  std::vector<KeyFrame*> local_keyframes_;
+  std::vector<MapPointPtr> local_points_;
+  // Temporal stereo points created for the last frame (not in the map).
+  std::vector<MapPointPtr> temporal_points_;
+
+  std::vector<FrameRecord> records_;
+  bool trace_enabled_ = false;
+  std::vector<TraceRow> trace_;
+  SelectorDecision last_decision_;
+};
+
+}  // namespace pkslam

@@ -1,0 +1,48 @@
+// Options of the tracking thread (ORB-SLAM3 defaults; see ORBSLAM3_FACTS.md "Tracking").
+#pragma once
+
+#include "tracking/pose_optimizer.h"
+
+namespace pkslam {
+
+struct TrackingOptions {
+  // Stereo/RGB-D: features needed in the first frame to initialise a map.
+  int min_features_stereo_init = 500;
+  // Stereo/RGB-D initialisation creates points for keypoints closer than this many
+  // th_depth... ORB-SLAM uses every keypoint with positive depth; kept as a switch.
+  bool init_only_close_points = false;
+  // Motion-model search radius (pixels at level 0), stereo/RGB-D and monocular.
+  double motion_model_radius_stereo = 7.0;
+  double motion_model_radius_mono = 15.0;
+  // Minimum matches for motion-model / reference-keyframe tracking to succeed.
+  int min_matches_motion_model = 20;
+  int min_matches_reference_kf = 15;
+  // Lowe ratio for reference-keyframe BoW matching.
+  double reference_kf_ratio = 0.7;
+  // Local map: maximum local keyframes.
+  int max_local_keyframes = 80;
+  // Local-map search radius (pixels, times the octave scale); larger right after
+  // relocalisation.
+  double local_map_radius = 1.0;
+  double local_map_radius_after_reloc = 5.0;
+  // Inliers required for tracking to be OK: right after relocalisation / otherwise.
+  int min_inliers_after_reloc = 50;
+  int min_inliers = 30;
+  // Stereo: temporary "visual odometry" points for close untracked keypoints of the last
+  // frame, at most this many (ORB-SLAM's UpdateLastFrame creates up to 100).
+  int max_temporal_points = 100;
+  // New keyframes (stereo/RGB-D): create points from close untracked keypoints, at least
+  // this many (ORB-SLAM: 100 closest, and all closer than th_depth).
+  int new_keyframe_min_close_points = 100;
+  // Seconds in RECENTLY_LOST before declaring LOST (inertial).
+  double recently_lost_timeout_s = 5.0;
+  // A lost map with at most this many keyframes is reset instead of kept in the Atlas.
+  int min_keyframes_to_keep_map = 10;
+  // Deterministic mode: wait for local mapping to finish each keyframe before going on.
+  bool lockstep = false;
+  PoseOptimizerOptions pose;
+
+  void Check() const;
+};
+
+}  // namespace pkslam
