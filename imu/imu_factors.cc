@@ -169,12 +169,12 @@ bool InertialError::Evaluate(double const* const* parameters, double* residuals,
 BiasRandomWalkError::BiasRandomWalkError(const Mat3& covariance)
     : sqrt_info_(SqrtInformation<3>(covariance)) {}
 
-BiasRandomWalkError* BiasRandomWalkError::Gyro(const PreintegratedImu& pim) {
-  return new BiasRandomWalkError(pim.covariance.block<3, 3>(9, 9));
+std::unique_ptr<BiasRandomWalkError> BiasRandomWalkError::Gyro(const PreintegratedImu& pim) {
+  return std::make_unique<BiasRandomWalkError>(pim.covariance.block<3, 3>(9, 9));
 }
 
-BiasRandomWalkError* BiasRandomWalkError::Accel(const PreintegratedImu& pim) {
-  return new BiasRandomWalkError(pim.covariance.block<3, 3>(12, 12));
+std::unique_ptr<BiasRandomWalkError> BiasRandomWalkError::Accel(const PreintegratedImu& pim) {
+  return std::make_unique<BiasRandomWalkError>(pim.covariance.block<3, 3>(12, 12));
 }
 
 bool BiasRandomWalkError::Evaluate(double const* const* parameters, double* residuals,

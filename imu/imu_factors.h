@@ -15,6 +15,7 @@
 #include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
+#include <memory>
 
 #include "core/geometry/se3.h"
 #include "core/imu/imu_types.h"
@@ -48,8 +49,8 @@ class BiasRandomWalkError final : public ceres::SizedCostFunction<3, 3, 3> {
  public:
   explicit BiasRandomWalkError(const Eigen::Matrix3d& covariance);
   // The gyro (accel) walk over pim's interval: covariance block 9..11 (12..14).
-  static BiasRandomWalkError* Gyro(const PreintegratedImu& pim);
-  static BiasRandomWalkError* Accel(const PreintegratedImu& pim);
+  static std::unique_ptr<BiasRandomWalkError> Gyro(const PreintegratedImu& pim);
+  static std::unique_ptr<BiasRandomWalkError> Accel(const PreintegratedImu& pim);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 

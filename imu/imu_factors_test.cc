@@ -109,11 +109,16 @@ TEST(InertialError, SolvesForTheSecondStateInCeres) {
   Block ba = VecBlock(s.true_bias.accel);
   Block pose_j = PoseBlock(b.world_from_body * SE3d::Exp(RandomTangent<6>(rng, 0.15)));
   Block v_j = VecBlock(b.velocity_world + Vec3(0.3, -0.2, 0.1));
-  ceres::Problem problem;
-  problem.AddResidualBlock(new InertialError(s.pim, kTestGravity), nullptr, pose_i.data(),
-                           v_i.data(), bg.data(), ba.data(), pose_j.data(), v_j.data());
-  problem.SetManifold(pose_i.data(), new BodyPoseManifold);
-  problem.SetManifold(pose_j.data(), new BodyPoseManifold);
+  InertialError cost(s.pim, kTestGravity);
+  BodyPoseManifold manifold;
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  problem.AddResidualBlock(&cost, nullptr, pose_i.data(), v_i.data(), bg.data(), ba.data(),
+                           pose_j.data(), v_j.data());
+  problem.SetManifold(pose_i.data(), &manifold);
+  problem.SetManifold(pose_j.data(), &manifold);
   for (double* fixed : {pose_i.data(), v_i.data(), bg.data(), ba.data()}) {
     problem.SetParameterBlockConstant(fixed);
   }
@@ -149,6 +154,7 @@ TEST(InertialGravityScaleError, ResidualVanishesAtTruthAndJacobiansMatch) {
                                gravity,
                                {std::log(scale)}};
   std::vector<const double*> params;
+  params.reserve(blocks.size());
   for (const Block& blk : blocks) params.push_back(blk.data());
   Eigen::Matrix<double, 9, 1> r;
   ASSERT_TRUE(cost.Evaluate(params.data(), r.data(), nullptr));
@@ -174,8 +180,8 @@ TEST(InertialGravityScaleError, ResidualVanishesAtTruthAndJacobiansMatch) {
 
 TEST(BiasRandomWalkError, WhitensTheDifferenceAndJacobiansMatch) {
   const Scenario s;
-  std::unique_ptr<BiasRandomWalkError> gyro(BiasRandomWalkError::Gyro(s.pim));
-  std::unique_ptr<BiasRandomWalkError> accel(BiasRandomWalkError::Accel(s.pim));
+  const std::unique_ptr<BiasRandomWalkError> gyro = BiasRandomWalkError::Gyro(s.pim);
+  const std::unique_ptr<BiasRandomWalkError> accel = BiasRandomWalkError::Accel(s.pim);
   const std::vector<Block> blocks = {VecBlock(Vec3(0.01, 0.02, 0.03)), VecBlock(Vec3(0.02, 0, 0))};
   std::vector<const double*> params = {blocks[0].data(), blocks[1].data()};
   Vec3 r;
@@ -212,6 +218,7 @@ TEST(InertialStatePriorError, ZeroAtPriorAndJacobiansMatch) {
   std::vector<Block> blocks = {PoseBlock(prior.world_from_body), VecBlock(prior.velocity_world),
                                VecBlock(prior_bias.gyro), VecBlock(prior_bias.accel)};
   std::vector<const double*> params;
+  params.reserve(blocks.size());
   for (const Block& b : blocks) params.push_back(b.data());
   Eigen::Matrix<double, 15, 1> r;
   ASSERT_TRUE(cost.Evaluate(params.data(), r.data(), nullptr));

@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <cmath>
+#include <memory>
 
 #include "core/util/error.h"
 #include "imu/imu_factors.h"
@@ -79,25 +80,32 @@ InertialInitResult InitializeInertial(const std::vector<InertialInitKeyFrame>& k
                          gravity_block);
   double log_scale = 0.0;
 
-  ceres::Problem problem;
+  // The problem borrows the cost functions and the manifold; they live until the solve ends.
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+  GravityDirectionManifold gravity_manifold;
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
   for (std::size_t k = 0; k + 1 < n; ++k) {
-    problem.AddResidualBlock(
-        new InertialGravityScaleError(preintegrations[k], keyframes[k].world_from_body,
-                                      keyframes[k + 1].world_from_body, options.gravity_magnitude),
-        nullptr, velocities[k].data(), velocities[k + 1].data(), bias_gyro.data(),
-        bias_accel.data(), gravity_block, &log_scale);
+    costs.push_back(std::make_unique<InertialGravityScaleError>(
+        preintegrations[k], keyframes[k].world_from_body, keyframes[k + 1].world_from_body,
+        options.gravity_magnitude));
+    problem.AddResidualBlock(costs.back().get(), nullptr, velocities[k].data(),
+                             velocities[k + 1].data(), bias_gyro.data(), bias_accel.data(),
+                             gravity_block, &log_scale);
   }
   if (options.gyro_bias_prior_information > 0) {
-    problem.AddResidualBlock(
-        new BiasPriorError(Eigen::Vector3d::Zero(), options.gyro_bias_prior_information), nullptr,
-        bias_gyro.data());
+    costs.push_back(std::make_unique<BiasPriorError>(Eigen::Vector3d::Zero(),
+                                                     options.gyro_bias_prior_information));
+    problem.AddResidualBlock(costs.back().get(), nullptr, bias_gyro.data());
   }
   if (options.accel_bias_prior_information > 0) {
-    problem.AddResidualBlock(
-        new BiasPriorError(Eigen::Vector3d::Zero(), options.accel_bias_prior_information), nullptr,
-        bias_accel.data());
+    costs.push_back(std::make_unique<BiasPriorError>(Eigen::Vector3d::Zero(),
+                                                     options.accel_bias_prior_information));
+    problem.AddResidualBlock(costs.back().get(), nullptr, bias_accel.data());
   }
-  problem.SetManifold(gravity_block, new GravityDirectionManifold);
+  problem.SetManifold(gravity_block, &gravity_manifold);
   if (!options.estimate_scale) problem.SetParameterBlockConstant(&log_scale);
 
   ceres::Solver::Options solver_options;

@@ -183,14 +183,21 @@ Eigen::Matrix<double, 9, 9> MonteCarloCovariance(int runs, const PreintegratedIm
 // Relative error of each 3x3 diagonal block's trace and of the whole matrix.
 void ExpectCovarianceClose(const Eigen::Matrix<double, 9, 9>& predicted,
                            const Eigen::Matrix<double, 9, 9>& sampled, double tolerance) {
-  for (int b = 0; b < 3; ++b) {
-    const double p = predicted.block<3, 3>(3 * b, 3 * b).trace();
-    const double s = sampled.block<3, 3>(3 * b, 3 * b).trace();
+  const Eigen::Matrix<double, 9, 9> w = SqrtInformation<9>(predicted);
+  const Eigen::Matrix<double, 9, 9> white = w * sampled * w.transpose();
+  std::printf(
+      "[ covariance ] sampled/predicted trace: rotation %.3f, velocity %.3f, position "
+      "%.3f; whitened trace/9 %.3f, max |whitened - I| %.3f\n",
+      sampled.block<3, 3>(0, 0).trace() / predicted.block<3, 3>(0, 0).trace(),
+      sampled.block<3, 3>(3, 3).trace() / predicted.block<3, 3>(3, 3).trace(),
+      sampled.block<3, 3>(6, 6).trace() / predicted.block<3, 3>(6, 6).trace(), white.trace() / 9.0,
+      (white - Eigen::Matrix<double, 9, 9>::Identity()).cwiseAbs().maxCoeff());
+  for (Eigen::Index b = 0; b < 9; b += 3) {
+    const double p = predicted.block<3, 3>(b, b).trace();
+    const double s = sampled.block<3, 3>(b, b).trace();
     EXPECT_NEAR(s / p, 1.0, tolerance) << "block " << b << " predicted " << p << " sampled " << s;
   }
   // Whitened: the sampled covariance in the predicted metric should be near identity.
-  const Eigen::Matrix<double, 9, 9> w = SqrtInformation<9>(predicted);
-  const Eigen::Matrix<double, 9, 9> white = w * sampled * w.transpose();
   EXPECT_NEAR(white.trace() / 9.0, 1.0, tolerance);
   EXPECT_LT((white - Eigen::Matrix<double, 9, 9>::Identity()).cwiseAbs().maxCoeff(), 3 * tolerance);
 }
