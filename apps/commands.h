@@ -8,6 +8,7 @@ namespace pkslam::apps {
 
 void RegisterEvalCommand(CLI::App& app);
 void RegisterInfoCommand(CLI::App& app);
+void RegisterRunCommand(CLI::App& app);
 void RegisterVocabCommand(CLI::App& app);
 
 }  // namespace pkslam::apps

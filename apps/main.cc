@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
 
   pkslam::apps::RegisterEvalCommand(app);
   pkslam::apps::RegisterInfoCommand(app);
+  pkslam::apps::RegisterRunCommand(app);
   pkslam::apps::RegisterVocabCommand(app);
 
   try {

@@ -1,6 +1,7 @@
 #include "keyframe/orbslam3_selector.h"
 
 #include "core/util/error.h"
+#include "keyframe/selector_common.h"
 
 namespace pkslam {
 
@@ -40,24 +41,9 @@ SelectorDecision OrbSlam3Selector::Decide(const SelectorInput& in) {
   SelectorDecision no;
   no.reason = "no";
 
-  if (IsInertial(s) && !in.imu_initialized) {
-    if (since_kf >= options_.imu_uninitialised_interval_s) {
-      SelectorDecision d;
-      d.insert = true;
-      d.reason = "imu-uninit-time";
-      return d;
-    }
-    return no;
-  }
-  if (in.only_tracking) return {false, false, "only-tracking", {}};
-  if (in.local_mapping_stopped) return {false, false, "mapping-stopped", {}};
-
+  if (auto exit = CommonSafetyExits(in, options_.imu_uninitialised_interval_s)) return *exit;
   const int max_frames =
       options_.max_frames > 0 ? options_.max_frames : static_cast<int>(in.fps + 0.5);
-  if (in.frame_id < in.last_relocalisation_frame_id + max_frames &&
-      in.keyframes_in_map > max_frames) {
-    return {false, false, "after-reloc", {}};
-  }
 
   const bool need_close = in.tracked_close < options_.close_tracked_max &&
                           in.untracked_close > options_.close_untracked_min;

@@ -4,7 +4,9 @@
 #include <fmt/ranges.h>
 
 #include "core/util/error.h"
+#include "keyframe/baseline_selectors.h"
 #include "keyframe/orbslam3_selector.h"
+#include "keyframe/pks_selector.h"
 
 namespace pkslam {
 namespace {
@@ -41,7 +43,9 @@ class ParameterReader {
 
 }  // namespace
 
-std::vector<std::string> KeyframeSelectorNames() { return {"orbslam3"}; }
+std::vector<std::string> KeyframeSelectorNames() {
+  return {"orbslam3", "pks", "pks-released", "interval", "ptam", "match-count", "vins-parallax"};
+}
 
 std::unique_ptr<KeyframeSelector> MakeKeyframeSelector(
     const std::string& name, const std::map<std::string, double>& parameters) {
@@ -56,6 +60,53 @@ std::unique_ptr<KeyframeSelector> MakeKeyframeSelector(
     reader.Read("close_untracked_min", &o.close_untracked_min);
     reader.RejectUnknown();
     return std::make_unique<OrbSlam3Selector>(o);
+  }
+  if (name == "pks" || name == "pks-released") {
+    PksOptions o;
+    reader.Read("region_width", &o.region_width_deg);
+    reader.Read("regions", &o.regions);
+    reader.Read("delta", &o.delta_deg);
+    reader.Read("grid", &o.grid);
+    reader.Read("normal_neighbours", &o.normal_neighbours);
+    reader.Read("imu_threshold", &o.imu_threshold);
+    reader.Read("min_translation", &o.min_translation_m);
+    reader.Read("imu_uninitialised_interval", &o.imu_uninitialised_interval_s);
+    reader.Read("inertial_interval", &o.inertial_interval_s);
+    reader.Read("close_tracked_max", &o.close_tracked_max);
+    reader.Read("close_untracked_min", &o.close_untracked_min);
+    reader.Read("weak_tracking_ratio", &o.weak_tracking_ratio);
+    reader.Read("forced_interval", &o.forced_interval);
+    reader.Read("late_denominator_after", &o.late_denominator_after);
+    reader.RejectUnknown();
+    return std::make_unique<PksSelector>(o, name == "pks-released");
+  }
+  const std::map<std::string, BaselineKind> baselines = {
+      {"interval", BaselineKind::kInterval},
+      {"ptam", BaselineKind::kPtam},
+      {"match-count", BaselineKind::kMatchCount},
+      {"vins-parallax", BaselineKind::kVinsParallax}};
+  if (auto it = baselines.find(name); it != baselines.end()) {
+    BaselineOptions o;
+    switch (it->second) {
+      case BaselineKind::kInterval:
+        reader.Read("frames", &o.interval_frames);
+        reader.Read("seconds", &o.interval_seconds);
+        break;
+      case BaselineKind::kPtam:
+        reader.Read("min_frames", &o.ptam_min_frames);
+        reader.Read("min_distance_ratio", &o.ptam_min_distance_ratio);
+        break;
+      case BaselineKind::kMatchCount:
+        reader.Read("min_matches", &o.match_count_min);
+        break;
+      case BaselineKind::kVinsParallax:
+        reader.Read("parallax", &o.vins_parallax_px);
+        reader.Read("min_tracked", &o.vins_min_tracked);
+        break;
+    }
+    reader.Read("imu_uninitialised_interval", &o.imu_uninitialised_interval_s);
+    reader.RejectUnknown();
+    return std::make_unique<BaselineSelector>(it->second, o);
   }
   throw OptionError(fmt::format("unknown keyframe selector '{}' (known: {})", name,
                                 fmt::join(KeyframeSelectorNames(), ", ")));

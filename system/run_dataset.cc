@@ -71,7 +71,8 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   Settings settings;
   if (EurocDataset::LooksLikeEuroc(options.dataset)) {
     EurocOptions eo;
-    eo.read_imu = IsInertial(sensor);
+    // The IMU sensor carries the body frame (EuRoC ground truth) even for visual-only runs.
+    eo.read_imu = true;
     euroc = EurocDataset::Open(options.dataset, eo);
     if (IsRgbd(sensor)) throw OptionError("an EuRoC dataset has no depth: use stereo or mono");
     if (IsStereo(sensor)) {

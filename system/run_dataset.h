@@ -2,6 +2,7 @@
 // run's outputs. Used by `pkslam run` and `pkslam bench`.
 //
 // OUT/trajectory.txt   every tracked frame, TUM format (seconds), camera pose world_from_camera
+// OUT/trajectory_body.txt  the same as body (IMU) poses world_from_body (EuRoC ground truth's frame)
 // OUT/keyframes.txt    keyframes of the final map, same format
 // OUT/map_points.ply   map points (binary PLY)
 // OUT/stats.json       timings, counts, tracking states, memory

@@ -63,6 +63,11 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   const auto& out = options.out;
   const Trajectory frames = system.FrameTrajectory();
   WriteTrajectory(frames, out / "trajectory.txt", TrajectoryFormat::kTum);
+  // The same poses for the body (IMU) frame, comparable with EuRoC ground truth.
+  Trajectory body = frames;
+  const SE3d camera_from_body = system.rig().body_from_camera.Inverse();
+  for (auto& p : body.poses) p.pose = p.pose * camera_from_body;
+  WriteTrajectory(body, out / "trajectory_body.txt", TrajectoryFormat::kTum);
   WriteTrajectory(system.KeyFrameTrajectory(), out / "keyframes.txt", TrajectoryFormat::kTum);
   system.WriteMapPly(out / "map_points.ply");
   if (options.system.trace) WriteTrace(system.tracker(), out / "keyframe_trace.csv");

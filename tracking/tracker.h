@@ -21,6 +21,7 @@
 namespace pkslam {
 
 class Vocabulary;
+struct TwoViewResult;
 
 enum class TrackingState { kNotInitialized, kOk, kRecentlyLost, kLost };
 const char* TrackingStateName(TrackingState s);
@@ -81,6 +82,7 @@ class Tracker {
   TrackResult Track(Frame frame);
   void StereoInitialization();
   void MonocularInitialization();
+  void CreateInitialMapMonocular(const TwoViewResult& reconstruction);
   bool TrackReferenceKeyFrame();
   bool TrackWithMotionModel();
   bool TrackLocalMap();

@@ -1,21 +1,16 @@
 #include "core/bow/binary_kmeans.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
-
 #include <algorithm>
 #include <array>
 #include <climits>
 #include <functional>
 
+#include "core/bow/parallel.h"
 #include "core/bow/vocabulary_internal.h"
 #include "core/util/error.h"
 
 namespace pkslam::bow_internal {
 namespace {
-
-constexpr std::size_t kGrain = 4096;
 
 // kByteLanes[v]: bit j of v moved to the lowest bit of byte j.
 constexpr std::array<std::uint64_t, 256> MakeByteLanes() {
@@ -30,9 +25,10 @@ constexpr std::array<std::uint64_t, 256> MakeByteLanes() {
 constexpr std::array<std::uint64_t, 256> kByteLanes = MakeByteLanes();
 
 // Nearest centre of each point in [begin, end); returns how many labels changed.
-PKSLAM_POPCNT_CLONES
-std::size_t AssignRange(const Descriptor* points, std::size_t begin, std::size_t end,
-                        const Descriptor* centres, std::size_t k, std::uint32_t* labels) {
+[[gnu::always_inline]] inline std::size_t AssignRangeBody(const Descriptor* points,
+                                                          std::size_t begin, std::size_t end,
+                                                          const Descriptor* centres, std::size_t k,
+                                                          std::uint32_t* labels) {
   std::size_t changed = 0;
   for (std::size_t i = begin; i < end; ++i) {
     std::uint32_t best = 0;
@@ -52,10 +48,27 @@ std::size_t AssignRange(const Descriptor* points, std::size_t begin, std::size_t
   return changed;
 }
 
+PKSLAM_TARGET_POPCNT std::size_t AssignRangePopcnt(const Descriptor* points, std::size_t begin,
+                                                   std::size_t end, const Descriptor* centres,
+                                                   std::size_t k, std::uint32_t* labels) {
+  return AssignRangeBody(points, begin, end, centres, k, labels);
+}
+std::size_t AssignRangeBaseline(const Descriptor* points, std::size_t begin, std::size_t end,
+                                const Descriptor* centres, std::size_t k, std::uint32_t* labels) {
+  return AssignRangeBody(points, begin, end, centres, k, labels);
+}
+std::size_t AssignRange(const Descriptor* points, std::size_t begin, std::size_t end,
+                        const Descriptor* centres, std::size_t k, std::uint32_t* labels) {
+  return (CpuHasPopcnt() ? AssignRangePopcnt : AssignRangeBaseline)(points, begin, end, centres, k,
+                                                                    labels);
+}
+
 // min_d2[i] = min(min_d2[i], d(points[i], centre)^2) over [begin, end); returns their sum.
-PKSLAM_POPCNT_CLONES
-std::uint64_t UpdateMinDistances(const Descriptor* points, std::size_t begin, std::size_t end,
-                                 const Descriptor& centre, std::uint64_t* min_d2) {
+[[gnu::always_inline]] inline std::uint64_t UpdateMinDistancesBody(const Descriptor* points,
+                                                                   std::size_t begin,
+                                                                   std::size_t end,
+                                                                   const Descriptor& centre,
+                                                                   std::uint64_t* min_d2) {
   std::uint64_t sum = 0;
   for (std::size_t i = begin; i < end; ++i) {
     const auto d = static_cast<std::uint64_t>(HammingDistance(points[i], centre));
@@ -64,38 +77,64 @@ std::uint64_t UpdateMinDistances(const Descriptor* points, std::size_t begin, st
   }
   return sum;
 }
+PKSLAM_TARGET_POPCNT std::uint64_t UpdateMinDistancesPopcnt(const Descriptor* points,
+                                                            std::size_t begin, std::size_t end,
+                                                            const Descriptor& centre,
+                                                            std::uint64_t* min_d2) {
+  return UpdateMinDistancesBody(points, begin, end, centre, min_d2);
+}
+std::uint64_t UpdateMinDistancesBaseline(const Descriptor* points, std::size_t begin,
+                                         std::size_t end, const Descriptor& centre,
+                                         std::uint64_t* min_d2) {
+  return UpdateMinDistancesBody(points, begin, end, centre, min_d2);
+}
+std::uint64_t UpdateMinDistances(const Descriptor* points, std::size_t begin, std::size_t end,
+                                 const Descriptor& centre, std::uint64_t* min_d2) {
+  return (CpuHasPopcnt() ? UpdateMinDistancesPopcnt : UpdateMinDistancesBaseline)(
+      points, begin, end, centre, min_d2);
+}
 
-// Integer sum over [0, n) of f(begin, end), in parallel when n is large. Integer addition is
-// associative, so the result does not depend on how TBB splits the range.
+// Splits [0, n) into contiguous chunks, one task each: serial below options.parallel_min
+// points or with one thread.
+std::size_t ChunkCount(std::size_t n, const ClusterOptions& options) {
+  if (options.threads <= 1 || n < options.parallel_min) return 1;
+  return std::min<std::size_t>(n, static_cast<std::size_t>(options.threads) * 4);
+}
+std::size_t ChunkBegin(std::size_t chunk, std::size_t chunks, std::size_t n) {
+  return chunk * n / chunks;
+}
+
+// Sum over chunks of f(begin, end). Integer addition is exact, so the result does not depend
+// on the chunking or the thread count.
 template <typename T>
-T SumOverRange(std::size_t n, std::size_t parallel_min,
+T SumOverRange(std::size_t n, const ClusterOptions& options,
                const std::function<T(std::size_t, std::size_t)>& f) {
-  if (n < parallel_min) return f(0, n);
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, n, kGrain), T{0},
-      [&f](const tbb::blocked_range<std::size_t>& r, T acc) { return acc + f(r.begin(), r.end()); },
-      std::plus<T>());
+  const std::size_t chunks = ChunkCount(n, options);
+  if (chunks == 1) return f(0, n);
+  std::vector<T> partial(chunks, T{0});
+  ParallelFor(chunks, options.threads, [&](std::size_t c) {
+    partial[c] = f(ChunkBegin(c, chunks, n), ChunkBegin(c + 1, chunks, n));
+  });
+  T sum{0};
+  for (T x : partial) sum += x;
+  return sum;
 }
 
 std::vector<BitCounter> CountBits(std::span<const Descriptor> points,
                                   const std::vector<std::uint32_t>& labels, std::size_t k,
-                                  std::size_t parallel_min) {
-  const auto count_range = [&](std::size_t begin, std::size_t end, std::vector<BitCounter> acc) {
-    for (std::size_t i = begin; i < end; ++i) acc[labels[i]].Add(points[i]);
-    return acc;
-  };
-  if (points.size() < parallel_min) {
-    return count_range(0, points.size(), std::vector<BitCounter>(k));
+                                  const ClusterOptions& options) {
+  const std::size_t n = points.size();
+  const std::size_t chunks = ChunkCount(n, options);
+  std::vector<std::vector<BitCounter>> partial(chunks, std::vector<BitCounter>(k));
+  ParallelFor(chunks, options.threads, [&](std::size_t c) {
+    for (std::size_t i = ChunkBegin(c, chunks, n); i < ChunkBegin(c + 1, chunks, n); ++i) {
+      partial[c][labels[i]].Add(points[i]);
+    }
+  });
+  for (std::size_t c = 1; c < chunks; ++c) {
+    for (std::size_t j = 0; j < k; ++j) partial[0][j].Merge(partial[c][j]);
   }
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, points.size(), kGrain), std::vector<BitCounter>(k),
-      [&](const tbb::blocked_range<std::size_t>& r, std::vector<BitCounter> acc) {
-        return count_range(r.begin(), r.end(), std::move(acc));
-      },
-      [](std::vector<BitCounter> a, const std::vector<BitCounter>& b) {
-        for (std::size_t j = 0; j < a.size(); ++j) a[j].Merge(b[j]);
-        return a;
-      });
+  return std::move(partial[0]);
 }
 
 // k-means++ seeds: the first uniformly, each next with probability ~ squared distance to the
@@ -109,8 +148,8 @@ std::vector<Descriptor> SeedCentres(std::span<const Descriptor> points,
   std::vector<std::uint64_t> min_d2(n, UINT64_MAX);
   while (centres.size() < static_cast<std::size_t>(options.k)) {
     const Descriptor& newest = centres.back();
-    const std::uint64_t total = SumOverRange<std::uint64_t>(
-        n, options.parallel_min, [&](std::size_t begin, std::size_t end) {
+    const std::uint64_t total =
+        SumOverRange<std::uint64_t>(n, options, [&](std::size_t begin, std::size_t end) {
           return UpdateMinDistances(points.data(), begin, end, newest, min_d2.data());
         });
     if (total == 0) break;  // every point coincides with a seed
@@ -206,8 +245,8 @@ Descriptor MajorityCentre(std::span<const Descriptor> descriptors) {
 
 ClusterResult ClusterDescriptors(std::span<const Descriptor> points,
                                  const ClusterOptions& options) {
-  PKSLAM_CHECK(options.k >= 1 && options.max_iterations >= 1, "k {} iterations {}", options.k,
-               options.max_iterations);
+  PKSLAM_CHECK(options.k >= 1 && options.max_iterations >= 1 && options.threads >= 1,
+               "k {} iterations {} threads {}", options.k, options.max_iterations, options.threads);
   ClusterResult result;
   const std::size_t n = points.size();
   if (n == 0) return result;
@@ -226,7 +265,7 @@ ClusterResult ClusterDescriptors(std::span<const Descriptor> points,
   const std::size_t k = result.centres.size();
   std::fill(result.labels.begin(), result.labels.end(), UINT32_MAX);
   const auto assign = [&] {
-    return SumOverRange<std::size_t>(n, options.parallel_min, [&](std::size_t b, std::size_t e) {
+    return SumOverRange<std::size_t>(n, options, [&](std::size_t b, std::size_t e) {
       return AssignRange(points.data(), b, e, result.centres.data(), k, result.labels.data());
     });
   };
@@ -234,8 +273,7 @@ ClusterResult ClusterDescriptors(std::span<const Descriptor> points,
   result.converged = false;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     ++result.iterations;
-    const std::vector<BitCounter> counters =
-        CountBits(points, result.labels, k, options.parallel_min);
+    const std::vector<BitCounter> counters = CountBits(points, result.labels, k, options);
     for (std::size_t j = 0; j < k; ++j) {
       // An empty cluster keeps its centre (it may win points back next round).
       if (counters[j].total() > 0) result.centres[j] = counters[j].Majority();

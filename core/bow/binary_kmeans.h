@@ -65,6 +65,7 @@ struct ClusterOptions {
   int max_iterations = 50;
   std::uint64_t seed = 1;
   std::size_t parallel_min = 50000;  // split assignment across threads above this many points
+  int threads = 1;                   // threads for the split steps (>= 1)
 };
 
 // Clusters `descriptors` into at most k groups. With n <= k every distinct descriptor is its

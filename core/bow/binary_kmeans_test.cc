@@ -1,7 +1,6 @@
 #include "core/bow/binary_kmeans.h"
 
 #include <gtest/gtest.h>
-#include <tbb/task_arena.h>
 
 #include <random>
 #include <set>
@@ -131,15 +130,16 @@ TEST(ClusterDescriptors, DeterministicAcrossThreadCounts) {
   ClusterOptions serial;
   serial.k = 10;
   serial.seed = 5;
-  serial.parallel_min = 1u << 30;
-  ClusterOptions parallel = serial;
-  parallel.parallel_min = 1;
   const ClusterResult a = ClusterDescriptors(points, serial);
-  ClusterResult b;
-  tbb::task_arena arena(2);
-  arena.execute([&] { b = ClusterDescriptors(points, parallel); });
-  EXPECT_EQ(a.centres, b.centres);
-  EXPECT_EQ(a.labels, b.labels);
+  for (int threads : {2, 3}) {
+    ClusterOptions parallel = serial;
+    parallel.parallel_min = 1;
+    parallel.threads = threads;
+    const ClusterResult b = ClusterDescriptors(points, parallel);
+    EXPECT_EQ(a.centres, b.centres);
+    EXPECT_EQ(a.labels, b.labels);
+    EXPECT_EQ(a.iterations, b.iterations);
+  }
   serial.seed = 6;
   EXPECT_NE(ClusterDescriptors(points, serial).centres, a.centres);
 }

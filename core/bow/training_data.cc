@@ -1,17 +1,14 @@
 #include "core/bow/training_data.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cctype>
-#include <cstring>
 #include <exception>
 #include <mutex>
-#include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "core/bow/parallel.h"
+#include "core/features/orb_extractor.h"
 #include "core/util/error.h"
 #include "core/util/progress.h"
 
@@ -37,17 +34,12 @@ void TrainingFeatureOptions::Check() const {
 std::vector<Descriptor> ExtractTrainingDescriptors(const cv::Mat& gray,
                                                    const TrainingFeatureOptions& options) {
   PKSLAM_CHECK(gray.type() == CV_8UC1, "expected an 8-bit grey image, type {}", gray.type());
-  const cv::Ptr<cv::ORB> orb = cv::ORB::create(
-      options.max_features, static_cast<float>(options.scale_factor), options.levels);
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat mat;
-  orb->detectAndCompute(gray, cv::noArray(), keypoints, mat);
-  std::vector<Descriptor> out(static_cast<std::size_t>(mat.rows));
-  if (mat.rows > 0) {
-    PKSLAM_CHECK(mat.cols == 32 && mat.type() == CV_8UC1, "unexpected ORB descriptor layout");
-    for (int r = 0; r < mat.rows; ++r) std::memcpy(out[r].bytes.data(), mat.ptr(r), 32);
-  }
-  return out;
+  OrbOptions orb;
+  orb.n_features = options.max_features;
+  orb.n_levels = options.levels;
+  orb.scale_factor = options.scale_factor;
+  orb.parallel = false;  // training already extracts one image per thread
+  return OrbExtractor(orb).Extract(gray).descriptors;
 }
 
 std::vector<std::filesystem::path> ListTrainingImages(
@@ -75,7 +67,7 @@ std::vector<std::filesystem::path> ListTrainingImages(
 
 std::vector<std::vector<Descriptor>> ExtractTrainingSet(
     const std::vector<std::filesystem::path>& images, const TrainingFeatureOptions& options,
-    bool quiet) {
+    bool quiet, int threads) {
   options.Check();
   std::vector<std::vector<Descriptor>> out(images.size());
   // One slot per image, so the error reported (the first bad image in list order) does not
@@ -83,17 +75,18 @@ std::vector<std::vector<Descriptor>> ExtractTrainingSet(
   std::vector<std::exception_ptr> errors(images.size());
   std::mutex progress_mutex;  // Progress is single-threaded: serialise its updates
   Progress progress("vocab features", images.size(), quiet);
-  tbb::parallel_for(std::size_t{0}, images.size(), [&](std::size_t i) {
-    try {
-      const cv::Mat gray = cv::imread(images[i].string(), cv::IMREAD_GRAYSCALE);
-      if (gray.empty()) throw InputError(images[i], "cannot read image");
-      out[i] = ExtractTrainingDescriptors(gray, options);
-    } catch (...) {
-      errors[i] = std::current_exception();
-    }
-    std::lock_guard lock(progress_mutex);
-    progress.Add();
-  });
+  bow_internal::ParallelFor(
+      images.size(), bow_internal::ResolveThreadCount(threads), [&](std::size_t i) {
+        try {
+          const cv::Mat gray = cv::imread(images[i].string(), cv::IMREAD_GRAYSCALE);
+          if (gray.empty()) throw InputError(images[i], "cannot read image");
+          out[i] = ExtractTrainingDescriptors(gray, options);
+        } catch (...) {
+          errors[i] = std::current_exception();
+        }
+        std::lock_guard lock(progress_mutex);
+        progress.Add();
+      });
   progress.Finish();
   for (const auto& error : errors) {
     if (error) std::rethrow_exception(error);

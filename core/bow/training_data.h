@@ -20,8 +20,8 @@ struct TrainingFeatureOptions {
   void Check() const;
 };
 
-// ORB descriptors of one 8-bit grey image, as the vocabulary will later see them.
-// The single place that chooses the extractor (cv::ORB until pkslam's OrbExtractor is on main).
+// ORB descriptors of one 8-bit grey image, as the vocabulary will later see them: pkslam's
+// OrbExtractor (ORB-SLAM's quadtree-distributed ORB), the extractor tracking uses.
 std::vector<Descriptor> ExtractTrainingDescriptors(const cv::Mat& gray,
                                                    const TrainingFeatureOptions& options);
 
@@ -31,10 +31,11 @@ std::vector<Descriptor> ExtractTrainingDescriptors(const cv::Mat& gray,
 std::vector<std::filesystem::path> ListTrainingImages(
     const std::vector<std::filesystem::path>& dirs, std::size_t max_images);
 
-// Loads each image as grey and extracts its descriptors, in parallel, with a progress bar.
-// Result i belongs to images[i]. InputError naming the file for an unreadable image.
+// Loads each image as grey and extracts its descriptors on `threads` threads (0 = one per
+// hardware thread), with a progress bar. Result i belongs to images[i]. InputError naming the
+// file for an unreadable image (the first in list order).
 std::vector<std::vector<Descriptor>> ExtractTrainingSet(
     const std::vector<std::filesystem::path>& images, const TrainingFeatureOptions& options,
-    bool quiet);
+    bool quiet, int threads = 0);
 
 }  // namespace pkslam

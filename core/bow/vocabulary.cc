@@ -137,10 +137,10 @@ inline void PrefetchBlock(const Descriptor* p, std::uint32_t count) {
 // contiguous block of 32-byte descriptors; below the top levels every block is a cache miss,
 // so descriptors descend in batches, level by level, with each block prefetched for the whole
 // batch before any of them is scanned (the misses overlap instead of queueing).
-PKSLAM_POPCNT_CLONES
-void Descend(const Descriptor* descriptors, std::size_t count, const Descriptor* node_descriptors,
-             const bow_detail::ChildSpan* children, int di_level, NodeId* leaves,
-             NodeId* di_nodes) {
+[[gnu::always_inline]] inline void DescendBody(const Descriptor* descriptors, std::size_t count,
+                                               const Descriptor* node_descriptors,
+                                               const bow_detail::ChildSpan* children, int di_level,
+                                               NodeId* leaves, NodeId* di_nodes) {
   constexpr std::size_t kBatch = 16;
   NodeId node[kBatch];
   NodeId di_node[kBatch];
@@ -181,6 +181,26 @@ void Descend(const Descriptor* descriptors, std::size_t count, const Descriptor*
   }
 }
 
+PKSLAM_TARGET_POPCNT void DescendPopcnt(const Descriptor* descriptors, std::size_t count,
+                                        const Descriptor* node_descriptors,
+                                        const bow_detail::ChildSpan* children, int di_level,
+                                        NodeId* leaves, NodeId* di_nodes) {
+  DescendBody(descriptors, count, node_descriptors, children, di_level, leaves, di_nodes);
+}
+
+void DescendBaseline(const Descriptor* descriptors, std::size_t count,
+                     const Descriptor* node_descriptors, const bow_detail::ChildSpan* children,
+                     int di_level, NodeId* leaves, NodeId* di_nodes) {
+  DescendBody(descriptors, count, node_descriptors, children, di_level, leaves, di_nodes);
+}
+
+void Descend(const Descriptor* descriptors, std::size_t count, const Descriptor* node_descriptors,
+             const bow_detail::ChildSpan* children, int di_level, NodeId* leaves,
+             NodeId* di_nodes) {
+  (bow_internal::CpuHasPopcnt() ? DescendPopcnt : DescendBaseline)(
+      descriptors, count, node_descriptors, children, di_level, leaves, di_nodes);
+}
+
 }  // namespace
 
 Vocabulary Vocabulary::FromNodes(const VocabularyParams& params,
@@ -189,6 +209,11 @@ Vocabulary Vocabulary::FromNodes(const VocabularyParams& params,
   if (auto problem = bow_internal::FindTreeProblem(params, nodes)) {
     throw Error(fmt::format("vocabulary node {}: {}", problem->node, problem->message));
   }
+  return FromValidNodes(params, std::move(nodes));
+}
+
+Vocabulary Vocabulary::FromValidNodes(const VocabularyParams& params,
+                                      std::vector<VocabularyNode> nodes) {
   if (!ChildrenContiguous(nodes)) nodes = RenumberBreadthFirst(nodes);
   Vocabulary v;
   v.params_ = params;

@@ -82,6 +82,8 @@ struct VocabularyTrainOptions {
   std::uint64_t seed = 1;
   // Nodes with more descriptors than this split their assignment step across threads.
   std::size_t parallel_assign_min = 50000;
+  // Worker threads (0 = one per hardware thread). The result does not depend on it.
+  int threads = 0;
   // No progress bar.
   bool quiet = false;
 
@@ -177,6 +179,10 @@ class Vocabulary {
  private:
   using ChildSpan = bow_detail::ChildSpan;
 
+  // FromNodes for a node list that already passed FindTreeProblem (the loaders check it
+  // themselves to report file lines and offsets).
+  static Vocabulary FromValidNodes(const VocabularyParams& params,
+                                   std::vector<VocabularyNode> nodes);
   // Lays out validated nodes (children contiguous) into the lookup arrays.
   void BuildArrays(const std::vector<VocabularyNode>& nodes);
   // Quantises descriptors: word (kNoWord if its weight is 0) and direct-index node each.

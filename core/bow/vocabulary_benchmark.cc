@@ -61,9 +61,9 @@ BENCHMARK(BM_VocabularyTransform1200_K10L6)->Unit(benchmark::kMicrosecond);
 
 // The vocabulary shipped in Vocabulary/ (trained), when present.
 void BM_VocabularyTransform1200_Shipped(benchmark::State& state) {
-  const fs::path file = fs::path(PKSLAM_SOURCE_DIR) / "Vocabulary/pkslam_k10_l6.pkvoc";
+  const fs::path file = fs::path(PKSLAM_SOURCE_DIR) / "Vocabulary/pkslam_orb_k10_L6.bin";
   if (!fs::exists(file)) {
-    state.SkipWithError("Vocabulary/pkslam_k10_l6.pkvoc not found");
+    state.SkipWithError("Vocabulary/pkslam_orb_k10_L6.bin not found");
     return;
   }
   RunTransform(state, Vocabulary::Load(file));
@@ -124,6 +124,52 @@ void BM_VocabularyTrainK10L6(benchmark::State& state) {
 }
 BENCHMARK(BM_VocabularyTrainK10L6)
     ->Arg(200000)
+    ->Arg(3000000)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+
+// k=10, L=6 training on real ORB structure at scale: the descriptors of the EuRoC static slice
+// and the opencv-doc photos (~0.3 M), each repeated with 0-15 random bit flips up to the
+// requested count. Arg: descriptor count.
+void BM_VocabularyTrainK10L6_RealPerturbed(benchmark::State& state) {
+  std::vector<fs::path> dirs;
+  if (const auto shared = pkslam::testing::SharedDataDir()) {
+    dirs.push_back(*shared / "euroc/V1_01_easy_static/mav0");
+  }
+  dirs.push_back("/usr/share/doc/opencv-doc/examples/data");
+  std::erase_if(dirs, [](const fs::path& d) { return !fs::is_directory(d); });
+  if (dirs.empty()) {
+    state.SkipWithError("no real images (shared data, opencv-doc)");
+    return;
+  }
+  TrainingFeatureOptions features;
+  features.max_features = 1200;
+  const auto real = ExtractTrainingSet(ListTrainingImages(dirs, 0), features, true);
+  const auto n = static_cast<std::size_t>(state.range(0));
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<int> flips(0, 15);
+  std::vector<std::vector<Descriptor>> images;
+  std::size_t count = 0;
+  for (std::size_t copy = 0; count < n; ++copy) {
+    for (const auto& image : real) {
+      images.emplace_back();
+      for (const Descriptor& d : image) {
+        if (count == n) break;
+        images.back().push_back(copy == 0 ? d : pkslam::testing::FlipBits(d, flips(rng), rng));
+        ++count;
+      }
+    }
+  }
+  VocabularyTrainOptions options;
+  options.quiet = true;
+  std::size_t words = 0;
+  for (auto _ : state) {
+    words = Vocabulary::Train(images, options).word_count();
+  }
+  state.counters["words"] = static_cast<double>(words);
+  state.counters["images"] = static_cast<double>(images.size());
+}
+BENCHMARK(BM_VocabularyTrainK10L6_RealPerturbed)
     ->Arg(3000000)
     ->Unit(benchmark::kSecond)
     ->Iterations(1);

@@ -144,10 +144,11 @@ Vocabulary Vocabulary::LoadBinary(const std::filesystem::path& file) {
     const std::size_t at = problem->node == 0 ? 0 : kHeaderSize + (problem->node - 1) * kRecordSize;
     throw AtOffset(file, at, fmt::format("node {}: {}", problem->node, problem->message));
   }
-  return FromNodes(params, std::move(nodes));
+  return FromValidNodes(params, std::move(nodes));
 }
 
 void Vocabulary::SaveBinary(const std::filesystem::path& file) const {
+  PKSLAM_CHECK(!empty(), "cannot save an empty vocabulary to {}", file.string());
   std::string out;
   const std::size_t count = node_count() - (node_count() > 0 ? 1 : 0);
   out.reserve(kHeaderSize + count * kRecordSize + kChecksumSize);

@@ -7,17 +7,26 @@
 
 #include "core/bow/vocabulary.h"
 
-// GCC/Clang on x86-64 without -mpopcnt turn std::popcount into a library call; the Hamming
-// hot loops are compiled twice (POPCNT and baseline) and picked at load time by the dynamic
-// loader, so the binary stays portable and fast.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__POPCNT__) && \
-    !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
-#define PKSLAM_POPCNT_CLONES __attribute__((target_clones("popcnt", "default")))
+// GCC/Clang on x86-64 without -mpopcnt turn std::popcount into a library call. The Hamming
+// hot loops are therefore compiled twice, with POPCNT and for the baseline, and picked per
+// call with CpuHasPopcnt() (explicit dispatch, as core/features does, rather than ifunc
+// target_clones, whose resolvers run before sanitizer runtimes are initialised).
+#if defined(__x86_64__) && defined(__GNUC__)
+#define PKSLAM_TARGET_POPCNT [[gnu::target("popcnt")]]
 #else
-#define PKSLAM_POPCNT_CLONES
+#define PKSLAM_TARGET_POPCNT
 #endif
 
 namespace pkslam::bow_internal {
+
+// Whether the running CPU has the POPCNT instruction (a cached flag read, cheap per call).
+inline bool CpuHasPopcnt() {
+#if defined(__x86_64__) && defined(__GNUC__)
+  return __builtin_cpu_supports("popcnt");
+#else
+  return false;
+#endif
+}
 
 // Limits we accept in files and options.
 inline constexpr int kMaxBranching = 255;

@@ -205,6 +205,7 @@ TEST_F(VocabularyIo, CorruptBinaryNamesFileAndOffset) {
 TEST_F(VocabularyIo, SaveByExtension) {
   const Vocabulary v = Vocabulary::LoadText(Write("voc.txt", kOrbVocLike));
   EXPECT_THROW(v.Save(dir_ / "voc.yaml"), OptionError);
+  EXPECT_THROW(Vocabulary().Save(dir_ / "empty.bin"), Error);
   v.Save(dir_ / "voc.pkvoc");
   EXPECT_TRUE(IsBinaryVocabularyFile(dir_ / "voc.pkvoc"));
   EXPECT_FALSE(IsBinaryVocabularyFile(dir_ / "voc.txt"));

@@ -172,10 +172,11 @@ Vocabulary Vocabulary::LoadText(const std::filesystem::path& file) {
     // Node i is on line i + 1; problems of the whole tree are reported at the header.
     throw InputError(file, problem->node == 0 ? 1 : problem->node + 1, problem->message);
   }
-  return FromNodes(params, std::move(nodes));
+  return FromValidNodes(params, std::move(nodes));
 }
 
 void Vocabulary::SaveText(const std::filesystem::path& file) const {
+  PKSLAM_CHECK(!empty(), "cannot save an empty vocabulary to {}", file.string());
   std::string out;
   out.reserve(node_count() * 120 + 32);
   out += fmt::format("{} {}  {} {}\n", params_.branching, params_.levels,

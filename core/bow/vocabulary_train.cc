@@ -1,13 +1,13 @@
 // Vocabulary training: hierarchical k-means++ (DBoW2's HKmeans) over all training descriptors,
 // then word weights from the training images' document frequencies.
 //
-// Threads: sibling subtrees are clustered as independent TBB tasks (and large nodes split
-// their assignment step). Each task owns its node and a disjoint slice of the shared
-// descriptor array; the only shared mutable state is the atomic progress counter. The calling
-// thread only draws the progress bar. Every node's seed derives from its path in the tree, so
-// the result does not depend on scheduling.
-#include <tbb/parallel_for.h>
-
+// Threads: the tree grows level by level. Nodes of one level are independent: the large ones
+// are clustered one after the other with their assignment steps split across the threads, the
+// others concurrently, one node per task. A task owns its node and a disjoint slice of the
+// shared descriptor array; the only shared mutable state is the atomic progress counter, read
+// by the calling thread to draw the progress bar. Every node's seed derives from its path in
+// the tree and the results are collected in frontier order, so the vocabulary does not depend
+// on the thread count or on scheduling.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/bow/binary_kmeans.h"
+#include "core/bow/parallel.h"
 #include "core/bow/vocabulary.h"
 #include "core/bow/vocabulary_internal.h"
 #include "core/util/error.h"
@@ -34,38 +35,79 @@ struct TrainNode {
   std::vector<TrainNode> children;
 };
 
-struct TreeBuilder {
-  const VocabularyTrainOptions& options;
-  std::vector<Descriptor>& points;  // reordered in place: each node's points are contiguous
-  std::atomic<std::size_t>& progress;
-  std::atomic<std::size_t>& clustered_nodes;    // nodes split by k-means (statistics)
-  std::atomic<std::size_t>& unconverged_nodes;  // of which stopped by max_iterations
-  std::atomic<std::size_t>& iterations;         // Lloyd iterations over all nodes
+// A node still to be split: its points are points[begin, end).
+struct PendingNode {
+  TrainNode* node = nullptr;
+  std::size_t begin = 0;
+  std::size_t end = 0;
+  std::uint64_t seed = 0;
+};
 
-  // Clusters points [begin, end) of `node` (at `level`) and recurses into the children.
-  void Build(TrainNode& node, std::size_t begin, std::size_t end, int level,
-             std::uint64_t seed) const {
-    const std::size_t n = end - begin;
-    const auto remaining = static_cast<std::size_t>(options.levels - level);
-    if (level == options.levels || n <= 1) {
-      progress += n * remaining;
-      return;
+struct SplitStats {
+  std::atomic<std::size_t> clustered{0};    // nodes split by k-means proper
+  std::atomic<std::size_t> unconverged{0};  // of which stopped by max_iterations
+  std::atomic<std::size_t> iterations{0};   // Lloyd iterations over all of them
+};
+
+class TreeBuilder {
+ public:
+  TreeBuilder(const VocabularyTrainOptions& options, int threads, std::vector<Descriptor>& points,
+              std::atomic<std::size_t>& progress)
+      : options_(options), threads_(threads), points_(points), progress_(progress) {}
+
+  const SplitStats& stats() const { return stats_; }
+
+  void Build(TrainNode& root, std::uint64_t seed) {
+    std::vector<PendingNode> frontier = {{&root, 0, points_.size(), seed}};
+    for (int level = 0; !frontier.empty(); ++level) {
+      std::vector<std::vector<PendingNode>> children(frontier.size());
+      std::vector<std::size_t> small;
+      for (std::size_t i = 0; i < frontier.size(); ++i) {
+        const std::size_t n = frontier[i].end - frontier[i].begin;
+        if (threads_ > 1 && n >= options_.parallel_assign_min) {
+          children[i] = Split(frontier[i], level, threads_);
+        } else {
+          small.push_back(i);
+        }
+      }
+      bow_internal::ParallelFor(small.size(), threads_, [&](std::size_t j) {
+        children[small[j]] = Split(frontier[small[j]], level, 1);
+      });
+      frontier.clear();
+      for (auto& c : children) frontier.insert(frontier.end(), c.begin(), c.end());
+    }
+  }
+
+ private:
+  // Clusters one node (at `level`) into children; returns those that need splitting further.
+  std::vector<PendingNode> Split(const PendingNode& pending, int level, int threads) {
+    const std::size_t n = pending.end - pending.begin;
+    const auto remaining = static_cast<std::size_t>(options_.levels - level);
+    if (level == options_.levels || n <= 1) {
+      progress_ += n * remaining;
+      return {};
     }
     bow_internal::ClusterOptions cluster_options;
-    cluster_options.k = options.branching;
-    cluster_options.max_iterations = options.max_iterations;
-    cluster_options.seed = seed;
-    cluster_options.parallel_min = options.parallel_assign_min;
-    const std::span<const Descriptor> slice(points.data() + begin, n);
+    cluster_options.k = options_.branching;
+    cluster_options.max_iterations = options_.max_iterations;
+    cluster_options.seed = pending.seed;
+    cluster_options.parallel_min = options_.parallel_assign_min;
+    cluster_options.threads = threads;
+    const std::span<const Descriptor> slice(points_.data() + pending.begin, n);
     bow_internal::ClusterResult clusters = bow_internal::ClusterDescriptors(slice, cluster_options);
-    if (n > static_cast<std::size_t>(options.branching)) {
-      ++clustered_nodes;
-      iterations += static_cast<std::size_t>(clusters.iterations);
-      if (!clusters.converged) ++unconverged_nodes;
+    if (n > static_cast<std::size_t>(options_.branching)) {
+      ++stats_.clustered;
+      stats_.iterations += static_cast<std::size_t>(clusters.iterations);
+      if (!clusters.converged) ++stats_.unconverged;
+      if (n >= 100000) {
+        PKSLAM_LOG_DEBUG("vocabulary: level {} node of {} points: {} clusters, {} iterations{}",
+                         level, n, clusters.centres.size(), clusters.iterations,
+                         clusters.converged ? "" : " (not converged)");
+      }
     }
     if (clusters.centres.size() <= 1) {  // identical points: nothing to split
-      progress += n * remaining;
-      return;
+      progress_ += n * remaining;
+      return {};
     }
 
     // Stable counting sort of the slice by cluster, so each child owns a contiguous range.
@@ -77,18 +119,28 @@ struct TreeBuilder {
       std::vector<Descriptor> sorted(n);
       std::vector<std::size_t> cursor(offset.begin(), offset.end() - 1);
       for (std::size_t i = 0; i < n; ++i) sorted[cursor[clusters.labels[i]]++] = slice[i];
-      std::copy(sorted.begin(), sorted.end(), points.begin() + static_cast<std::ptrdiff_t>(begin));
+      std::copy(sorted.begin(), sorted.end(),
+                points_.begin() + static_cast<std::ptrdiff_t>(pending.begin));
     }
-    clusters.labels = {};
+    TrainNode& node = *pending.node;
     node.children.resize(c);
-    for (std::size_t j = 0; j < c; ++j) node.children[j].centre = clusters.centres[j];
-    progress += n;
-
-    tbb::parallel_for(std::size_t{0}, c, [&](std::size_t j) {
-      Build(node.children[j], begin + offset[j], begin + offset[j + 1], level + 1,
-            bow_internal::ChildSeed(seed, j));
-    });
+    std::vector<PendingNode> next;
+    next.reserve(c);
+    for (std::size_t j = 0; j < c; ++j) {
+      node.children[j].centre = clusters.centres[j];
+      next.push_back(PendingNode{&node.children[j], pending.begin + offset[j],
+                                 pending.begin + offset[j + 1],
+                                 bow_internal::ChildSeed(pending.seed, j)});
+    }
+    progress_ += n;
+    return next;
   }
+
+  const VocabularyTrainOptions& options_;
+  const int threads_;
+  std::vector<Descriptor>& points_;  // reordered in place: each node's points contiguous
+  std::atomic<std::size_t>& progress_;
+  SplitStats stats_;
 };
 
 // DBoW2's node numbering: a node's children get consecutive ids when it is expanded, then
@@ -156,20 +208,20 @@ Vocabulary Vocabulary::Train(const std::vector<std::vector<Descriptor>>& images,
   const Descriptor first_point = points.front();
 
   // 1. Hierarchical k-means.
+  const int threads = bow_internal::ResolveThreadCount(options.threads);
   TrainNode root;
   std::atomic<std::size_t> progress{0};
-  std::atomic<std::size_t> clustered{0};
-  std::atomic<std::size_t> unconverged{0};
-  std::atomic<std::size_t> iterations{0};
-  const TreeBuilder builder{options, points, progress, clustered, unconverged, iterations};
+  TreeBuilder builder(options, threads, points, progress);
   RunWithProgress("vocab k-means", total * static_cast<std::size_t>(options.levels), options.quiet,
-                  progress, [&] { builder.Build(root, 0, points.size(), 0, options.seed); });
+                  progress, [&] { builder.Build(root, options.seed); });
   points = {};
+  const SplitStats& stats = builder.stats();
   PKSLAM_LOG_INFO(
-      "vocabulary: k-means on {} nodes, {:.1f} Lloyd iterations per node on average, {} stopped "
-      "at max_iterations {}",
-      clustered.load(), clustered > 0 ? static_cast<double>(iterations) / clustered : 0.0,
-      unconverged.load(), options.max_iterations);
+      "vocabulary: k-means on {} nodes ({} threads), {:.1f} Lloyd iterations per node on "
+      "average, {} stopped at max_iterations {}",
+      stats.clustered.load(), threads,
+      stats.clustered > 0 ? static_cast<double>(stats.iterations) / stats.clustered : 0.0,
+      stats.unconverged.load(), options.max_iterations);
 
   std::vector<VocabularyNode> nodes(1);
   EmitChildren(root, 0, &nodes);
@@ -197,7 +249,7 @@ Vocabulary Vocabulary::Train(const std::vector<std::vector<Descriptor>>& images,
   std::vector<std::vector<WordId>> image_words(images.size());
   std::atomic<std::size_t> images_done{0};
   RunWithProgress("vocab idf", images.size(), options.quiet, images_done, [&] {
-    tbb::parallel_for(std::size_t{0}, images.size(), [&](std::size_t i) {
+    bow_internal::ParallelFor(images.size(), threads, [&](std::size_t i) {
       std::vector<WordId>& words = image_words[i];
       words.reserve(images[i].size());
       for (const Descriptor& d : images[i]) words.push_back(vocabulary.FindWord(d));

@@ -1,5 +1,4 @@
 #include <gtest/gtest.h>
-#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <random>
@@ -141,13 +140,37 @@ TEST(VocabularyTrain, DeterministicForSeedAndThreadCount) {
   const auto images = NoisyImages(30, 400, 3);
   auto options = Quiet(6, 3);
   options.parallel_assign_min = 1000;  // exercise the split assignment too
+  options.threads = 1;
   const Vocabulary a = Vocabulary::Train(images, options);
-  Vocabulary b;
-  tbb::task_arena one_thread(1);
-  one_thread.execute([&] { b = Vocabulary::Train(images, options); });
-  EXPECT_EQ(a.Nodes(), b.Nodes());
+  for (int threads : {2, 3}) {
+    options.threads = threads;
+    EXPECT_EQ(Vocabulary::Train(images, options).Nodes(), a.Nodes()) << threads << " threads";
+  }
   options.seed = 2;
   EXPECT_NE(Vocabulary::Train(images, options).Nodes(), a.Nodes());
+}
+
+// Descriptor sets, not hand-made vectors: the same set scores 1; sets drawn from disjoint
+// prototype pools score near 0; two sets from the same pool in between.
+TEST(VocabularyTrain, IdenticalSetsScoreOneDisjointNearZero) {
+  std::mt19937_64 rng(4);
+  std::vector<Descriptor> pool_a, pool_b;
+  for (int i = 0; i < 100; ++i) pool_a.push_back(RandomDescriptor(rng));
+  for (int i = 0; i < 100; ++i) pool_b.push_back(RandomDescriptor(rng));
+  const auto draw = [&](const std::vector<Descriptor>& pool) {
+    std::vector<Descriptor> image;
+    for (int i = 0; i < 300; ++i) image.push_back(FlipBits(pool[rng() % pool.size()], 15, rng));
+    return image;
+  };
+  std::vector<std::vector<Descriptor>> images;
+  for (int i = 0; i < 10; ++i) images.push_back(draw(i % 2 == 0 ? pool_a : pool_b));
+  const Vocabulary v = Vocabulary::Train(images, Quiet(10, 3));
+  const BowVector a1 = v.Transform(draw(pool_a));
+  const BowVector a2 = v.Transform(draw(pool_a));
+  const BowVector b1 = v.Transform(draw(pool_b));
+  EXPECT_NEAR(v.Score(a1, a1), 1.0, 1e-12);
+  EXPECT_LT(v.Score(a1, b1), 0.05);
+  EXPECT_GT(v.Score(a1, a2), 0.2);
 }
 
 TEST(VocabularyTrain, IdenticalDescriptorsGiveOneWord) {

@@ -24,6 +24,9 @@ class FeatureGrid {
   std::vector<int> FeaturesInArea(const std::vector<cv::KeyPoint>& keypoints, double x,
                                   double y, double radius, int min_level = -1,
                                   int max_level = -1) const;
+  // Same, into a caller-owned buffer (cleared first): no allocation in hot loops.
+  void FeaturesInArea(const std::vector<cv::KeyPoint>& keypoints, double x, double y,
+                      double radius, int min_level, int max_level, std::vector<int>* out) const;
 
  private:
   bool CellOf(const cv::Point2f& p, int* col, int* row) const;
@@ -31,8 +34,10 @@ class FeatureGrid {
   ImageBounds bounds_;
   double inv_cell_width_ = 0;
   double inv_cell_height_ = 0;
-  // cells_[row * kCols + col] -> keypoint indices
-  std::vector<std::vector<std::int32_t>> cells_;
+  // Compressed rows: keypoints of cell c are indices_[cell_start_[c] .. cell_start_[c + 1]),
+  // cells in row-major order, keypoints ascending within a cell.
+  std::vector<std::int32_t> cell_start_;
+  std::vector<std::int32_t> indices_;
 };
 
 }  // namespace pkslam

@@ -58,6 +58,11 @@ class Frame {
                                   int max_level = -1) const {
     return grid_.FeaturesInArea(keypoints_un_, x, y, radius, min_level, max_level);
   }
+  // Into a caller-owned buffer (no allocation per query in matching loops).
+  void FeaturesInArea(double x, double y, double radius, int min_level, int max_level,
+                      std::vector<int>* out) const {
+    grid_.FeaturesInArea(keypoints_un_, x, y, radius, min_level, max_level, out);
+  }
 
   // BoW of the descriptors (computed once; later calls are no-ops).
   void ComputeBoW(const Vocabulary& vocabulary);

@@ -54,6 +54,11 @@ class KeyFrame {
                                   int max_level = -1) const {
     return grid_.FeaturesInArea(keypoints_un_, x, y, radius, min_level, max_level);
   }
+  // Into a caller-owned buffer (no allocation per query in matching loops).
+  void FeaturesInArea(double x, double y, double radius, int min_level, int max_level,
+                      std::vector<int>* out) const {
+    grid_.FeaturesInArea(keypoints_un_, x, y, radius, min_level, max_level, out);
+  }
   bool HasDepth(int i) const { return !depth_.empty() && depth_[i] > 0; }
   std::optional<Eigen::Vector3d> UnprojectStereo(int i) const;
 

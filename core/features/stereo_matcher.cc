@@ -1,0 +1,212 @@
+#include "core/features/stereo_matcher.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <optional>
+#include <utility>
+
+#include "core/features/orb_extractor.h"
+#include "core/util/error.h"
+
+namespace pkslam {
+namespace {
+
+// Sum of absolute differences over the (2w+1)^2 windows centred at `cl` (left) and `cr`
+// (right), after adding to the left window the brightness offset `normalization` asks for.
+int WindowSad(const cv::Mat& left, cv::Point cl, const cv::Mat& right, cv::Point cr, int w,
+              SadNormalization normalization) {
+  int offset = 0;
+  if (normalization == SadNormalization::kCentrePixel) {
+    offset = int(right.at<std::uint8_t>(cr)) - int(left.at<std::uint8_t>(cl));
+  } else if (normalization == SadNormalization::kWindowMean) {
+    int sum_left = 0;
+    int sum_right = 0;
+    for (int dy = -w; dy <= w; ++dy) {
+      const std::uint8_t* l = left.ptr<std::uint8_t>(cl.y + dy) + cl.x;
+      const std::uint8_t* r = right.ptr<std::uint8_t>(cr.y + dy) + cr.x;
+      for (int dx = -w; dx <= w; ++dx) {
+        sum_left += l[dx];
+        sum_right += r[dx];
+      }
+    }
+    offset =
+        static_cast<int>(std::lround(double(sum_right - sum_left) / ((2 * w + 1) * (2 * w + 1))));
+  }
+  int sad = 0;
+  for (int dy = -w; dy <= w; ++dy) {
+    const std::uint8_t* l = left.ptr<std::uint8_t>(cl.y + dy) + cl.x;
+    const std::uint8_t* r = right.ptr<std::uint8_t>(cr.y + dy) + cr.x;
+    for (int dx = -w; dx <= w; ++dx) sad += std::abs(int(l[dx]) + offset - int(r[dx]));
+  }
+  return sad;
+}
+
+// Sub-pixel offset of the minimum from the costs at -1, 0, +1 (c0 the smallest), or nullopt
+// when the costs are flat.
+std::optional<double> SubpixelOffset(double c_minus, double c0, double c_plus, SubpixelFit fit) {
+  if (fit == SubpixelFit::kParabola) {
+    const double curvature = c_minus + c_plus - 2.0 * c0;
+    if (curvature <= 0.0) return std::nullopt;
+    return (c_minus - c_plus) / (2.0 * curvature);
+  }
+  // Two lines of opposite slope through the three costs (the shape of a SAD minimum).
+  const double slope = std::max(c_minus, c_plus) - c0;
+  if (slope <= 0.0) return std::nullopt;
+  return (c_minus - c_plus) / (2.0 * slope);
+}
+
+}  // namespace
+
+void StereoMatcherOptions::Check() const {
+  PKSLAM_CHECK_OPTION(max_descriptor_distance >= 1 && max_descriptor_distance <= 257,
+                      "max_descriptor_distance", "{}", max_descriptor_distance);
+  PKSLAM_CHECK_OPTION(row_band_scale >= 0.0, "row_band_scale", "{}", row_band_scale);
+  PKSLAM_CHECK_OPTION(octave_tolerance >= 0, "octave_tolerance", "{}", octave_tolerance);
+  PKSLAM_CHECK_OPTION(min_depth_baselines > 0.0, "min_depth_baselines", "{}", min_depth_baselines);
+  PKSLAM_CHECK_OPTION(sad_half_window >= 1, "sad_half_window", "{}", sad_half_window);
+  PKSLAM_CHECK_OPTION(sad_search_radius >= 2, "sad_search_radius", "{}", sad_search_radius);
+  PKSLAM_CHECK_OPTION(sad_outlier_factor > 0.0, "sad_outlier_factor", "{}", sad_outlier_factor);
+}
+
+StereoMatches MatchStereo(std::span<const cv::KeyPoint> left_keypoints,
+                          std::span<const Descriptor> left_descriptors,
+                          const ImagePyramid& left_pyramid,
+                          std::span<const cv::KeyPoint> right_keypoints,
+                          std::span<const Descriptor> right_descriptors,
+                          const ImagePyramid& right_pyramid, double bf, double fx,
+                          const StereoMatcherOptions& options) {
+  options.Check();
+  PKSLAM_CHECK(left_keypoints.size() == left_descriptors.size() &&
+                   right_keypoints.size() == right_descriptors.size(),
+               "keypoint and descriptor counts differ");
+  PKSLAM_CHECK(left_pyramid.NumLevels() >= 1 &&
+                   left_pyramid.NumLevels() == right_pyramid.NumLevels() &&
+                   left_pyramid.levels[0].size() == right_pyramid.levels[0].size(),
+               "stereo pyramids must have the same levels and image size");
+  PKSLAM_CHECK(bf > 0.0 && fx > 0.0, "bf {} and fx {} must be positive", bf, fx);
+
+  const int n_left = static_cast<int>(left_keypoints.size());
+  const int n_levels = left_pyramid.NumLevels();
+  StereoMatches out;
+  out.u_right.assign(n_left, -1.0f);
+  out.depth.assign(n_left, -1.0f);
+  out.right_index.assign(n_left, -1);
+  out.sad.assign(n_left, -1);
+
+  // Right keypoints listed under every row their band covers.
+  const int rows = left_pyramid.levels[0].rows;
+  std::vector<std::vector<int>> row_candidates(rows);
+  for (int i = 0; i < static_cast<int>(right_keypoints.size()); ++i) {
+    const cv::KeyPoint& kp = right_keypoints[i];
+    PKSLAM_CHECK(kp.octave >= 0 && kp.octave < n_levels, "right octave {} out of range", kp.octave);
+    const double r = options.row_band_scale * right_pyramid.ScaleY(kp.octave);
+    const int lo = std::max(0, static_cast<int>(std::floor(kp.pt.y - r)));
+    const int hi = std::min(rows - 1, static_cast<int>(std::ceil(kp.pt.y + r)));
+    for (int y = lo; y <= hi; ++y) row_candidates[y].push_back(i);
+  }
+
+  const double min_disparity = 0.0;
+  const double max_disparity = fx / options.min_depth_baselines;  // bf / (min_depth * b)
+  const int w = options.sad_half_window;
+  const int radius = options.sad_search_radius;
+  std::vector<int> costs(2 * radius + 1);
+  std::vector<std::pair<int, int>> sad_and_index;
+  sad_and_index.reserve(n_left);
+
+  for (int il = 0; il < n_left; ++il) {
+    const cv::KeyPoint& kl = left_keypoints[il];
+    const int level = kl.octave;
+    PKSLAM_CHECK(level >= 0 && level < n_levels, "left octave {} out of range", level);
+    const int row = static_cast<int>(kl.pt.y);
+    if (row < 0 || row >= rows) continue;
+    const double u_left = kl.pt.x;
+    const double min_u = u_left - max_disparity;
+    const double max_u = u_left - min_disparity;
+    if (max_u < 0.0) continue;
+
+    // Best descriptor among right keypoints of a neighbouring octave in the disparity range.
+    int best_distance = options.max_descriptor_distance;
+    int best_right = -1;
+    for (int ir : row_candidates[row]) {
+      const cv::KeyPoint& kr = right_keypoints[ir];
+      if (std::abs(kr.octave - level) > options.octave_tolerance) continue;
+      if (kr.pt.x < min_u || kr.pt.x > max_u) continue;
+      const int d = HammingDistance(left_descriptors[il], right_descriptors[ir]);
+      if (d < best_distance) {
+        best_distance = d;
+        best_right = ir;
+      }
+    }
+    if (best_right < 0) continue;
+
+    // SAD refinement on the left keypoint's level around the matched right position.
+    const cv::Mat& left_image = left_pyramid.levels[level];
+    const cv::Mat& right_image = right_pyramid.levels[level];
+    const int xl = static_cast<int>(std::lround(left_pyramid.ToLevelX(level, u_left)));
+    const int yl = static_cast<int>(std::lround(left_pyramid.ToLevelY(level, kl.pt.y)));
+    const int xr0 = static_cast<int>(
+        std::lround(right_pyramid.ToLevelX(level, right_keypoints[best_right].pt.x)));
+    if (yl - w < 0 || yl + w >= left_image.rows || yl + w >= right_image.rows || xl - w < 0 ||
+        xl + w >= left_image.cols || xr0 - radius - w < 0 || xr0 + radius + w >= right_image.cols) {
+      continue;
+    }
+    int best_cost = std::numeric_limits<int>::max();
+    int best_shift = 0;
+    for (int shift = -radius; shift <= radius; ++shift) {
+      const int cost = WindowSad(left_image, {xl, yl}, right_image, {xr0 + shift, yl}, w,
+                                 options.sad_normalization);
+      costs[shift + radius] = cost;
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_shift = shift;
+      }
+    }
+    if (best_shift == -radius || best_shift == radius) continue;  // minimum not bracketed
+
+    const std::optional<double> delta =
+        SubpixelOffset(costs[best_shift + radius - 1], costs[best_shift + radius],
+                       costs[best_shift + radius + 1], options.subpixel_fit);
+    if (!delta || *delta < -1.0 || *delta > 1.0) continue;
+
+    double u_right = right_pyramid.ToBaseX(level, xr0 + best_shift + *delta);
+    double disparity = u_left - u_right;
+    if (disparity < min_disparity || disparity >= max_disparity) continue;
+    if (disparity <= 0.0) {  // at infinity: keep a tiny disparity so depth stays finite
+      disparity = 0.01;
+      u_right = u_left - disparity;
+    }
+    out.u_right[il] = static_cast<float>(u_right);
+    out.depth[il] = static_cast<float>(bf / disparity);
+    out.right_index[il] = best_right;
+    out.sad[il] = best_cost;
+    sad_and_index.emplace_back(best_cost, il);
+  }
+
+  // Drop the matches whose SAD is far above the median (kept at equality, unlike ORB-SLAM,
+  // so that a median of 0 on noise-free images does not reject everything).
+  if (!sad_and_index.empty()) {
+    std::sort(sad_and_index.begin(), sad_and_index.end());
+    const int median = sad_and_index[sad_and_index.size() / 2].first;
+    const double threshold = options.sad_outlier_factor * median;
+    for (const auto& [cost, il] : sad_and_index) {
+      if (cost <= threshold) continue;
+      out.u_right[il] = -1.0f;
+      out.depth[il] = -1.0f;
+      out.right_index[il] = -1;
+      out.sad[il] = -1;
+    }
+  }
+  out.num_matches = static_cast<int>(
+      std::count_if(out.depth.begin(), out.depth.end(), [](float d) { return d > 0.0f; }));
+  return out;
+}
+
+StereoMatches MatchStereo(const OrbFeatures& left, const OrbFeatures& right, double bf, double fx,
+                          const StereoMatcherOptions& options) {
+  return MatchStereo(left.keypoints, left.descriptors, left.pyramid, right.keypoints,
+                     right.descriptors, right.pyramid, bf, fx, options);
+}
+
+}  // namespace pkslam

@@ -1,0 +1,159 @@
+#include "keyframe/pks_math.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <Eigen/Geometry>
+#include <nanoflann.hpp>
+
+namespace pkslam::pks {
+namespace {
+
+// nanoflann dataset adaptor over a vector of points.
+struct PointCloud {
+  const std::vector<Eigen::Vector3d>& points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  double kdtree_get_pt(std::size_t i, std::size_t dim) const { return points[i][dim]; }
+  template <class BoundingBox>
+  bool kdtree_get_bbox(BoundingBox& /*bb*/) const {
+    return false;
+  }
+};
+
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>,
+                                        PointCloud, 3, std::size_t>;
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> EstimateNormals(const std::vector<Eigen::Vector3d>& points, int k,
+                                             bool align_signs) {
+  const std::size_t n = points.size();
+  std::vector<Eigen::Vector3d> normals(n, Eigen::Vector3d::Zero());
+  if (k < 2 || n < static_cast<std::size_t>(k) + 1) return normals;
+  const PointCloud cloud{points};
+  const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  // A few spare neighbours so exact distance ties at the k-th place resolve by index.
+  const std::size_t want = std::min(n, static_cast<std::size_t>(k) + 3);
+  std::vector<std::size_t> indices(want);
+  std::vector<double> distances(want);
+  std::vector<std::pair<double, std::size_t>> candidates;
+  std::vector<Eigen::Vector3d> offsets(k);
+  std::vector<Eigen::Vector3d> crosses;
+  for (std::size_t i = 0; i < n; ++i) {
+    nanoflann::KNNResultSet<double, std::size_t> result(want);
+    result.init(indices.data(), distances.data());
+    tree.findNeighbors(result, points[i].data(), nanoflann::SearchParams());
+    const std::size_t found = result.size();
+    candidates.clear();
+    for (std::size_t j = 0; j < found; ++j) {
+      if (indices[j] != i) candidates.emplace_back(distances[j], indices[j]);
+    }
+    if (candidates.size() < static_cast<std::size_t>(k)) continue;
+    std::sort(candidates.begin(), candidates.end());
+    for (int j = 0; j < k; ++j) offsets[j] = points[candidates[j].second] - points[i];
+    crosses.clear();
+    for (int a = 0; a < k; ++a) {
+      for (int b = a + 1; b < k; ++b) crosses.push_back(offsets[a].cross(offsets[b]));
+    }
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    if (align_signs) {
+      const Eigen::Vector3d& ref = *std::max_element(
+          crosses.begin(), crosses.end(), [](const Eigen::Vector3d& x, const Eigen::Vector3d& y) {
+            return x.squaredNorm() < y.squaredNorm();
+          });
+      for (const auto& c : crosses) sum += c.dot(ref) >= 0 ? c : Eigen::Vector3d(-c);
+    } else {
+      for (const auto& c : crosses) sum += c;
+    }
+    const double norm = sum.norm();
+    if (norm > 1e-12) normals[i] = sum / norm;
+  }
+  return normals;
+}
+
+double ViewAngleDeg(const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
+                    const Eigen::Vector3d& camera_center, bool released_z_flip) {
+  const Eigen::Vector3d ray = camera_center - point;
+  const double ray_norm = ray.norm();
+  if (ray_norm <= 0 || normal.isZero()) return 0.0;
+  const Eigen::Vector3d r = ray / ray_norm;
+  double c = 0;
+  if (released_z_flip) {
+    c = normal.x() * r.x() + normal.y() * r.y() + std::abs(normal.z()) * r.z();
+  } else {
+    c = std::abs(normal.dot(r));
+  }
+  return std::acos(std::clamp(c, -1.0, 1.0)) * kRadToDeg;
+}
+
+int ConeRegion(double angle_deg, double width_deg, int regions) {
+  if (angle_deg <= width_deg) return 0;
+  const int r = static_cast<int>(std::ceil(angle_deg / width_deg)) - 1;
+  return std::min(r, regions - 1);
+}
+
+AdaptiveThreshold ComputeAdaptiveThreshold(int a_c, int m_c, int d_c, int a_r, int m_r, int d_r,
+                                           bool released) {
+  AdaptiveThreshold t;
+  if (m_r <= 0 || a_r <= 0 || m_c <= 0) return t;
+  t.valid = true;
+  const double mc = m_c, dc = d_c, ac = a_c, mr = m_r, dr = d_r, ar = a_r;
+  t.th_initial = (mc * dr / mr + ac * dr / ar) / 2.0;  // Eq. 2
+  t.theta = 1.0 - mc / mr;                              // Eq. 4
+  t.beta = dc / mc - dr / mr;                           // Eq. 6
+  t.alpha = dc / mc - 0.5;                              // Eq. 8
+  if (released && 2 * m_c < m_r) t.gamma = (mr - 2 * mc) / (mr + 2 * mc);
+  t.th_adaptive = t.th_initial * (1.0 + t.theta - t.beta - t.alpha - t.gamma);  // Eq. 1, 9
+  if (released && t.theta < 0.1) t.th_adaptive = 1.1 * t.th_initial;
+  return t;
+}
+
+Ecog ComputeEcog(const std::vector<int>& grid, int n, bool late_denominator) {
+  Ecog e;
+  const int cells = n * n;
+  const long total = std::accumulate(grid.begin(), grid.begin() + cells, 0L);
+  if (total <= 0) return e;
+  e.valid = true;
+  // Largest and second-largest cells; ties keep the first in row-major order.
+  int i1 = 0;
+  for (int i = 1; i < cells; ++i) {
+    if (grid[i] > grid[i1]) i1 = i;
+  }
+  int i2 = -1;
+  for (int i = 0; i < cells; ++i) {
+    if (i == i1) continue;
+    if (i2 < 0 || grid[i] > grid[i2]) i2 = i;
+  }
+  e.max1 = grid[i1];
+  e.max2 = grid[i2];
+  const double dr = i2 / n - i1 / n;
+  const double dc = i2 % n - i1 % n;
+  e.distance = std::sqrt(dr * dr + dc * dc);  // Eq. 11
+  const double max_distance = (n - 1) * std::sqrt(2.0);
+  const double denominator = late_denominator ? std::sqrt(2.0) * e.max1 : max_distance * e.max1;
+  e.ecog = e.distance * e.max2 / denominator;  // Eq. 10
+  // Centre of gravity with the outer rows/columns at -1 and +1.
+  const double half = (n - 1) / 2.0;
+  double sx = 0;
+  double sy = 0;
+  for (int i = 0; i < cells; ++i) {
+    sx += grid[i] * ((i % n) - half) / half;
+    sy += grid[i] * ((i / n) - half) / half;
+  }
+  e.xc = sx / static_cast<double>(total);
+  e.yc = sy / static_cast<double>(total);
+  e.cog = std::sqrt(e.xc * e.xc + e.yc * e.yc);  // Eq. 12
+  return e;
+}
+
+int GridCell(double u, double v, int width, int height, int n) {
+  const int col = std::clamp(static_cast<int>(u * n / width), 0, n - 1);
+  const int row = std::clamp(static_cast<int>(v * n / height), 0, n - 1);
+  return row * n + col;
+}
+
+}  // namespace pkslam::pks

@@ -1,0 +1,93 @@
+// PKS, the photogrammetric keyframe selector (../shared/docs/PKS.md): camera criterion =
+// cone-region changes above an adaptive threshold (Eq. 1-9) AND a balanced distribution of
+// effective points (ECOG > |COG|, Eq. 10-12); an IMU criterion on sharp acceleration changes;
+// combined with ORB-SLAM3's safety exits. Two variants:
+//  - "pks": the paper. Deliberate readings (documented in docs/keyframe_selectors.md):
+//    each point's surface normal is estimated once, when the keyframe is taken, from its 5
+//    nearest tracked points, and reused for the current frame, so a region change measures
+//    the change of viewing direction and not the noise of a re-estimated normal; the normal
+//    is an unoriented axis (angles in [0, 90]); effective points changed their viewing angle
+//    by more than delta; the IMU trigger compares the gravity-compensated mean specific force
+//    (world frame) of the current frame interval with that of the keyframe's interval.
+//  - "pks-released": the authors' released code (gamma term, theta < 0.1 clamp, forced
+//    keyframe at exactly 6 frames, ECOG denominator switch after 4 frames, normals recomputed
+//    every frame and reflected to world z >= 0, effective = region changed AND angle changed
+//    by more than delta, IMU delta between consecutive frame intervals with gravity, criteria
+//    only after more than one frame).
+#pragma once
+
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "keyframe/keyframe_selector.h"
+#include "keyframe/pks_math.h"
+
+namespace pkslam {
+
+struct PksOptions {
+  // Width of one cone region (degrees) and number of regions.
+  double region_width_deg = 10.0;
+  int regions = 4;
+  // Viewing-angle change (degrees) that makes a point "effective" for ECOG.
+  double delta_deg = 30.0;
+  // ECOG grid is grid x grid cells over the image.
+  int grid = 3;
+  // Neighbours used for a point's surface normal.
+  int normal_neighbours = 5;
+  // IMU trigger: |delta a| above this (m/s^2); <= 0 disables it.
+  double imu_threshold = 1.0;
+  // Safety exits and extra triggers kept from ORB-SLAM3 (PKS.md "How it combines").
+  double min_translation_m = 0.02;          // no keyframe if the camera moved less (> 2 KFs)
+  double imu_uninitialised_interval_s = 0.25;
+  double inertial_interval_s = 0.5;         // c1
+  int close_tracked_max = 100;              // c3: stereo close-point rule
+  int close_untracked_min = 70;
+  // Visual-only sensors (not evaluated by the paper): also insert when inliers fall below this
+  // share of the reference keyframe's tracked points (ORB-SLAM3's c1c); 0 disables.
+  double weak_tracking_ratio = 0.25;
+  // Released-code constants.
+  int forced_interval = 6;          // forced keyframe at exactly this many frames
+  int late_denominator_after = 4;   // ECOG denominator switch after this many frames
+
+  void Check() const;
+};
+
+class PksSelector : public KeyframeSelector {
+ public:
+  PksSelector(PksOptions options, bool released);
+  std::string_view name() const override { return released_ ? "pks-released" : "pks"; }
+  bool NeedsTrackedPoints() const override { return true; }
+  SelectorDecision Decide(const SelectorInput& input) override;
+  void OnKeyFrameInserted(const SelectorInput& input) override;
+  void Reset() override;
+
+ private:
+  struct SnapshotPoint {
+    Eigen::Vector3d normal;
+    double angle_deg;
+    int region;
+  };
+  struct Counts {
+    int a = 0;  // tracked points
+    int m = 0;  // matched to the last keyframe
+    int d = 0;  // matched with a changed cone region
+    std::vector<int> grid;  // effective points per cell
+  };
+  Counts Measure(const SelectorInput& input) const;
+  bool CameraCriterion(const SelectorInput& input, SelectorTrace* trace);
+  std::optional<double> AccelerationChange(const SelectorInput& input) const;
+
+  PksOptions options_;
+  bool released_;
+  // Snapshot of the last keyframe (map point id -> normal/angle/region).
+  std::unordered_map<MapPointId, SnapshotPoint> snapshot_;
+  bool has_snapshot_ = false;
+  std::optional<Eigen::Vector3d> keyframe_accel_;  // pks: world, gravity removed
+  std::optional<Eigen::Vector3d> previous_accel_;  // released: previous frame interval
+  std::optional<Counts> reference_;
+};
+
+}  // namespace pkslam

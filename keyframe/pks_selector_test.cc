@@ -1,0 +1,230 @@
+#include "keyframe/pks_selector.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/util/error.h"
+#include "keyframe/selector_factory.h"
+
+namespace pkslam {
+namespace {
+
+constexpr double kFx = 435.0;
+constexpr int kWidth = 752;
+constexpr int kHeight = 480;
+
+// A camera at `center` looking at `target` (y down, z forward).
+SE3d LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - center).normalized();
+  const Eigen::Vector3d x = Eigen::Vector3d(0, 1, 0).cross(z).normalized() * -1.0;
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix3d world_from_camera_r;
+  world_from_camera_r << x, y, z;
+  return SE3d(world_from_camera_r, center).Inverse();
+}
+
+struct Patch {
+  Eigen::Vector3d center;
+  Eigen::Vector3d normal;
+};
+
+// 3x3 points (5 cm apart) on a small plane per patch; ids are stable across frames.
+std::vector<std::pair<MapPointId, Eigen::Vector3d>> PatchPoints(const std::vector<Patch>& patches) {
+  std::vector<std::pair<MapPointId, Eigen::Vector3d>> out;
+  MapPointId id = 0;
+  for (const Patch& p : patches) {
+    const Eigen::Vector3d t1 = p.normal.unitOrthogonal();
+    const Eigen::Vector3d t2 = p.normal.cross(t1);
+    for (int a = -1; a <= 1; ++a) {
+      for (int b = -1; b <= 1; ++b) {
+        // A slight irregular offset so neighbour distances are not tied.
+        out.emplace_back(id++, p.center + 0.05 * a * t1 + (0.05 * b + 0.003 * a) * t2);
+      }
+    }
+  }
+  return out;
+}
+
+SelectorInput MakeInput(const std::vector<std::pair<MapPointId, Eigen::Vector3d>>& points,
+                        const SE3d& camera_from_world, FrameId frame) {
+  SelectorInput in;
+  in.last_keyframe_camera_from_world = SE3d(SO3d(), Eigen::Vector3d(2.5, 0, 0));  // at -2.5 x
+  in.sensor = Sensor::kStereo;
+  in.fps = 20;
+  in.image_width = kWidth;
+  in.image_height = kHeight;
+  in.frame_id = frame;
+  in.t_ns = frame * 50'000'000;
+  in.last_keyframe_frame_id = 0;
+  in.last_keyframe_t_ns = 0;
+  in.keyframes_in_map = 10;
+  in.inliers = static_cast<int>(points.size());
+  in.local_mapping_idle = true;
+  in.camera_from_world = camera_from_world;
+  for (const auto& [id, p] : points) {
+    const Eigen::Vector3d c = camera_from_world * p;
+    SelectorPoint sp;
+    sp.id = id;
+    sp.position_world = p;
+    sp.uv = Eigen::Vector2d(kFx * c.x() / c.z() + kWidth / 2.0, kFx * c.y() / c.z() + kHeight / 2.0);
+    sp.in_last_keyframe = true;
+    in.points.push_back(sp);
+  }
+  return in;
+}
+
+class PksScenario : public ::testing::Test {
+ protected:
+  // Current camera at the origin looking along +z with patches 2 m away in the four corners
+  // of its image; the keyframe camera was 2.5 m to the side, aimed at the same spot.
+  const Eigen::Vector3d c0_{-2.5, 0, 0};
+  const Eigen::Vector3d c1_{0, 0, 0};
+  const Eigen::Vector3d target_{0, 0, 2};
+  const std::vector<Eigen::Vector3d> centers_ = {
+      {-0.8, -0.5, 2}, {0.8, -0.5, 2}, {-0.8, 0.5, 2}, {0.8, 0.5, 2}};  // TL, TR, BL, BR
+
+  // A normal facing the keyframe camera: its viewing angle goes from 0 to the parallax.
+  Patch Facing(const Eigen::Vector3d& p) const { return {p, (c0_ - p).normalized()}; }
+  // A normal perpendicular to both rays: 90 degrees from either camera, no region change.
+  Patch Grazing(const Eigen::Vector3d& p) const {
+    return {p, (c0_ - p).cross(c1_ - p).normalized()};
+  }
+};
+
+TEST_F(PksScenario, BalancedViewChangeTriggersTheCameraCriterion) {
+  // TL and BR change region and viewing angle by > 30 deg (60.8 and 36.9 deg of parallax);
+  // TR and BL do not.
+  const auto points = PatchPoints({Facing(centers_[0]), Grazing(centers_[1]),
+                                   Grazing(centers_[2]), Facing(centers_[3])});
+  PksOptions o;
+  o.weak_tracking_ratio = 0;
+  PksSelector s(o, false);
+  s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
+  // Frame 1 (the reference): barely moved.
+  const auto r = s.Decide(MakeInput(points, LookAt(c0_ + Eigen::Vector3d(0.03, 0, 0), target_), 1));
+  EXPECT_EQ(r.reason, "no");
+  ASSERT_EQ(r.trace.count("M_c"), 1u) << r.reason << " " << r.trace.size();
+  EXPECT_EQ(r.trace.at("M_c"), 36);
+  const auto d = s.Decide(MakeInput(points, LookAt(c1_, target_), 2));
+  EXPECT_EQ(d.trace.at("D_c"), 18);
+  EXPECT_GT(d.trace.at("D_c"), d.trace.at("Th_adaptive"));
+  EXPECT_GT(d.trace.at("ECOG"), d.trace.at("COG"));
+  EXPECT_TRUE(d.insert);
+  EXPECT_NE(d.reason.find("camera"), std::string::npos) << d.reason;
+}
+
+TEST_F(PksScenario, OneSidedViewChangeFailsTheBalanceCriterion) {
+  // Only the TL patch changes: all effective points in one cell, ECOG = 0.
+  const auto points = PatchPoints({Facing(centers_[0]), Grazing(centers_[1]),
+                                   Grazing(centers_[2]), Grazing(centers_[3])});
+  PksOptions o;
+  o.weak_tracking_ratio = 0;
+  PksSelector s(o, false);
+  s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
+  s.Decide(MakeInput(points, LookAt(c0_ + Eigen::Vector3d(0.03, 0, 0), target_), 1));
+  const auto d = s.Decide(MakeInput(points, LookAt(c1_, target_), 2));
+  EXPECT_EQ(d.trace.at("D_c"), 9);
+  EXPECT_GT(d.trace.at("D_c"), d.trace.at("Th_adaptive"));  // criterion 1 holds...
+  EXPECT_DOUBLE_EQ(d.trace.at("ECOG"), 0.0);                 // ...criterion 2 does not
+  EXPECT_FALSE(d.insert);
+}
+
+TEST_F(PksScenario, FewerThanSixPointsGiveNoCameraDecision) {
+  auto points = PatchPoints({Facing(centers_[0])});
+  points.resize(5);
+  PksSelector s(PksOptions{}, false);
+  s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
+  const auto d = s.Decide(MakeInput(points, LookAt(c1_, target_), 2));
+  EXPECT_EQ(d.trace.count("D_c"), 0u);
+  EXPECT_EQ(d.reason.find("camera"), std::string::npos);
+}
+
+TEST_F(PksScenario, NoKeyframeSnapshotNoCameraDecisionAndResetForgets) {
+  const auto points = PatchPoints({Facing(centers_[0]), Grazing(centers_[1]),
+                                   Grazing(centers_[2]), Facing(centers_[3])});
+  PksOptions o;
+  o.weak_tracking_ratio = 0;
+  PksSelector s(o, false);
+  EXPECT_FALSE(s.Decide(MakeInput(points, LookAt(c1_, target_), 2)).insert);
+  s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
+  s.Reset();
+  EXPECT_FALSE(s.Decide(MakeInput(points, LookAt(c1_, target_), 2)).insert);
+}
+
+TEST_F(PksScenario, CameraThatDidNotMoveTakesNoKeyframe) {
+  const auto points = PatchPoints({Facing(centers_[0]), Facing(centers_[3])});
+  PksSelector s(PksOptions{}, false);
+  s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
+  auto in = MakeInput(points, LookAt(c0_ + Eigen::Vector3d(0.01, 0, 0), target_), 30);
+  in.tracked_close = 0;
+  in.untracked_close = 500;  // would trigger the close-point rule otherwise
+  EXPECT_EQ(s.Decide(in).reason, "still");
+}
+
+TEST(PksReleased, ForcedKeyframeAtExactlySixFrames) {
+  const std::vector<std::pair<MapPointId, Eigen::Vector3d>> none;
+  PksSelector released(PksOptions{}, true);
+  PksSelector paper(PksOptions{}, false);
+  for (FrameId f : {5, 6, 7}) {
+    SelectorInput in = MakeInput(none, SE3d(), f);
+    in.last_keyframe_camera_from_world = SE3d(SO3d(), Eigen::Vector3d(1, 0, 0));
+    EXPECT_EQ(released.Decide(in).insert, f == 6) << f;
+    EXPECT_FALSE(paper.Decide(in).insert) << f;
+  }
+}
+
+TEST(PksImu, AccelerationTriggerPaperVersusReleased) {
+  const std::vector<std::pair<MapPointId, Eigen::Vector3d>> none;
+  auto input = [&](FrameId f, const Eigen::Vector3d& body, const Eigen::Vector3d& world) {
+    SelectorInput in = MakeInput(none, SE3d(), f);
+    in.sensor = Sensor::kStereoInertial;
+    in.imu_initialized = true;
+    in.t_ns = in.last_keyframe_t_ns + 100'000'000;  // below the 0.5 s time rule
+    in.last_keyframe_camera_from_world = SE3d(SO3d(), Eigen::Vector3d(1, 0, 0));
+    SelectorImuInterval imu;
+    imu.dt = 0.05;
+    imu.mean_accel = body;
+    imu.mean_accel_world_no_gravity = world;
+    in.imu_since_last_frame = imu;
+    return in;
+  };
+  const Eigen::Vector3d g(0, 0, 9.81);
+  PksSelector paper(PksOptions{}, false);
+  paper.OnKeyFrameInserted(input(0, g, Eigen::Vector3d::Zero()));
+  EXPECT_FALSE(paper.Decide(input(1, g, {0.5, 0, 0})).insert);  // |da| 0.5
+  const auto fire = paper.Decide(input(2, g, {1.2, 0, 0}));       // |da| 1.2 > 1
+  EXPECT_TRUE(fire.insert);
+  EXPECT_NEAR(fire.trace.at("delta_a"), 1.2, 1e-12);
+
+  // Released: consecutive frame intervals, gravity included, only after frame 1.
+  PksSelector released(PksOptions{}, true);
+  EXPECT_FALSE(released.Decide(input(1, g, Eigen::Vector3d::Zero())).insert);
+  EXPECT_FALSE(released.Decide(input(2, g + Eigen::Vector3d(0.8, 0, 0), Eigen::Vector3d::Zero())).insert);
+  const auto r = released.Decide(input(3, g + Eigen::Vector3d(-0.8, 0, 0), Eigen::Vector3d::Zero()));
+  EXPECT_NEAR(r.trace.at("delta_a"), 1.6, 1e-12);
+  EXPECT_TRUE(r.insert);
+}
+
+TEST(PksImu, NoImuMeansNoImuCriterion) {
+  const std::vector<std::pair<MapPointId, Eigen::Vector3d>> none;
+  PksSelector s(PksOptions{}, false);
+  SelectorInput in = MakeInput(none, SE3d(), 3);
+  in.last_keyframe_camera_from_world = SE3d(SO3d(), Eigen::Vector3d(1, 0, 0));
+  const auto d = s.Decide(in);
+  EXPECT_EQ(d.trace.count("delta_a"), 0u);
+  EXPECT_FALSE(d.insert);
+}
+
+TEST(SelectorFactory, KnowsEverySelectorAndRejectsUnknownParameters) {
+  for (const auto& name : KeyframeSelectorNames()) {
+    EXPECT_EQ(MakeKeyframeSelector(name)->name(), name);
+  }
+  EXPECT_THROW(MakeKeyframeSelector("pks", {{"delat", 20}}), OptionError);
+  EXPECT_THROW(MakeKeyframeSelector("nope"), OptionError);
+  EXPECT_THROW(MakeKeyframeSelector("pks", {{"delta", -1}}), OptionError);
+  EXPECT_NO_THROW(MakeKeyframeSelector("pks", {{"delta", 20}, {"region_width", 5}}));
+}
+
+}  // namespace
+}  // namespace pkslam
