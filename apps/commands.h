@@ -11,5 +11,6 @@ void RegisterInfoCommand(CLI::App& app);
 void RegisterRunCommand(CLI::App& app);
 void RegisterVocabCommand(CLI::App& app);
 void RegisterSimulateCommand(CLI::App& app);
+void RegisterBenchCommand(CLI::App& app);
 
 }  // namespace pkslam::apps

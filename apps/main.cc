@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterRunCommand(app);
   pkslam::apps::RegisterVocabCommand(app);
   pkslam::apps::RegisterSimulateCommand(app);
+  pkslam::apps::RegisterBenchCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,165 @@
+// pkslam bench: benchmark suites (datasets x sensors x selectors x sweeps x runs) with
+// reports, resumable runs and scale-out job lists. See evaluation/bench/ and README.md.
+#include <fmt/format.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "apps/commands.h"
+#include "core/util/error.h"
+#include "evaluation/bench/bench.h"
+#include "evaluation/bench/report.h"
+
+namespace pkslam::apps {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Set by SIGINT/SIGTERM: running children are stopped, unfinished runs stay pending.
+std::atomic<bool> bench_interrupted{false};
+
+void OnBenchSignal(int signal) {
+  bench_interrupted.store(true);
+  std::signal(signal, SIG_DFL);
+}
+
+struct BenchArgs {
+  std::string suite;
+  std::string out;
+  std::string cache;
+  std::string emit_jobs;
+  std::vector<std::string> collect;
+  std::vector<std::string> run_ids;
+  std::string pkslam;
+  std::string python = "/usr/bin/python3";
+  int jobs = 1;
+  bool retry_failed = false;
+  bool no_plots = false;
+  bool list = false;
+  bool quiet = false;
+};
+
+fs::path SelfExecutable() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw Error("cannot find the pkslam executable (/proc/self/exe); pass --pkslam");
+  return exe;
+}
+
+void PrintReport(const std::vector<bench::RunResult>& results, const bench::ReportFiles& files,
+                 const fs::path& out) {
+  for (const auto& t : bench::HeadlineTables(bench::Summarize(results))) {
+    std::cout << t.title << "\n" << bench::MarkdownTable(t) << "\n";
+  }
+  std::cout << fmt::format("report: {}/report.html ({} plots), {}/report.md, {}/results.csv, "
+                           "{}/summary.csv\n",
+                           out.string(), files.pngs.size(), out.string(), out.string(),
+                           out.string());
+  if (!files.plot_error.empty()) std::cout << "plots unavailable: " << files.plot_error << "\n";
+}
+
+void Run(const BenchArgs& a) {
+  bench::ReportOptions report;
+  report.python = a.python;
+  report.plots = !a.no_plots;
+  if (!a.collect.empty()) {
+    if (!a.suite.empty()) throw OptionError("--collect takes no SUITE");
+    std::vector<fs::path> dirs(a.collect.begin(), a.collect.end());
+    report.out = a.out.empty() ? dirs.front() : fs::path(a.out);
+    for (const auto& d : dirs) report.run_roots.push_back(d / "runs");
+    report.title = bench::ReadBenchTitle(dirs.front(), "pkslam bench");
+    const auto results = bench::CollectResults(dirs);
+    if (results.empty()) throw InputError(dirs.front(), "no finished runs to collect");
+    std::cout << fmt::format("collected {} runs from {} folder(s)\n", results.size(), dirs.size());
+    PrintReport(results, bench::WriteReport(results, report), report.out);
+    return;
+  }
+  if (a.suite.empty()) throw OptionError("a SUITE file is required (or --collect DIR)");
+  const bench::Suite suite = bench::ReadSuite(a.suite);
+  const auto all = bench::ExpandSuite(suite);
+  const auto runs = bench::SelectRuns(all, a.run_ids);
+  if (a.list) {
+    for (const auto& r : runs) std::cout << r.id << '\n';
+    return;
+  }
+  bench::HarnessOptions h;
+  h.pkslam = a.pkslam.empty() ? SelfExecutable() : fs::path(a.pkslam);
+  h.out = !a.emit_jobs.empty() ? a.emit_jobs : a.out;
+  if (h.out.empty()) throw OptionError("--out DIR is required");
+  if (!a.emit_jobs.empty() && !a.out.empty() && a.out != a.emit_jobs) {
+    throw OptionError("--emit-jobs DIR is also the output folder: drop --out");
+  }
+  const char* env_cache = std::getenv("PKSLAM_SIM_CACHE");
+  h.cache = !a.cache.empty() ? fs::path(a.cache)
+            : env_cache != nullptr ? fs::path(env_cache)
+                                   : h.out / "sim_cache";
+  h.jobs = a.jobs;
+  h.quiet = a.quiet;
+  h.retry_failed = a.retry_failed;
+  if (!a.emit_jobs.empty()) {
+    const auto e = bench::EmitJobs(suite, runs, h);
+    std::cout << fmt::format(
+        "emitted {} jobs ({} runs in the suite): {}\n  GNU parallel: parallel --jobs 2 < {}  "
+        "(or sh {})\n  Slurm: sbatch {}\n  then: pkslam bench --collect {}\n",
+        e.jobs, runs.size(), e.jobs_file.string(), e.jobs_file.string(),
+        e.parallel_script.string(), e.slurm_script.string(), fs::absolute(h.out).string());
+    return;
+  }
+  bench::WriteBenchInfo(h.out, suite);
+  std::signal(SIGINT, OnBenchSignal);
+  std::signal(SIGTERM, OnBenchSignal);
+  bench::BenchCounts counts;
+  const auto results = bench::RunSuite(suite, runs, h, &counts, &bench_interrupted);
+  if (counts.cancelled) throw Error("interrupted: finished runs are kept; run again to resume");
+  if (!a.run_ids.empty()) {
+    // One job of an emitted list: its result.csv is the output; --collect reports.
+    for (const auto& r : results) {
+      if (!r.ok) throw Error(fmt::format("run {} failed: {}", r.run_id, r.error));
+    }
+    return;
+  }
+  std::cout << fmt::format("{} runs: {} executed, {} already finished, {} failed\n", counts.total,
+                           counts.executed, counts.skipped, counts.failed);
+  report.out = h.out;
+  report.title = suite.name;
+  PrintReport(results, bench::WriteReport(results, report), h.out);
+}
+
+}  // namespace
+
+void RegisterBenchCommand(CLI::App& app) {
+  auto args = std::make_shared<BenchArgs>();
+  auto* cmd = app.add_subcommand(
+      "bench",
+      "Benchmark suite: datasets x sensors x keyframe selectors x sweeps x runs -> results.csv, "
+      "summary tables, report.md/report.html with plots; resumable; scale-out job lists");
+  cmd->add_option("suite", args->suite, "Suite YAML (see evaluation/suites/)");
+  cmd->add_option("--out", args->out, "Output folder (runs/, results.csv, report.html)");
+  cmd->add_option("-j,--jobs", args->jobs, "Runs executed at once (child processes)")
+      ->capture_default_str();
+  cmd->add_option("--cache", args->cache,
+                  "Simulator renderings cache (default: $PKSLAM_SIM_CACHE or OUT/sim_cache)");
+  cmd->add_option("--emit-jobs", args->emit_jobs,
+                  "Write DIR/jobs.txt (one command per pending run, for GNU parallel), "
+                  "DIR/run_parallel.sh and DIR/slurm.sh instead of running");
+  cmd->add_option("--collect", args->collect,
+                  "Merge the finished runs of these folders into one report (in --out, default "
+                  "the first folder)");
+  cmd->add_option("--run-id", args->run_ids, "Execute only these runs (ids as --list prints)");
+  cmd->add_flag("--retry-failed", args->retry_failed, "Run failed runs again");
+  cmd->add_flag("--list", args->list, "Print the run ids of the matrix and exit");
+  cmd->add_flag("--no-plots", args->no_plots, "Tables only (no matplotlib)");
+  cmd->add_option("--python", args->python, "Python with matplotlib and numpy for the plots")
+      ->capture_default_str();
+  cmd->add_option("--pkslam", args->pkslam,
+                  "pkslam executable for the runs (default: this one)");
+  cmd->add_flag("--quiet", args->quiet, "No progress bars");
+  cmd->callback([args] { Run(*args); });
+}
+
+}  // namespace pkslam::apps

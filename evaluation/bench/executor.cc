@@ -1,0 +1,183 @@
+#include "evaluation/bench/executor.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "core/util/error.h"
+#include "evaluation/bench/process.h"
+#include "evaluation/bench/run_evaluation.h"
+
+namespace pkslam::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::uint64_t Fnv1a(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char ch : text) {
+    h ^= ch;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+// The last non-empty line of a log (the one-line error of a failed pkslam command).
+std::string LastLine(const fs::path& log) {
+  std::ifstream in(log);
+  std::string line;
+  std::string last;
+  while (std::getline(in, line)) {
+    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  }
+  const std::size_t cr = last.rfind('\r');
+  return cr == std::string::npos ? last : last.substr(cr + 1);
+}
+
+void WriteResult(const fs::path& run_dir, const RunResult& r) {
+  WriteResultsCsv(run_dir / "result.csv", {r});
+}
+
+}  // namespace
+
+void HarnessOptions::Check() const {
+  PKSLAM_CHECK_OPTION(jobs >= 1, "--jobs", "{} < 1", jobs);
+  PKSLAM_CHECK_OPTION(!out.empty(), "--out", "empty");
+  PKSLAM_CHECK_OPTION(!cache.empty(), "--cache", "empty");
+  if (!fs::exists(pkslam)) throw OptionError("pkslam executable not found: " + pkslam.string());
+}
+
+fs::path RunDir(const fs::path& out, const RunSpec& run) { return out / "runs" / run.id; }
+
+std::vector<std::string> SimulateArguments(const SimRecipe& r, const fs::path& out_dir) {
+  std::vector<std::string> a = {"simulate", "--out", out_dir.string(), "--seed",
+                                std::to_string(r.seed), "--quiet"};
+  if (!r.trajectory.empty()) {
+    a.insert(a.end(), {"--trajectory", r.trajectory.string()});
+  } else {
+    a.insert(a.end(), {"--motion", r.motion});
+  }
+  if (r.start_s > 0) a.insert(a.end(), {"--start", FormatNumber(r.start_s)});
+  if (r.duration_s > 0) a.insert(a.end(), {"--duration", FormatNumber(r.duration_s)});
+  if (!r.scene.empty()) a.insert(a.end(), {"--scene", r.scene});
+  if (!r.quality.empty()) a.insert(a.end(), {"--quality", r.quality});
+  a.insert(a.end(), r.extra_args.begin(), r.extra_args.end());
+  return a;
+}
+
+fs::path SimCacheDir(const fs::path& cache, const std::string& dataset, const SimRecipe& recipe) {
+  std::vector<std::string> args = SimulateArguments(recipe, "");
+  std::string key;
+  for (const auto& a : args) key += a + '\x1f';
+  return cache / fmt::format("{}-seed{}-{:08x}", dataset, recipe.seed,
+                             static_cast<std::uint32_t>(Fnv1a(key) & 0xffffffffu));
+}
+
+fs::path EnsureSimulated(const HarnessOptions& options, const std::string& dataset,
+                         const SimRecipe& recipe, const std::atomic<bool>* cancel) {
+  const fs::path dir = SimCacheDir(options.cache, dataset, recipe);
+  const fs::path done = dir / ".complete";
+  if (fs::exists(done)) return dir;
+  FileLock lock(dir.string() + ".lock");
+  if (fs::exists(done)) return dir;  // another job rendered it while we waited
+  const fs::path tmp = dir.string() + ".partial";
+  const fs::path log = dir.string() + ".log";
+  fs::remove_all(tmp);
+  fs::remove(log);
+  std::vector<std::string> argv = {options.pkslam.string()};
+  const auto args = SimulateArguments(recipe, tmp);
+  argv.insert(argv.end(), args.begin(), args.end());
+  {
+    std::ofstream(log) << "# " << ShellCommand(argv) << '\n';
+  }
+  const ProcessResult p = RunProcess(argv, log, 24.0 * 3600.0, cancel);
+  if (!p.ok()) {
+    throw Error(fmt::format("simulating {} failed ({}): {} (log {})", dataset, p.Describe(),
+                            LastLine(log), log.string()));
+  }
+  fs::remove_all(dir);
+  fs::rename(tmp, dir);
+  std::ofstream(dir / "recipe.txt") << ShellCommand(argv) << '\n';
+  std::ofstream(done) << fmt::format("{:.1f} s\n", p.wall_s);
+  return dir;
+}
+
+fs::path PrepareDataset(const Suite& suite, const RunSpec& run, const HarnessOptions& options,
+                        const std::atomic<bool>* cancel) {
+  const DatasetSpec& d = DatasetOf(suite, run);
+  if (run.sim) return EnsureSimulated(options, d.name, *run.sim, cancel);
+  if (!fs::is_directory(*d.path)) {
+    throw InputError(suite.file, "dataset '" + d.name + "': " + d.path->string() + " is not a directory");
+  }
+  return *d.path;
+}
+
+std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
+                                      const fs::path& dataset, const fs::path& run_dir) {
+  const DatasetSpec& d = DatasetOf(suite, run);
+  std::vector<std::string> a = {"run",        "--dataset",   dataset.string(), "--out",
+                                run_dir.string(), "--sensor", run.sensor,       "--selector",
+                                run.selector, "--quiet"};
+  for (const auto& [k, v] : run.params) a.insert(a.end(), {"--param", k + "=" + FormatNumber(v)});
+  if (d.settings) a.insert(a.end(), {"--settings", d.settings->string()});
+  if (d.max_frames > 0) a.insert(a.end(), {"--max-frames", std::to_string(d.max_frames)});
+  if (suite.deterministic) a.push_back("--deterministic");
+  return a;
+}
+
+std::optional<RunResult> ReadFinished(const fs::path& run_dir) {
+  const fs::path file = run_dir / "result.csv";
+  if (!fs::exists(file)) return std::nullopt;
+  try {
+    const auto rows = ReadResultsCsv(file);
+    if (rows.size() == 1) return rows.front();
+  } catch (const InputError&) {
+  }
+  return std::nullopt;  // unreadable: run again
+}
+
+bool NeedsExecution(const HarnessOptions& options, const RunSpec& run) {
+  const auto r = ReadFinished(RunDir(options.out, run));
+  return !r || (!r->ok && options.retry_failed);
+}
+
+std::optional<RunResult> ExecuteRun(const Suite& suite, const RunSpec& run,
+                                    const HarnessOptions& options,
+                                    const std::atomic<bool>* cancel) {
+  RunResult result = ResultSkeleton(run, suite);
+  const fs::path run_dir = RunDir(options.out, run);
+  fs::remove_all(run_dir);
+  fs::create_directories(run_dir);
+  fs::path dataset;
+  try {
+    dataset = PrepareDataset(suite, run, options, cancel);
+  } catch (const Error& e) {
+    if (cancel != nullptr && cancel->load()) return std::nullopt;
+    result.error = e.what();
+    WriteResult(run_dir, result);
+    return result;
+  }
+  std::vector<std::string> argv = {options.pkslam.string()};
+  const auto args = RunArguments(suite, run, dataset, run_dir);
+  argv.insert(argv.end(), args.begin(), args.end());
+  const fs::path log = run_dir / "pkslam.log";
+  std::ofstream(run_dir / "command.txt") << ShellCommand(argv) << '\n';
+  const ProcessResult p = RunProcess(argv, log, suite.timeout_s, cancel);
+  if (cancel != nullptr && cancel->load()) return std::nullopt;
+  if (!p.ok()) {
+    result.error = fmt::format("pkslam run {}: {}", p.Describe(), LastLine(log));
+    result.wall_s = p.wall_s;
+    WriteResult(run_dir, result);
+    return result;
+  }
+  try {
+    const DatasetSpec& d = DatasetOf(suite, run);
+    EvaluateRun({run_dir, dataset, d.ground_truth, suite.rpe_delta_m}, &result);
+  } catch (const Error& e) {
+    result.ok = false;
+    result.error = std::string("evaluation: ") + e.what();
+  }
+  WriteResult(run_dir, result);
+  return result;
+}
+
+}  // namespace pkslam::bench

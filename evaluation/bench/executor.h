@@ -1,0 +1,68 @@
+// Executes runs of a suite as child processes of the pkslam executable:
+//   `pkslam simulate` renders each simulator recipe once into the cache (a file lock makes
+//   concurrent jobs - threads or separate processes - wait for one rendering), then
+//   `pkslam run` writes OUT/runs/<run id>/, which is evaluated in-process and gets its
+//   result.csv (one results.csv row). A folder with result.csv is finished and is skipped.
+#pragma once
+
+#include <atomic>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "evaluation/bench/matrix.h"
+#include "evaluation/bench/results.h"
+#include "evaluation/bench/suite.h"
+
+namespace pkslam::bench {
+
+struct HarnessOptions {
+  std::filesystem::path pkslam;  // the pkslam executable the child processes run
+  std::filesystem::path out;     // OUT: runs/, results.csv, summary, report
+  std::filesystem::path cache;   // simulator renderings (shared between suites)
+  int jobs = 1;                  // runs executed at once
+  bool quiet = false;            // no progress bars
+  bool retry_failed = false;     // re-execute runs whose result.csv says failed
+
+  void Check() const;
+};
+
+// OUT/runs/<run id>.
+std::filesystem::path RunDir(const std::filesystem::path& out, const RunSpec& run);
+
+// The cache folder of a recipe: CACHE/<dataset>-seed<S>-<hash of the recipe>.
+std::filesystem::path SimCacheDir(const std::filesystem::path& cache, const std::string& dataset,
+                                  const SimRecipe& recipe);
+// The `pkslam simulate` command line of a recipe (without the executable).
+std::vector<std::string> SimulateArguments(const SimRecipe& recipe,
+                                           const std::filesystem::path& out_dir);
+// Renders the recipe unless cached; returns its folder. Throws Error when the simulator fails
+// (its log is CACHE/<name>.log).
+std::filesystem::path EnsureSimulated(const HarnessOptions& options, const std::string& dataset,
+                                      const SimRecipe& recipe,
+                                      const std::atomic<bool>* cancel = nullptr);
+
+// The dataset folder a run reads (rendering it first for simulator recipes).
+std::filesystem::path PrepareDataset(const Suite& suite, const RunSpec& run,
+                                     const HarnessOptions& options,
+                                     const std::atomic<bool>* cancel = nullptr);
+
+// The `pkslam run` command line (without the executable).
+std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
+                                      const std::filesystem::path& dataset,
+                                      const std::filesystem::path& run_dir);
+
+// The recorded result of a finished run, if its folder has a readable result.csv.
+std::optional<RunResult> ReadFinished(const std::filesystem::path& run_dir);
+// Whether a run still has to be executed (no result, or failed and retry_failed).
+bool NeedsExecution(const HarnessOptions& options, const RunSpec& run);
+
+// Renders (if needed), runs and evaluates one run; writes its result.csv. Failures of the run
+// or its evaluation are recorded in the result (ok=false), not thrown; a cancelled run is not
+// recorded (it will run again on resume) and returns nullopt.
+std::optional<RunResult> ExecuteRun(const Suite& suite, const RunSpec& run,
+                                    const HarnessOptions& options,
+                                    const std::atomic<bool>* cancel = nullptr);
+
+}  // namespace pkslam::bench

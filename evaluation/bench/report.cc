@@ -1,0 +1,242 @@
+#include "evaluation/bench/report.h"
+
+#include <algorithm>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "evaluation/bench/process.h"
+
+namespace pkslam::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Plot {
+  fs::path file;  // relative to OUT
+  std::string section;
+  std::string caption;
+};
+
+std::string Html(const std::string& s) {
+  std::string out;
+  for (char ch : s) {
+    switch (ch) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += ch;
+    }
+  }
+  return out;
+}
+
+// Runs plots.py; it writes PNGs and plots/index.tsv (file, section, caption per line).
+std::vector<Plot> DrawPlots(const ReportOptions& o, const std::vector<fs::path>& roots,
+                            std::string* error) {
+  const fs::path script = o.plots_script.empty() ? DefaultPlotsScript() : o.plots_script;
+  const fs::path dir = o.out / "plots";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  if (!fs::exists(o.python)) {
+    *error = "python not found: " + o.python.string();
+    return {};
+  }
+  if (!fs::exists(script)) {
+    *error = "plot script not found: " + script.string();
+    return {};
+  }
+  std::vector<std::string> argv = {o.python.string(), script.string(), "--results",
+                                   (o.out / "results.csv").string(), "--out", dir.string()};
+  for (const auto& r : roots) argv.insert(argv.end(), {"--runs", r.string()});
+  const fs::path log = o.out / "plots.log";
+  fs::remove(log);
+  const ProcessResult p = RunProcess(argv, log, 1800.0);
+  if (!p.ok()) {
+    std::ifstream in(log);
+    std::string line, last;
+    while (std::getline(in, line)) {
+      if (!line.empty()) last = line;
+    }
+    *error = fmt::format("plots.py failed ({}): {} (see {})", p.Describe(), last, log.string());
+    return {};
+  }
+  std::vector<Plot> plots;
+  std::ifstream index(dir / "index.tsv");
+  std::string line;
+  while (std::getline(index, line)) {
+    std::stringstream ss(line);
+    Plot plot;
+    std::string file;
+    if (!std::getline(ss, file, '\t') || !std::getline(ss, plot.section, '\t')) continue;
+    std::getline(ss, plot.caption);
+    plot.file = fs::path("plots") / file;
+    if (fs::exists(o.out / plot.file)) plots.push_back(plot);
+  }
+  return plots;
+}
+
+struct Document {
+  std::string md;
+  std::string html;
+
+  void Heading(int level, const std::string& text) {
+    md += std::string(level, '#') + " " + text + "\n\n";
+    html += fmt::format("<h{0}>{1}</h{0}>\n", level, Html(text));
+  }
+  void Paragraph(const std::string& text) {
+    md += text + "\n\n";
+    html += "<p>" + Html(text) + "</p>\n";
+  }
+  void AddTable(const Table& t) {
+    if (!t.title.empty()) {
+      md += "**" + t.title + "**\n\n";
+      html += "<p><b>" + Html(t.title) + "</b></p>\n";
+    }
+    md += MarkdownTable(t) + "\n";
+    html += HtmlTable(t);
+  }
+  void Image(const Plot& p) {
+    md += fmt::format("![{}]({})\n\n*{}*\n\n", p.caption, p.file.string(), p.caption);
+    html += fmt::format("<figure><img src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>\n",
+                        Html(p.file.string()), Html(p.caption), Html(p.caption));
+  }
+  void Images(const std::vector<Plot>& plots, const std::string& section) {
+    for (const auto& p : plots) {
+      if (p.section == section) Image(p);
+    }
+  }
+};
+
+std::string Now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buffer[64];
+  std::strftime(buffer, sizeof(buffer), "%Y-%m-%d %H:%M UTC", &tm);
+  return buffer;
+}
+
+const char* kHtmlHead = R"(<!DOCTYPE html>
+<html><head><meta charset="utf-8"><title>{}</title>
+<style>
+body {{ font-family: sans-serif; max-width: 1200px; margin: 2em auto; color: #222; }}
+table {{ border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.9em; }}
+th, td {{ border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: right; }}
+th:first-child, td:first-child {{ text-align: left; }}
+th {{ background: #eee; }}
+figure {{ margin: 1em 0; }} img {{ max-width: 100%; }}
+figcaption {{ font-style: italic; color: #555; }}
+</style></head><body>
+)";
+
+}  // namespace
+
+fs::path DefaultPlotsScript() {
+  const fs::path name = "evaluation/plots.py";
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path();
+         dir = dir.parent_path()) {
+      if (fs::exists(dir / name)) return dir / name;
+    }
+  }
+  return fs::path(PKSLAM_SOURCE_DIR) / name;
+}
+
+std::string HtmlTable(const Table& table) {
+  std::string out = "<table>\n<tr>";
+  for (const auto& h : table.header) out += "<th>" + Html(h) + "</th>";
+  out += "</tr>\n";
+  for (const auto& row : table.rows) {
+    out += "<tr>";
+    for (const auto& c : row) out += "<td>" + Html(c) + "</td>";
+    out += "</tr>\n";
+  }
+  return out + "</table>\n";
+}
+
+ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& options) {
+  std::sort(results.begin(), results.end(),
+            [](const RunResult& a, const RunResult& b) { return a.index < b.index; });
+  fs::create_directories(options.out);
+  WriteResultsCsv(options.out / "results.csv", results);
+  const std::vector<GroupSummary> groups = Summarize(results);
+  WriteSummaryCsv(options.out / "summary.csv", groups);
+
+  ReportFiles files;
+  std::vector<Plot> plots;
+  if (options.plots) {
+    const auto roots =
+        options.run_roots.empty() ? std::vector<fs::path>{options.out / "runs"} : options.run_roots;
+    plots = DrawPlots(options, roots, &files.plot_error);
+    for (const auto& p : plots) files.pngs.push_back(options.out / p.file);
+    if (!files.plot_error.empty()) PKSLAM_LOG_WARN("no plots: {}", files.plot_error);
+  }
+
+  const int ok = static_cast<int>(std::count_if(results.begin(), results.end(),
+                                                [](const RunResult& r) { return r.ok; }));
+  std::string baseline = results.empty() ? "" : results.front().baseline;
+  Document doc;
+  doc.Heading(1, options.title);
+  doc.Paragraph(fmt::format(
+      "{} runs ({} succeeded, {} failed) in {} configurations; generated {}. ATE is the RMSE of "
+      "positions after the alignment each table names (results.csv has both SE(3) and Sim(3)); "
+      "improvement = 100 · (ATE_{} − ATE) / ATE_{} on the means over runs. Data: results.csv "
+      "(one row per run), summary.csv (one row per configuration).",
+      results.size(), ok, results.size() - ok, groups.size(), Now(), baseline, baseline));
+  doc.Heading(2, "Accuracy");
+  for (const auto& t : HeadlineTables(groups)) doc.AddTable(t);
+  doc.Images(plots, "accuracy");
+  doc.Heading(2, "Trajectories");
+  doc.Paragraph("Top view (x-y) of ground truth and the median-ATE run of each configuration, "
+                "aligned as above; dots mark keyframes.");
+  doc.Images(plots, "trajectories");
+  doc.Heading(2, "Keyframes, maps and run time");
+  doc.AddTable(DetailTable(groups));
+  doc.Images(plots, "keyframes");
+  const auto sweeps = SweepTables(groups);
+  if (!sweeps.empty()) {
+    doc.Heading(2, "Parameter sweeps");
+    for (const auto& t : sweeps) doc.AddTable(t);
+    doc.Images(plots, "sweeps");
+  }
+  const Table failures = FailureTable(results);
+  if (!failures.rows.empty()) {
+    doc.Heading(2, "Failed runs");
+    doc.AddTable(failures);
+  }
+  if (!files.plot_error.empty()) doc.Paragraph("Plots unavailable: " + files.plot_error);
+
+  std::ofstream md(options.out / "report.md", std::ios::trunc);
+  md << doc.md;
+  std::ofstream html(options.out / "report.html", std::ios::trunc);
+  html << fmt::format(fmt::runtime(kHtmlHead), Html(options.title)) << doc.html
+       << "</body></html>\n";
+  if (!md || !html) throw Error("cannot write the report in " + options.out.string());
+  return files;
+}
+
+std::vector<RunResult> CollectResults(const std::vector<fs::path>& dirs) {
+  std::map<std::string, RunResult> by_id;
+  for (const auto& dir : dirs) {
+    const fs::path runs = dir / "runs";
+    if (!fs::is_directory(runs)) throw InputError(dir, "no runs/ folder to collect");
+    for (const auto& entry : fs::recursive_directory_iterator(runs)) {
+      if (entry.path().filename() != "result.csv") continue;
+      for (auto& r : ReadResultsCsv(entry.path())) by_id[r.run_id] = std::move(r);
+    }
+  }
+  std::vector<RunResult> out;
+  for (auto& [id, r] : by_id) out.push_back(std::move(r));
+  std::sort(out.begin(), out.end(),
+            [](const RunResult& a, const RunResult& b) { return a.index < b.index; });
+  return out;
+}
+
+}  // namespace pkslam::bench

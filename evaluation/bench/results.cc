@@ -1,0 +1,203 @@
+#include "evaluation/bench/results.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/util/error.h"
+
+namespace pkslam::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Num(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : ""; }
+
+double ParseDouble(const std::string& s, const fs::path& file, std::size_t line,
+                   const std::string& column) {
+  if (s.empty() || s == "nan") return kNaN;
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(s, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != s.size()) throw InputError(file, line, column + ": '" + s + "' is not a number");
+  return v;
+}
+
+long long ParseInt(const std::string& s, const fs::path& file, std::size_t line,
+                   const std::string& column) {
+  const double v = ParseDouble(s, file, line, column);
+  if (!std::isfinite(v) || v != std::floor(v)) {
+    throw InputError(file, line, column + ": '" + s + "' is not an integer");
+  }
+  return static_cast<long long>(v);
+}
+
+}  // namespace
+
+std::string PrimaryAlignment(const std::string& sensor, const std::string& suite_choice) {
+  if (suite_choice == "se3" || suite_choice == "sim3") return suite_choice;
+  return sensor.rfind("mono", 0) == 0 ? "sim3" : "se3";
+}
+
+RunResult ResultSkeleton(const RunSpec& run, const Suite& suite) {
+  RunResult r;
+  r.index = run.index;
+  r.run_id = run.id;
+  r.dataset = run.dataset;
+  r.sensor = run.sensor;
+  r.config = run.config;
+  r.selector = run.selector;
+  r.params = FormatParams(run.params);
+  r.sweep_param = run.sweep_param;
+  r.sweep_value = run.sweep_param.empty() ? kNaN : run.sweep_value;
+  r.seed = run.seed;
+  r.baseline = suite.baseline;
+  r.alignment = PrimaryAlignment(run.sensor, suite.alignment);
+  return r;
+}
+
+std::vector<std::string> ResultColumns() {
+  return {"index",       "run_id",         "dataset",       "sensor",
+          "config",      "selector",       "params",        "sweep_param",
+          "sweep_value", "seed",           "baseline",      "status",
+          "error",       "alignment",      "ate_m",         "ate_se3_rmse_m",
+          "ate_sim3_rmse_m", "sim3_scale", "rpe_trans_rmse_m", "rpe_rot_rmse_deg",
+          "coverage",    "frames",         "keyframes",     "map_points",
+          "lost_frames", "wall_s",         "median_tracking_ms"};
+}
+
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char ch : text) {
+    if (ch == '"') out += '"';
+    out += (ch == '\n' || ch == '\r') ? ' ' : ch;
+  }
+  return out + "\"";
+}
+
+std::vector<std::string> SplitCsvLine(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char ch = line[i];
+    if (quoted) {
+      if (ch == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        out.back() += '"';
+        ++i;
+      } else if (ch == '"') {
+        quoted = false;
+      } else {
+        out.back() += ch;
+      }
+    } else if (ch == '"') {
+      quoted = true;
+    } else if (ch == ',') {
+      out.emplace_back();
+    } else if (ch != '\r') {
+      out.back() += ch;
+    }
+  }
+  return out;
+}
+
+std::string ResultCsvHeader() {
+  std::string out;
+  for (const auto& c : ResultColumns()) {
+    if (!out.empty()) out.push_back(',');
+    out.append(c);
+  }
+  return out;
+}
+
+std::string ResultCsvRow(const RunResult& r) {
+  const std::vector<std::string> f = {
+      std::to_string(r.index), CsvField(r.run_id), CsvField(r.dataset), CsvField(r.sensor),
+      CsvField(r.config), CsvField(r.selector), CsvField(r.params), CsvField(r.sweep_param),
+      Num(r.sweep_value), std::to_string(r.seed), CsvField(r.baseline), r.ok ? "ok" : "failed",
+      CsvField(r.error), r.alignment, Num(r.ate_m), Num(r.ate_se3_m), Num(r.ate_sim3_m),
+      Num(r.scale), Num(r.rpe_trans_m), Num(r.rpe_rot_deg), Num(r.coverage),
+      std::to_string(r.frames), std::to_string(r.keyframes), std::to_string(r.map_points),
+      std::to_string(r.lost_frames), Num(r.wall_s), Num(r.median_tracking_ms)};
+  std::string out;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (i > 0) out.push_back(',');
+    out.append(f[i]);
+  }
+  return out;
+}
+
+void WriteResultsCsv(const fs::path& file, const std::vector<RunResult>& results) {
+  if (file.has_parent_path()) fs::create_directories(file.parent_path());
+  const fs::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << ResultCsvHeader() << '\n';
+    for (const auto& r : results) out << ResultCsvRow(r) << '\n';
+    if (!out) throw Error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, file);
+}
+
+std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file, "cannot read");
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(file, "empty file (expected a results.csv header)");
+  const auto header = SplitCsvLine(line);
+  if (header != ResultColumns()) {
+    throw InputError(file, 1, "header does not match results.csv columns (" + ResultCsvHeader() + ")");
+  }
+  std::vector<RunResult> out;
+  std::size_t n = 1;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.empty()) continue;
+    const auto f = SplitCsvLine(line);
+    if (f.size() != header.size()) {
+      throw InputError(file, n, fmt::format("{} fields, expected {}", f.size(), header.size()));
+    }
+    RunResult r;
+    std::size_t i = 0;
+    auto next = [&]() -> const std::string& { return f[i++]; };
+    r.index = static_cast<int>(ParseInt(next(), file, n, "index"));
+    r.run_id = next();
+    r.dataset = next();
+    r.sensor = next();
+    r.config = next();
+    r.selector = next();
+    r.params = next();
+    r.sweep_param = next();
+    r.sweep_value = ParseDouble(next(), file, n, "sweep_value");
+    r.seed = static_cast<std::uint64_t>(ParseInt(next(), file, n, "seed"));
+    r.baseline = next();
+    const std::string status = next();
+    if (status != "ok" && status != "failed") {
+      throw InputError(file, n, "status '" + status + "' is not ok|failed");
+    }
+    r.ok = status == "ok";
+    r.error = next();
+    r.alignment = next();
+    r.ate_m = ParseDouble(next(), file, n, "ate_m");
+    r.ate_se3_m = ParseDouble(next(), file, n, "ate_se3_rmse_m");
+    r.ate_sim3_m = ParseDouble(next(), file, n, "ate_sim3_rmse_m");
+    r.scale = ParseDouble(next(), file, n, "sim3_scale");
+    r.rpe_trans_m = ParseDouble(next(), file, n, "rpe_trans_rmse_m");
+    r.rpe_rot_deg = ParseDouble(next(), file, n, "rpe_rot_rmse_deg");
+    r.coverage = ParseDouble(next(), file, n, "coverage");
+    r.frames = static_cast<int>(ParseInt(next(), file, n, "frames"));
+    r.keyframes = static_cast<int>(ParseInt(next(), file, n, "keyframes"));
+    r.map_points = static_cast<int>(ParseInt(next(), file, n, "map_points"));
+    r.lost_frames = static_cast<int>(ParseInt(next(), file, n, "lost_frames"));
+    r.wall_s = ParseDouble(next(), file, n, "wall_s");
+    r.median_tracking_ms = ParseDouble(next(), file, n, "median_tracking_ms");
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace pkslam::bench

@@ -1,0 +1,67 @@
+// One row of results.csv per run, and the CSV files that hold them. Each finished run folder
+// holds its row as result.csv (the resumability marker and what --collect merges).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "evaluation/bench/matrix.h"
+
+namespace pkslam::bench {
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct RunResult {
+  int index = 0;
+  std::string run_id;
+  std::string dataset;
+  std::string sensor;
+  std::string config;
+  std::string selector;
+  std::string params;  // FormatParams
+  std::string sweep_param;
+  double sweep_value = kNaN;
+  std::uint64_t seed = 0;
+  std::string baseline;      // the suite's baseline configuration
+  bool ok = false;           // run and evaluation succeeded
+  std::string error;         // why not, when !ok
+  std::string alignment;     // "se3" or "sim3": the one ate_m uses (sim3 for monocular)
+  double ate_m = kNaN;       // primary ATE RMSE (m)
+  double ate_se3_m = kNaN;   // ATE RMSE after SE(3) alignment (m)
+  double ate_sim3_m = kNaN;  // ATE RMSE after Sim(3) alignment (m)
+  double scale = kNaN;       // the Sim(3) alignment's scale
+  double rpe_trans_m = kNaN;  // RPE translation RMSE over pose pairs rpe_delta_m apart
+  double rpe_rot_deg = kNaN;
+  double coverage = kNaN;  // fraction of ground-truth poses with an associated estimate
+  int frames = 0;
+  int keyframes = 0;
+  int map_points = 0;
+  int lost_frames = 0;
+  double wall_s = kNaN;
+  double median_tracking_ms = kNaN;
+};
+
+// The headline alignment of a run: `suite_choice` when "se3"/"sim3"; for "auto" "sim3" for
+// monocular sensors (scale unobservable) and "se3" otherwise.
+std::string PrimaryAlignment(const std::string& sensor, const std::string& suite_choice);
+
+// A result with the run's identity filled in (not yet measured).
+RunResult ResultSkeleton(const RunSpec& run, const Suite& suite);
+
+std::vector<std::string> ResultColumns();
+std::string ResultCsvHeader();
+std::string ResultCsvRow(const RunResult& r);
+
+// Writes header + rows (atomically: temp file then rename).
+void WriteResultsCsv(const std::filesystem::path& file, const std::vector<RunResult>& results);
+// Throws InputError(file, line) for a malformed file (wrong columns, bad numbers).
+std::vector<RunResult> ReadResultsCsv(const std::filesystem::path& file);
+
+// CSV field splitting with RFC 4180 quotes (exposed for tests).
+std::vector<std::string> SplitCsvLine(const std::string& line);
+std::string CsvField(const std::string& text);
+
+}  // namespace pkslam::bench

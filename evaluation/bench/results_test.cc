@@ -1,0 +1,95 @@
+#include "evaluation/bench/results.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "core/util/error.h"
+#include "tests/support/test_data.h"
+
+namespace pkslam::bench {
+namespace {
+
+TEST(ResultsCsv, QuotesFieldsWithCommasAndQuotes) {
+  EXPECT_EQ(CsvField("plain"), "plain");
+  EXPECT_EQ(CsvField("a,b"), "\"a,b\"");
+  EXPECT_EQ(CsvField("say \"hi\""), "\"say \"\"hi\"\"\"");
+  const auto f = SplitCsvLine("1,\"a,b\",\"say \"\"hi\"\"\",,x");
+  ASSERT_EQ(f.size(), 5u);
+  EXPECT_EQ(f[1], "a,b");
+  EXPECT_EQ(f[2], "say \"hi\"");
+  EXPECT_EQ(f[3], "");
+}
+
+TEST(ResultsCsv, RoundTripsEveryField) {
+  RunSpec spec;
+  spec.index = 4;
+  spec.id = "d/mono/pks@delta_deg=20/seed3";
+  spec.dataset = "d";
+  spec.sensor = "mono";
+  spec.config = "pks@delta_deg=20";
+  spec.selector = "pks";
+  spec.params = {{"delta_deg", 20}, {"tau", 0.25}};
+  spec.sweep_param = "delta_deg";
+  spec.sweep_value = 20;
+  spec.seed = 3;
+  Suite suite;
+  RunResult ok = ResultSkeleton(spec, suite);
+  EXPECT_EQ(ok.alignment, "sim3");  // monocular
+  ok.ok = true;
+  ok.ate_m = 0.0123;
+  ok.ate_se3_m = 0.5;
+  ok.ate_sim3_m = 0.0123;
+  ok.scale = 0.87;
+  ok.keyframes = 42;
+  ok.map_points = 1234;
+  ok.lost_frames = 2;
+  ok.frames = 200;
+  ok.wall_s = 12.5;
+  ok.median_tracking_ms = 20.25;
+  RunResult failed = ok;
+  failed.index = 5;
+  failed.run_id = "d/mono/pks/seed4";
+  failed.ok = false;
+  failed.error = "pkslam run exit 1: bad, \"quoted\" input";
+  failed.ate_m = kNaN;
+  const auto dir = testing::MakeTempDir("bench_results");
+  WriteResultsCsv(dir / "results.csv", {ok, failed});
+  const auto back = ReadResultsCsv(dir / "results.csv");
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[0].run_id, ok.run_id);
+  EXPECT_EQ(back[0].params, "delta_deg=20;tau=0.25");
+  EXPECT_EQ(back[0].sweep_value, 20.0);
+  EXPECT_TRUE(back[0].ok);
+  EXPECT_DOUBLE_EQ(back[0].ate_m, 0.0123);
+  EXPECT_DOUBLE_EQ(back[0].scale, 0.87);
+  EXPECT_EQ(back[0].keyframes, 42);
+  EXPECT_EQ(back[0].map_points, 1234);
+  EXPECT_DOUBLE_EQ(back[0].median_tracking_ms, 20.25);
+  EXPECT_TRUE(std::isnan(back[0].rpe_trans_m));
+  EXPECT_FALSE(back[1].ok);
+  EXPECT_EQ(back[1].error, failed.error);
+  EXPECT_TRUE(std::isnan(back[1].ate_m));
+}
+
+TEST(ResultsCsv, MalformedFilesNameTheLine) {
+  const auto dir = testing::MakeTempDir("bench_results_bad");
+  {
+    std::ofstream(dir / "wrong_header.csv") << "a,b\n";
+    std::ofstream(dir / "short_row.csv") << ResultCsvHeader() << "\n1,2,3\n";
+    std::ofstream(dir / "empty.csv");
+  }
+  try {
+    ReadResultsCsv(dir / "short_row.csv");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 2u);
+  }
+  EXPECT_THROW(ReadResultsCsv(dir / "wrong_header.csv"), InputError);
+  EXPECT_THROW(ReadResultsCsv(dir / "empty.csv"), InputError);
+  EXPECT_THROW(ReadResultsCsv(dir / "missing.csv"), InputError);
+}
+
+}  // namespace
+}  // namespace pkslam::bench

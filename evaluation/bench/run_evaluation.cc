@@ -1,0 +1,134 @@
+#include "evaluation/bench/run_evaluation.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+
+#include "core/util/error.h"
+#include "evaluation/evaluate.h"
+#include "io/trajectory.h"
+
+namespace pkslam::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct StatsJson {
+  int frames = 0;
+  int keyframes = 0;
+  int map_points = 0;
+  int lost_frames = 0;
+  double wall_s = kNaN;
+  double median_tracking_ms = kNaN;
+};
+
+// stats.json is plain JSON, which yaml-cpp reads as YAML flow style.
+StatsJson ReadStats(const fs::path& file) {
+  if (!fs::exists(file)) throw InputError(file, "missing (the run did not finish)");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(file, e.mark.line + 1, "not valid JSON: " + e.msg);
+  }
+  auto get = [&](const char* key, auto fallback) {
+    using T = decltype(fallback);
+    if (!root[key]) throw InputError(file, std::string("no '") + key + "' field");
+    try {
+      return root[key].as<T>();
+    } catch (const YAML::Exception&) {
+      throw InputError(file, root[key].Mark().line + 1, std::string("bad '") + key + "'");
+    }
+  };
+  StatsJson s;
+  s.frames = get("frames", 0);
+  s.keyframes = get("keyframes", 0);
+  s.map_points = get("map_points", 0);
+  s.lost_frames = get("lost_frames", 0);
+  s.wall_s = get("wall_time_s", 0.0);
+  s.median_tracking_ms = get("median_tracking_ms", 0.0);
+  return s;
+}
+
+void WritePlotFiles(const fs::path& dir, const Trajectory& gt, const Trajectory& est,
+                    const Trajectory& keyframes, const EvaluationResult& primary) {
+  std::ofstream traj(dir / "plot_trajectory.csv", std::ios::trunc);
+  traj << "t_s,gt_x,gt_y,gt_z,est_x,est_y,est_z\n";
+  for (const auto& [i_ref, i_est] : primary.pairs) {
+    const Eigen::Vector3d g = gt.poses[i_ref].pose.translation();
+    const Eigen::Vector3d e = primary.ref_from_est * est.poses[i_est].pose.translation();
+    traj << fmt::format("{:.6f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f}\n",
+                        1e-9 * static_cast<double>(gt.poses[i_ref].t_ns), g.x(), g.y(), g.z(),
+                        e.x(), e.y(), e.z());
+  }
+  std::ofstream kf(dir / "plot_keyframes.csv", std::ios::trunc);
+  kf << "t_s,x,y,z\n";
+  for (const auto& p : keyframes.poses) {
+    const Eigen::Vector3d e = primary.ref_from_est * p.pose.translation();
+    kf << fmt::format("{:.6f},{:.5f},{:.5f},{:.5f}\n", 1e-9 * static_cast<double>(p.t_ns), e.x(),
+                      e.y(), e.z());
+  }
+  if (!traj || !kf) throw Error("cannot write plot files in " + dir.string());
+}
+
+}  // namespace
+
+fs::path FindGroundTruth(const fs::path& dataset) {
+  const fs::path euroc = dataset / "mav0" / "state_groundtruth_estimate0" / "data.csv";
+  if (fs::exists(euroc)) return euroc;
+  const fs::path tum = dataset / "groundtruth.txt";
+  if (fs::exists(tum)) return tum;
+  throw InputError(dataset,
+                   "no ground truth (mav0/state_groundtruth_estimate0/data.csv or groundtruth.txt);"
+                   " set the dataset's ground_truth in the suite");
+}
+
+void EvaluateRun(const RunFiles& files, RunResult* result) {
+  const StatsJson stats = ReadStats(files.run_dir / "stats.json");
+  result->frames = stats.frames;
+  result->keyframes = stats.keyframes;
+  result->map_points = stats.map_points;
+  result->lost_frames = stats.lost_frames;
+  result->wall_s = stats.wall_s;
+  result->median_tracking_ms = stats.median_tracking_ms;
+
+  const fs::path gt_file = files.ground_truth.value_or(FindGroundTruth(files.dataset));
+  // EuRoC ground truth is the body (IMU) frame: compare body poses; TUM's is the camera's.
+  const bool body = gt_file.filename() == "data.csv" ||
+                    DetectTrajectoryFormat(gt_file) == TrajectoryFormat::kEuroc;
+  const fs::path est_file = files.run_dir / (body ? "trajectory_body.txt" : "trajectory.txt");
+  const Trajectory gt = ReadTrajectory(gt_file);
+  const Trajectory est = ReadTrajectory(est_file, TrajectoryFormat::kTum);
+  const Trajectory keyframes = ReadTrajectory(files.run_dir / "keyframes.txt", TrajectoryFormat::kTum);
+
+  EvaluationOptions options;
+  options.compute_rpe = false;
+  options.alignment = AlignmentMethod::kSE3;
+  const EvaluationResult se3 = EvaluateTrajectories(gt, est, options);
+  options.alignment = AlignmentMethod::kSim3;
+  const EvaluationResult sim3 = EvaluateTrajectories(gt, est, options);
+
+  result->ate_se3_m = se3.ate_translation_m.rmse;
+  result->ate_sim3_m = sim3.ate_translation_m.rmse;
+  result->scale = sim3.scale();
+  const bool use_sim3 = result->alignment == "sim3";
+  result->ate_m = use_sim3 ? result->ate_sim3_m : result->ate_se3_m;
+  // RPE is scale dependent: measured after the primary alignment (Sim(3) for monocular runs).
+  // A path shorter than the RPE distance has no pose pair: RPE stays empty (NaN).
+  options.alignment = use_sim3 ? AlignmentMethod::kSim3 : AlignmentMethod::kSE3;
+  options.compute_rpe = true;
+  options.rpe.delta = files.rpe_delta_m;
+  options.rpe.unit = RpeUnit::kMeters;
+  try {
+    const EvaluationResult with_rpe = EvaluateTrajectories(gt, est, options);
+    result->rpe_trans_m = with_rpe.rpe->translation_m.rmse;
+    result->rpe_rot_deg = with_rpe.rpe->rotation_deg.rmse;
+  } catch (const OptionError&) {
+  }
+  result->coverage = stats.frames > 0 ? static_cast<double>(se3.pairs.size()) / stats.frames : 0.0;
+  WritePlotFiles(files.run_dir, gt, est, keyframes, use_sim3 ? sim3 : se3);
+  result->ok = true;
+  result->error.clear();
+}
+
+}  // namespace pkslam::bench

@@ -1,0 +1,109 @@
+#include "evaluation/bench/run_evaluation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "core/geometry/se3.h"
+#include "core/util/error.h"
+#include "tests/support/test_data.h"
+
+namespace pkslam::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A EuRoC-layout dataset with ground truth along a 4 m helix, and a run folder whose body
+// trajectory is that ground truth in another world frame, scaled by `scale`, with the
+// x coordinate of every 2nd pose offset by +-`offset`.
+struct Fixture {
+  fs::path dataset;
+  fs::path run;
+};
+
+Fixture MakeRun(const std::string& name, double scale, double offset) {
+  Fixture f;
+  const fs::path root = testing::MakeTempDir(name);
+  f.dataset = root / "data";
+  f.run = root / "run";
+  fs::create_directories(f.dataset / "mav0" / "state_groundtruth_estimate0");
+  fs::create_directories(f.run);
+  std::ofstream gt(f.dataset / "mav0" / "state_groundtruth_estimate0" / "data.csv");
+  gt << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
+        "q_RS_z []\n";
+  std::ofstream est(f.run / "trajectory_body.txt");
+  std::ofstream kf(f.run / "keyframes.txt");
+  const SE3d est_from_world(SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.7)), Eigen::Vector3d(1, 2, 3));
+  const std::int64_t t0 = 1'600'000'000'000'000'000;
+  for (int i = 0; i < 100; ++i) {
+    const double a = 0.1 * i;
+    const SE3d world_from_body(SO3d::Exp(Eigen::Vector3d(0, 0, a)),
+                               Eigen::Vector3d(std::cos(a), std::sin(a), 0.04 * i));
+    const std::int64_t t = t0 + std::int64_t{i} * 50'000'000;
+    const Eigen::Quaterniond q = world_from_body.so3().quaternion();
+    const Eigen::Vector3d p = world_from_body.translation();
+    gt << fmt::format("{},{},{},{},{},{},{},{}\n", t, p.x(), p.y(), p.z(), q.w(), q.x(), q.y(),
+                      q.z());
+    SE3d e = est_from_world * world_from_body;
+    Eigen::Vector3d pe = scale * e.translation();
+    pe.x() += (i % 2 == 0 ? offset : -offset);
+    const Eigen::Quaterniond qe = e.so3().quaternion();
+    const std::string line = fmt::format("{:.9f} {:.9f} {:.9f} {:.9f} {} {} {} {}\n", 1e-9 * t,
+                                         pe.x(), pe.y(), pe.z(), qe.x(), qe.y(), qe.z(), qe.w());
+    est << line;
+    if (i % 10 == 0) kf << line;
+  }
+  std::ofstream(f.run / "stats.json")
+      << R"({"frames": 120, "keyframes": 10, "map_points": 900, "lost_frames": 3,
+            "wall_time_s": 4.5, "median_tracking_ms": 21.5, "tracking_ms": [1.0, 2.0]})";
+  return f;
+}
+
+TEST(EvaluateRun, MeasuresAteBothAlignmentsAndReadsStats) {
+  const Fixture f = MakeRun("bench_eval_stereo", 1.0, 0.01);
+  RunResult r;
+  r.alignment = "se3";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_TRUE(r.ok);
+  // Alternating +-1 cm in x: after the best alignment every pose is 1 cm off.
+  EXPECT_NEAR(r.ate_se3_m, 0.01, 2e-4);
+  EXPECT_NEAR(r.ate_sim3_m, 0.01, 2e-4);
+  EXPECT_NEAR(r.scale, 1.0, 1e-3);
+  EXPECT_DOUBLE_EQ(r.ate_m, r.ate_se3_m);
+  EXPECT_TRUE(std::isfinite(r.rpe_trans_m));
+  EXPECT_EQ(r.frames, 120);
+  EXPECT_EQ(r.keyframes, 10);
+  EXPECT_EQ(r.map_points, 900);
+  EXPECT_EQ(r.lost_frames, 3);
+  EXPECT_DOUBLE_EQ(r.wall_s, 4.5);
+  EXPECT_DOUBLE_EQ(r.median_tracking_ms, 21.5);
+  EXPECT_NEAR(r.coverage, 100.0 / 120.0, 1e-12);
+  EXPECT_TRUE(fs::exists(f.run / "plot_trajectory.csv"));
+  EXPECT_TRUE(fs::exists(f.run / "plot_keyframes.csv"));
+}
+
+TEST(EvaluateRun, MonocularUsesSim3AndRecoversScale) {
+  const Fixture f = MakeRun("bench_eval_mono", 0.5, 0.0);
+  RunResult r;
+  r.alignment = "sim3";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_NEAR(r.scale, 2.0, 1e-6);  // ref_from_est undoes the half scale
+  EXPECT_LT(r.ate_sim3_m, 1e-6);
+  EXPECT_GT(r.ate_se3_m, 0.1);  // a rigid alignment cannot fix the scale
+  EXPECT_DOUBLE_EQ(r.ate_m, r.ate_sim3_m);
+}
+
+TEST(EvaluateRun, MissingOrBrokenFilesAreInputErrors) {
+  const Fixture f = MakeRun("bench_eval_bad", 1.0, 0.0);
+  RunResult r;
+  r.alignment = "se3";
+  fs::remove(f.run / "trajectory_body.txt");
+  EXPECT_THROW(EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r), InputError);
+  std::ofstream(f.run / "stats.json") << "{\"frames\": 1}";
+  EXPECT_THROW(EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r), InputError);
+  EXPECT_THROW(FindGroundTruth(f.run), InputError);
+}
+
+}  // namespace
+}  // namespace pkslam::bench

@@ -1,0 +1,148 @@
+#include "evaluation/bench/suite.h"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include "core/util/error.h"
+#include "evaluation/bench/matrix.h"
+
+namespace pkslam::bench {
+namespace {
+
+const char* kSuite = R"(name: demo
+runs: 3
+seed: 10
+sensors: [stereo, mono]
+selectors:
+  - orbslam3
+  - {name: pks, params: {tau: 0.5}}
+params: {Keyframe.min_frames: 2}
+sweeps:
+  - {selector: pks, param: delta_deg, values: [10, 20]}
+datasets:
+  - {name: real, path: data/real}
+  - name: only_stereo
+    path: /abs/path
+    sensors: [stereo]
+)";
+
+// Expects ParseSuite(text) to throw InputError on `line` whose message contains `what`.
+void ExpectError(const std::string& text, std::size_t line, const std::string& what) {
+  try {
+    ParseSuite(text, "dir/suite.yaml");
+    FAIL() << "no error for:\n" << text;
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), line) << e.what();
+    EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("dir/suite.yaml"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Suite, ParsesAllFields) {
+  const Suite s = ParseSuite(kSuite, "dir/suite.yaml");
+  EXPECT_EQ(s.name, "demo");
+  EXPECT_EQ(s.runs, 3);
+  EXPECT_EQ(s.seed, 10u);
+  ASSERT_EQ(s.selectors.size(), 2u);
+  EXPECT_EQ(s.selectors[1].label, "pks");
+  EXPECT_EQ(s.selectors[1].params.at("tau"), 0.5);
+  EXPECT_EQ(s.params.at("min_frames"), 2.0);  // Keyframe. prefix dropped
+  ASSERT_EQ(s.datasets.size(), 2u);
+  EXPECT_EQ(*s.datasets[0].path, std::filesystem::path("dir/data/real"));
+  EXPECT_EQ(*s.datasets[1].path, std::filesystem::path("/abs/path"));
+}
+
+TEST(Suite, ExpandsTheMatrixInOrderWithDistinctSeeds) {
+  const Suite s = ParseSuite(kSuite, "dir/suite.yaml");
+  const auto runs = ExpandSuite(s);
+  // real: 2 sensors x (2 selectors + 2 sweep points) x 3 runs; only_stereo: 1 x 4 x 3.
+  ASSERT_EQ(runs.size(), 24u + 12u);
+  EXPECT_EQ(runs[0].id, "real/stereo/orbslam3/seed10");
+  EXPECT_EQ(runs[2].id, "real/stereo/orbslam3/seed12");
+  EXPECT_EQ(runs[3].config, "pks");
+  EXPECT_EQ(runs[3].params.at("tau"), 0.5);
+  EXPECT_EQ(runs[3].params.at("min_frames"), 2.0);
+  EXPECT_EQ(runs[6].config, "pks@delta_deg=10");
+  EXPECT_EQ(runs[6].params.at("delta_deg"), 10.0);
+  EXPECT_EQ(runs[6].params.at("tau"), 0.5);  // a sweep inherits its selector's params
+  EXPECT_EQ(runs[9].sweep_value, 20.0);
+  EXPECT_EQ(runs[12].sensor, "mono");
+  EXPECT_EQ(runs[24].id, "only_stereo/stereo/orbslam3/seed10");
+  for (std::size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(runs[i].index, static_cast<int>(i));
+}
+
+TEST(Suite, SweepsCanBeLimitedToDatasets) {
+  const Suite s = ParseSuite(R"(sensors: [stereo]
+runs: 1
+selectors: [orbslam3, pks]
+sweeps: [{selector: pks, param: delta, values: [10, 40], datasets: [b]}]
+datasets: [{name: a, path: x}, {name: b, path: y}]
+)",
+                             "s.yaml");
+  const auto runs = ExpandSuite(s);
+  ASSERT_EQ(runs.size(), 2u + 4u);
+  EXPECT_EQ(runs[1].id, "a/stereo/pks/seed1");
+  EXPECT_EQ(runs[5].id, "b/stereo/pks@delta=40/seed1");
+  ExpectError("sensors: [stereo]\nselectors: [a]\nsweeps: [{selector: a, param: p, values: [1], "
+              "datasets: [zz]}]\ndatasets: [{name: x, path: p}]\n",
+              3, "sweep dataset 'zz'");
+}
+
+TEST(Suite, SimSeedPerRunGivesEachRunItsOwnRendering) {
+  const Suite s = ParseSuite(R"(sensors: [stereo]
+runs: 2
+selectors: [orbslam3]
+datasets:
+  - {name: a, sim: {motion: easy, duration: 5, seed: 7, seed_per_run: true}}
+  - {name: b, sim: {motion: easy, duration: 5, seed: 7}}
+)",
+                             "s.yaml");
+  const auto runs = ExpandSuite(s);
+  ASSERT_EQ(runs.size(), 4u);
+  EXPECT_EQ(runs[0].sim->seed, 7u);
+  EXPECT_EQ(runs[1].sim->seed, 8u);
+  EXPECT_EQ(runs[2].sim->seed, 7u);
+  EXPECT_EQ(runs[3].sim->seed, 7u);
+}
+
+TEST(Suite, ErrorsNameFileAndLine) {
+  ExpectError("runs: 2\nselectors: [a]\nbogus: 1\n", 3, "unknown key 'bogus'");
+  ExpectError("runs: zero\n", 1, "'runs' must be an integer");
+  ExpectError("runs: 0\n", 1, "'runs' must be >= 1");
+  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - {name: x}\n", 4,
+              "needs 'path'");
+  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - {name: x, path: p, sim: {}}\n",
+              4, "not both");
+  ExpectError("sensors: [stereo]\nselectors: [a, a]\ndatasets: [{name: x, path: p}]\n", 2,
+              "repeats");
+  ExpectError("sensors: [stereo]\nselectors: [a]\nsweeps: [{selector: b, param: p, values: [1]}]\n"
+              "datasets: [{name: x, path: p}]\n",
+              3, "not one of the suite's selectors");
+  ExpectError("selectors: [a]\ndatasets: [{name: x, path: p}]\n", 1, "has no sensors");
+  ExpectError("a: [1, 2\n", 2, "YAML syntax");
+  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - {name: x, sim: {motion: easy, "
+              "args: [--seed, 3]}}\n",
+              4, "must not contain --seed");
+  ExpectError("", 0, "empty suite");
+}
+
+TEST(Suite, ExpandsEnvironmentVariables) {
+  setenv("PKSLAM_BENCH_TEST_ROOT", "/data/euroc", 1);
+  unsetenv("PKSLAM_BENCH_TEST_UNSET");
+  EXPECT_EQ(ExpandEnvironment("${PKSLAM_BENCH_TEST_ROOT}/MH_01", "f", 1), "/data/euroc/MH_01");
+  EXPECT_EQ(ExpandEnvironment("${PKSLAM_BENCH_TEST_UNSET:-/x}/y", "f", 1), "/x/y");
+  EXPECT_THROW(ExpandEnvironment("${PKSLAM_BENCH_TEST_UNSET}/y", "f", 1), InputError);
+  EXPECT_THROW(ExpandEnvironment("${OOPS", "f", 1), InputError);
+  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - name: x\n    path: "
+              "${PKSLAM_BENCH_TEST_UNSET}/MH\n",
+              5, "PKSLAM_BENCH_TEST_UNSET is not set");
+}
+
+TEST(Matrix, FormatsNumbersShortestRoundTrip) {
+  EXPECT_EQ(FormatNumber(20.0), "20");
+  EXPECT_EQ(FormatNumber(0.35), "0.35");
+  EXPECT_EQ(FormatParams({{"b", 1.5}, {"a", 2}}), "a=2;b=1.5");
+}
+
+}  // namespace
+}  // namespace pkslam::bench

@@ -1,0 +1,290 @@
+#include "evaluation/bench/summary.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <tuple>
+
+#include "core/util/error.h"
+#include "evaluation/bench/matrix.h"
+
+namespace pkslam::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Num(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : ""; }
+
+double Median(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string Percent(double p) {
+  if (!std::isfinite(p)) return "";
+  return fmt::format("{:+.1f}%", p);
+}
+
+}  // namespace
+
+MeanStd ComputeMeanStd(const std::vector<double>& values) {
+  MeanStd m;
+  double sum = 0;
+  for (double v : values) {
+    if (std::isfinite(v)) {
+      sum += v;
+      ++m.n;
+    }
+  }
+  if (m.n == 0) return m;
+  m.mean = sum / m.n;
+  double ss = 0;
+  for (double v : values) {
+    if (std::isfinite(v)) ss += (v - m.mean) * (v - m.mean);
+  }
+  m.std = m.n > 1 ? std::sqrt(ss / (m.n - 1)) : 0.0;
+  return m;
+}
+
+std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
+  using Key = std::tuple<std::string, std::string, std::string>;
+  std::map<Key, std::vector<const RunResult*>> by_group;
+  for (const auto& r : results) by_group[{r.dataset, r.sensor, r.config}].push_back(&r);
+  std::vector<GroupSummary> groups;
+  for (const auto& [key, runs] : by_group) {
+    GroupSummary g;
+    const RunResult& first = *runs.front();
+    g.order = first.index;
+    g.dataset = first.dataset;
+    g.sensor = first.sensor;
+    g.config = first.config;
+    g.selector = first.selector;
+    g.sweep_param = first.sweep_param;
+    g.sweep_value = first.sweep_value;
+    g.baseline = first.baseline;
+    g.alignment = first.alignment;
+    g.runs = static_cast<int>(runs.size());
+    std::vector<double> ate, se3, sim3, scale, rpe, kf, mp, lost, wall, track;
+    for (const RunResult* r : runs) {
+      g.order = std::min(g.order, r->index);
+      if (!r->ok) continue;
+      ++g.ok;
+      ate.push_back(r->ate_m);
+      se3.push_back(r->ate_se3_m);
+      sim3.push_back(r->ate_sim3_m);
+      scale.push_back(r->scale);
+      rpe.push_back(r->rpe_trans_m);
+      kf.push_back(r->keyframes);
+      mp.push_back(r->map_points);
+      lost.push_back(r->lost_frames);
+      wall.push_back(r->wall_s);
+      track.push_back(r->median_tracking_ms);
+    }
+    g.ate_m = ComputeMeanStd(ate);
+    g.ate_se3_m = ComputeMeanStd(se3);
+    g.ate_sim3_m = ComputeMeanStd(sim3);
+    g.scale = ComputeMeanStd(scale);
+    g.rpe_trans_m = ComputeMeanStd(rpe);
+    g.keyframes = ComputeMeanStd(kf);
+    g.map_points = ComputeMeanStd(mp);
+    g.lost_frames = ComputeMeanStd(lost);
+    g.wall_s = ComputeMeanStd(wall);
+    g.median_tracking_ms = ComputeMeanStd(track);
+    g.ate_median_m = Median(ate);
+    groups.push_back(std::move(g));
+  }
+  std::sort(groups.begin(), groups.end(),
+            [](const GroupSummary& a, const GroupSummary& b) { return a.order < b.order; });
+  for (auto& g : groups) {
+    for (const auto& b : groups) {
+      if (b.dataset == g.dataset && b.sensor == g.sensor && b.config == g.baseline &&
+          std::isfinite(b.ate_m.mean) && b.ate_m.mean > 0 && std::isfinite(g.ate_m.mean)) {
+        g.improvement_pct = 100.0 * (b.ate_m.mean - g.ate_m.mean) / b.ate_m.mean;
+      }
+    }
+  }
+  return groups;
+}
+
+void WriteSummaryCsv(const fs::path& file, const std::vector<GroupSummary>& groups) {
+  std::ofstream out(file, std::ios::trunc);
+  out << "dataset,sensor,config,selector,sweep_param,sweep_value,runs,ok,alignment,"
+         "ate_mean_m,ate_std_m,ate_median_m,ate_se3_mean_m,ate_sim3_mean_m,scale_mean,"
+         "rpe_trans_mean_m,improvement_pct,keyframes_mean,keyframes_std,map_points_mean,"
+         "lost_frames_mean,wall_mean_s,median_tracking_mean_ms\n";
+  for (const auto& g : groups) {
+    out << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                       CsvField(g.dataset), CsvField(g.sensor), CsvField(g.config),
+                       CsvField(g.selector), CsvField(g.sweep_param), Num(g.sweep_value), g.runs,
+                       g.ok, g.alignment, Num(g.ate_m.mean), Num(g.ate_m.std), Num(g.ate_median_m),
+                       Num(g.ate_se3_m.mean), Num(g.ate_sim3_m.mean), Num(g.scale.mean),
+                       Num(g.rpe_trans_m.mean), Num(g.improvement_pct), Num(g.keyframes.mean),
+                       Num(g.keyframes.std), Num(g.map_points.mean), Num(g.lost_frames.mean),
+                       Num(g.wall_s.mean), Num(g.median_tracking_ms.mean));
+  }
+  if (!out) throw Error("cannot write " + file.string());
+}
+
+std::string FormatMeanStd(const MeanStd& m, int decimals) {
+  if (m.n == 0) return "—";
+  return fmt::format("{:.{}f} ± {:.{}f}", m.mean, decimals, m.std, decimals);
+}
+
+std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
+  std::vector<std::string> sensors, configs, datasets;
+  auto add = [](std::vector<std::string>& v, const std::string& x) {
+    if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
+  };
+  for (const auto& g : groups) {
+    add(sensors, g.sensor);
+    add(datasets, g.dataset);
+    if (g.sweep_param.empty()) add(configs, g.config);
+  }
+  std::vector<Table> tables;
+  for (const auto& sensor : sensors) {
+    Table t;
+    std::string alignment;
+    std::map<std::string, std::vector<double>> improvements;
+    for (const auto& dataset : datasets) {
+      std::vector<std::string> row = {dataset};
+      bool any = false;
+      for (const auto& config : configs) {
+        std::string cell = "";
+        for (const auto& g : groups) {
+          if (g.sensor != sensor || g.dataset != dataset || g.config != config) continue;
+          any = true;
+          alignment = g.alignment;
+          cell = FormatMeanStd(g.ate_m, 4);
+          if (config != g.baseline && std::isfinite(g.improvement_pct)) {
+            cell += " (" + Percent(g.improvement_pct) + ")";
+            improvements[config].push_back(g.improvement_pct);
+          }
+          if (g.ok < g.runs) cell += fmt::format(" [{}/{} ok]", g.ok, g.runs);
+        }
+        row.push_back(cell);
+      }
+      if (any) t.rows.push_back(row);
+    }
+    if (t.rows.empty()) continue;
+    t.title = fmt::format("ATE RMSE [m] ({} alignment), {}: mean ± std over runs (improvement "
+                          "over the baseline)",
+                          alignment == "sim3" ? "Sim(3)" : "SE(3)", sensor);
+    t.header = {"dataset"};
+    t.header.insert(t.header.end(), configs.begin(), configs.end());
+    if (!improvements.empty()) {
+      // The paper's summary lines: mean ATE over the sequences (and its improvement), the mean
+      // of the per-sequence improvements, and on how many sequences a configuration wins.
+      std::vector<std::string> mean_row = {"mean over sequences"};
+      std::vector<std::string> avg_row = {"mean of per-sequence improvements"};
+      std::vector<std::string> wins_row = {"better than baseline on"};
+      std::map<std::string, double> mean_ate;
+      for (const auto& config : configs) {
+        std::vector<double> means;
+        for (const auto& g : groups) {
+          if (g.sensor == sensor && g.config == config) means.push_back(g.ate_m.mean);
+        }
+        mean_ate[config] = ComputeMeanStd(means).mean;
+      }
+      const std::string baseline = groups.front().baseline;
+      for (const auto& config : configs) {
+        std::string cell = fmt::format("{:.4f}", mean_ate[config]);
+        const auto b = mean_ate.find(baseline);
+        if (config != baseline && b != mean_ate.end() && b->second > 0) {
+          cell += " (" + Percent(100.0 * (b->second - mean_ate[config]) / b->second) + ")";
+        }
+        mean_row.push_back(cell);
+        const auto it = improvements.find(config);
+        avg_row.push_back(it == improvements.end() ? "" : Percent(ComputeMeanStd(it->second).mean));
+        if (it == improvements.end()) {
+          wins_row.push_back("");
+        } else {
+          const auto wins = std::count_if(it->second.begin(), it->second.end(),
+                                          [](double p) { return p > 0; });
+          wins_row.push_back(fmt::format("{}/{}", wins, it->second.size()));
+        }
+      }
+      t.rows.push_back(mean_row);
+      t.rows.push_back(avg_row);
+      t.rows.push_back(wins_row);
+    }
+    tables.push_back(t);
+  }
+  return tables;
+}
+
+Table DetailTable(const std::vector<GroupSummary>& groups) {
+  Table t;
+  t.title = "Per configuration: keyframes, map, losses and run time (mean ± std over runs)";
+  t.header = {"dataset", "sensor", "config", "ok/runs", "ATE [m]", "RPE [m]", "scale",
+              "keyframes", "map points", "lost frames", "wall [s]", "median tracking [ms]"};
+  for (const auto& g : groups) {
+    t.rows.push_back({g.dataset, g.sensor, g.config, fmt::format("{}/{}", g.ok, g.runs),
+                      FormatMeanStd(g.ate_m, 4), FormatMeanStd(g.rpe_trans_m, 4),
+                      FormatMeanStd(g.scale, 3), FormatMeanStd(g.keyframes, 1),
+                      FormatMeanStd(g.map_points, 0), FormatMeanStd(g.lost_frames, 1),
+                      FormatMeanStd(g.wall_s, 1), FormatMeanStd(g.median_tracking_ms, 1)});
+  }
+  return t;
+}
+
+std::vector<Table> SweepTables(const std::vector<GroupSummary>& groups) {
+  std::vector<std::string> params;
+  for (const auto& g : groups) {
+    if (!g.sweep_param.empty() &&
+        std::find(params.begin(), params.end(), g.sweep_param) == params.end()) {
+      params.push_back(g.sweep_param);
+    }
+  }
+  std::vector<Table> tables;
+  for (const auto& p : params) {
+    Table t;
+    t.title = "Sweep of " + p;
+    t.header = {"dataset", "sensor", "config", p, "ATE [m]", "keyframes", "ok/runs"};
+    for (const auto& g : groups) {
+      if (g.sweep_param != p) continue;
+      t.rows.push_back({g.dataset, g.sensor, g.config, FormatNumber(g.sweep_value),
+                        FormatMeanStd(g.ate_m, 4), FormatMeanStd(g.keyframes, 1),
+                        fmt::format("{}/{}", g.ok, g.runs)});
+    }
+    tables.push_back(t);
+  }
+  return tables;
+}
+
+Table FailureTable(const std::vector<RunResult>& results) {
+  Table t;
+  t.title = "Failed runs";
+  t.header = {"run", "error"};
+  for (const auto& r : results) {
+    if (!r.ok) t.rows.push_back({r.run_id, r.error});
+  }
+  return t;
+}
+
+std::string MarkdownTable(const Table& table) {
+  auto cell = [](std::string* out, const std::string& text) {
+    out->append(" ");
+    for (char ch : text) {
+      if (ch == '|') out->push_back('\\');
+      out->push_back(ch);
+    }
+    out->append(" |");
+  };
+  std::string out = "|";
+  for (const auto& h : table.header) cell(&out, h);
+  out.append("\n|");
+  for (std::size_t i = 0; i < table.header.size(); ++i) out.append(i == 0 ? " --- |" : " ---: |");
+  out.append("\n");
+  for (const auto& row : table.rows) {
+    out.append("|");
+    for (const auto& c : row) cell(&out, c);
+    out.append("\n");
+  }
+  return out;
+}
+
+}  // namespace pkslam::bench

@@ -1,0 +1,77 @@
+// Aggregates run results per (dataset, sensor, configuration): mean +- std over the runs that
+// succeeded, and the relative improvement over the baseline configuration as the PKS paper
+// reports it: 100 * (ATE_baseline - ATE) / ATE_baseline (positive = more accurate).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "evaluation/bench/results.h"
+
+namespace pkslam::bench {
+
+// Mean and sample standard deviation (n - 1; 0 for one value) of the finite values.
+struct MeanStd {
+  int n = 0;
+  double mean = kNaN;
+  double std = kNaN;
+};
+MeanStd ComputeMeanStd(const std::vector<double>& values);
+
+struct GroupSummary {
+  int order = 0;  // smallest run index of the group (tables keep the matrix order)
+  std::string dataset;
+  std::string sensor;
+  std::string config;
+  std::string selector;
+  std::string sweep_param;
+  double sweep_value = kNaN;
+  std::string baseline;
+  std::string alignment;
+  int runs = 0;
+  int ok = 0;
+  MeanStd ate_m;
+  MeanStd ate_se3_m;
+  MeanStd ate_sim3_m;
+  MeanStd scale;
+  MeanStd rpe_trans_m;
+  MeanStd keyframes;
+  MeanStd map_points;
+  MeanStd lost_frames;
+  MeanStd wall_s;
+  MeanStd median_tracking_ms;
+  double ate_median_m = kNaN;
+  double improvement_pct = kNaN;  // vs the baseline group of the same dataset and sensor
+};
+
+// Groups in matrix order (by their first run's index).
+std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results);
+
+// summary.csv: one row per group (the numbers --collect must reproduce).
+void WriteSummaryCsv(const std::filesystem::path& file, const std::vector<GroupSummary>& groups);
+
+// "0.0123 ± 0.0012" (or "—" without values).
+std::string FormatMeanStd(const MeanStd& m, int decimals);
+
+// A table: header row and body rows of cells (rendered to Markdown or HTML by report.cc).
+struct Table {
+  std::string title;
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+};
+
+// Headline: one table per sensor, rows = datasets, columns = the non-sweep configurations,
+// cells = ATE mean ± std [m] and the improvement over the baseline; a last row averages the
+// improvements over the datasets.
+std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups);
+// Keyframes, map points, lost frames and timings per group.
+Table DetailTable(const std::vector<GroupSummary>& groups);
+// One table per swept parameter: value -> ATE and keyframes per dataset and sensor.
+std::vector<Table> SweepTables(const std::vector<GroupSummary>& groups);
+// Failed runs with their error (empty table when none).
+Table FailureTable(const std::vector<RunResult>& results);
+
+std::string MarkdownTable(const Table& table);
+
+}  // namespace pkslam::bench

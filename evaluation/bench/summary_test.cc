@@ -1,0 +1,70 @@
+#include "evaluation/bench/summary.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace pkslam::bench {
+namespace {
+
+RunResult Result(int index, const std::string& dataset, const std::string& config, double ate,
+                 int keyframes, bool ok = true) {
+  RunResult r;
+  r.index = index;
+  r.run_id = dataset + "/stereo/" + config + "/seed" + std::to_string(index);
+  r.dataset = dataset;
+  r.sensor = "stereo";
+  r.config = config;
+  r.selector = config;
+  r.baseline = "orbslam3";
+  r.alignment = "se3";
+  r.ok = ok;
+  r.ate_m = ok ? ate : kNaN;
+  r.keyframes = keyframes;
+  return r;
+}
+
+TEST(Summary, MeanAndSampleStd) {
+  const MeanStd m = ComputeMeanStd({1.0, 2.0, 3.0, kNaN});
+  EXPECT_EQ(m.n, 3);
+  EXPECT_DOUBLE_EQ(m.mean, 2.0);
+  EXPECT_DOUBLE_EQ(m.std, 1.0);
+  EXPECT_EQ(ComputeMeanStd({}).n, 0);
+  EXPECT_DOUBLE_EQ(ComputeMeanStd({5.0}).std, 0.0);
+}
+
+TEST(Summary, GroupsInMatrixOrderWithImprovementOverBaseline) {
+  // Deliberately shuffled input; failed runs count in runs but not in the statistics.
+  const std::vector<RunResult> results = {
+      Result(3, "A", "pks", 0.08, 30),      Result(0, "A", "orbslam3", 0.10, 50),
+      Result(1, "A", "orbslam3", 0.10, 52), Result(2, "A", "pks", 0.07, 28),
+      Result(5, "A", "pks", 0.0, 0, false), Result(6, "B", "orbslam3", 0.2, 10),
+      Result(7, "B", "pks", 0.3, 9)};
+  const auto groups = Summarize(results);
+  ASSERT_EQ(groups.size(), 4u);
+  EXPECT_EQ(groups[0].config, "orbslam3");
+  EXPECT_EQ(groups[1].config, "pks");
+  EXPECT_EQ(groups[1].runs, 3);
+  EXPECT_EQ(groups[1].ok, 2);
+  EXPECT_NEAR(groups[1].ate_m.mean, 0.075, 1e-12);
+  EXPECT_NEAR(groups[1].keyframes.mean, 29.0, 1e-12);
+  EXPECT_NEAR(groups[1].improvement_pct, 25.0, 1e-9);   // (0.10 - 0.075) / 0.10
+  EXPECT_NEAR(groups[3].improvement_pct, -50.0, 1e-9);  // worse than the baseline
+  EXPECT_NEAR(groups[0].improvement_pct, 0.0, 1e-12);
+
+  const auto tables = HeadlineTables(groups);
+  ASSERT_EQ(tables.size(), 1u);
+  ASSERT_EQ(tables[0].header, (std::vector<std::string>{"dataset", "orbslam3", "pks"}));
+  ASSERT_EQ(tables[0].rows.size(), 5u);  // A, B, mean ATE, mean improvement, wins
+  EXPECT_EQ(tables[0].rows[0][2], "0.0750 ± 0.0071 (+25.0%) [2/3 ok]");
+  EXPECT_EQ(tables[0].rows[2][1], "0.1500");
+  EXPECT_EQ(tables[0].rows[2][2], "0.1875 (-25.0%)");  // (0.15 - 0.1875) / 0.15
+  EXPECT_EQ(tables[0].rows[3][2], "-12.5%");
+  EXPECT_EQ(tables[0].rows[4][2], "1/2");
+  EXPECT_EQ(FailureTable(results).rows.size(), 1u);
+  const std::string md = MarkdownTable(tables[0]);
+  EXPECT_NE(md.find("| dataset | orbslam3 | pks |"), std::string::npos) << md;
+}
+
+}  // namespace
+}  // namespace pkslam::bench

@@ -1,0 +1,255 @@
+#!/usr/bin/python3
+"""Plots for `pkslam bench` reports (Debian python3-matplotlib + python3-numpy).
+
+Reads OUT/results.csv (one row per run) and the run folders' plot_trajectory.csv /
+plot_keyframes.csv (written by the harness), writes PNGs into --out and an index.tsv listing
+`file<TAB>section<TAB>caption` per PNG, which report.md / report.html embed.
+
+  /usr/bin/python3 evaluation/plots.py --results OUT/results.csv --runs OUT/runs --out OUT/plots
+"""
+
+import argparse
+import csv
+import math
+import os
+import sys
+from collections import OrderedDict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+DPI = 110
+
+
+def number(text):
+    try:
+        v = float(text)
+    except (TypeError, ValueError):
+        return math.nan
+    return v
+
+
+def read_results(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    for r in rows:
+        r["ok"] = r["status"] == "ok"
+        for k in ("ate_m", "keyframes", "median_tracking_ms", "wall_s", "sweep_value"):
+            r[k] = number(r[k])
+        r["index"] = int(r["index"])
+    rows.sort(key=lambda r: r["index"])
+    return rows
+
+
+def unique(values):
+    return list(OrderedDict.fromkeys(values))
+
+
+def mean_std(values):
+    v = np.array([x for x in values if math.isfinite(x)], dtype=float)
+    if v.size == 0:
+        return math.nan, math.nan
+    return float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else 0.0
+
+
+def safe(name):
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
+
+
+class Index:
+    def __init__(self, out):
+        self.out = out
+        self.lines = []
+
+    def save(self, fig, name, section, caption):
+        fig.savefig(os.path.join(self.out, name), dpi=DPI, bbox_inches="tight")
+        plt.close(fig)
+        self.lines.append(f"{name}\t{section}\t{caption}")
+
+    def write(self):
+        with open(os.path.join(self.out, "index.tsv"), "w") as f:
+            f.write("\n".join(self.lines) + ("\n" if self.lines else ""))
+
+
+def grouped_bars(ax, rows, datasets, configs, key, ylabel):
+    width = 0.8 / max(len(configs), 1)
+    x = np.arange(len(datasets))
+    for i, config in enumerate(configs):
+        means, stds = [], []
+        for d in datasets:
+            m, s = mean_std([r[key] for r in rows if r["dataset"] == d and r["config"] == config
+                             and r["ok"]])
+            means.append(m)
+            stds.append(s)
+        ax.bar(x + (i - (len(configs) - 1) / 2) * width, means, width, yerr=stds, capsize=3,
+               label=config)
+    ax.set_xticks(x)
+    ax.set_xticklabels(datasets, rotation=20, ha="right")
+    ax.set_ylabel(ylabel)
+    ax.grid(axis="y", alpha=0.3)
+    ax.legend(fontsize=8)
+
+
+def per_sensor_bars(index, rows, key, ylabel, name, section, caption):
+    sensors = unique(r["sensor"] for r in rows)
+    fig, axes = plt.subplots(1, len(sensors), figsize=(max(6, 4 + 1.5 * len(sensors) * 2), 4.2),
+                             squeeze=False)
+    for ax, sensor in zip(axes[0], sensors):
+        sub = [r for r in rows if r["sensor"] == sensor]
+        datasets = unique(r["dataset"] for r in sub)
+        configs = unique(r["config"] for r in sub)
+        grouped_bars(ax, sub, datasets, configs, key, ylabel)
+        ax.set_title(sensor)
+    index.save(fig, name, section, caption)
+
+
+def ate_cdf(index, rows):
+    sensors = unique(r["sensor"] for r in rows)
+    fig, axes = plt.subplots(1, len(sensors), figsize=(5.5 * len(sensors), 4), squeeze=False)
+    for ax, sensor in zip(axes[0], sensors):
+        sub = [r for r in rows if r["sensor"] == sensor]
+        for config in unique(r["config"] for r in sub):
+            v = np.sort([r["ate_m"] for r in sub if r["config"] == config and r["ok"]
+                         and math.isfinite(r["ate_m"])])
+            n_all = sum(1 for r in sub if r["config"] == config)
+            if v.size == 0:
+                continue
+            # Failed runs never reach the top: the curve ends at (succeeded / all runs).
+            ax.step(np.concatenate([[0], v]), np.arange(v.size + 1) / n_all, where="post",
+                    label=f"{config} ({v.size}/{n_all})")
+        ax.set_xlabel("ATE RMSE [m]")
+        ax.set_ylabel("fraction of runs")
+        ax.set_ylim(0, 1.02)
+        ax.set_title(sensor)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    index.save(fig, "ate_cdf.png", "accuracy",
+               "Cumulative distribution of ATE over all runs and datasets per configuration "
+               "(failed runs keep the curve below 1)")
+
+
+def read_xyz(path, columns):
+    if not os.path.exists(path):
+        return None
+    data = np.genfromtxt(path, delimiter=",", names=True)
+    if data.size == 0:
+        return None
+    data = np.atleast_1d(data)
+    return np.stack([data[c] for c in columns], axis=1)
+
+
+def find_run(roots, run_id):
+    for root in roots:
+        d = os.path.join(root, run_id)
+        if os.path.isdir(d):
+            return d
+    return None
+
+
+def trajectories(index, rows, roots):
+    for dataset in unique(r["dataset"] for r in rows):
+        for sensor in unique(r["sensor"] for r in rows if r["dataset"] == dataset):
+            sub = [r for r in rows if r["dataset"] == dataset and r["sensor"] == sensor
+                   and r["ok"] and not r["sweep_param"]]
+            configs = unique(r["config"] for r in sub)
+            if not configs:
+                continue
+            fig, ax = plt.subplots(figsize=(6.5, 6))
+            gt_drawn = False
+            colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+            for i, config in enumerate(configs):
+                runs = sorted((r for r in sub if r["config"] == config), key=lambda r: r["ate_m"])
+                median = runs[(len(runs) - 1) // 2]
+                d = find_run(roots, median["run_id"])
+                if d is None:
+                    continue
+                traj = read_xyz(os.path.join(d, "plot_trajectory.csv"),
+                                ["gt_x", "gt_y", "est_x", "est_y"])
+                if traj is None:
+                    continue
+                if not gt_drawn:
+                    ax.plot(traj[:, 0], traj[:, 1], "k-", lw=2.0, alpha=0.6, label="ground truth")
+                    ax.plot(traj[0, 0], traj[0, 1], "ko", ms=6)
+                    gt_drawn = True
+                color = colors[i % len(colors)]
+                ax.plot(traj[:, 2], traj[:, 3], "-", color=color, lw=1.0,
+                        label=f"{config} (ATE {median['ate_m']:.3f} m, "
+                              f"{int(median['keyframes'])} KFs)")
+                kf = read_xyz(os.path.join(d, "plot_keyframes.csv"), ["x", "y"])
+                if kf is not None:
+                    ax.plot(kf[:, 0], kf[:, 1], "o", color=color, ms=3.5, mfc="none")
+            if not gt_drawn:
+                plt.close(fig)
+                continue
+            ax.set_aspect("equal", adjustable="datalim")
+            ax.set_xlabel("x [m]")
+            ax.set_ylabel("y [m]")
+            ax.set_title(f"{dataset} / {sensor}: top view (median-ATE run each)")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8, loc="best")
+            index.save(fig, f"traj_{safe(dataset)}_{safe(sensor)}.png", "trajectories",
+                       f"{dataset}, {sensor}: ground truth (black) and estimates; circles are "
+                       "keyframe positions")
+
+
+def sweeps(index, rows):
+    for param in unique(r["sweep_param"] for r in rows if r["sweep_param"]):
+        sub = [r for r in rows if r["sweep_param"] == param]
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
+        for dataset in unique(r["dataset"] for r in sub):
+            for sensor in unique(r["sensor"] for r in sub if r["dataset"] == dataset):
+                for base in unique(r["config"].split("@")[0] for r in sub):
+                    pts = [r for r in sub if r["dataset"] == dataset and r["sensor"] == sensor
+                           and r["config"].split("@")[0] == base]
+                    values = sorted(set(r["sweep_value"] for r in pts))
+                    ate = [mean_std([r["ate_m"] for r in pts if r["sweep_value"] == v
+                                     and r["ok"]]) for v in values]
+                    kfs = [mean_std([r["keyframes"] for r in pts if r["sweep_value"] == v
+                                     and r["ok"]]) for v in values]
+                    label = f"{dataset}/{sensor}/{base}"
+                    a1.errorbar(values, [m for m, _ in ate], yerr=[s for _, s in ate],
+                                marker="o", capsize=3, label=label)
+                    a2.errorbar(values, [m for m, _ in kfs], yerr=[s for _, s in kfs],
+                                marker="s", capsize=3, label=label)
+        a1.set_xlabel(param)
+        a1.set_ylabel("ATE RMSE [m] (mean ± std)")
+        a2.set_xlabel(param)
+        a2.set_ylabel("keyframes (mean ± std)")
+        for a in (a1, a2):
+            a.grid(alpha=0.3)
+            a.legend(fontsize=8)
+        index.save(fig, f"sweep_{safe(param)}.png", "sweeps",
+                   f"Sweep of {param}: accuracy and keyframe count per value")
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--results", required=True)
+    p.add_argument("--runs", action="append", default=[], help="folder of run folders")
+    p.add_argument("--out", required=True)
+    a = p.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    rows = read_results(a.results)
+    index = Index(a.out)
+    if rows:
+        main_rows = [r for r in rows if not r["sweep_param"]] or rows
+        per_sensor_bars(index, main_rows, "ate_m", "ATE RMSE [m]", "ate_bars.png", "accuracy",
+                        "ATE per sequence: mean over runs, error bars one standard deviation")
+        ate_cdf(index, main_rows)
+        trajectories(index, rows, a.runs)
+        per_sensor_bars(index, main_rows, "keyframes", "keyframes in the final map",
+                        "keyframes.png", "keyframes", "Keyframes per sequence (mean ± std)")
+        per_sensor_bars(index, main_rows, "median_tracking_ms", "median tracking time [ms]",
+                        "tracking_time.png", "keyframes",
+                        "Median per-frame tracking time (mean ± std over runs)")
+        sweeps(index, rows)
+    index.write()
+    print(f"plots: {len(index.lines)} PNGs in {a.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,125 @@
+// End-to-end: `pkslam bench` runs the smoke suite (evaluation/suites/smoke.yaml: a rendered
+// 5 s flight, stereo, orbslam3 vs pks vs pks with delta 40, 2 deterministic runs each), resumes
+// without re-running, and the scale-out path (--emit-jobs, the jobs run by GNU parallel or sh,
+// --collect) reproduces the same summary. Bad suites give one error line naming file:line.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/support/test_data.h"
+
+namespace pkslam {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+testing::CommandResult RunPkslam(const std::string& args) {
+  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
+}
+
+std::vector<std::string> Lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> out;
+  std::string line;
+  while (std::getline(in, line)) out.push_back(line);
+  return out;
+}
+
+// summary.csv without the timing columns (wall time and tracking time differ run to run).
+std::vector<std::string> SummaryWithoutTimes(const fs::path& file) {
+  std::vector<std::string> out;
+  for (const auto& line : Lines(file)) {
+    std::vector<std::string> fields;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) fields.push_back(f);
+    if (fields.size() > 2) fields.resize(fields.size() - 2);
+    std::string joined;
+    for (const auto& x : fields) joined += x + ",";
+    out.push_back(joined);
+  }
+  return out;
+}
+
+const fs::path kSmoke = fs::path(PKSLAM_SOURCE_DIR) / "evaluation/suites/smoke.yaml";
+
+TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
+  const fs::path dir = testing::MakeTempDir("bench_smoke");
+  const fs::path cache = dir / "cache";
+  const fs::path out = dir / "local";
+  auto r = RunPkslam(fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --jobs 2 "
+                                 "--quiet",
+                                 kSmoke.string(), out.string(), cache.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("6 runs: 6 executed, 0 already finished, 0 failed"));
+  const auto rows = Lines(out / "results.csv");
+  ASSERT_EQ(rows.size(), 9u);  // header + 6 runs
+  for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_THAT(rows[i], HasSubstr(",ok,")) << rows[i];
+  EXPECT_TRUE(fs::exists(out / "report.html"));
+  EXPECT_TRUE(fs::exists(out / "report.md"));
+  EXPECT_TRUE(fs::exists(out / "runs/sim_medium_5s/stereo/pks@delta=40/seed2/trajectory.txt"));
+  if (fs::exists("/usr/bin/python3")) {
+    EXPECT_TRUE(fs::exists(out / "plots/ate_bars.png")) << r.output;
+    EXPECT_TRUE(fs::exists(out / "plots/sweep_delta.png")) << r.output;
+  }
+
+  // Resume: everything is finished, nothing runs again.
+  r = RunPkslam(fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --quiet --no-plots",
+                            kSmoke.string(), out.string(), cache.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("6 runs: 0 executed, 6 already finished"));
+
+  // Scale-out: emitted jobs run by GNU parallel (or sh without it), then --collect.
+  const fs::path jobs = dir / "jobs";
+  r = RunPkslam(fmt::format("bench '{}' --emit-jobs '{}' --cache '{}'", kSmoke.string(),
+                            jobs.string(), cache.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("emitted 6 jobs"));
+  ASSERT_EQ(Lines(jobs / "jobs.txt").size(), 6u);
+  EXPECT_TRUE(fs::exists(jobs / "slurm.sh"));
+  const bool have_parallel = testing::RunCommand("command -v parallel").exit_code == 0;
+  const std::string runner = have_parallel ? "parallel --will-cite --jobs 2" : "sh";
+  r = testing::RunCommand(fmt::format("{} < '{}'", runner, (jobs / "jobs.txt").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = RunPkslam(fmt::format("--log-level warn bench --collect '{}' --no-plots", jobs.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("collected 6 runs"));
+  // Deterministic runs: the same numbers as the local bench.
+  EXPECT_EQ(SummaryWithoutTimes(jobs / "summary.csv"), SummaryWithoutTimes(out / "summary.csv"));
+}
+
+TEST(BenchCli, BadSuitesAreOneErrorLineWithFileAndLine) {
+  const fs::path dir = testing::MakeTempDir("bench_bad");
+  std::ofstream(dir / "bad.yaml") << "runs: 2\nselectors: [orbslam3]\nsensors: [stereo]\n"
+                                     "datasets:\n  - {name: a, path: x, colour: red}\n";
+  auto r = RunPkslam(fmt::format("bench '{}' --out '{}'", (dir / "bad.yaml").string(),
+                                 (dir / "out").string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, StartsWith("pkslam: error: "));
+  EXPECT_THAT(r.output, HasSubstr("bad.yaml:5: unknown key 'colour'"));
+  r = RunPkslam(fmt::format("bench '{}' --out x", (dir / "missing.yaml").string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("missing.yaml: cannot read the suite file"));
+  r = RunPkslam(fmt::format("bench --collect '{}'", dir.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("no runs/ folder"));
+  // A dataset that does not exist fails its runs (recorded, reported) without aborting.
+  std::ofstream(dir / "nodata.yaml") << "runs: 1\nselectors: [orbslam3]\nsensors: [stereo]\n"
+                                        "datasets: [{name: a, path: no_such_dir}]\n";
+  r = RunPkslam(fmt::format("--log-level error bench '{}' --out '{}' --quiet --no-plots",
+                            (dir / "nodata.yaml").string(), (dir / "out").string()));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("1 runs: 1 executed, 0 already finished, 1 failed"));
+  EXPECT_THAT(Lines(dir / "out/results.csv").at(1), HasSubstr("no_such_dir is not a directory"));
+}
+
+}  // namespace
+}  // namespace pkslam
