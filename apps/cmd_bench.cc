@@ -56,10 +56,10 @@ void PrintReport(const std::vector<bench::RunResult>& results, const bench::Repo
   for (const auto& t : bench::HeadlineTables(bench::Summarize(results))) {
     std::cout << t.title << "\n" << bench::MarkdownTable(t) << "\n";
   }
-  std::cout << fmt::format("report: {}/report.html ({} plots), {}/report.md, {}/results.csv, "
-                           "{}/summary.csv\n",
-                           out.string(), files.pngs.size(), out.string(), out.string(),
-                           out.string());
+  std::cout << fmt::format(
+      "report: {}/report.html ({} plots), {}/report.md, {}/results.csv, "
+      "{}/summary.csv\n",
+      out.string(), files.pngs.size(), out.string(), out.string(), out.string());
   if (!files.plot_error.empty()) std::cout << "plots unavailable: " << files.plot_error << "\n";
 }
 
@@ -95,7 +95,7 @@ void Run(const BenchArgs& a) {
     throw OptionError("--emit-jobs DIR is also the output folder: drop --out");
   }
   const char* env_cache = std::getenv("PKSLAM_SIM_CACHE");
-  h.cache = !a.cache.empty() ? fs::path(a.cache)
+  h.cache = !a.cache.empty()       ? fs::path(a.cache)
             : env_cache != nullptr ? fs::path(env_cache)
                                    : h.out / "sim_cache";
   h.jobs = a.jobs;
@@ -106,8 +106,8 @@ void Run(const BenchArgs& a) {
     std::cout << fmt::format(
         "emitted {} jobs ({} runs in the suite): {}\n  GNU parallel: parallel --jobs 2 < {}  "
         "(or sh {})\n  Slurm: sbatch {}\n  then: pkslam bench --collect {}\n",
-        e.jobs, runs.size(), e.jobs_file.string(), e.jobs_file.string(),
-        e.parallel_script.string(), e.slurm_script.string(), fs::absolute(h.out).string());
+        e.jobs, runs.size(), e.jobs_file.string(), e.jobs_file.string(), e.parallel_script.string(),
+        e.slurm_script.string(), fs::absolute(h.out).string());
     return;
   }
   bench::WriteBenchInfo(h.out, suite);
@@ -156,8 +156,7 @@ void RegisterBenchCommand(CLI::App& app) {
   cmd->add_flag("--no-plots", args->no_plots, "Tables only (no matplotlib)");
   cmd->add_option("--python", args->python, "Python with matplotlib and numpy for the plots")
       ->capture_default_str();
-  cmd->add_option("--pkslam", args->pkslam,
-                  "pkslam executable for the runs (default: this one)");
+  cmd->add_option("--pkslam", args->pkslam, "pkslam executable for the runs (default: this one)");
   cmd->add_flag("--quiet", args->quiet, "No progress bars");
   cmd->callback([args] { Run(*args); });
 }

@@ -55,9 +55,10 @@ TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
   const fs::path dir = testing::MakeTempDir("bench_smoke");
   const fs::path cache = dir / "cache";
   const fs::path out = dir / "local";
-  auto r = RunPkslam(fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --jobs 2 "
-                                 "--quiet",
-                                 kSmoke.string(), out.string(), cache.string()));
+  auto r =
+      RunPkslam(fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --jobs 2 "
+                            "--quiet",
+                            kSmoke.string(), out.string(), cache.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("6 runs: 6 executed, 0 already finished, 0 failed"));
   const auto rows = Lines(out / "results.csv");
@@ -72,8 +73,9 @@ TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
   }
 
   // Resume: everything is finished, nothing runs again.
-  r = RunPkslam(fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --quiet --no-plots",
-                            kSmoke.string(), out.string(), cache.string()));
+  r = RunPkslam(
+      fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --quiet --no-plots",
+                  kSmoke.string(), out.string(), cache.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("6 runs: 0 executed, 6 already finished"));
 
@@ -100,8 +102,8 @@ TEST(BenchCli, BadSuitesAreOneErrorLineWithFileAndLine) {
   const fs::path dir = testing::MakeTempDir("bench_bad");
   std::ofstream(dir / "bad.yaml") << "runs: 2\nselectors: [orbslam3]\nsensors: [stereo]\n"
                                      "datasets:\n  - {name: a, path: x, colour: red}\n";
-  auto r = RunPkslam(fmt::format("bench '{}' --out '{}'", (dir / "bad.yaml").string(),
-                                 (dir / "out").string()));
+  auto r = RunPkslam(
+      fmt::format("bench '{}' --out '{}'", (dir / "bad.yaml").string(), (dir / "out").string()));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.output, StartsWith("pkslam: error: "));
   EXPECT_THAT(r.output, HasSubstr("bad.yaml:5: unknown key 'colour'"));

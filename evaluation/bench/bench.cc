@@ -180,8 +180,8 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
 void WriteBenchInfo(const fs::path& out, const Suite& suite) {
   fs::create_directories(out);
   YAML::Emitter e;
-  e << YAML::BeginMap << YAML::Key << "title" << YAML::Value << suite.name << YAML::Key
-    << "suite" << YAML::Value << fs::absolute(suite.file).string() << YAML::EndMap;
+  e << YAML::BeginMap << YAML::Key << "title" << YAML::Value << suite.name << YAML::Key << "suite"
+    << YAML::Value << fs::absolute(suite.file).string() << YAML::EndMap;
   std::ofstream(out / "bench.yaml") << e.c_str() << '\n';
 }
 
@@ -207,19 +207,18 @@ EmittedJobs EmitJobs(const Suite& suite, const std::vector<RunSpec>& runs,
     std::ofstream jobs(e.jobs_file, std::ios::trunc);
     for (const auto& r : runs) {
       if (!NeedsExecution(options, r)) continue;
-      std::vector<std::string> argv = {fs::absolute(options.pkslam).string(), "--log-level",
-                                       "warn", "bench", fs::absolute(suite.file).string(),
-                                       "--out", out.string(), "--cache",
-                                       fs::absolute(options.cache).string(), "--run-id", r.id,
-                                       "--quiet"};
+      std::vector<std::string> argv = {
+          fs::absolute(options.pkslam).string(), "--log-level", "warn",       "bench",
+          fs::absolute(suite.file).string(),     "--out",       out.string(), "--cache",
+          fs::absolute(options.cache).string(),  "--run-id",    r.id,         "--quiet"};
       if (options.retry_failed) argv.push_back("--retry-failed");
       jobs << ShellCommand(argv) << '\n';
       ++e.jobs;
     }
     if (!jobs) throw Error("cannot write " + e.jobs_file.string());
   }
-  const std::string collect = ShellCommand(
-      {fs::absolute(options.pkslam).string(), "bench", "--collect", out.string()});
+  const std::string collect =
+      ShellCommand({fs::absolute(options.pkslam).string(), "bench", "--collect", out.string()});
   {
     std::ofstream sh(e.parallel_script, std::ios::trunc);
     sh << "#!/bin/sh\n"

@@ -49,8 +49,8 @@ void HarnessOptions::Check() const {
 fs::path RunDir(const fs::path& out, const RunSpec& run) { return out / "runs" / run.id; }
 
 std::vector<std::string> SimulateArguments(const SimRecipe& r, const fs::path& out_dir) {
-  std::vector<std::string> a = {"simulate", "--out", out_dir.string(), "--seed",
-                                std::to_string(r.seed), "--quiet"};
+  std::vector<std::string> a = {
+      "simulate", "--out", out_dir.string(), "--seed", std::to_string(r.seed), "--quiet"};
   if (!r.trajectory.empty()) {
     a.insert(a.end(), {"--trajectory", r.trajectory.string()});
   } else {
@@ -86,9 +86,7 @@ fs::path EnsureSimulated(const HarnessOptions& options, const std::string& datas
   std::vector<std::string> argv = {options.pkslam.string()};
   const auto args = SimulateArguments(recipe, tmp);
   argv.insert(argv.end(), args.begin(), args.end());
-  {
-    std::ofstream(log) << "# " << ShellCommand(argv) << '\n';
-  }
+  { std::ofstream(log) << "# " << ShellCommand(argv) << '\n'; }
   const ProcessResult p = RunProcess(argv, log, 24.0 * 3600.0, cancel);
   if (!p.ok()) {
     throw Error(fmt::format("simulating {} failed ({}): {} (log {})", dataset, p.Describe(),
@@ -106,7 +104,8 @@ fs::path PrepareDataset(const Suite& suite, const RunSpec& run, const HarnessOpt
   const DatasetSpec& d = DatasetOf(suite, run);
   if (run.sim) return EnsureSimulated(options, d.name, *run.sim, cancel);
   if (!fs::is_directory(*d.path)) {
-    throw InputError(suite.file, "dataset '" + d.name + "': " + d.path->string() + " is not a directory");
+    throw InputError(suite.file,
+                     "dataset '" + d.name + "': " + d.path->string() + " is not a directory");
   }
   return *d.path;
 }
@@ -114,9 +113,9 @@ fs::path PrepareDataset(const Suite& suite, const RunSpec& run, const HarnessOpt
 std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
                                       const fs::path& dataset, const fs::path& run_dir) {
   const DatasetSpec& d = DatasetOf(suite, run);
-  std::vector<std::string> a = {"run",        "--dataset",   dataset.string(), "--out",
-                                run_dir.string(), "--sensor", run.sensor,       "--selector",
-                                run.selector, "--quiet"};
+  std::vector<std::string> a = {
+      "run",      "--dataset", dataset.string(), "--out",      run_dir.string(),
+      "--sensor", run.sensor,  "--selector",     run.selector, "--quiet"};
   for (const auto& [k, v] : run.params) a.insert(a.end(), {"--param", k + "=" + FormatNumber(v)});
   if (d.settings) a.insert(a.end(), {"--settings", d.settings->string()});
   if (d.max_frames > 0) a.insert(a.end(), {"--max-frames", std::to_string(d.max_frames)});

@@ -114,7 +114,8 @@ std::string ShellCommand(const std::vector<std::string>& argv) {
 FileLock::FileLock(const std::filesystem::path& file) {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
   fd_ = open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd_ < 0) throw Error(fmt::format("cannot open lock {}: {}", file.string(), std::strerror(errno)));
+  if (fd_ < 0)
+    throw Error(fmt::format("cannot open lock {}: {}", file.string(), std::strerror(errno)));
   while (flock(fd_, LOCK_EX) != 0) {
     if (errno != EINTR) {
       close(fd_);

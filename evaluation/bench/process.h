@@ -9,8 +9,8 @@
 namespace pkslam::bench {
 
 struct ProcessResult {
-  int exit_code = -1;     // exit status, or -1 when killed by a signal
-  int signal = 0;         // the terminating signal, if any
+  int exit_code = -1;  // exit status, or -1 when killed by a signal
+  int signal = 0;      // the terminating signal, if any
   bool timed_out = false;
   double wall_s = 0.0;
   bool ok() const { return exit_code == 0 && !timed_out; }

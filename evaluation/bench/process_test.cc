@@ -25,7 +25,8 @@ std::string Read(const fs::path& file) {
 
 TEST(RunProcess, CapturesOutputAndExitCode) {
   const fs::path dir = testing::MakeTempDir("bench_process");
-  const ProcessResult ok = RunProcess({"/bin/sh", "-c", "echo out; echo err >&2"}, dir / "a.log", 10);
+  const ProcessResult ok =
+      RunProcess({"/bin/sh", "-c", "echo out; echo err >&2"}, dir / "a.log", 10);
   EXPECT_TRUE(ok.ok());
   EXPECT_EQ(Read(dir / "a.log"), "out\nerr\n");
   const ProcessResult bad = RunProcess({"/bin/sh", "-c", "exit 3"}, dir / "b.log", 10);

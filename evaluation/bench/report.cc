@@ -25,11 +25,20 @@ std::string Html(const std::string& s) {
   std::string out;
   for (char ch : s) {
     switch (ch) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += ch;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += ch;
     }
   }
   return out;
@@ -50,8 +59,9 @@ std::vector<Plot> DrawPlots(const ReportOptions& o, const std::vector<fs::path>&
     *error = "plot script not found: " + script.string();
     return {};
   }
-  std::vector<std::string> argv = {o.python.string(), script.string(), "--results",
-                                   (o.out / "results.csv").string(), "--out", dir.string()};
+  std::vector<std::string> argv = {o.python.string(), script.string(),
+                                   "--results",       (o.out / "results.csv").string(),
+                                   "--out",           dir.string()};
   for (const auto& r : roots) argv.insert(argv.end(), {"--runs", r.string()});
   const fs::path log = o.out / "plots.log";
   fs::remove(log);
@@ -179,8 +189,8 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
     if (!files.plot_error.empty()) PKSLAM_LOG_WARN("no plots: {}", files.plot_error);
   }
 
-  const int ok = static_cast<int>(std::count_if(results.begin(), results.end(),
-                                                [](const RunResult& r) { return r.ok; }));
+  const int ok = static_cast<int>(
+      std::count_if(results.begin(), results.end(), [](const RunResult& r) { return r.ok; }));
   std::string baseline = results.empty() ? "" : results.front().baseline;
   Document doc;
   doc.Heading(1, options.title);
@@ -194,8 +204,9 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
   for (const auto& t : HeadlineTables(groups)) doc.AddTable(t);
   doc.Images(plots, "accuracy");
   doc.Heading(2, "Trajectories");
-  doc.Paragraph("Top view (x-y) of ground truth and the median-ATE run of each configuration, "
-                "aligned as above; dots mark keyframes.");
+  doc.Paragraph(
+      "Top view (x-y) of ground truth and the median-ATE run of each configuration, "
+      "aligned as above; dots mark keyframes.");
   doc.Images(plots, "trajectories");
   doc.Heading(2, "Keyframes, maps and run time");
   doc.AddTable(DetailTable(groups));

@@ -12,13 +12,13 @@
 namespace pkslam::bench {
 
 struct ReportOptions {
-  std::filesystem::path out;             // OUT: where the report goes
+  std::filesystem::path out;  // OUT: where the report goes
   // Folders holding the run folders (plot data); empty: OUT/runs.
   std::vector<std::filesystem::path> run_roots;
-  std::string title = "pkslam bench";    // report heading (the suite name)
+  std::string title = "pkslam bench";                 // report heading (the suite name)
   std::filesystem::path python = "/usr/bin/python3";  // with matplotlib + numpy
-  std::filesystem::path plots_script;    // empty: DefaultPlotsScript()
-  bool plots = true;                     // false: tables only
+  std::filesystem::path plots_script;                 // empty: DefaultPlotsScript()
+  bool plots = true;                                  // false: tables only
 };
 
 // evaluation/plots.py of the source tree this binary belongs to.

@@ -61,13 +61,33 @@ RunResult ResultSkeleton(const RunSpec& run, const Suite& suite) {
 }
 
 std::vector<std::string> ResultColumns() {
-  return {"index",       "run_id",         "dataset",       "sensor",
-          "config",      "selector",       "params",        "sweep_param",
-          "sweep_value", "seed",           "baseline",      "status",
-          "error",       "alignment",      "ate_m",         "ate_se3_rmse_m",
-          "ate_sim3_rmse_m", "sim3_scale", "rpe_trans_rmse_m", "rpe_rot_rmse_deg",
-          "coverage",    "frames",         "keyframes",     "map_points",
-          "lost_frames", "wall_s",         "median_tracking_ms"};
+  return {"index",
+          "run_id",
+          "dataset",
+          "sensor",
+          "config",
+          "selector",
+          "params",
+          "sweep_param",
+          "sweep_value",
+          "seed",
+          "baseline",
+          "status",
+          "error",
+          "alignment",
+          "ate_m",
+          "ate_se3_rmse_m",
+          "ate_sim3_rmse_m",
+          "sim3_scale",
+          "rpe_trans_rmse_m",
+          "rpe_rot_rmse_deg",
+          "coverage",
+          "frames",
+          "keyframes",
+          "map_points",
+          "lost_frames",
+          "wall_s",
+          "median_tracking_ms"};
 }
 
 std::string CsvField(const std::string& text) {
@@ -115,14 +135,33 @@ std::string ResultCsvHeader() {
 }
 
 std::string ResultCsvRow(const RunResult& r) {
-  const std::vector<std::string> f = {
-      std::to_string(r.index), CsvField(r.run_id), CsvField(r.dataset), CsvField(r.sensor),
-      CsvField(r.config), CsvField(r.selector), CsvField(r.params), CsvField(r.sweep_param),
-      Num(r.sweep_value), std::to_string(r.seed), CsvField(r.baseline), r.ok ? "ok" : "failed",
-      CsvField(r.error), r.alignment, Num(r.ate_m), Num(r.ate_se3_m), Num(r.ate_sim3_m),
-      Num(r.scale), Num(r.rpe_trans_m), Num(r.rpe_rot_deg), Num(r.coverage),
-      std::to_string(r.frames), std::to_string(r.keyframes), std::to_string(r.map_points),
-      std::to_string(r.lost_frames), Num(r.wall_s), Num(r.median_tracking_ms)};
+  const std::vector<std::string> f = {std::to_string(r.index),
+                                      CsvField(r.run_id),
+                                      CsvField(r.dataset),
+                                      CsvField(r.sensor),
+                                      CsvField(r.config),
+                                      CsvField(r.selector),
+                                      CsvField(r.params),
+                                      CsvField(r.sweep_param),
+                                      Num(r.sweep_value),
+                                      std::to_string(r.seed),
+                                      CsvField(r.baseline),
+                                      r.ok ? "ok" : "failed",
+                                      CsvField(r.error),
+                                      r.alignment,
+                                      Num(r.ate_m),
+                                      Num(r.ate_se3_m),
+                                      Num(r.ate_sim3_m),
+                                      Num(r.scale),
+                                      Num(r.rpe_trans_m),
+                                      Num(r.rpe_rot_deg),
+                                      Num(r.coverage),
+                                      std::to_string(r.frames),
+                                      std::to_string(r.keyframes),
+                                      std::to_string(r.map_points),
+                                      std::to_string(r.lost_frames),
+                                      Num(r.wall_s),
+                                      Num(r.median_tracking_ms)};
   std::string out;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (i > 0) out.push_back(',');
@@ -150,7 +189,8 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
   if (!std::getline(in, line)) throw InputError(file, "empty file (expected a results.csv header)");
   const auto header = SplitCsvLine(line);
   if (header != ResultColumns()) {
-    throw InputError(file, 1, "header does not match results.csv columns (" + ResultCsvHeader() + ")");
+    throw InputError(file, 1,
+                     "header does not match results.csv columns (" + ResultCsvHeader() + ")");
   }
   std::vector<RunResult> out;
   std::size_t n = 1;

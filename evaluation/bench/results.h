@@ -25,14 +25,14 @@ struct RunResult {
   std::string sweep_param;
   double sweep_value = kNaN;
   std::uint64_t seed = 0;
-  std::string baseline;      // the suite's baseline configuration
-  bool ok = false;           // run and evaluation succeeded
-  std::string error;         // why not, when !ok
-  std::string alignment;     // "se3" or "sim3": the one ate_m uses (sim3 for monocular)
-  double ate_m = kNaN;       // primary ATE RMSE (m)
-  double ate_se3_m = kNaN;   // ATE RMSE after SE(3) alignment (m)
-  double ate_sim3_m = kNaN;  // ATE RMSE after Sim(3) alignment (m)
-  double scale = kNaN;       // the Sim(3) alignment's scale
+  std::string baseline;       // the suite's baseline configuration
+  bool ok = false;            // run and evaluation succeeded
+  std::string error;          // why not, when !ok
+  std::string alignment;      // "se3" or "sim3": the one ate_m uses (sim3 for monocular)
+  double ate_m = kNaN;        // primary ATE RMSE (m)
+  double ate_se3_m = kNaN;    // ATE RMSE after SE(3) alignment (m)
+  double ate_sim3_m = kNaN;   // ATE RMSE after Sim(3) alignment (m)
+  double scale = kNaN;        // the Sim(3) alignment's scale
   double rpe_trans_m = kNaN;  // RPE translation RMSE over pose pairs rpe_delta_m apart
   double rpe_rot_deg = kNaN;
   double coverage = kNaN;  // fraction of ground-truth poses with an associated estimate

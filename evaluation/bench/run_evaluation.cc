@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fstream>
+#include <map>
 
 #include "core/util/error.h"
 #include "evaluation/evaluate.h"
@@ -63,8 +64,16 @@ void WritePlotFiles(const fs::path& dir, const Trajectory& gt, const Trajectory&
   }
   std::ofstream kf(dir / "plot_keyframes.csv", std::ios::trunc);
   kf << "t_s,x,y,z\n";
+  // keyframes.txt holds camera poses; the estimate the ground truth is compared with may be
+  // the body's. A keyframe is also a tracked frame with the same timestamp and pose, so take
+  // its position from the estimate (the camera's when the frame is absent).
+  std::map<std::int64_t, std::size_t> est_index;
+  for (std::size_t i = 0; i < est.poses.size(); ++i) est_index[est.poses[i].t_ns] = i;
   for (const auto& p : keyframes.poses) {
-    const Eigen::Vector3d e = primary.ref_from_est * p.pose.translation();
+    const auto it = est_index.find(p.t_ns);
+    const Eigen::Vector3d position =
+        it != est_index.end() ? est.poses[it->second].pose.translation() : p.pose.translation();
+    const Eigen::Vector3d e = primary.ref_from_est * position;
     kf << fmt::format("{:.6f},{:.5f},{:.5f},{:.5f}\n", 1e-9 * static_cast<double>(p.t_ns), e.x(),
                       e.y(), e.z());
   }
@@ -99,7 +108,8 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   const fs::path est_file = files.run_dir / (body ? "trajectory_body.txt" : "trajectory.txt");
   const Trajectory gt = ReadTrajectory(gt_file);
   const Trajectory est = ReadTrajectory(est_file, TrajectoryFormat::kTum);
-  const Trajectory keyframes = ReadTrajectory(files.run_dir / "keyframes.txt", TrajectoryFormat::kTum);
+  const Trajectory keyframes =
+      ReadTrajectory(files.run_dir / "keyframes.txt", TrajectoryFormat::kTum);
 
   EvaluationOptions options;
   options.compute_rpe = false;

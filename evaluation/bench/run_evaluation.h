@@ -2,7 +2,7 @@
 // Sim(3) alignment, RPE, counts and timings from stats.json. Also writes the small CSV files
 // the plots read, so a run folder is self-contained (--collect works on copies of it):
 //   plot_trajectory.csv  t_s, ground truth x y z, estimate x y z aligned by the primary alignment
-//   plot_keyframes.csv   t_s, keyframe x y z under the same alignment
+//   plot_keyframes.csv   t_s, keyframe x y z (the estimate's frame: body or camera), aligned alike
 #pragma once
 
 #include <filesystem>
@@ -13,8 +13,8 @@
 namespace pkslam::bench {
 
 struct RunFiles {
-  std::filesystem::path run_dir;       // pkslam run --out
-  std::filesystem::path dataset;       // the dataset the run read
+  std::filesystem::path run_dir;                      // pkslam run --out
+  std::filesystem::path dataset;                      // the dataset the run read
   std::optional<std::filesystem::path> ground_truth;  // override (default: found in dataset)
   double rpe_delta_m = 1.0;
 };

@@ -148,7 +148,8 @@ DatasetSpec ParseDataset(const Context& c, const YAML::Node& node) {
   if (d.name.empty() || d.name.find_first_of("/\\ \t") != std::string::npos) {
     c.Fail(node["name"], "dataset name '" + d.name + "' must be non-empty without '/' or spaces");
   }
-  if (node["path"] && node["sim"]) c.Fail(node, "dataset '" + d.name + "': 'path' or 'sim', not both");
+  if (node["path"] && node["sim"])
+    c.Fail(node, "dataset '" + d.name + "': 'path' or 'sim', not both");
   if (node["path"]) {
     d.path = Path(c, node["path"], "path");
   } else if (node["sim"]) {
@@ -204,7 +205,8 @@ void Validate(const Context& c, const YAML::Node& root, Suite& s) {
   if (s.selectors.empty()) c.Fail(root, "the suite lists no selectors");
   std::set<std::string> names;
   for (const auto& d : s.datasets) {
-    if (!names.insert(d.name).second) c.Fail(root["datasets"], "dataset name '" + d.name + "' repeats");
+    if (!names.insert(d.name).second)
+      c.Fail(root["datasets"], "dataset name '" + d.name + "' repeats");
     if (d.sensors.empty() && s.sensors.empty()) {
       c.Fail(root, "dataset '" + d.name + "' has no sensors (set 'sensors' in the suite)");
     }
@@ -216,14 +218,15 @@ void Validate(const Context& c, const YAML::Node& root, Suite& s) {
     }
   }
   for (const auto& sw : s.sweeps) {
-    const bool known = std::any_of(s.selectors.begin(), s.selectors.end(), [&](const auto& sel) {
-      return sel.label == sw.selector;
-    });
+    const bool known = std::any_of(s.selectors.begin(), s.selectors.end(),
+                                   [&](const auto& sel) { return sel.label == sw.selector; });
     if (!known) {
-      c.Fail(root["sweeps"], "sweep selector '" + sw.selector + "' is not one of the suite's selectors");
+      c.Fail(root["sweeps"],
+             "sweep selector '" + sw.selector + "' is not one of the suite's selectors");
     }
     for (const auto& d : sw.datasets) {
-      if (names.count(d) == 0) c.Fail(root["sweeps"], "sweep dataset '" + d + "' is not in the suite");
+      if (names.count(d) == 0)
+        c.Fail(root["sweeps"], "sweep dataset '" + d + "' is not in the suite");
     }
   }
 }
@@ -239,7 +242,8 @@ std::string ExpandEnvironment(const std::string& text, const fs::path& file, std
       continue;
     }
     const std::size_t close = text.find('}', i);
-    if (close == std::string::npos) throw InputError(file, line, "unterminated ${ in '" + text + "'");
+    if (close == std::string::npos)
+      throw InputError(file, line, "unterminated ${ in '" + text + "'");
     const std::string inner = text.substr(i + 2, close - i - 2);
     const std::size_t dash = inner.find(":-");
     const std::string var = inner.substr(0, dash);
@@ -257,7 +261,9 @@ std::string ExpandEnvironment(const std::string& text, const fs::path& file, std
 }
 
 Suite ParseSuite(const std::string& text, const fs::path& file) {
-  Context c{file, file.parent_path().empty() ? fs::path(".") : file.parent_path()};
+  // Absolute, so commands work from any directory (emitted jobs) and cache keys are stable.
+  Context c{file, fs::absolute(file.parent_path().empty() ? fs::path(".") : file.parent_path())
+                      .lexically_normal()};
   YAML::Node root;
   try {
     root = YAML::Load(text);
@@ -266,8 +272,8 @@ Suite ParseSuite(const std::string& text, const fs::path& file) {
   }
   if (!root || root.IsNull()) throw InputError(file, "empty suite");
   CheckKeys(c, root, "the suite",
-            {"name", "runs", "seed", "deterministic", "baseline", "alignment", "timeout_s", "rpe_delta_m",
-             "sensors", "selectors", "params", "sweeps", "datasets"});
+            {"name", "runs", "seed", "deterministic", "baseline", "alignment", "timeout_s",
+             "rpe_delta_m", "sensors", "selectors", "params", "sweeps", "datasets"});
   Suite s;
   s.file = file;
   s.name = root["name"] ? String(c, root["name"], "name") : file.stem().string();

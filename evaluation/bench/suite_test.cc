@@ -48,7 +48,7 @@ TEST(Suite, ParsesAllFields) {
   EXPECT_EQ(s.selectors[1].params.at("tau"), 0.5);
   EXPECT_EQ(s.params.at("min_frames"), 2.0);  // Keyframe. prefix dropped
   ASSERT_EQ(s.datasets.size(), 2u);
-  EXPECT_EQ(*s.datasets[0].path, std::filesystem::path("dir/data/real"));
+  EXPECT_EQ(*s.datasets[0].path, std::filesystem::absolute("dir/data/real"));
   EXPECT_EQ(*s.datasets[1].path, std::filesystem::path("/abs/path"));
 }
 
@@ -83,9 +83,10 @@ datasets: [{name: a, path: x}, {name: b, path: y}]
   ASSERT_EQ(runs.size(), 2u + 4u);
   EXPECT_EQ(runs[1].id, "a/stereo/pks/seed1");
   EXPECT_EQ(runs[5].id, "b/stereo/pks@delta=40/seed1");
-  ExpectError("sensors: [stereo]\nselectors: [a]\nsweeps: [{selector: a, param: p, values: [1], "
-              "datasets: [zz]}]\ndatasets: [{name: x, path: p}]\n",
-              3, "sweep dataset 'zz'");
+  ExpectError(
+      "sensors: [stereo]\nselectors: [a]\nsweeps: [{selector: a, param: p, values: [1], "
+      "datasets: [zz]}]\ndatasets: [{name: x, path: p}]\n",
+      3, "sweep dataset 'zz'");
 }
 
 TEST(Suite, SimSeedPerRunGivesEachRunItsOwnRendering) {
@@ -109,20 +110,21 @@ TEST(Suite, ErrorsNameFileAndLine) {
   ExpectError("runs: 2\nselectors: [a]\nbogus: 1\n", 3, "unknown key 'bogus'");
   ExpectError("runs: zero\n", 1, "'runs' must be an integer");
   ExpectError("runs: 0\n", 1, "'runs' must be >= 1");
-  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - {name: x}\n", 4,
-              "needs 'path'");
-  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - {name: x, path: p, sim: {}}\n",
-              4, "not both");
+  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - {name: x}\n", 4, "needs 'path'");
+  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - {name: x, path: p, sim: {}}\n", 4,
+              "not both");
   ExpectError("sensors: [stereo]\nselectors: [a, a]\ndatasets: [{name: x, path: p}]\n", 2,
               "repeats");
-  ExpectError("sensors: [stereo]\nselectors: [a]\nsweeps: [{selector: b, param: p, values: [1]}]\n"
-              "datasets: [{name: x, path: p}]\n",
-              3, "not one of the suite's selectors");
+  ExpectError(
+      "sensors: [stereo]\nselectors: [a]\nsweeps: [{selector: b, param: p, values: [1]}]\n"
+      "datasets: [{name: x, path: p}]\n",
+      3, "not one of the suite's selectors");
   ExpectError("selectors: [a]\ndatasets: [{name: x, path: p}]\n", 1, "has no sensors");
   ExpectError("a: [1, 2\n", 2, "YAML syntax");
-  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - {name: x, sim: {motion: easy, "
-              "args: [--seed, 3]}}\n",
-              4, "must not contain --seed");
+  ExpectError(
+      "sensors: [stereo]\nselectors: [a]\ndatasets:\n  - {name: x, sim: {motion: easy, "
+      "args: [--seed, 3]}}\n",
+      4, "must not contain --seed");
   ExpectError("", 0, "empty suite");
 }
 
@@ -133,9 +135,10 @@ TEST(Suite, ExpandsEnvironmentVariables) {
   EXPECT_EQ(ExpandEnvironment("${PKSLAM_BENCH_TEST_UNSET:-/x}/y", "f", 1), "/x/y");
   EXPECT_THROW(ExpandEnvironment("${PKSLAM_BENCH_TEST_UNSET}/y", "f", 1), InputError);
   EXPECT_THROW(ExpandEnvironment("${OOPS", "f", 1), InputError);
-  ExpectError("sensors: [stereo]\nselectors: [a]\ndatasets:\n  - name: x\n    path: "
-              "${PKSLAM_BENCH_TEST_UNSET}/MH\n",
-              5, "PKSLAM_BENCH_TEST_UNSET is not set");
+  ExpectError(
+      "sensors: [stereo]\nselectors: [a]\ndatasets:\n  - name: x\n    path: "
+      "${PKSLAM_BENCH_TEST_UNSET}/MH\n",
+      5, "PKSLAM_BENCH_TEST_UNSET is not set");
 }
 
 TEST(Matrix, FormatsNumbersShortestRoundTrip) {

@@ -170,9 +170,10 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
       if (any) t.rows.push_back(row);
     }
     if (t.rows.empty()) continue;
-    t.title = fmt::format("ATE RMSE [m] ({} alignment), {}: mean ± std over runs (improvement "
-                          "over the baseline)",
-                          alignment == "sim3" ? "Sim(3)" : "SE(3)", sensor);
+    t.title = fmt::format(
+        "ATE RMSE [m] ({} alignment), {}: mean ± std over runs (improvement "
+        "over the baseline)",
+        alignment == "sim3" ? "Sim(3)" : "SE(3)", sensor);
     t.header = {"dataset"};
     t.header.insert(t.header.end(), configs.begin(), configs.end());
     if (!improvements.empty()) {
@@ -202,8 +203,8 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
         if (it == improvements.end()) {
           wins_row.push_back("");
         } else {
-          const auto wins = std::count_if(it->second.begin(), it->second.end(),
-                                          [](double p) { return p > 0; });
+          const auto wins =
+              std::count_if(it->second.begin(), it->second.end(), [](double p) { return p > 0; });
           wins_row.push_back(fmt::format("{}/{}", wins, it->second.size()));
         }
       }
@@ -219,8 +220,9 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
 Table DetailTable(const std::vector<GroupSummary>& groups) {
   Table t;
   t.title = "Per configuration: keyframes, map, losses and run time (mean ± std over runs)";
-  t.header = {"dataset", "sensor", "config", "ok/runs", "ATE [m]", "RPE [m]", "scale",
-              "keyframes", "map points", "lost frames", "wall [s]", "median tracking [ms]"};
+  t.header = {"dataset",    "sensor",      "config",   "ok/runs",
+              "ATE [m]",    "RPE [m]",     "scale",    "keyframes",
+              "map points", "lost frames", "wall [s]", "median tracking [ms]"};
   for (const auto& g : groups) {
     t.rows.push_back({g.dataset, g.sensor, g.config, fmt::format("{}/{}", g.ok, g.runs),
                       FormatMeanStd(g.ate_m, 4), FormatMeanStd(g.rpe_trans_m, 4),
