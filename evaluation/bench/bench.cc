@@ -228,7 +228,8 @@ EmittedJobs EmitJobs(const Suite& suite, const std::vector<RunSpec>& runs,
           "set -e\n"
           "cd \"$(dirname \"$0\")\"\n"
           "if [ -n \"$SSHLOGINFILE\" ]; then remote=\"--sshloginfile $SSHLOGINFILE\"; fi\n"
-          "parallel --will-cite --jobs \"${JOBS:-2}\" $remote --joblog parallel.joblog < jobs.txt || true\n"
+          "parallel --will-cite --jobs \"${JOBS:-2}\" $remote --joblog parallel.joblog < jobs.txt "
+          "|| true\n"
        << collect << "\n";
   }
   {

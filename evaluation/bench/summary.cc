@@ -68,7 +68,7 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
     g.baseline = first.baseline;
     g.alignment = first.alignment;
     g.runs = static_cast<int>(runs.size());
-    std::vector<double> ate, se3, sim3, scale, rpe, kf, mp, lost, wall, track;
+    std::vector<double> ate, se3, sim3, scale, rpe, kf, mp, lost, wall, track, coverage;
     for (const RunResult* r : runs) {
       g.order = std::min(g.order, r->index);
       if (!r->ok) continue;
@@ -83,6 +83,7 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
       lost.push_back(r->lost_frames);
       wall.push_back(r->wall_s);
       track.push_back(r->median_tracking_ms);
+      coverage.push_back(r->coverage);
     }
     g.ate_m = ComputeMeanStd(ate);
     g.ate_se3_m = ComputeMeanStd(se3);
@@ -94,6 +95,7 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
     g.lost_frames = ComputeMeanStd(lost);
     g.wall_s = ComputeMeanStd(wall);
     g.median_tracking_ms = ComputeMeanStd(track);
+    g.coverage = ComputeMeanStd(coverage);
     g.ate_median_m = Median(ate);
     groups.push_back(std::move(g));
   }
@@ -115,16 +117,16 @@ void WriteSummaryCsv(const fs::path& file, const std::vector<GroupSummary>& grou
   out << "dataset,sensor,config,selector,sweep_param,sweep_value,runs,ok,alignment,"
          "ate_mean_m,ate_std_m,ate_median_m,ate_se3_mean_m,ate_sim3_mean_m,scale_mean,"
          "rpe_trans_mean_m,improvement_pct,keyframes_mean,keyframes_std,map_points_mean,"
-         "lost_frames_mean,wall_mean_s,median_tracking_mean_ms\n";
+         "lost_frames_mean,coverage_mean,wall_mean_s,median_tracking_mean_ms\n";
   for (const auto& g : groups) {
-    out << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+    out << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
                        CsvField(g.dataset), CsvField(g.sensor), CsvField(g.config),
                        CsvField(g.selector), CsvField(g.sweep_param), Num(g.sweep_value), g.runs,
                        g.ok, g.alignment, Num(g.ate_m.mean), Num(g.ate_m.std), Num(g.ate_median_m),
                        Num(g.ate_se3_m.mean), Num(g.ate_sim3_m.mean), Num(g.scale.mean),
                        Num(g.rpe_trans_m.mean), Num(g.improvement_pct), Num(g.keyframes.mean),
                        Num(g.keyframes.std), Num(g.map_points.mean), Num(g.lost_frames.mean),
-                       Num(g.wall_s.mean), Num(g.median_tracking_ms.mean));
+                       Num(g.coverage.mean), Num(g.wall_s.mean), Num(g.median_tracking_ms.mean));
   }
   if (!out) throw Error("cannot write " + file.string());
 }
@@ -164,6 +166,9 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
             improvements[config].push_back(g.improvement_pct);
           }
           if (g.ok < g.runs) cell += fmt::format(" [{}/{} ok]", g.ok, g.runs);
+          if (g.coverage.n > 0 && g.coverage.mean < kLowCoverage) {
+            cell += fmt::format(" [cov {:.0f}%]", 100.0 * g.coverage.mean);
+          }
         }
         row.push_back(cell);
       }
@@ -226,9 +231,11 @@ Table DetailTable(const std::vector<GroupSummary>& groups) {
   for (const auto& g : groups) {
     t.rows.push_back({g.dataset, g.sensor, g.config, fmt::format("{}/{}", g.ok, g.runs),
                       FormatMeanStd(g.ate_m, 4), FormatMeanStd(g.rpe_trans_m, 4),
-                      FormatMeanStd(g.scale, 3), FormatMeanStd(g.keyframes, 1),
-                      FormatMeanStd(g.map_points, 0), FormatMeanStd(g.lost_frames, 1),
-                      FormatMeanStd(g.wall_s, 1), FormatMeanStd(g.median_tracking_ms, 1)});
+                      FormatMeanStd(g.scale, 3),
+                      g.coverage.n > 0 ? fmt::format("{:.0f}%", 100.0 * g.coverage.mean) : "—",
+                      FormatMeanStd(g.keyframes, 1), FormatMeanStd(g.map_points, 0),
+                      FormatMeanStd(g.lost_frames, 1), FormatMeanStd(g.wall_s, 1),
+                      FormatMeanStd(g.median_tracking_ms, 1)});
   }
   return t;
 }

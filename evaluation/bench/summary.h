@@ -39,6 +39,7 @@ struct GroupSummary {
   MeanStd keyframes;
   MeanStd map_points;
   MeanStd lost_frames;
+  MeanStd coverage;  // fraction of frames with a pose in the evaluated trajectory
   MeanStd wall_s;
   MeanStd median_tracking_ms;
   double ate_median_m = kNaN;
@@ -62,8 +63,10 @@ struct Table {
 };
 
 // Headline: one table per sensor, rows = datasets, columns = the non-sweep configurations,
-// cells = ATE mean ± std [m] and the improvement over the baseline; a last row averages the
-// improvements over the datasets.
+// cells = ATE mean ± std [m] and the improvement over the baseline, flagged "[cov N%]" when the
+// evaluated trajectory covers less than kLowCoverage of the frames (an ATE over a short piece
+// is not comparable); summary rows as the paper's (mean ATE, mean improvement, wins).
+inline constexpr double kLowCoverage = 0.9;
 std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups);
 // Keyframes, map points, lost frames and timings per group.
 Table DetailTable(const std::vector<GroupSummary>& groups);

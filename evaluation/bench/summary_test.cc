@@ -21,6 +21,7 @@ RunResult Result(int index, const std::string& dataset, const std::string& confi
   r.ok = ok;
   r.ate_m = ok ? ate : kNaN;
   r.keyframes = keyframes;
+  r.coverage = 1.0;
   return r;
 }
 
@@ -62,6 +63,13 @@ TEST(Summary, GroupsInMatrixOrderWithImprovementOverBaseline) {
   EXPECT_EQ(tables[0].rows[3][2], "-12.5%");
   EXPECT_EQ(tables[0].rows[4][2], "1/2");
   EXPECT_EQ(FailureTable(results).rows.size(), 1u);
+
+  // A configuration tracking only part of the sequence is flagged.
+  auto partial = results;
+  for (auto& r : partial) {
+    if (r.dataset == "B" && r.config == "pks") r.coverage = 0.25;
+  }
+  EXPECT_EQ(HeadlineTables(Summarize(partial))[0].rows[1][2], "0.3000 ± 0.0000 (-50.0%) [cov 25%]");
   const std::string md = MarkdownTable(tables[0]);
   EXPECT_NE(md.find("| dataset | orbslam3 | pks |"), std::string::npos) << md;
 }
