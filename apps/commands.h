@@ -10,5 +10,8 @@ void RegisterEvalCommand(CLI::App& app);
 void RegisterInfoCommand(CLI::App& app);
 void RegisterRunCommand(CLI::App& app);
 void RegisterVocabCommand(CLI::App& app);
+void RegisterDenseCommand(CLI::App& app);
+void RegisterCloudCompareCommand(CLI::App& app);
+void RegisterExportColmapCommand(CLI::App& app);
 
 }  // namespace pkslam::apps
