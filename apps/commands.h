@@ -13,5 +13,6 @@ void RegisterVocabCommand(CLI::App& app);
 void RegisterDenseCommand(CLI::App& app);
 void RegisterCloudCompareCommand(CLI::App& app);
 void RegisterExportColmapCommand(CLI::App& app);
+void RegisterSimulateCommand(CLI::App& app);
 
 }  // namespace pkslam::apps

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterDenseCommand(app);
   pkslam::apps::RegisterCloudCompareCommand(app);
   pkslam::apps::RegisterExportColmapCommand(app);
+  pkslam::apps::RegisterSimulateCommand(app);
 
   try {
     app.parse(argc, argv);
