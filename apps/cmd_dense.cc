@@ -38,7 +38,9 @@ void RunDense(const DenseArgs& args) {
       args.dataset, args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings));
   dense::DenseStats stats;
   const dense::PointCloud cloud = BuildDenseCloud(keyframes, source, args.options, &stats);
-  if (cloud.empty()) throw Error("the dense cloud is empty (no voxel passed the view filter)");
+  if (cloud.empty()) {
+    throw Error("the dense cloud is empty (no depth passed the multi-view filter)");
+  }
   const auto colour = args.colour ? dense::PlyColour::kRgb : dense::PlyColour::kGrey;
   dense::WritePly(cloud, args.out, colour,
                   fmt::format("pkslam dense: {} keyframes, voxel {} m, min views {}",
@@ -47,9 +49,14 @@ void RunDense(const DenseArgs& args) {
              stats.keyframes, stats.keyframes_used, stats.missing_t_ns.size(),
              source.source() == dense::DepthSource::kStereo ? "stereo SGBM" : "RGB-D",
              args.options.MaxDepth());
-  fmt::print("depth points {} (valid depth {:.1f}% of pixels), voxels {}, kept {} (>= {} views)\n",
-             stats.depth_points, 100.0 * stats.mean_valid_depth_share, stats.voxels, stats.points,
-             args.options.min_views);
+  fmt::print(
+      "depth points {} (valid depth {:.1f}% of pixels), {} ({:.1f}%) confirmed by >= {} "
+      "keyframes, {} voxels of {} m\n",
+      stats.depth_points, 100.0 * stats.mean_valid_depth_share, stats.consistent_points,
+      stats.depth_points > 0 ? 100.0 * static_cast<double>(stats.consistent_points) /
+                                   static_cast<double>(stats.depth_points)
+                             : 0.0,
+      args.options.min_views, stats.points, args.options.voxel_m);
   fmt::print("{:.1f} s; cloud: {}\n", stats.seconds, args.out);
   if (!args.json.empty()) {
     JsonWriter json;
@@ -63,7 +70,10 @@ void RunDense(const DenseArgs& args) {
     json.Member("voxel_m", args.options.voxel_m);
     json.Member("max_depth_m", args.options.MaxDepth());
     json.Member("min_views", args.options.min_views);
+    json.Member("consistency_rel", args.options.consistency_rel);
+    json.Member("window", args.options.window);
     json.Member("depth_points", static_cast<std::uint64_t>(stats.depth_points));
+    json.Member("consistent_points", static_cast<std::uint64_t>(stats.consistent_points));
     json.Member("valid_depth_share", stats.mean_valid_depth_share);
     json.Member("voxels", static_cast<std::uint64_t>(stats.voxels));
     json.Member("points", static_cast<std::uint64_t>(stats.points));
@@ -82,7 +92,7 @@ void RegisterDenseCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "dense",
       "Dense point cloud from a run's keyframes: stereo SGBM (rectified, left-right checked) or "
-      "RGB-D depth, fused in a voxel grid keeping voxels seen by >= --min-views keyframes");
+      "RGB-D depth, kept where >= --min-views keyframes agree, fused in a voxel grid");
   cmd->add_option("--run", args->run, "Run directory of `pkslam run` (keyframes.txt)")->required();
   cmd->add_option("--dataset", args->dataset, "The dataset the run used (EuRoC or TUM RGB-D)")
       ->required();
@@ -93,7 +103,14 @@ void RegisterDenseCommand(CLI::App& app) {
   cmd->add_option("--max-depth", o.max_depth_m, "Largest depth used (m; 0: 4 m)")
       ->capture_default_str();
   cmd->add_option("--min-depth", o.min_depth_m, "Smallest depth used (m)")->capture_default_str();
-  cmd->add_option("--min-views", o.min_views, "Keep voxels seen by at least N keyframes")
+  cmd->add_option("--min-views", o.min_views,
+                  "Keep depths at least N keyframes agree on (itself included; 1: no filter)")
+      ->capture_default_str();
+  cmd->add_option("--consistency", o.consistency_rel,
+                  "Relative depth agreement of a confirming keyframe")
+      ->capture_default_str();
+  cmd->add_option("--window", o.window,
+                  "Keyframes on each side (in keyframe order) that may confirm a depth")
       ->capture_default_str();
   cmd->add_flag("--colour,--color", args->colour,
                 "Write red/green/blue (colour images; grey replicated) instead of intensity");

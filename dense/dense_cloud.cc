@@ -2,8 +2,10 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -33,7 +35,14 @@ void FilterDisparityEdges(double max_step, cv::Mat* disparity) {
 struct ViewPoints {
   std::vector<Eigen::Vector3f> points;
   std::vector<Rgb> colours;
+  std::size_t candidates = 0;
   double valid_share = 0;
+};
+
+struct DepthImage {
+  cv::Mat depth;  // metres, CV_32FC1
+  cv::Mat grey;
+  cv::Mat colour;
 };
 
 }  // namespace
@@ -43,11 +52,22 @@ void DenseOptions::Check() const {
   PKSLAM_CHECK_OPTION(max_depth_m >= 0, "--max-depth", "{}", max_depth_m);
   PKSLAM_CHECK_OPTION(min_depth_m >= 0 && min_depth_m < MaxDepth(), "--min-depth",
                       "{} (max depth {})", min_depth_m, MaxDepth());
-  PKSLAM_CHECK_OPTION(min_views >= 1, "--min-views", "{}", min_views);
+  PKSLAM_CHECK_OPTION(window >= 0, "--window", "{}", window);
+  PKSLAM_CHECK_OPTION(min_views <= 2 * window + 1, "--min-views",
+                      "{} needs a window of at least {} keyframes each side", min_views,
+                      min_views / 2);
+  Consistency().Check();
   PKSLAM_CHECK_OPTION(pixel_step >= 1, "--pixel-step", "{}", pixel_step);
   PKSLAM_CHECK_OPTION(border_px >= 0, "border_px", "{}", border_px);
   PKSLAM_CHECK_OPTION(batch >= 1, "batch", "{}", batch);
   stereo.Check();
+}
+
+ConsistencyOptions DenseOptions::Consistency() const {
+  ConsistencyOptions c;
+  c.tolerance_rel = consistency_rel;
+  c.min_views = min_views;
+  return c;
 }
 
 cv::Mat KeyframeDepth(const KeyframeImages& images, const KeyframeImageSource& source,
@@ -79,9 +99,9 @@ cv::Mat RayTable(const CameraModel& camera) {
     auto* row = rays.ptr<cv::Vec2f>(r);
     for (int c = 0; c < rays.cols; ++c) {
       const Eigen::Vector3d b = camera.Unproject(Eigen::Vector2d(c, r));
-      row[c] = b.z() > 1e-9 ? cv::Vec2f(static_cast<float>(b.x() / b.z()),
-                                        static_cast<float>(b.y() / b.z()))
-                            : cv::Vec2f(NAN, NAN);
+      row[c] = b.z() > 1e-9
+                   ? cv::Vec2f(static_cast<float>(b.x() / b.z()), static_cast<float>(b.y() / b.z()))
+                   : cv::Vec2f(NAN, NAN);
     }
   }
   return rays;
@@ -137,44 +157,74 @@ PointCloud BuildDenseCloud(const Trajectory& keyframes, const KeyframeImageSourc
                      "no keyframe timestamp matches a frame of the dataset (another dataset?)");
   }
   if (!stats->missing_t_ns.empty()) {
-    PKSLAM_LOG_WARN("{} of {} keyframes have no dataset frame with the same timestamp "
-                    "(first {:.9f} s); skipped",
-                    stats->missing_t_ns.size(), keyframes.size(),
-                    static_cast<double>(stats->missing_t_ns.front()) * 1e-9);
+    PKSLAM_LOG_WARN(
+        "{} of {} keyframes have no dataset frame with the same timestamp "
+        "(first {:.9f} s); skipped",
+        stats->missing_t_ns.size(), keyframes.size(),
+        static_cast<double>(stats->missing_t_ns.front()) * 1e-9);
   }
 
   const cv::Mat rays = RayTable(source.camera());
+  const ConsistencyOptions consistency = options.Consistency();
+  const std::size_t n = jobs.size();
+  const std::size_t window = static_cast<std::size_t>(options.window);
+  const std::size_t batch = static_cast<std::size_t>(options.batch);
+  // Depth maps (and the images for colours) of the keyframes a block of the window needs;
+  // entries are released once no later keyframe's window reaches them.
+  std::vector<std::optional<DepthImage>> held(n);
+  std::size_t computed = 0;  // depth maps [0, computed) were computed
   VoxelGrid grid(options.voxel_m);
-  Progress progress("dense", jobs.size(), options.quiet);
+  Progress progress("dense", n, options.quiet);
   double valid_share_sum = 0;
-  for (std::size_t begin = 0; begin < jobs.size(); begin += options.batch) {
-    const std::size_t end = std::min(jobs.size(), begin + static_cast<std::size_t>(options.batch));
+  for (std::size_t begin = 0; begin < n; begin += batch) {
+    const std::size_t end = std::min(n, begin + batch);
+    const std::size_t need_end = std::min(n, end + window);
+    tbb::parallel_for(computed, need_end, [&](std::size_t j) {
+      KeyframeImages images = source.Load(jobs[j].frame);
+      DepthImage& d = held[j].emplace();
+      d.depth = KeyframeDepth(images, source, options);
+      d.grey = std::move(images.grey);
+      d.colour = std::move(images.colour);
+    });
+    computed = need_end;
     std::vector<ViewPoints> views(end - begin);
-    tbb::parallel_for(begin, end, [&](std::size_t j) {
-      const KeyframeImages images = source.Load(jobs[j].frame);
-      const cv::Mat depth = KeyframeDepth(images, source, options);
-      ViewPoints& v = views[j - begin];
-      v.valid_share = static_cast<double>(cv::countNonZero(depth)) / static_cast<double>(depth.total());
-      BackProject(depth, rays, jobs[j].world_from_camera, images.grey, images.colour,
+    tbb::parallel_for(begin, end, [&](std::size_t i) {
+      const DepthImage& d = *held[i];
+      std::vector<DepthView> neighbours;
+      const std::size_t first = i >= window ? i - window : 0;
+      for (std::size_t j = first; j < std::min(n, i + window + 1); ++j) {
+        if (j != i) neighbours.push_back({&held[j]->depth, jobs[j].world_from_camera.Inverse()});
+      }
+      const ConsistencyResult filtered =
+          FilterByConsistency(d.depth, jobs[i].world_from_camera, neighbours, rays, source.camera(),
+                              options.pixel_step, consistency);
+      ViewPoints& v = views[i - begin];
+      v.valid_share =
+          static_cast<double>(cv::countNonZero(d.depth)) / static_cast<double>(d.depth.total());
+      v.candidates = static_cast<std::size_t>(filtered.candidates);
+      BackProject(filtered.depth, rays, jobs[i].world_from_camera, d.grey, d.colour,
                   options.pixel_step, &v.points, &v.colours);
     });
-    for (std::size_t j = begin; j < end; ++j) {
-      ViewPoints& v = views[j - begin];
-      stats->depth_points += v.points.size();
+    for (std::size_t i = begin; i < end; ++i) {
+      ViewPoints& v = views[i - begin];
+      stats->depth_points += v.candidates;
+      stats->consistent_points += v.points.size();
       valid_share_sum += v.valid_share;
-      grid.AddView(static_cast<int>(j), v.points, v.colours);
+      grid.AddView(static_cast<int>(i), v.points, v.colours);
       v = ViewPoints{};
       progress.Add();
     }
-    progress.SetSuffix(fmt::format("{:.1f} M voxels", static_cast<double>(grid.NumVoxels()) * 1e-6));
+    // Keyframes before end - window are outside every remaining window.
+    for (std::size_t j = 0; j + window < end; ++j) held[j].reset();
+    progress.SetSuffix(
+        fmt::format("{:.1f} M voxels", static_cast<double>(grid.NumVoxels()) * 1e-6));
   }
   progress.Finish();
   stats->voxels = grid.NumVoxels();
-  PointCloud cloud = grid.Extract(options.min_views);
+  PointCloud cloud = grid.Extract(1);
   stats->points = cloud.size();
-  stats->mean_valid_depth_share = valid_share_sum / static_cast<double>(jobs.size());
-  stats->seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats->mean_valid_depth_share = valid_share_sum / static_cast<double>(n);
+  stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return cloud;
 }
 
