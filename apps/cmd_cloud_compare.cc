@@ -110,31 +110,34 @@ void RunCompare(const CompareArgs& args) {
     const fs::path keyframes_file = fs::path(args.align_run) / "keyframes.txt";
     const Trajectory keyframes = ReadTrajectory(keyframes_file, TrajectoryFormat::kTum);
     const auto source = dense::KeyframeImageSource::Open(
-        args.dataset, args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings));
+        args.dataset,
+        args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings));
     std::vector<SE3d> camera_from_ref;
     const Sim3d& s = alignment->ref_from_slam;
     for (const StampedPose& kf : keyframes.poses) {
       const SE3d ref_from_camera(s.so3() * kf.pose.so3(), s * kf.pose.translation());
       camera_from_ref.push_back(ref_from_camera.Inverse());
     }
-    visible = dense::VisibleFromCameras(ref.points, camera_from_ref, source.camera(),
-                                        args.visibility);
+    visible =
+        dense::VisibleFromCameras(ref.points, camera_from_ref, source.camera(), args.visibility);
   }
 
   const dense::CompareResult r =
-      dense::CompareClouds(cloud.points, ref.points, args.compare, visible);
+      dense::CompareClouds(cloud.points, ref.points, args.compare, visible, ref.normals);
   fmt::print("cloud {} ({} points), reference {} ({} points)\n", args.cloud, r.cloud_points,
              args.ref, r.ref_points);
   PrintStats("accuracy", r.accuracy);
+  if (r.surface_accuracy) PrintStats("to surface", *r.surface_accuracy);
   PrintStats("ref->cloud", r.reference_to_cloud);
   fmt::print("completeness  {:.1f}% of reference points have a cloud point within {:g} cm\n",
              100 * r.completeness, args.compare.completeness_m * 100);
   if (r.subset_completeness) {
-    fmt::print("completeness  {:.1f}% of the {} reference points ({:.1f}%) visible from the "
-               "keyframes (depth {:g}..{:g} m, unoccluded)\n",
-               100 * *r.subset_completeness, *r.subset_points,
-               100.0 * static_cast<double>(*r.subset_points) / static_cast<double>(r.ref_points),
-               args.visibility.min_depth_m, args.visibility.max_depth_m);
+    fmt::print(
+        "completeness  {:.1f}% of the {} reference points ({:.1f}%) visible from the "
+        "keyframes (depth {:g}..{:g} m, unoccluded)\n",
+        100 * *r.subset_completeness, *r.subset_points,
+        100.0 * static_cast<double>(*r.subset_points) / static_cast<double>(r.ref_points),
+        args.visibility.min_depth_m, args.visibility.max_depth_m);
   }
 
   if (!args.json.empty()) {
@@ -159,6 +162,12 @@ void RunCompare(const CompareArgs& args) {
     }
     json.Key("accuracy");
     dense::WriteDistanceStatsJson(r.accuracy, json);
+    json.Key("surface_accuracy");
+    if (r.surface_accuracy) {
+      dense::WriteDistanceStatsJson(*r.surface_accuracy, json);
+    } else {
+      json.Null();
+    }
     json.Key("reference_to_cloud");
     dense::WriteDistanceStatsJson(r.reference_to_cloud, json);
     json.Member("completeness_threshold_m", args.compare.completeness_m);
@@ -181,10 +190,9 @@ void RunCompare(const CompareArgs& args) {
     if (!out) throw Error(fmt::format("cannot write {}", args.json));
   }
   if (!args.hist.empty()) {
-    dense::PlotDistanceHistograms(
-        {{"cloud -> reference (accuracy)", r.accuracy_distances},
-         {"reference -> cloud (completeness)", r.completeness_distances}},
-        fs::path(args.cloud).filename().string(), 10.0, args.hist);
+    dense::PlotDistanceHistograms({{"cloud -> reference (accuracy)", r.accuracy_distances},
+                                   {"reference -> cloud (completeness)", r.completeness_distances}},
+                                  fs::path(args.cloud).filename().string(), 10.0, args.hist);
     fmt::print("histogram {}\n", args.hist);
   }
 }

@@ -21,8 +21,9 @@ struct PointsAdaptor {
   }
 };
 
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointsAdaptor>,
-                                                   PointsAdaptor, 3, std::size_t>;
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointsAdaptor>,
+                                        PointsAdaptor, 3, std::size_t>;
 
 }  // namespace
 
@@ -61,8 +62,11 @@ DistanceStats SummariseDistances(const std::vector<float>& distances,
 }
 
 std::vector<float> NearestDistances(const std::vector<Eigen::Vector3f>& query,
-                                    const std::vector<Eigen::Vector3f>& target) {
+                                    const std::vector<Eigen::Vector3f>& target,
+                                    std::vector<std::uint32_t>* nearest) {
   PKSLAM_CHECK(!target.empty(), "nearest-neighbour search in an empty cloud");
+  PKSLAM_CHECK(target.size() < UINT32_MAX, "too many points");
+  if (nearest != nullptr) nearest->assign(query.size(), 0);
   const PointsAdaptor adaptor{target};
   KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
   std::vector<float> distances(query.size());
@@ -75,8 +79,27 @@ std::vector<float> NearestDistances(const std::vector<Eigen::Vector3f>& query,
                         result.init(&index, &d2);
                         tree.findNeighbors(result, query[i].data(), nanoflann::SearchParams());
                         distances[i] = std::sqrt(d2);
+                        if (nearest != nullptr) {
+                          (*nearest)[i] = static_cast<std::uint32_t>(index);
+                        }
                       }
                     });
+  return distances;
+}
+
+std::vector<float> SurfaceDistances(const std::vector<Eigen::Vector3f>& query,
+                                    const std::vector<Eigen::Vector3f>& target,
+                                    const std::vector<Eigen::Vector3f>& target_normals,
+                                    const std::vector<std::uint32_t>& nearest) {
+  PKSLAM_CHECK(target_normals.size() == target.size() && nearest.size() == query.size(),
+               "{} normals for {} points, {} indices for {} queries", target_normals.size(),
+               target.size(), nearest.size(), query.size());
+  std::vector<float> distances(query.size());
+  for (std::size_t i = 0; i < query.size(); ++i) {
+    const std::uint32_t q = nearest[i];
+    PKSLAM_CHECK(q < target.size(), "index {} of {}", q, target.size());
+    distances[i] = std::abs(target_normals[q].dot(query[i] - target[q]));
+  }
   return distances;
 }
 
@@ -84,14 +107,15 @@ void CompareOptions::Check() const {
   for (double t : thresholds_m) {
     PKSLAM_CHECK_OPTION(t > 0 && std::isfinite(t), "thresholds", "{}", t);
   }
-  PKSLAM_CHECK_OPTION(completeness_m > 0 && std::isfinite(completeness_m), "--completeness",
-                      "{}", completeness_m);
+  PKSLAM_CHECK_OPTION(completeness_m > 0 && std::isfinite(completeness_m), "--completeness", "{}",
+                      completeness_m);
 }
 
 CompareResult CompareClouds(const std::vector<Eigen::Vector3f>& cloud,
                             const std::vector<Eigen::Vector3f>& reference,
                             const CompareOptions& options,
-                            const std::vector<std::uint8_t>& ref_subset) {
+                            const std::vector<std::uint8_t>& ref_subset,
+                            const std::vector<Eigen::Vector3f>& ref_normals) {
   options.Check();
   PKSLAM_CHECK(!cloud.empty() && !reference.empty(), "comparing an empty cloud");
   PKSLAM_CHECK(ref_subset.empty() || ref_subset.size() == reference.size(),
@@ -99,8 +123,15 @@ CompareResult CompareClouds(const std::vector<Eigen::Vector3f>& cloud,
   CompareResult r;
   r.cloud_points = cloud.size();
   r.ref_points = reference.size();
-  r.accuracy_distances = NearestDistances(cloud, reference);
+  PKSLAM_CHECK(ref_normals.empty() || ref_normals.size() == reference.size(),
+               "{} normals for {} reference points", ref_normals.size(), reference.size());
+  std::vector<std::uint32_t> nearest;
+  r.accuracy_distances = NearestDistances(cloud, reference, &nearest);
   r.accuracy = SummariseDistances(r.accuracy_distances, options.thresholds_m);
+  if (!ref_normals.empty()) {
+    r.surface_accuracy = SummariseDistances(
+        SurfaceDistances(cloud, reference, ref_normals, nearest), options.thresholds_m);
+  }
   r.completeness_distances = NearestDistances(reference, cloud);
   r.reference_to_cloud = SummariseDistances(r.completeness_distances, options.thresholds_m);
   std::size_t covered = 0, subset = 0, subset_covered = 0;

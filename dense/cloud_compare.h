@@ -1,7 +1,10 @@
 // Comparing a reconstructed cloud with a reference cloud by nearest-neighbour distances
 // (k-d tree, nanoflann):
 //   accuracy      distances cloud -> reference: mean, median, RMS, max, share within
-//                 1 / 2 / 5 cm;
+//                 1 / 2 / 5 cm; with reference normals also the distance to the reference
+//                 surface (|n . (p - q)| at the nearest reference point q: a point sampled
+//                 every s metres puts an exact surface point up to s / sqrt(2) from the
+//                 nearest sample, which the nearest-neighbour distance counts as error);
 //   completeness  distances reference -> cloud: the share of reference points with a cloud
 //                 point within 5 cm (optionally only over a subset of the reference, e.g.
 //                 the part the keyframes saw: dense/visibility.h).
@@ -9,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -30,7 +34,15 @@ DistanceStats SummariseDistances(const std::vector<float>& distances,
 // For each query point, the Euclidean distance to its nearest point of `target` (parallel).
 // Throws Error when target is empty.
 std::vector<float> NearestDistances(const std::vector<Eigen::Vector3f>& query,
-                                    const std::vector<Eigen::Vector3f>& target);
+                                    const std::vector<Eigen::Vector3f>& target,
+                                    std::vector<std::uint32_t>* nearest = nullptr);
+
+// Point-to-plane distances |n_q . (p - q)| of the query points to their nearest target points q
+// (indices from NearestDistances) with target normals n.
+std::vector<float> SurfaceDistances(const std::vector<Eigen::Vector3f>& query,
+                                    const std::vector<Eigen::Vector3f>& target,
+                                    const std::vector<Eigen::Vector3f>& target_normals,
+                                    const std::vector<std::uint32_t>& nearest);
 
 struct CompareOptions {
   // Accuracy thresholds (m).
@@ -44,9 +56,10 @@ struct CompareOptions {
 struct CompareResult {
   std::size_t cloud_points = 0;
   std::size_t ref_points = 0;
-  DistanceStats accuracy;            // cloud -> reference
-  DistanceStats reference_to_cloud;  // reference -> cloud, all reference points
-  double completeness = 0;           // share of reference points covered
+  DistanceStats accuracy;                         // cloud -> reference
+  std::optional<DistanceStats> surface_accuracy;  // cloud -> reference surface (with normals)
+  DistanceStats reference_to_cloud;               // reference -> cloud, all reference points
+  double completeness = 0;                        // share of reference points covered
   // Over the reference points flagged in `ref_subset` (when given).
   std::optional<std::size_t> subset_points;
   std::optional<double> subset_completeness;
@@ -55,10 +68,12 @@ struct CompareResult {
 };
 
 // `ref_subset`: empty, or one flag per reference point (restricted completeness).
+// `ref_normals`: empty, or one unit normal per reference point (surface accuracy).
 CompareResult CompareClouds(const std::vector<Eigen::Vector3f>& cloud,
                             const std::vector<Eigen::Vector3f>& reference,
                             const CompareOptions& options,
-                            const std::vector<std::uint8_t>& ref_subset = {});
+                            const std::vector<std::uint8_t>& ref_subset = {},
+                            const std::vector<Eigen::Vector3f>& ref_normals = {});
 
 // {"count", "mean", "median", "rms", "max", "within": {"0.01": share, ...}}
 void WriteDistanceStatsJson(const DistanceStats& stats, JsonWriter& json);

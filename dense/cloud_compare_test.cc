@@ -39,6 +39,25 @@ TEST(CloudCompareTest, ShiftedCloudHasThatAccuracy) {
   EXPECT_DOUBLE_EQ(r.completeness, 1.0);
 }
 
+TEST(CloudCompareTest, SurfaceAccuracyIgnoresTheSampleSpacing) {
+  const auto ref = Grid();
+  const std::vector<Eigen::Vector3f> normals(ref.size(), Eigen::Vector3f(0, 0, 1));
+  // Points between the samples (half a spacing off in x and y) and 3 mm above the plane: the
+  // nearest sample is 7.7 mm away, the surface 3 mm.
+  std::vector<Eigen::Vector3f> cloud;
+  for (int i = 10; i < 90; ++i) {
+    for (int j = 10; j < 90; ++j)
+      cloud.emplace_back(0.01f * i + 0.005f, 0.01f * j + 0.005f, 0.003f);
+  }
+  const CompareResult r = CompareClouds(cloud, ref, CompareOptions{}, {}, normals);
+  EXPECT_NEAR(r.accuracy.mean, std::sqrt(0.005 * 0.005 * 2 + 0.003 * 0.003), 1e-5);
+  ASSERT_TRUE(r.surface_accuracy.has_value());
+  EXPECT_NEAR(r.surface_accuracy->mean, 0.003, 1e-5);
+  EXPECT_EQ(r.surface_accuracy->count, cloud.size());
+  EXPECT_FALSE(CompareClouds(cloud, ref, CompareOptions{}).surface_accuracy.has_value());
+  EXPECT_THROW(CompareClouds(cloud, ref, CompareOptions{}, {}, {Eigen::Vector3f(0, 0, 1)}), Error);
+}
+
 TEST(CloudCompareTest, CompletenessCountsCoveredReferencePoints) {
   const auto ref = Grid();
   // The cloud covers x <= 0.3 only; reference points with x <= 0.34 are within 4.5 cm (a

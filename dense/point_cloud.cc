@@ -34,13 +34,17 @@ std::optional<PlyType> ParsePlyType(const std::string& name) {
 std::size_t TypeSize(PlyType type) {
   switch (type) {
     case PlyType::kInt8:
-    case PlyType::kUint8: return 1;
+    case PlyType::kUint8:
+      return 1;
     case PlyType::kInt16:
-    case PlyType::kUint16: return 2;
+    case PlyType::kUint16:
+      return 2;
     case PlyType::kInt32:
     case PlyType::kUint32:
-    case PlyType::kFloat32: return 4;
-    case PlyType::kFloat64: return 8;
+    case PlyType::kFloat32:
+      return 4;
+    case PlyType::kFloat64:
+      return 8;
   }
   return 0;
 }
@@ -52,14 +56,22 @@ double ReadBinaryValue(const char* p, PlyType type) {
     return static_cast<double>(v);
   };
   switch (type) {
-    case PlyType::kInt8: return get(std::int8_t{});
-    case PlyType::kUint8: return get(std::uint8_t{});
-    case PlyType::kInt16: return get(std::int16_t{});
-    case PlyType::kUint16: return get(std::uint16_t{});
-    case PlyType::kInt32: return get(std::int32_t{});
-    case PlyType::kUint32: return get(std::uint32_t{});
-    case PlyType::kFloat32: return get(float{});
-    case PlyType::kFloat64: return get(double{});
+    case PlyType::kInt8:
+      return get(std::int8_t{});
+    case PlyType::kUint8:
+      return get(std::uint8_t{});
+    case PlyType::kInt16:
+      return get(std::int16_t{});
+    case PlyType::kUint16:
+      return get(std::uint16_t{});
+    case PlyType::kInt32:
+      return get(std::int32_t{});
+    case PlyType::kUint32:
+      return get(std::uint32_t{});
+    case PlyType::kFloat32:
+      return get(float{});
+    case PlyType::kFloat64:
+      return get(double{});
   }
   return 0;
 }
@@ -162,6 +174,8 @@ void PointCloud::CheckSizes() const {
                colours.size(), points.size());
   PKSLAM_CHECK(views.empty() || views.size() == points.size(), "{} views for {} points",
                views.size(), points.size());
+  PKSLAM_CHECK(normals.empty() || normals.size() == points.size(), "{} normals for {} points",
+               normals.size(), points.size());
 }
 
 PointCloud ReadPly(const std::filesystem::path& file) {
@@ -175,11 +189,15 @@ PointCloud ReadPly(const std::filesystem::path& file) {
   const bool rgb = ir >= 0 && ig >= 0 && ib >= 0;
   const int igrey = rgb ? -1 : FindProperty(h, {"intensity", "grey", "gray"});
   const int iviews = FindProperty(h, {"views"});
+  const int inx = FindProperty(h, {"nx"}), iny = FindProperty(h, {"ny"}),
+            inz = FindProperty(h, {"nz"});
+  const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
 
   PointCloud cloud;
   cloud.points.resize(h.vertices);
   if (rgb || igrey >= 0) cloud.colours.resize(h.vertices);
   if (iviews >= 0) cloud.views.resize(h.vertices);
+  if (normals) cloud.normals.resize(h.vertices);
   std::vector<double> values(h.properties.size());
   std::vector<char> record(h.stride);
   std::string line;
@@ -201,8 +219,9 @@ PointCloud ReadPly(const std::filesystem::path& file) {
         if (!(words >> value)) throw InputError(file, line_no, "too few or non-numeric values");
       }
     }
-    cloud.points[v] = Eigen::Vector3f(static_cast<float>(values[ix]), static_cast<float>(values[iy]),
-                                      static_cast<float>(values[iz]));
+    cloud.points[v] =
+        Eigen::Vector3f(static_cast<float>(values[ix]), static_cast<float>(values[iy]),
+                        static_cast<float>(values[iz]));
     if (!cloud.points[v].allFinite()) {
       throw InputError(file, h.binary ? 0 : h.lines + v + 1,
                        fmt::format("vertex {} has a non-finite coordinate", v));
@@ -214,6 +233,16 @@ PointCloud ReadPly(const std::filesystem::path& file) {
       cloud.colours[v] = {g, g, g};
     }
     if (iviews >= 0) cloud.views[v] = ToByte(values[iviews]);
+    if (normals) {
+      Eigen::Vector3f n(static_cast<float>(values[inx]), static_cast<float>(values[iny]),
+                        static_cast<float>(values[inz]));
+      const float norm = n.norm();
+      if (!(norm > 0.5f && norm < 1.5f)) {
+        throw InputError(file, h.binary ? 0 : h.lines + v + 1,
+                         fmt::format("vertex {} has a normal of length {}", v, norm));
+      }
+      cloud.normals[v] = n / norm;
+    }
   }
   return cloud;
 }

@@ -76,17 +76,36 @@ TEST_F(PointCloudTest, ReadsAsciiWithOtherPropertiesAndTrailingFaces) {
   EXPECT_EQ(r.colours[0], (Rgb{10, 20, 30}));
 }
 
+TEST_F(PointCloudTest, ReadsNormalizedNormalsAndRejectsZeroOnes) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+      "property float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n";
+  const PointCloud r = ReadPly(Write("n.ply", header + "0 0 0 0 0 1\n1 1 1 0 1.1 0\n"));
+  ASSERT_TRUE(r.has_normals());
+  EXPECT_EQ(r.normals[0], Eigen::Vector3f(0, 0, 1));
+  EXPECT_NEAR((r.normals[1] - Eigen::Vector3f(0, 1, 0)).norm(), 0.0f, 1e-6f);
+  EXPECT_NE(ErrorOf(Write("z.ply", header + "0 0 0 0 0 1\n1 1 1 0 0 0\n")).find("z.ply:12:"),
+            std::string::npos);
+  EXPECT_FALSE(ReadPly(Write("p.ply",
+                             "ply\nformat ascii 1.0\nelement vertex 1\n"
+                             "property float x\nproperty float y\nproperty float z\n"
+                             "property float nx\nend_header\n1 2 3 0.5\n"))
+                   .has_normals());
+}
+
 TEST_F(PointCloudTest, MalformedFilesNameFileAndLine) {
   EXPECT_NE(ErrorOf(Write("n.ply", "PLY\n")).find("n.ply:1:"), std::string::npos);
   EXPECT_NE(ErrorOf(Write("f.ply", "ply\nformat binary_big_endian 1.0\nend_header\n"))
                 .find("f.ply:2: unsupported PLY format"),
             std::string::npos);
-  EXPECT_NE(ErrorOf(Write("x.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\n"
-                                   "property float z\nend_header\n1 2\n"))
+  EXPECT_NE(ErrorOf(Write("x.ply",
+                          "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\n"
+                          "property float z\nend_header\n1 2\n"))
                 .find("no x, y, z"),
             std::string::npos);
-  EXPECT_NE(ErrorOf(Write("a.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
-                                   "property float y\nproperty float z\nend_header\n1 2 3\n1 2\n"))
+  EXPECT_NE(ErrorOf(Write("a.ply",
+                          "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                          "property float y\nproperty float z\nend_header\n1 2 3\n1 2\n"))
                 .find("a.ply:9:"),
             std::string::npos);
   // Binary file cut short.
