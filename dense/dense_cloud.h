@@ -35,7 +35,7 @@ struct DenseOptions {
   // multi-view filter).
   int min_views = 2;
   // Relative depth agreement of a confirming keyframe (dense/depth_consistency.h).
-  double consistency_rel = 0.03;
+  double consistency_rel = 0.05;
   // Keyframes (in keyframe order) on each side of a keyframe that may confirm its depths.
   int window = 5;
   // Use every pixel_step-th pixel in both directions (1 = all).

@@ -26,7 +26,7 @@ namespace pkslam::dense {
 struct ConsistencyOptions {
   // Relative depth agreement for a confirmation (|z_j - z_proj| / z_proj). Stereo depth
   // error grows with depth (dz = z^2 / bf per pixel of disparity), so the tolerance is relative.
-  double tolerance_rel = 0.03;
+  double tolerance_rel = 0.05;
   // Views (this one included) that must agree; 1 keeps every pixel (no averaging either).
   int min_views = 2;
   // Replace the depth by the mean of the confirming estimates (else keep z_i).
