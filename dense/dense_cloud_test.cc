@@ -3,9 +3,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 
 #include "core/util/error.h"
 #include "io/settings_euroc.h"
@@ -28,7 +27,7 @@ fs::path MakeRgbdDataset(const fs::path& dir, int frames) {
   for (int i = 0; i < frames; ++i) {
     const std::string t = fmt::format("{:.6f}", 1.0 + 0.1 * i);
     cv::Mat colour(kH, kW, CV_8UC3, cv::Scalar(10, 20, 200));  // BGR
-    cv::Mat d(kH, kW, CV_16U, cv::Scalar(10000));               // 2 m * 5000
+    cv::Mat d(kH, kW, CV_16U, cv::Scalar(10000));              // 2 m * 5000
     cv::imwrite((dir / "rgb" / (t + ".png")).string(), colour);
     cv::imwrite((dir / "depth" / (t + ".png")).string(), d);
     rgb << t << " rgb/" << t << ".png\n";
@@ -45,8 +44,8 @@ fs::path MakeRgbdDataset(const fs::path& dir, int frames) {
 Trajectory Keyframes(const std::vector<int>& frames) {
   Trajectory t;
   for (int i : frames) {
-    t.poses.push_back({1'000'000'000LL + 100'000'000LL * i,
-                       SE3d(SO3d(), Eigen::Vector3d(0.1 * i, 0, 0))});
+    t.poses.push_back(
+        {1'000'000'000LL + 100'000'000LL * i, SE3d(SO3d(), Eigen::Vector3d(0.1 * i, 0, 0))});
   }
   return t;
 }
@@ -86,6 +85,32 @@ TEST_F(DenseCloudTest, RgbdKeyframesFuseOntoTheWall) {
   EXPECT_EQ(stats.voxels, all.size());
 }
 
+TEST_F(DenseCloudTest, WindowAndBatchSizes) {
+  const auto source = KeyframeImageSource::Open(MakeRgbdDataset(dir_ / "ds", 6), std::nullopt);
+  DenseOptions o;
+  o.voxel_m = 0.02;
+  o.quiet = true;
+  o.window = 1;
+  o.batch = 1;  // depth maps released as soon as the window has passed them
+  DenseStats stats;
+  const Trajectory kfs = Keyframes({0, 1, 2, 3, 4, 5});
+  const PointCloud one = BuildDenseCloud(kfs, source, o, &stats);
+  o.batch = 4;
+  const PointCloud four = BuildDenseCloud(kfs, source, o, &stats);
+  ASSERT_GT(one.size(), 100u);
+  EXPECT_EQ(one.points, four.points);
+  // Three views: the first and last keyframes have one neighbour each, so nothing of theirs
+  // survives; the confirmed points lie where a keyframe and both its neighbours see the wall.
+  o.min_views = 3;
+  const PointCloud three = BuildDenseCloud(kfs, source, o, &stats);
+  EXPECT_LT(three.size(), one.size());
+  EXPECT_LT(stats.consistent_points, stats.depth_points * 4 / 6 + 1);
+  EXPECT_GT(stats.consistent_points, stats.depth_points / 2);
+  // A window too small for min_views is an option error.
+  o.window = 0;
+  EXPECT_THROW(BuildDenseCloud(kfs, source, o, &stats), OptionError);
+}
+
 TEST_F(DenseCloudTest, KeyframesWithoutFramesAreSkippedOrRejected) {
   const auto source = KeyframeImageSource::Open(MakeRgbdDataset(dir_ / "ds", 2), std::nullopt);
   DenseOptions o;
@@ -121,8 +146,7 @@ TEST(DenseStereoSourceTest, SameRectifiedCameraAsTheRun) {
   const fs::path dataset = shared / "euroc" / "V1_01_easy_static";
   const auto source = KeyframeImageSource::Open(dataset, std::nullopt);
   ASSERT_EQ(source.source(), DepthSource::kStereo);
-  const RigSetup rig =
-      MakeRig(SettingsFromEuroc(EurocDataset::Open(dataset)), Sensor::kStereo);
+  const RigSetup rig = MakeRig(SettingsFromEuroc(EurocDataset::Open(dataset)), Sensor::kStereo);
   EXPECT_EQ(source.camera().fx(), rig.rig->camera.fx());
   EXPECT_EQ(source.camera().cx(), rig.rig->camera.cx());
   EXPECT_EQ(source.camera().cy(), rig.rig->camera.cy());
