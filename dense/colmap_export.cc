@@ -2,11 +2,10 @@
 
 #include <fmt/format.h>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 #include <unordered_map>
 
 #include "core/util/error.h"
@@ -85,8 +84,9 @@ ColmapExportStats WriteColmapText(const SparseModel& model,
       const SparseKeyframe& kf = model.keyframes[i];
       const Eigen::Quaterniond& q = kf.camera_from_world.quaternion();
       const Eigen::Vector3d& t = kf.camera_from_world.translation();
-      fmt::format_to(std::back_inserter(b), "{} {:.12f} {:.12f} {:.12f} {:.12f} {:.9f} {:.9f} {:.9f} 1 {}\n",
-                     i + 1, q.w(), q.x(), q.y(), q.z(), t.x(), t.y(), t.z(), image_names[i]);
+      fmt::format_to(std::back_inserter(b),
+                     "{} {:.12f} {:.12f} {:.12f} {:.12f} {:.9f} {:.9f} {:.9f} 1 {}\n", i + 1, q.w(),
+                     q.x(), q.y(), q.z(), t.x(), t.y(), t.z(), image_names[i]);
       for (std::size_t k = 0; k < kf.keypoints.size(); ++k) {
         const SparseKeypoint& kp = kf.keypoints[k];
         const std::int64_t id = exported.count(kp.point_id) > 0 ? kp.point_id + 1 : -1;
@@ -147,7 +147,9 @@ ColmapExportStats ExportColmap(const SparseModel& model, const KeyframeImageSour
   options.Check();
   const CameraModel pinhole = source.PinholeCamera();
   const SparseCamera& c = model.camera;
-  const auto differs = [](double a, double b) { return std::abs(a - b) > 1e-6 * std::abs(b) + 1e-9; };
+  const auto differs = [](double a, double b) {
+    return std::abs(a - b) > 1e-6 * std::abs(b) + 1e-9;
+  };
   if (c.width != pinhole.width() || c.height != pinhole.height() || differs(c.fx, pinhole.fx()) ||
       differs(c.fy, pinhole.fy()) || differs(c.cx, pinhole.cx()) || differs(c.cy, pinhole.cy())) {
     throw OptionError(fmt::format(
@@ -166,7 +168,8 @@ ColmapExportStats ExportColmap(const SparseModel& model, const KeyframeImageSour
   for (const SparseKeyframe& kf : model.keyframes) {
     const auto frame = source.FindFrame(kf.t_ns);
     if (!frame) {
-      throw InputError(model.source, fmt::format("keyframe {} at {:.9f} s has no dataset frame with that "
+      throw InputError(model.source,
+                       fmt::format("keyframe {} at {:.9f} s has no dataset frame with that "
                                    "timestamp (another dataset?)",
                                    kf.id, static_cast<double>(kf.t_ns) * 1e-9));
     }
@@ -205,7 +208,8 @@ ColmapExportStats ExportColmap(const SparseModel& model, const KeyframeImageSour
   for (std::size_t n = 0; n < colours.size(); ++n) {
     const auto& s = colour_sums[n];
     if (s[3] > 0) {
-      for (int a = 0; a < 3; ++a) colours[n][a] = static_cast<std::uint8_t>(std::lround(s[a] / s[3]));
+      for (int a = 0; a < 3; ++a)
+        colours[n][a] = static_cast<std::uint8_t>(std::lround(s[a] / s[3]));
     }
   }
   return WriteColmapText(model, names, colours, options, out_dir / "sparse");

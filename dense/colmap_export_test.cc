@@ -116,9 +116,8 @@ TEST_F(ColmapExportTest, ModelAnalyzerReadsTheModel) {
   if (!fs::exists(colmap)) GTEST_SKIP() << "colmap is not installed (apt-get install colmap)";
   const SparseModel m = GeometricModel();
   WriteColmapText(m, {"a.png", "b.png", "c.png"}, {}, ColmapExportOptions{}, dir_);
-  const auto r = testing::RunCommand(
-      fmt::format("QT_QPA_PLATFORM=offscreen {} model_analyzer --path '{}'", colmap.string(),
-                  dir_.string()));
+  const auto r = testing::RunCommand(fmt::format(
+      "QT_QPA_PLATFORM=offscreen {} model_analyzer --path '{}'", colmap.string(), dir_.string()));
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("Cameras: 1"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("Images: 3"), std::string::npos) << r.output;

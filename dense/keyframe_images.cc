@@ -1,9 +1,8 @@
 #include "dense/keyframe_images.h"
 
+#include <algorithm>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
-
-#include <algorithm>
 
 #include "core/util/error.h"
 #include "io/settings_euroc.h"
@@ -48,7 +47,8 @@ KeyframeImageSource KeyframeImageSource::Open(const fs::path& dataset,
     s.source_ = DepthSource::kRgbd;
     const fs::path fallback = dataset / "settings.yaml";
     if (!settings && !fs::exists(fallback)) {
-      throw InputError(dataset, "TUM RGB-D layout needs --settings (or settings.yaml in the dataset)");
+      throw InputError(dataset,
+                       "TUM RGB-D layout needs --settings (or settings.yaml in the dataset)");
     }
     s.settings_ = ReadOrbSlam3Settings(settings.value_or(fallback));
     if (!s.settings_.depth_map_factor) s.settings_.depth_map_factor = s.tum_->depth_factor();

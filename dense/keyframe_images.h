@@ -8,10 +8,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/camera/camera_model.h"
 #include "core/camera/stereo_rectification.h"

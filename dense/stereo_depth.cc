@@ -1,9 +1,8 @@
 #include "dense/stereo_depth.h"
 
+#include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
-
-#include <cmath>
 
 #include "core/util/error.h"
 
@@ -15,11 +14,10 @@ cv::Ptr<cv::StereoSGBM> MakeMatcher(const StereoDepthOptions& o) {
   const int p1 = o.p1 > 0 ? o.p1 : 8 * area;
   const int p2 = o.p2 > 0 ? o.p2 : 32 * area;
   // disp12MaxDiff -1: OpenCV's own (one-sided) left-right check is off; ours is below.
-  return cv::StereoSGBM::create(o.min_disparity, o.num_disparities, o.block_size, p1, p2,
-                                /*disp12MaxDiff=*/-1, /*preFilterCap=*/31, o.uniqueness_ratio,
-                                o.speckle_window_size, o.speckle_range,
-                                o.three_way ? cv::StereoSGBM::MODE_SGBM_3WAY
-                                            : cv::StereoSGBM::MODE_SGBM);
+  return cv::StereoSGBM::create(
+      o.min_disparity, o.num_disparities, o.block_size, p1, p2,
+      /*disp12MaxDiff=*/-1, /*preFilterCap=*/31, o.uniqueness_ratio, o.speckle_window_size,
+      o.speckle_range, o.three_way ? cv::StereoSGBM::MODE_SGBM_3WAY : cv::StereoSGBM::MODE_SGBM);
 }
 
 // SGBM's fixed-point output (16 * d; below min_disparity * 16 = invalid) as float pixels.
@@ -50,8 +48,8 @@ void StereoDepthOptions::Check() const {
                       "{} is not a positive multiple of 16", num_disparities);
   PKSLAM_CHECK_OPTION(block_size >= 1 && block_size <= 11 && block_size % 2 == 1, "block_size",
                       "{} is not odd in [1, 11]", block_size);
-  PKSLAM_CHECK_OPTION(p1 >= 0 && p2 >= 0 && (p1 == 0 || p2 == 0 || p2 > p1), "p1/p2",
-                      "p1 {} p2 {}", p1, p2);
+  PKSLAM_CHECK_OPTION(p1 >= 0 && p2 >= 0 && (p1 == 0 || p2 == 0 || p2 > p1), "p1/p2", "p1 {} p2 {}",
+                      p1, p2);
   PKSLAM_CHECK_OPTION(uniqueness_ratio >= 0 && uniqueness_ratio < 100, "uniqueness_ratio", "{}",
                       uniqueness_ratio);
   PKSLAM_CHECK_OPTION(speckle_window_size >= 0 && speckle_range >= 0, "speckle",

@@ -2,10 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/imgproc.hpp>
-
 #include <cmath>
 #include <functional>
+#include <opencv2/imgproc.hpp>
 #include <random>
 
 #include "core/util/error.h"
@@ -111,8 +110,8 @@ TEST(StereoDepthTest, SlantedPlaneDisparityIsSubpixelAccurate) {
   ASSERT_GT(d0, 0);
   EXPECT_FLOAT_EQ(depth.at<float>(240, 400), 48.0f / d0);
   const cv::Mat clipped = DisparityToDepth(disp, 48.0, 48.0 / 25.0);  // keeps d >= 25 only
-  EXPECT_EQ(clipped.at<float>(240, 100), 0.0f);   // d ~ 15
-  EXPECT_GT(clipped.at<float>(240, 700), 0.0f);   // d ~ 29
+  EXPECT_EQ(clipped.at<float>(240, 100), 0.0f);                       // d ~ 15
+  EXPECT_GT(clipped.at<float>(240, 700), 0.0f);                       // d ~ 29
 }
 
 TEST(StereoDepthTest, LeftRightCheckRemovesOccludedBackground) {
@@ -160,12 +159,12 @@ TEST(StereoDepthTest, LeftRightCheckRemovesOccludedBackground) {
 
 TEST(StereoDepthTest, LeftRightCheckByHand) {
   cv::Mat left = cv::Mat::zeros(1, 40, CV_32F), right = cv::Mat::zeros(1, 40, CV_32F);
-  left.at<float>(0, 20) = 10.0f;   // right x = 10 agrees
+  left.at<float>(0, 20) = 10.0f;  // right x = 10 agrees
   right.at<float>(0, 10) = 10.4f;
-  left.at<float>(0, 30) = 5.0f;    // right x = 25 disagrees
+  left.at<float>(0, 30) = 5.0f;  // right x = 25 disagrees
   right.at<float>(0, 25) = 7.0f;
-  left.at<float>(0, 3) = 6.0f;     // right x = -3: outside
-  left.at<float>(0, 35) = 2.0f;    // right x = 33 has no disparity
+  left.at<float>(0, 3) = 6.0f;   // right x = -3: outside
+  left.at<float>(0, 35) = 2.0f;  // right x = 33 has no disparity
   EXPECT_EQ(LeftRightCheck(right, 1.0, &left), 3);
   EXPECT_EQ(left.at<float>(0, 20), 10.0f);
   EXPECT_EQ(left.at<float>(0, 30), 0.0f);

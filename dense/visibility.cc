@@ -47,8 +47,8 @@ void MarkVisible(const std::vector<Eigen::Vector3f>& points, const SE3d& camera_
     }
     const double margin = 0.5 * f * o.spacing_m / pc.z() + 1.0;
     if (u < -margin || v < -margin || u > w - 1 + margin || v > h - 1 + margin) continue;
-    scratch->push_back({static_cast<float>(u), static_cast<float>(v), pc.z(),
-                        static_cast<std::uint32_t>(i)});
+    scratch->push_back(
+        {static_cast<float>(u), static_cast<float>(v), pc.z(), static_cast<std::uint32_t>(i)});
   }
   zbuffer->assign(static_cast<std::size_t>(w) * h, std::numeric_limits<float>::infinity());
   for (const Projected& p : *scratch) {
@@ -76,8 +76,8 @@ void MarkVisible(const std::vector<Eigen::Vector3f>& points, const SE3d& camera_
 }  // namespace
 
 void VisibilityOptions::Check() const {
-  PKSLAM_CHECK_OPTION(min_depth_m >= 0 && max_depth_m > min_depth_m, "depth range",
-                      "[{}, {}]", min_depth_m, max_depth_m);
+  PKSLAM_CHECK_OPTION(min_depth_m >= 0 && max_depth_m > min_depth_m, "depth range", "[{}, {}]",
+                      min_depth_m, max_depth_m);
   PKSLAM_CHECK_OPTION(border_px >= 0, "border_px", "{}", border_px);
   PKSLAM_CHECK_OPTION(spacing_m > 0, "spacing_m", "{}", spacing_m);
   PKSLAM_CHECK_OPTION(occlusion_tolerance_m >= 0, "occlusion_tolerance_m", "{}",
@@ -95,8 +95,9 @@ std::vector<std::uint8_t> VisibleFromCameras(const std::vector<Eigen::Vector3f>&
     std::vector<Projected> scratch;
     std::vector<float> zbuffer;
   };
-  tbb::enumerable_thread_specific<Local> locals(
-      [&] { return Local{std::vector<std::uint8_t>(points.size(), 0), {}, {}}; });
+  tbb::enumerable_thread_specific<Local> locals([&] {
+    return Local{std::vector<std::uint8_t>(points.size(), 0), {}, {}};
+  });
   tbb::parallel_for(std::size_t{0}, camera_from_world.size(), [&](std::size_t k) {
     Local& local = locals.local();
     MarkVisible(points, camera_from_world[k], camera, options, &local.scratch, &local.zbuffer,

@@ -49,7 +49,9 @@ TEST(VisibilityTest, BoardOccludesTheWallBehindIt) {
   }
   EXPECT_EQ(board_visible, board);
   // Behind the board's centre: hidden (the board at 2 m spans |x| < 0.3 m on the wall).
-  auto index_of_wall = [](int i, int j) { return static_cast<std::size_t>((i + 100) * 201 + j + 100); };
+  auto index_of_wall = [](int i, int j) {
+    return static_cast<std::size_t>((i + 100) * 201 + j + 100);
+  };
   EXPECT_EQ(visible[index_of_wall(0, 0)], 0);
   EXPECT_EQ(visible[index_of_wall(25, 0)], 0);
   // Outside its shadow (and inside the image): visible.
@@ -75,8 +77,8 @@ TEST(VisibilityTest, DepthRangeAndUnionOverCameras) {
   // A second camera looking at the wall from behind it (rotated 180 degrees about y, placed at
   // z = 5) sees the wall's back, including the part the board hides from the first.
   const SE3d world_from_back(SO3d::Exp(Eigen::Vector3d(0, M_PI, 0)), Eigen::Vector3d(0, 0, 5));
-  const auto both =
-      VisibleFromCameras(s.points, {SE3d(), world_from_back.Inverse()}, Camera(), VisibilityOptions{});
+  const auto both = VisibleFromCameras(s.points, {SE3d(), world_from_back.Inverse()}, Camera(),
+                                       VisibilityOptions{});
   EXPECT_EQ(both[static_cast<std::size_t>(100 * 201 + 100)], 1);  // wall centre
   EXPECT_EQ(both[s.points.size() - 1], 1);                        // a board corner
   VisibilityOptions bad;

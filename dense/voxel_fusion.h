@@ -42,7 +42,7 @@ class VoxelGrid {
 
  private:
   struct Voxel {
-    float offset_sum[3] = {0, 0, 0};   // sum of (point - voxel corner), metres
+    float offset_sum[3] = {0, 0, 0};  // sum of (point - voxel corner), metres
     std::uint32_t colour_sum[3] = {0, 0, 0};
     std::uint32_t count = 0;
     std::int32_t last_view = -1;

@@ -63,7 +63,8 @@ TEST(VoxelFusionTest, NoisyViewsOfAPlaneAverageTowardsIt) {
   for (int view = 0; view < 10; ++view) {
     std::vector<Eigen::Vector3f> pts;
     for (int i = 0; i < 50; ++i) {
-      for (int j = 0; j < 50; ++j) pts.emplace_back(0.01f * i + 0.001f, 0.01f * j + 0.001f, 2.01f + noise(rng));
+      for (int j = 0; j < 50; ++j)
+        pts.emplace_back(0.01f * i + 0.001f, 0.01f * j + 0.001f, 2.01f + noise(rng));
     }
     grid.AddView(view, pts, {});
   }

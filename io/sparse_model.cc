@@ -14,9 +14,9 @@ namespace pkslam {
 namespace fs = std::filesystem;
 
 // A failed cross-reference check: a plain message (the reader turns it into an InputError).
-#define CONSISTENT(cond, ...)                                \
-  do {                                                       \
-    if (!(cond)) throw Error(fmt::format(__VA_ARGS__));      \
+#define CONSISTENT(cond, ...)                           \
+  do {                                                  \
+    if (!(cond)) throw Error(fmt::format(__VA_ARGS__)); \
   } while (false)
 
 void SparseModel::CheckConsistency() const {
@@ -30,13 +30,12 @@ void SparseModel::CheckConsistency() const {
     for (const auto& [kf_id, index] : p.observations) {
       const auto it = keyframe_by_id.find(kf_id);
       CONSISTENT(it != keyframe_by_id.end(), "point {} observed by unknown keyframe {}", p.id,
-                   kf_id);
+                 kf_id);
       const auto& kps = it->second->keypoints;
       CONSISTENT(index >= 0 && index < static_cast<int>(kps.size()),
-                   "point {}: keyframe {} has no keypoint {}", p.id, kf_id, index);
-      CONSISTENT(kps[index].point_id == p.id,
-                   "point {}: keyframe {} keypoint {} names point {}", p.id, kf_id, index,
-                   kps[index].point_id);
+                 "point {}: keyframe {} has no keypoint {}", p.id, kf_id, index);
+      CONSISTENT(kps[index].point_id == p.id, "point {}: keyframe {} keypoint {} names point {}",
+                 p.id, kf_id, index, kps[index].point_id);
     }
   }
   for (const SparseKeyframe& kf : keyframes) {
@@ -44,8 +43,8 @@ void SparseModel::CheckConsistency() const {
       const std::int64_t id = kf.keypoints[i].point_id;
       if (id < 0) continue;
       const auto it = point_by_id.find(id);
-      CONSISTENT(it != point_by_id.end(), "keyframe {} keypoint {} names unknown point {}",
-                   kf.id, i, id);
+      CONSISTENT(it != point_by_id.end(), "keyframe {} keypoint {} names unknown point {}", kf.id,
+                 i, id);
       bool listed = false;
       for (const auto& obs : it->second->observations) {
         listed |= obs.first == kf.id && obs.second == static_cast<int>(i);
@@ -159,7 +158,8 @@ SparseModel ReadSparseModel(const fs::path& file) {
         }
         const Eigen::Vector3d t(d(3, "tx"), d(4, "ty"), d(5, "tz"));
         const Eigen::Quaterniond q(d(9, "qw"), d(6, "qx"), d(7, "qy"), d(8, "qz"));
-        if (std::abs(q.norm() - 1.0) > 1e-6) throw InputError(file, row.line, "quaternion not unit");
+        if (std::abs(q.norm() - 1.0) > 1e-6)
+          throw InputError(file, row.line, "quaternion not unit");
         kf.camera_from_world = SE3d(q, t);
         keypoints_left = count_field(row.fields[10], row.line, "keypoint count");
         kf.keypoints.reserve(keypoints_left);

@@ -29,8 +29,8 @@
 namespace pkslam {
 
 struct SparseKeypoint {
-  float u = 0, v = 0;      // undistorted / rectified pixel
-  int octave = 0;          // pyramid level
+  float u = 0, v = 0;          // undistorted / rectified pixel
+  int octave = 0;              // pyramid level
   std::int64_t point_id = -1;  // observed map point, -1 = none
 };
 

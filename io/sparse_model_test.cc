@@ -21,8 +21,8 @@ SparseModel SmallModel() {
   SparseKeyframe a;
   a.id = 2;
   a.t_ns = 1600000000050000000;
-  a.camera_from_world = SE3d(Eigen::Quaterniond(0.9, 0.1, -0.2, 0.3).normalized(),
-                             Eigen::Vector3d(0.5, -1.25, 2.0));
+  a.camera_from_world =
+      SE3d(Eigen::Quaterniond(0.9, 0.1, -0.2, 0.3).normalized(), Eigen::Vector3d(0.5, -1.25, 2.0));
   a.keypoints = {{10.5f, 20.25f, 0, 7}, {100.0f, 200.0f, 3, -1}, {33.0f, 44.0f, 1, -1}};
   SparseKeyframe b;
   b.id = 4;
