@@ -10,6 +10,9 @@ void RegisterEvalCommand(CLI::App& app);
 void RegisterInfoCommand(CLI::App& app);
 void RegisterRunCommand(CLI::App& app);
 void RegisterVocabCommand(CLI::App& app);
+void RegisterDenseCommand(CLI::App& app);
+void RegisterCloudCompareCommand(CLI::App& app);
+void RegisterExportColmapCommand(CLI::App& app);
 void RegisterSimulateCommand(CLI::App& app);
 void RegisterBenchCommand(CLI::App& app);
 

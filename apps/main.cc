@@ -20,6 +20,9 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterInfoCommand(app);
   pkslam::apps::RegisterRunCommand(app);
   pkslam::apps::RegisterVocabCommand(app);
+  pkslam::apps::RegisterDenseCommand(app);
+  pkslam::apps::RegisterCloudCompareCommand(app);
+  pkslam::apps::RegisterExportColmapCommand(app);
   pkslam::apps::RegisterSimulateCommand(app);
   pkslam::apps::RegisterBenchCommand(app);
 

@@ -5,6 +5,8 @@
 // OUT/trajectory_body.txt  the same as body (IMU) poses world_from_body (EuRoC ground truth's frame)
 // OUT/keyframes.txt    keyframes of the final map, same format
 // OUT/map_points.ply   map points (binary PLY)
+// OUT/sparse_model.txt keyframes with keypoints and map points with observations
+//                      (io/sparse_model.h; for `pkslam export-colmap`)
 // OUT/stats.json       timings, counts, tracking states, memory
 // OUT/run.log          the log of the run
 // OUT/keyframe_trace.csv  per-frame keyframe decisions (with trace enabled)

@@ -8,6 +8,7 @@
 
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
+#include "system/sparse_model_builder.h"
 
 namespace pkslam {
 namespace {
@@ -70,6 +71,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   WriteTrajectory(body, out / "trajectory_body.txt", TrajectoryFormat::kTum);
   WriteTrajectory(system.KeyFrameTrajectory(), out / "keyframes.txt", TrajectoryFormat::kTum);
   system.WriteMapPly(out / "map_points.ply");
+  WriteSparseModel(BuildSparseModel(system), out / "sparse_model.txt");
   if (options.system.trace) WriteTrace(system.tracker(), out / "keyframe_trace.csv");
 
   const auto& records = system.tracker().records();

@@ -67,8 +67,12 @@ class SlamSystem {
   int NumMapPoints() const;
   int NumMaps() const;
 
- private:
+  // For output writers (system/sparse_model_builder.h): the Atlas (take its mutex shared to
+  // read) and the map the outputs describe, the one with the most keyframes.
+  const Atlas& atlas() const { return atlas_; }
   const Map* LargestMap() const;  // requires the Atlas lock
+
+ private:
 
   SystemOptions options_;
   RigSetup setup_;
