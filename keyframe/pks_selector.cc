@@ -20,6 +20,7 @@ void PksOptions::Check() const {
   PKSLAM_CHECK_OPTION(inertial_interval_s > 0 && imu_uninitialised_interval_s > 0,
                       "Keyframe.inertial_interval", "{} / {}", inertial_interval_s,
                       imu_uninitialised_interval_s);
+  PKSLAM_CHECK_OPTION(visual_interval_s > 0, "Keyframe.visual_interval", "{}", visual_interval_s);
   PKSLAM_CHECK_OPTION(weak_tracking_ratio >= 0 && weak_tracking_ratio < 1,
                       "Keyframe.weak_tracking_ratio", "{}", weak_tracking_ratio);
   PKSLAM_CHECK_OPTION(forced_interval >= 0 && late_denominator_after >= 0,
@@ -62,6 +63,26 @@ void PksSelector::OnKeyFrameInserted(const SelectorInput& input) {
   }
 }
 
+void PksSelector::ExtendSnapshot(const SelectorInput& input) {
+  std::vector<std::size_t> missing;
+  for (std::size_t i = 0; i < input.points.size(); ++i) {
+    const SelectorPoint& p = input.points[i];
+    if (p.in_last_keyframe && !snapshot_.contains(p.id)) missing.push_back(i);
+  }
+  if (missing.empty()) return;
+  std::vector<Eigen::Vector3d> positions;
+  positions.reserve(input.points.size());
+  for (const auto& p : input.points) positions.push_back(p.position_world);
+  const auto normals = pks::EstimateNormals(positions, options_.normal_neighbours, true);
+  const Eigen::Vector3d kf_center = input.last_keyframe_camera_from_world.Inverse().translation();
+  for (const std::size_t i : missing) {
+    const double angle = pks::ViewAngleDeg(normals[i], positions[i], kf_center, false);
+    snapshot_[input.points[i].id] = {
+        normals[i], angle, pks::ConeRegion(angle, options_.region_width_deg, options_.regions)};
+  }
+  has_snapshot_ = true;
+}
+
 PksSelector::Counts PksSelector::Measure(const SelectorInput& input) const {
   Counts c;
   const int n = options_.grid;
@@ -99,6 +120,12 @@ PksSelector::Counts PksSelector::Measure(const SelectorInput& input) const {
 
 bool PksSelector::CameraCriterion(const SelectorInput& input, SelectorTrace* trace) {
   const int frames = input.FramesSinceLastKeyFrame();
+  // The paper's M counts every point matched between the keyframe and the current frame; the
+  // snapshot taken at insertion only holds the points tracked then (the released code's
+  // reading), so the paper variant completes it with points the keyframe gained since.
+  if (!released_ && input.points.size() > static_cast<std::size_t>(options_.normal_neighbours)) {
+    ExtendSnapshot(input);
+  }
   if (!has_snapshot_ || input.points.size() < static_cast<std::size_t>(options_.normal_neighbours) + 1) {
     return false;  // too few points for a surface normal: no camera decision
   }
@@ -183,7 +210,8 @@ SelectorDecision PksSelector::Decide(const SelectorInput& in) {
   const bool need_close = !IsMonocular(s) && in.tracked_close < options_.close_tracked_max &&
                           in.untracked_close > options_.close_untracked_min;
   const bool c3 = need_close && in.inliers > 15;
-  const bool c1 = IsInertial(s) && in.SecondsSinceLastKeyFrame() >= options_.inertial_interval_s;
+  const bool c1 = IsInertial(s) ? in.SecondsSinceLastKeyFrame() >= options_.inertial_interval_s
+                                 : in.SecondsSinceLastKeyFrame() >= options_.visual_interval_s;
   const bool c2 = s == Sensor::kMonocularInertial &&
                   ((in.inliers > 15 && in.inliers < 75) || in.recently_lost);
   const bool weak = !IsInertial(s) && options_.weak_tracking_ratio > 0 &&

@@ -43,6 +43,9 @@ struct PksOptions {
   double min_translation_m = 0.02;          // no keyframe if the camera moved less (> 2 KFs)
   double imu_uninitialised_interval_s = 0.25;
   double inertial_interval_s = 0.5;         // c1
+  // Visual-only sensors (not evaluated in the paper): ORB-SLAM3's c1a, a keyframe at least
+  // every this many seconds (its maxFrames = fps), so monocular maps are not starved.
+  double visual_interval_s = 1.0;
   int close_tracked_max = 100;              // c3: stereo close-point rule
   int close_untracked_min = 70;
   // Visual-only sensors (not evaluated by the paper): also insert when inliers fall below this
@@ -77,6 +80,10 @@ class PksSelector : public KeyframeSelector {
     std::vector<int> grid;  // effective points per cell
   };
   Counts Measure(const SelectorInput& input) const;
+  // Adds the last keyframe's points that the snapshot does not hold yet (created with the
+  // keyframe or triangulated from it afterwards): their normals from the current tracked
+  // points, their angle and region as seen from the keyframe.
+  void ExtendSnapshot(const SelectorInput& input);
   bool CameraCriterion(const SelectorInput& input, SelectorTrace* trace);
   std::optional<double> AccelerationChange(const SelectorInput& input) const;
 

@@ -66,6 +66,7 @@ std::unique_ptr<KeyframeSelector> MakeKeyframeSelector(
     reader.Read("region_width", &o.region_width_deg);
     reader.Read("regions", &o.regions);
     reader.Read("delta", &o.delta_deg);
+    reader.Read("visual_interval", &o.visual_interval_s);
     reader.Read("grid", &o.grid);
     reader.Read("normal_neighbours", &o.normal_neighbours);
     reader.Read("imu_threshold", &o.imu_threshold);
