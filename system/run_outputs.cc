@@ -8,6 +8,7 @@
 
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
+#include "system/inertial_outputs.h"
 
 namespace pkslam {
 namespace {
@@ -71,6 +72,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   WriteTrajectory(system.KeyFrameTrajectory(), out / "keyframes.txt", TrajectoryFormat::kTum);
   system.WriteMapPly(out / "map_points.ply");
   if (options.system.trace) WriteTrace(system.tracker(), out / "keyframe_trace.csv");
+  WriteInertialOutputs(system, out);
 
   const auto& records = system.tracker().records();
   std::vector<double> tracking_ms;
