@@ -106,6 +106,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
     std::shared_lock lock(atlas_->mutex());
     if (kf->IsBad() || kf->map() == nullptr) return false;
     chain = InertialChain(kf.get(), 0);
+    PKSLAM_LOG_DEBUG("IMU initialisation check at kf {}: chain {}", kf->id(), chain.size());
     if (static_cast<int>(chain.size()) < o.min_keyframes) return false;
     const double span = static_cast<double>(chain.back()->t_ns() - chain.front()->t_ns()) * 1e-9;
     if (span < (mono ? o.min_time_mono_s : o.min_time_stereo_s)) return false;
@@ -115,6 +116,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
         travel += (chain[i]->CameraCenter() - chain[i - 1]->CameraCenter()).norm();
       }
       // Scale is unobservable without motion: wait (documented in inertial_mapping.h).
+      PKSLAM_LOG_DEBUG("IMU initialisation check: travel {:.3f}", travel);
       if (travel < o.mono_min_travel) return false;
     }
     for (std::size_t i = 0; i < chain.size(); ++i) {

@@ -167,7 +167,9 @@ InertialPoseOutput OptimizeInertialPose(Frame* frame, const InertialPoseInput& i
   }
 
   ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
+  // 30 unknowns, but the (many) reprojection rows touch only the 6 pose columns: sparse normal
+  // equations avoid forming a dense rows x 30 Jacobian.
+  solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver_options.max_num_iterations = options.iterations_per_round;
   solver_options.num_threads = options.num_threads;
   solver_options.logging_type = ceres::SILENT;

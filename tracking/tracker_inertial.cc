@@ -163,21 +163,9 @@ bool Tracker::TrackWithImu() {
     n = matcher.SearchByProjection(&current_, last_, 2 * th, mono);
   }
   current_.outliers.assign(current_.size(), 0);
-  // Few matches: the IMU prediction stands and the local map search decides (ORB-SLAM3).
-  if (n < options_.min_matches_motion_model) return true;
-  const SE3d predicted = current_.camera_from_world();
-  OptimizePose(&current_, options_.pose);
-  int in_map = 0;
-  for (int i = 0; i < current_.size(); ++i) {
-    if (!current_.map_points[i]) continue;
-    if (current_.outliers[i]) {
-      current_.map_points[i].reset();
-      current_.outliers[i] = 0;
-    } else if (current_.map_points[i]->NumObservations() > 0) {
-      ++in_map;
-    }
-  }
-  if (in_map < 10) current_.SetPose(predicted);
+  // The IMU prediction stands: the matches are classified by the visual-inertial optimisation
+  // after the local map search (ORB-SLAM3 runs a visual-only optimisation here first; with the
+  // IMU prediction it only costs time).
   return true;
 }
 
