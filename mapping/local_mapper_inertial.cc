@@ -158,6 +158,9 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
       if (other->imu.from_previous) Reintegrate(r.bias, &*other->imu.from_previous);
     }
     ApplyScaledRotation(map, new_from_old, r.scale);
+    ++map->world_change_index;
+    map->last_world_rotation = new_from_old;
+    map->last_world_scale = r.scale;
     map->imu_initialized = true;
     if (!refinement) map->imu_init_t_ns = kf->t_ns();
     map->applied_scale *= r.scale;

@@ -99,6 +99,7 @@ TrackResult Tracker::Track(Frame frame) {
     SelectorInput selector_input;
     {
       std::shared_lock lock(atlas_->mutex());
+      if (imu_) SyncWithInertialMapLocked(/*correct_current=*/false);  // the world tracked in
       // Local mapping may have fused points of the last frame into others meanwhile.
       for (auto& mp : last_.map_points) {
         while (mp && mp->replaced_by()) mp = mp->replaced_by();
@@ -198,6 +199,7 @@ void Tracker::RecordFrame(bool keyframe, double ms) {
       state_ == TrackingState::kOk || (imu_ != nullptr && state_ == TrackingState::kRecentlyLost);
   if (posed && current_.HasPose() && ref) {
     std::shared_lock lock(atlas_->mutex());
+    if (imu_) SyncWithInertialMapLocked(/*correct_current=*/true);
     r.reference = ref;
     r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
   }

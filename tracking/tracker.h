@@ -108,6 +108,9 @@ class Tracker {
   bool ImuReady() const;  // the current map's IMU is initialised (Atlas lock held)
   void PreintegrateImu();
   void SyncWithInertialMap();
+  // The same with the Atlas lock held; `correct_current` carries the current frame's pose and
+  // velocity across a world change (rotation / rescale) made since it was tracked.
+  void SyncWithInertialMapLocked(bool correct_current);
   bool PredictWithImu();
   bool TrackWithImu();
   // Visual pose optimisation, or visual-inertial once the map's IMU is initialised.

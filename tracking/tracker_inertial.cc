@@ -92,11 +92,16 @@ void Tracker::PreintegrateImu() {
 
 void Tracker::SyncWithInertialMap() {
   std::shared_lock lock(atlas_->mutex());
+  SyncWithInertialMapLocked(false);
+}
+
+void Tracker::SyncWithInertialMapLocked(bool correct_current) {
   const Map* map = atlas_->current_map();
   if (map != imu_->map) {
     imu_->map = map;
     imu_->seen_change_index = map->imu_change_index;
     imu_->seen_scale = map->applied_scale;
+    imu_->seen_world_change_index = map->world_change_index;
     imu_->from_keyframe = true;
     imu_->last_frame_information.reset();
     return;
@@ -105,6 +110,19 @@ void Tracker::SyncWithInertialMap() {
     imu_->seen_change_index = map->imu_change_index;
     imu_->from_keyframe = true;
     imu_->last_frame_information.reset();
+  }
+  if (map->world_change_index != imu_->seen_world_change_index) {
+    // Local mapping rotated / rescaled the map after the current frame was tracked: its pose is
+    // in the old world. One change is carried across exactly; more cannot be (not observed).
+    if (correct_current && current_.HasPose() &&
+        map->world_change_index == imu_->seen_world_change_index + 1) {
+      const SE3d& tcw = current_.camera_from_world();
+      current_.SetPose(SE3d(tcw.so3() * map->last_world_rotation.Inverse(),
+                            map->last_world_scale * tcw.translation()));
+      current_.imu.state.velocity_world =
+          map->last_world_scale * (map->last_world_rotation * current_.imu.state.velocity_world);
+    }
+    imu_->seen_world_change_index = map->world_change_index;
   }
   if (map->applied_scale != imu_->seen_scale) {
     // Monocular-inertial initialisation rescaled the map: what tracking keeps relative to its
@@ -216,6 +234,12 @@ void Tracker::OptimizeCurrentPose() {
 
 void Tracker::AttachImu(KeyFrame* kf, KeyFrame* previous, const Frame& frame) {
   if (!imu_) return;
+  // A world change between tracking and keyframe creation: the keyframe takes the corrected
+  // pose (current_ is `frame` except at monocular initialisation, which precedes any change).
+  if (&frame == &current_) {
+    SyncWithInertialMapLocked(true);
+    kf->SetPose(current_.camera_from_world());
+  }
   kf->imu.state = frame.imu.state;
   if (previous == nullptr || previous->IsBad() || previous->map() != kf->map()) return;
   kf->imu.previous = previous;

@@ -21,6 +21,7 @@ struct InertialTrackingState {
   const Map* map = nullptr;
   int seen_change_index = 0;
   double seen_scale = 1.0;
+  int seen_world_change_index = 0;
   // Predict and optimise against the last keyframe (true after the map changed under us)
   // instead of the last frame.
   bool from_keyframe = true;

@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/geometry/so3.h"
 #include "core/map/ids.h"
 
 namespace pkslam {
@@ -65,6 +66,11 @@ class Map {
   // Product of the scale factors applied to the map (monocular-inertial initialisation), so
   // tracking can rescale what it stores relative to keyframes.
   double applied_scale = 1.0;
+  // Bumped when local mapping rotates / rescales the whole map (x' = scale * rotation * x);
+  // the last such change, so tracking can carry a frame tracked just before it across.
+  int world_change_index = 0;
+  SO3d last_world_rotation;
+  double last_world_scale = 1.0;
 
   // Drops everything (used on reset). Breaks every keyframe<->point link first.
   void Clear();
