@@ -27,7 +27,7 @@ TEST(InertialRun, StereoInertialSimulatedReplayMeetsAteBar) {
   const auto seq = dir / "seq";
   const auto out = dir / "out";
   const auto sim = RunPkslam(
-      fmt::format("--log-level warn simulate --out '{}' --trajectory '{}' --start 5 --duration 12 "
+      fmt::format("--log-level warn simulate --out '{}' --trajectory '{}' --start 5 --duration 8 "
                   "--quality fast --quiet --no-cloud --gyro-bias 0.002,-0.003,0.001 "
                   "--accel-bias 0.05,-0.03,0.04",
                   seq.string(), (shared / "euroc/groundtruth/V1_02_medium.txt").string()));
@@ -46,8 +46,9 @@ TEST(InertialRun, StereoInertialSimulatedReplayMeetsAteBar) {
   options.compute_rpe = false;
   const EvaluationResult r = EvaluateTrajectories(gt, est, options);
   // Nearly every frame is in the trajectory and the body trajectory meets the 3 cm bar.
-  EXPECT_GT(r.pairs.size(), 220u);
+  EXPECT_GT(r.pairs.size(), 150u);
   EXPECT_LT(r.ate_translation_m.rmse, 0.03) << "ATE " << r.ate_translation_m.rmse;
+  ::testing::Test::RecordProperty("ate_rmse_m", std::to_string(r.ate_translation_m.rmse));
 
   // The map's IMU was initialised and the last keyframes carry estimated biases.
   std::ifstream imu_csv(out / "keyframes_imu.csv");
