@@ -30,10 +30,10 @@ struct InertialBundleOptions {
   // Free keyframes of the local window (ORB-SLAM3: 10).
   int window = 10;
   // Local window: at most this many fixed visual-only keyframes (most shared points first).
-  int max_fixed_keyframes = 30;
+  int max_fixed_keyframes = 15;
   // Solver passes as BundleAdjustmentOptions (robust pass, outliers removed, refinement).
-  int iterations_first = 5;
-  int iterations_second = 5;
+  int iterations_first = 4;
+  int iterations_second = 4;
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
   int num_threads = 1;
