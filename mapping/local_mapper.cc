@@ -16,6 +16,7 @@ void LocalMappingOptions::Check() const {
   PKSLAM_CHECK_OPTION(min_found_ratio >= 0 && min_found_ratio < 1, "LocalMapping.min_found_ratio",
                       "{}", min_found_ratio);
   ba.Check();
+  inertial.Check();
 }
 
 LocalMapper::LocalMapper(Atlas* atlas, std::shared_ptr<const CameraRig> rig,

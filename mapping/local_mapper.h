@@ -21,6 +21,7 @@
 #include "core/map/atlas.h"
 #include "core/map/mapping_backend.h"
 #include "core/optim/bundle_adjustment.h"
+#include "mapping/inertial_mapping.h"
 
 namespace pkslam {
 
@@ -36,6 +37,8 @@ struct LocalMappingOptions {
   // Recent points: culled when found/visible < this ratio.
   double min_found_ratio = 0.25;
   BundleAdjustmentOptions ba;
+  // Inertial sensors: IMU initialisation stages and local inertial BA.
+  InertialMappingOptions inertial;
 
   void Check() const;
 };
@@ -91,6 +94,15 @@ class LocalMapper : public MappingBackend {
   void SearchInNeighbours(const KeyFramePtr& kf);
   void LocalBundleAdjustment(const KeyFramePtr& kf);
   void CullKeyFrames(const KeyFramePtr& kf);
+
+  // --- inertial sensors (mapping/local_mapper_inertial.cc) ---
+  // IMU initialisation stages (first, VIBA1, VIBA2) when due.
+  void InertialStep(const KeyFramePtr& kf);
+  bool InitializeImu(const KeyFramePtr& kf, double gyro_prior, double accel_prior, bool refinement);
+  void FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyro_prior, double accel_prior);
+  // Local inertial BA once the map's IMU is initialised; false if it did not apply (then the
+  // visual local BA runs).
+  bool LocalInertialBundleAdjustment(const KeyFramePtr& kf);
 
   Atlas* atlas_;
   std::shared_ptr<const CameraRig> rig_;

@@ -48,11 +48,15 @@ void LocalMapper::ProcessNext() {
     }
     if (keyframes > 2) {
       const auto ba_start = std::chrono::steady_clock::now();
-      LocalBundleAdjustment(kf);
+      if (!IsInertial(rig_->sensor) || !LocalInertialBundleAdjustment(kf)) {
+        LocalBundleAdjustment(kf);
+      }
       ba_ms = MsSince(ba_start);
     }
-    if (options_.cull_keyframes) CullKeyFrames(kf);
+    // Inertial maps keep every keyframe: the preintegration chain needs them (not culled).
+    if (options_.cull_keyframes && !IsInertial(rig_->sensor)) CullKeyFrames(kf);
   }
+  if (IsInertial(rig_->sensor) && !IsStoppedOrStopRequested()) InertialStep(kf);
   {
     std::lock_guard lock(mutex_);
     stats_.keyframe_ms.push_back(MsSince(start));

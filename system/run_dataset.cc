@@ -123,6 +123,14 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   Progress progress("tracking", sources.size(), options.quiet);
   const auto wall_start = std::chrono::steady_clock::now();
   const std::int64_t t0 = sources.front().t_ns;
+  // Inertial sensors: IMU samples are fed up to a little past each frame (the preintegration
+  // needs one at or after the frame's time).
+  constexpr std::int64_t kImuLookaheadNs = 20'000'000;
+  std::int64_t imu_fed_ns = t0 - kImuLookaheadNs;
+  if (IsInertial(sensor) && (!euroc || !euroc->has_imu() || euroc->imu().empty())) {
+    throw InputError(options.dataset,
+                     fmt::format("sensor {} needs IMU data (mav0/imu0)", SensorName(sensor)));
+  }
   for (const FrameSource& s : sources) {
     if (interrupt != nullptr && interrupt->load()) {
       summary.interrupted = true;
@@ -134,6 +142,10 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
       std::this_thread::sleep_until(due);
     }
     TrackResult r;
+    if (IsInertial(sensor)) {
+      system.AddImu(euroc->ImuBetween(imu_fed_ns, s.t_ns + kImuLookaheadNs));
+      imu_fed_ns = s.t_ns + kImuLookaheadNs;
+    }
     if (euroc) {
       const cv::Mat left = euroc->LoadCam0(s.a);
       if (IsStereo(sensor)) {

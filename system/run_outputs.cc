@@ -9,6 +9,7 @@
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "system/sparse_model_builder.h"
+#include "system/inertial_outputs.h"
 
 namespace pkslam {
 namespace {
@@ -73,6 +74,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   system.WriteMapPly(out / "map_points.ply");
   WriteSparseModel(BuildSparseModel(system), out / "sparse_model.txt");
   if (options.system.trace) WriteTrace(system.tracker(), out / "keyframe_trace.csv");
+  WriteInertialOutputs(system, out);
 
   const auto& records = system.tracker().records();
   std::vector<double> tracking_ms;

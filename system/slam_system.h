@@ -47,6 +47,8 @@ class SlamSystem {
   TrackResult TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns);
   TrackResult TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns);
   TrackResult TrackMonocular(const cv::Mat& image, std::int64_t t_ns);
+  // Inertial sensors: IMU samples (time-ordered) up to at least the next frame's time.
+  void AddImu(const std::vector<ImuMeasurement>& samples) { tracker_->AddImu(samples); }
 
   // Lets local mapping finish its queue and stops the threads (idempotent).
   void Shutdown();
@@ -61,6 +63,7 @@ class SlamSystem {
 
   const CameraRig& rig() const { return *setup_.rig; }
   const Tracker& tracker() const { return *tracker_; }
+  const Atlas& atlas() const { return atlas_; }
   LocalMappingStats mapping_stats() const { return mapper_->stats(); }
   // Keyframes and map points in the largest map; number of maps.
   int NumKeyFrames() const;

@@ -55,6 +55,10 @@ Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<con
   PKSLAM_CHECK(atlas_ != nullptr && vocabulary_ != nullptr && selector_ != nullptr &&
                    mapping_ != nullptr,
                "tracker needs an atlas, a vocabulary, a selector and local mapping");
+  if (IsInertial(rig_->sensor)) {
+    PKSLAM_CHECK(rig_->imu.has_value(), "inertial sensor without IMU noise model");
+    imu_ = std::make_unique<InertialTrackingState>();
+  }
 }
 
 Tracker::~Tracker() = default;
@@ -79,6 +83,7 @@ TrackResult Tracker::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
 TrackResult Tracker::Track(Frame frame) {
   const auto start = std::chrono::steady_clock::now();
   current_ = std::move(frame);
+  if (imu_) PreintegrateImu();
   TrackResult result;
   bool new_keyframe = false;
 
@@ -94,11 +99,17 @@ TrackResult Tracker::Track(Frame frame) {
     SelectorInput selector_input;
     {
       std::shared_lock lock(atlas_->mutex());
+      if (imu_) SyncWithInertialMapLocked(/*correct_current=*/false);  // the world tracked in
       // Local mapping may have fused points of the last frame into others meanwhile.
       for (auto& mp : last_.map_points) {
         while (mp && mp->replaced_by()) mp = mp->replaced_by();
       }
-      if (state_ == TrackingState::kOk) {
+      if (state_ == TrackingState::kOk && ImuReady()) {
+        ok = TrackWithImu();
+        if (!ok) ok = TrackReferenceKeyFrame();
+      } else if (state_ == TrackingState::kRecentlyLost && ImuReady()) {
+        ok = PredictWithImu();  // IMU-only prediction; the local map search decides
+      } else if (state_ == TrackingState::kOk) {
         if (!velocity_ || current_.id() < last_reloc_frame_id_ + 2) {
           ok = TrackReferenceKeyFrame();
         } else {
@@ -183,8 +194,12 @@ void Tracker::RecordFrame(bool keyframe, double ms) {
   r.tracking_ms = ms;
   r.inliers = inliers_;
   const KeyFramePtr& ref = current_.reference_kf ? current_.reference_kf : reference_kf_;
-  if (state_ == TrackingState::kOk && current_.HasPose() && ref) {
+  // Inertial: RECENTLY_LOST frames carry the IMU prediction and are recorded too.
+  const bool posed =
+      state_ == TrackingState::kOk || (imu_ != nullptr && state_ == TrackingState::kRecentlyLost);
+  if (posed && current_.HasPose() && ref) {
     std::shared_lock lock(atlas_->mutex());
+    if (imu_) SyncWithInertialMapLocked(/*correct_current=*/true);
     r.reference = ref;
     r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
   }
@@ -202,6 +217,7 @@ void Tracker::StereoInitialization() {
     current_.ComputeBoW(*vocabulary_);
     kf = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
     map->AddKeyFrame(kf);
+    AttachImu(kf.get(), nullptr, current_);
     for (int i = 0; i < current_.size(); ++i) {
       const auto p = current_.UnprojectStereo(i);
       if (!p) continue;

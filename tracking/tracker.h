@@ -16,6 +16,7 @@
 #include "core/map/mapping_backend.h"
 #include "keyframe/keyframe_selector.h"
 #include "tracking/frame_builder.h"
+#include "tracking/tracker_inertial.h"
 #include "tracking/tracking_options.h"
 
 namespace pkslam {
@@ -61,6 +62,9 @@ class Tracker {
   // Registered RGB-D pair: grey (or colour) image and depth (CV_16U raw or CV_32F metres).
   TrackResult TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns);
   TrackResult TrackMonocular(const cv::Mat& image, std::int64_t t_ns);
+  // Inertial sensors: IMU samples (time-ordered, after those already given) covering at least
+  // up to the next frame's time. Throws Error on out-of-order samples.
+  void AddImu(const std::vector<ImuMeasurement>& samples);
 
   TrackingState state() const { return state_; }
   const std::vector<FrameRecord>& records() const { return records_; }
@@ -100,6 +104,22 @@ class Tracker {
   void StartOver();
   void RecordFrame(bool keyframe, double ms);
 
+  // --- inertial sensors (tracking/tracker_inertial.cc) ---
+  bool ImuReady() const;  // the current map's IMU is initialised (Atlas lock held)
+  void PreintegrateImu();
+  void SyncWithInertialMap();
+  // The same with the Atlas lock held; `correct_current` carries the current frame's pose and
+  // velocity across a world change (rotation / rescale) made since it was tracked.
+  void SyncWithInertialMapLocked(bool correct_current);
+  bool PredictWithImu();
+  bool TrackWithImu();
+  // Visual pose optimisation, or visual-inertial once the map's IMU is initialised.
+  void OptimizeCurrentPose();
+  void AttachImu(KeyFrame* kf, KeyFrame* previous, const Frame& frame);
+  void FillImuSelectorInput(SelectorInput* in) const;
+  std::optional<PreintegratedImu> PreintegrateBetween(std::int64_t t0_ns, std::int64_t t1_ns,
+                                                      const ImuBias& bias) const;
+
   Atlas* atlas_;
   const Vocabulary* vocabulary_;
   std::shared_ptr<const CameraRig> rig_;
@@ -132,6 +152,7 @@ class Tracker {
   bool trace_enabled_ = false;
   std::vector<TraceRow> trace_;
   SelectorDecision last_decision_;
+  std::unique_ptr<InertialTrackingState> imu_;  // inertial sensors only
 };
 
 }  // namespace pkslam

@@ -39,6 +39,7 @@ SelectorInput Tracker::BuildSelectorInput() const {
     in.last_keyframe_camera_from_world = last_kf_->camera_from_world();
   }
   in.last_relocalisation_frame_id = last_reloc_frame_id_;
+  FillImuSelectorInput(&in);
   in.local_mapping_stopped = mapping_->IsStoppedOrStopRequested();
   in.local_mapping_idle = mapping_->AcceptsKeyFrames();
   in.local_mapping_initializing = mapping_->IsInitializingImu();
@@ -81,6 +82,7 @@ void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
     current_.ComputeBoW(*vocabulary_);
     kf = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
     map->AddKeyFrame(kf);
+    AttachImu(kf.get(), last_kf_.get(), current_);
     if (!IsMonocular(rig_->sensor)) {
       // New points from the closest keypoints with depth that have none (all closer than
       // th_depth and at least the nearest `new_keyframe_min_close_points`).
@@ -163,6 +165,8 @@ void Tracker::CreateInitialMapMonocular(const TwoViewResult& reconstruction) {
     kf_current = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
     map->AddKeyFrame(kf_init);
     map->AddKeyFrame(kf_current);
+    AttachImu(kf_init.get(), nullptr, *init_frame_);
+    AttachImu(kf_current.get(), kf_init.get(), current_);
     for (std::size_t i = 0; i < init_matches_.size(); ++i) {
       const int j = init_matches_[i];
       if (j < 0) continue;

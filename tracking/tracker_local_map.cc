@@ -77,7 +77,7 @@ bool Tracker::TrackLocalMap() {
   UpdateLocalPoints();
   SearchLocalPoints();
   current_.outliers.assign(current_.size(), 0);
-  OptimizePose(&current_, options_.pose);
+  OptimizeCurrentPose();
   inliers_ = 0;
   for (int i = 0; i < current_.size(); ++i) {
     const auto& mp = current_.map_points[i];

@@ -17,6 +17,7 @@
 #include "core/frame/camera_rig.h"
 #include "core/frame/feature_grid.h"
 #include "core/geometry/se3.h"
+#include "core/imu/inertial_state.h"
 #include "core/map/ids.h"
 
 namespace pkslam {
@@ -87,6 +88,7 @@ class Frame {
   std::vector<MapPointPtr> map_points;  // matched map point per keypoint, or nullptr
   std::vector<std::uint8_t> outliers;   // 1 = rejected by the last pose optimisation
   KeyFramePtr reference_kf;             // keyframe this frame's pose is stored relative to
+  FrameImu imu;                         // inertial sensors: preintegration and state
 
   int NumTrackedMapPoints() const;  // non-null, non-outlier matches
 

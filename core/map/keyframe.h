@@ -21,6 +21,7 @@
 #include "core/frame/camera_rig.h"
 #include "core/frame/feature_grid.h"
 #include "core/geometry/se3.h"
+#include "core/imu/inertial_state.h"
 #include "core/map/ids.h"
 
 namespace pkslam {
@@ -115,6 +116,9 @@ class KeyFrame {
   bool IsBad() const { return bad_; }
   // For a retired keyframe: camera_from_parent at retirement.
   const SE3d& camera_from_parent() const { return camera_from_parent_; }
+
+  // --- inertial sensors (guarded by the Atlas mutex; core/imu/inertial_state.h) ---
+  KeyFrameImu imu;
 
  private:
   void UpdateBestCovisibles();

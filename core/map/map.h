@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/geometry/so3.h"
 #include "core/map/ids.h"
 
 namespace pkslam {
@@ -56,6 +57,20 @@ class Map {
   bool imu_initialized = false;
   bool inertial_ba1_done = false;
   bool inertial_ba2_done = false;
+  // Time of the first keyframe of the IMU initialisation and of the initialisation [ns].
+  std::int64_t imu_init_t_ns = 0;
+  // Bumped whenever local mapping rotates / rescales the map or re-estimates keyframe
+  // velocities and biases (IMU initialisation, inertial BA): tracking then predicts from the
+  // last keyframe instead of the last frame.
+  int imu_change_index = 0;
+  // Product of the scale factors applied to the map (monocular-inertial initialisation), so
+  // tracking can rescale what it stores relative to keyframes.
+  double applied_scale = 1.0;
+  // Bumped when local mapping rotates / rescales the whole map (x' = scale * rotation * x);
+  // the last such change, so tracking can carry a frame tracked just before it across.
+  int world_change_index = 0;
+  SO3d last_world_rotation;
+  double last_world_scale = 1.0;
 
   // Drops everything (used on reset). Breaks every keyframe<->point link first.
   void Clear();

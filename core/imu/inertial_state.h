@@ -1,0 +1,42 @@
+// Inertial state carried by frames and keyframes of inertial sensors (value types; the
+// algorithms are in imu/, tracking/tracker_inertial.cc and mapping/).
+//
+// Ownership and locking: Frame::imu belongs to the tracking thread like the rest of a Frame.
+// KeyFrame::imu is guarded by the Atlas mutex (shared to read, exclusive to write) like the
+// keyframe's pose; `previous` / `next` point at live keyframes of the same map (the temporal
+// chain of an inertial map, kept by tracking when it creates keyframes).
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "core/imu/imu_types.h"
+#include "core/map/ids.h"
+
+namespace pkslam {
+
+// Velocity and biases of the body at one instant; `valid` once the map's IMU is initialised
+// (before that the velocity is unknown and the biases are the prior, zero).
+struct InertialState {
+  Eigen::Vector3d velocity_world = Eigen::Vector3d::Zero();  // [m/s], world frame
+  ImuBias bias;
+  bool valid = false;
+};
+
+// A frame's IMU data: the preintegration since the previous frame (linearised at the bias
+// tracking used) and the estimated state at the frame.
+struct FrameImu {
+  std::optional<PreintegratedImu> from_last_frame;
+  InertialState state;
+};
+
+// A keyframe's IMU data: the preintegration from the previous keyframe of the chain and the
+// estimated state.
+struct KeyFrameImu {
+  std::optional<PreintegratedImu> from_previous;  // spans previous->t_ns() .. this->t_ns()
+  KeyFrame* previous = nullptr;
+  KeyFrame* next = nullptr;
+  InertialState state;
+};
+
+}  // namespace pkslam

@@ -1,0 +1,218 @@
+// Collect and Apply phases of visual-inertial bundle adjustment; the solver is in
+// inertial_bundle_solve.cc.
+#include "mapping/inertial_bundle.h"
+
+#include <algorithm>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "core/map/keyframe.h"
+#include "core/map/map.h"
+#include "core/map/map_point.h"
+#include "core/util/error.h"
+#include "imu/preintegration.h"
+
+namespace pkslam {
+namespace {
+
+using KeyFrameIndex = std::unordered_map<const KeyFrame*, int>;
+
+// Inertial role of a problem keyframe (InertialBundleProblem::inertial).
+constexpr std::uint8_t kNoInertial = 0;
+constexpr std::uint8_t kFreeInertial = 1;
+constexpr std::uint8_t kFixedInertial = 2;
+
+PreintegratedImu WithoutSteps(const PreintegratedImu& pim) {
+  PreintegratedImu p = pim;
+  p.steps.clear();
+  p.steps.shrink_to_fit();
+  return p;
+}
+
+void AddKeyFrame(KeyFrame* kf, bool fixed, std::uint8_t inertial, InertialBundleProblem* problem,
+                 KeyFrameIndex* index) {
+  const KeyFramePtr shared = kf->map()->Share(kf);
+  PKSLAM_CHECK(shared != nullptr, "keyframe {} is not live in its map", kf->id());
+  (*index)[kf] = static_cast<int>(problem->visual.keyframes.size());
+  problem->visual.keyframes.push_back({shared, kf->camera_from_world(), fixed});
+  problem->inertial.push_back(inertial);
+  problem->velocities.push_back(kf->imu.state.velocity_world);
+  problem->biases.push_back(kf->imu.state.bias);
+}
+
+void AddPoint(const MapPointPtr& point, const KeyFrameIndex& index, BundleProblem* problem) {
+  const int point_index = static_cast<int>(problem->points.size());
+  bool any = false;
+  for (const auto& [id, obs] : point->observations()) {
+    const auto it = index.find(obs.keyframe);
+    if (it == index.end()) continue;
+    const KeyFrame& kf = *obs.keyframe;
+    const cv::KeyPoint& kp = kf.keypoints_undistorted()[obs.index];
+    const double u_right = kf.right_u().empty() ? -1.0 : kf.right_u()[obs.index];
+    problem->observations.push_back(
+        {it->second, point_index, obs.index, Eigen::Vector2d(kp.pt.x, kp.pt.y),
+         u_right >= 0 ? u_right : -1.0, kf.rig().pyramid.inv_sigma2[kp.octave]});
+    any = true;
+  }
+  if (any) problem->points.push_back({point, point->position()});
+}
+
+void SetCommon(const KeyFrame& kf, const InertialBundleOptions& options,
+               InertialBundleProblem* problem) {
+  const CameraRig& rig = kf.rig();
+  problem->visual.fx = rig.fx;
+  problem->visual.fy = rig.fy;
+  problem->visual.cx = rig.cx;
+  problem->visual.cy = rig.cy;
+  problem->visual.bf = rig.bf;
+  problem->camera_from_body = rig.body_from_camera.Inverse();
+  problem->gravity_world = Eigen::Vector3d(0, 0, -options.gravity_magnitude);
+}
+
+void AddEdges(const std::vector<KeyFrame*>& chain, const KeyFrameIndex& index,
+              InertialBundleProblem* problem) {
+  for (std::size_t i = 1; i < chain.size(); ++i) {
+    problem->edges.push_back(
+        {index.at(chain[i - 1]), index.at(chain[i]), WithoutSteps(*chain[i]->imu.from_previous)});
+  }
+}
+
+std::vector<MapPointPtr> PointsOf(const std::vector<KeyFrame*>& keyframes, const Map* map) {
+  std::vector<MapPointPtr> points;
+  std::unordered_set<const MapPoint*> seen;
+  for (const KeyFrame* kf : keyframes) {
+    for (const MapPointPtr& point : kf->map_points()) {
+      if (point && !point->IsBad() && point->map() == map && seen.insert(point.get()).second) {
+        points.push_back(point);
+      }
+    }
+  }
+  return points;
+}
+
+}  // namespace
+
+void InertialBundleOptions::Check() const {
+  PKSLAM_CHECK_OPTION(window >= 2, "inertial_ba.window", "{}", window);
+  PKSLAM_CHECK_OPTION(max_fixed_keyframes >= 0, "inertial_ba.max_fixed_keyframes", "{}",
+                      max_fixed_keyframes);
+  PKSLAM_CHECK_OPTION(iterations_first >= 1 && iterations_second >= 0, "inertial_ba.iterations",
+                      "{} / {}", iterations_first, iterations_second);
+  PKSLAM_CHECK_OPTION(chi2_mono > 0 && chi2_stereo > 0, "inertial_ba.chi2", "{} / {}", chi2_mono,
+                      chi2_stereo);
+  PKSLAM_CHECK_OPTION(num_threads >= 1, "inertial_ba.num_threads", "{}", num_threads);
+  PKSLAM_CHECK_OPTION(gravity_magnitude > 0, "inertial_ba.gravity_magnitude", "{}",
+                      gravity_magnitude);
+}
+
+std::vector<KeyFrame*> InertialChain(KeyFrame* newest, int max_length) {
+  std::vector<KeyFrame*> chain;
+  if (newest == nullptr || newest->IsBad()) return chain;
+  chain.push_back(newest);
+  KeyFrame* k = newest;
+  while ((max_length <= 0 || static_cast<int>(chain.size()) < max_length) &&
+         k->imu.previous != nullptr && k->imu.from_previous && !k->imu.previous->IsBad() &&
+         k->imu.previous->map() == newest->map()) {
+    k = k->imu.previous;
+    chain.push_back(k);
+  }
+  std::reverse(chain.begin(), chain.end());
+  return chain;
+}
+
+InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
+                                                 const InertialBundleOptions& options) {
+  options.Check();
+  InertialBundleProblem problem;
+  std::vector<KeyFrame*> chain = InertialChain(keyframe, options.window + 1);
+  // Only keyframes with an estimated inertial state take part (they all have one once the
+  // map's IMU is initialised, except possibly the newest few).
+  while (!chain.empty() && !chain.front()->imu.state.valid) chain.erase(chain.begin());
+  if (chain.size() < 2) return problem;
+  for (std::size_t i = 1; i < chain.size(); ++i) {
+    if (!chain[i]->imu.state.valid) {
+      chain.resize(i);
+      break;
+    }
+  }
+  if (chain.size() < 2) return problem;
+  const Map* map = keyframe->map();
+  SetCommon(*keyframe, options, &problem);
+  KeyFrameIndex index;
+  // The oldest is the anchor (fixed state, joined by its inertial edge).
+  for (std::size_t i = 0; i < chain.size(); ++i) {
+    AddKeyFrame(chain[i], i == 0, i == 0 ? kFixedInertial : kFreeInertial, &problem, &index);
+  }
+  AddEdges(chain, index, &problem);
+  const std::vector<KeyFrame*> free(chain.begin() + 1, chain.end());
+  const std::vector<MapPointPtr> points = PointsOf(free, map);
+  // Fixed visual keyframes: other observers of the points, those sharing most first.
+  std::unordered_map<KeyFrame*, int> shared;
+  for (const MapPointPtr& point : points) {
+    for (const auto& [id, obs] : point->observations()) {
+      if (index.count(obs.keyframe) > 0 || obs.keyframe->IsBad() || obs.keyframe->map() != map) {
+        continue;
+      }
+      ++shared[obs.keyframe];
+    }
+  }
+  std::vector<std::pair<int, KeyFrame*>> ranked;
+  for (const auto& [kf, count] : shared) ranked.emplace_back(count, kf);
+  std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second->id() < b.second->id();
+  });
+  if (static_cast<int>(ranked.size()) > options.max_fixed_keyframes) {
+    ranked.resize(static_cast<std::size_t>(options.max_fixed_keyframes));
+  }
+  for (const auto& [count, kf] : ranked) AddKeyFrame(kf, true, kNoInertial, &problem, &index);
+  for (const MapPointPtr& point : points) AddPoint(point, index, &problem.visual);
+  return problem;
+}
+
+InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
+                                                const InertialBundleOptions& options) {
+  options.Check();
+  InertialBundleProblem problem;
+  const std::vector<KeyFrame*> chain = InertialChain(newest, 0);
+  if (chain.size() < 2) return problem;
+  const Map* map = newest->map();
+  SetCommon(*newest, options, &problem);
+  KeyFrameIndex index;
+  // The first pose anchors position and yaw; its velocity and biases stay free.
+  for (std::size_t i = 0; i < chain.size(); ++i) {
+    AddKeyFrame(chain[i], i == 0, kFreeInertial, &problem, &index);
+  }
+  AddEdges(chain, index, &problem);
+  std::vector<KeyFrame*> others;
+  for (const auto& [id, kf] : map->keyframes()) {
+    if (!kf->IsBad() && index.count(kf.get()) == 0) others.push_back(kf.get());
+  }
+  for (KeyFrame* kf : others) AddKeyFrame(kf, true, kNoInertial, &problem, &index);
+  for (const MapPointPtr& point : PointsOf(chain, map)) AddPoint(point, index, &problem.visual);
+  return problem;
+}
+
+void ApplyInertialBundle(const InertialBundleProblem& problem, const InertialBundleResult& result) {
+  PKSLAM_CHECK(result.velocities.size() == problem.visual.keyframes.size() &&
+                   result.biases.size() == problem.visual.keyframes.size(),
+               "inertial result does not match the problem");
+  ApplyBundle(problem.visual, result.visual);
+  for (std::size_t i = 0; i < problem.visual.keyframes.size(); ++i) {
+    KeyFrame* kf = problem.visual.keyframes[i].keyframe.get();
+    if (problem.inertial[i] != kFreeInertial || kf->IsBad()) continue;
+    kf->imu.state.velocity_world = result.velocities[i];
+    kf->imu.state.bias = result.biases[i];
+    kf->imu.state.valid = true;
+  }
+  // Preintegrations follow their start keyframe's bias (re-integrated when it moved far).
+  const PreintegrationOptions reintegration;
+  for (const auto& edge : problem.edges) {
+    KeyFrame* from = problem.visual.keyframes[edge.from].keyframe.get();
+    KeyFrame* to = problem.visual.keyframes[edge.to].keyframe.get();
+    if (from->IsBad() || to->IsBad() || !to->imu.from_previous || to->imu.previous != from)
+      continue;
+    UpdateBias(from->imu.state.bias, reintegration, &*to->imu.from_previous);
+  }
+}
+
+}  // namespace pkslam

@@ -1,0 +1,92 @@
+// Visual-inertial bundle adjustment (ORB-SLAM3's LocalInertialBA and FullInertialBA) in Ceres,
+// in the three phases of core/optim/bundle_adjustment.h so the solver runs without the Atlas
+// lock: Collect (shared lock) -> Solve (no lock, abortable) -> Apply (exclusive lock).
+//
+// States are body poses world_from_body (BodyPoseManifold), velocities and biases; the visual
+// part (points, observations, outlier handling) is a BundleProblem whose keyframe poses are
+// converted through the rig's body_from_camera. Inertial edges (imu/imu_factors.h) join
+// consecutive keyframes of the map's temporal chain (KeyFrame::imu.previous).
+//
+// Local window: the newest `window` keyframes of the chain ending at the new keyframe are free
+// (pose, velocity, biases with random walks); the keyframe just before the window is fixed and
+// joined by its inertial edge: it anchors the window like a marginalisation prior with the
+// previous state held at its estimate (ORB-SLAM3's choice). Other keyframes observing the
+// window's points are fixed, visual only. Full: every chain keyframe, the first pose fixed;
+// optionally one bias pair shared by all with zero-mean priors (the BA right after the
+// inertial-only initialisation).
+#pragma once
+
+#include <Eigen/Core>
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "core/imu/imu_types.h"
+#include "core/optim/bundle_adjustment.h"
+
+namespace pkslam {
+
+struct InertialBundleOptions {
+  // Free keyframes of the local window (ORB-SLAM3: 10).
+  int window = 10;
+  // Local window: at most this many fixed visual-only keyframes (most shared points first).
+  int max_fixed_keyframes = 15;
+  // Solver passes as BundleAdjustmentOptions (robust pass, outliers removed, refinement).
+  int iterations_first = 4;
+  int iterations_second = 4;
+  double chi2_mono = 5.991;
+  double chi2_stereo = 7.815;
+  int num_threads = 1;
+  double gravity_magnitude = 9.81;
+
+  void Check() const;
+};
+
+struct InertialBundleProblem {
+  BundleProblem visual;
+  // Per visual.keyframes entry: whether it has inertial blocks, and their initial values.
+  std::vector<std::uint8_t> inertial;
+  std::vector<Eigen::Vector3d> velocities;
+  std::vector<ImuBias> biases;
+  // Preintegration between consecutive chain keyframes (indices into visual.keyframes).
+  struct Edge {
+    int from = -1;
+    int to = -1;
+    PreintegratedImu preintegration;  // without its steps
+  };
+  std::vector<Edge> edges;
+  SE3d camera_from_body;
+  Eigen::Vector3d gravity_world = Eigen::Vector3d(0, 0, -9.81);
+  // One gyro and one accel bias block for every keyframe, with zero-mean priors of these
+  // informations (0: none); otherwise per-keyframe biases joined by random walks.
+  bool shared_bias = false;
+  double gyro_prior_information = 0;
+  double accel_prior_information = 0;
+
+  bool empty() const { return visual.keyframes.empty(); }
+};
+
+struct InertialBundleResult {
+  BundleResult visual;
+  std::vector<Eigen::Vector3d> velocities;  // per visual.keyframes entry
+  std::vector<ImuBias> biases;
+};
+
+// Requires the Atlas mutex (shared). Keyframes without a valid inertial state end the chain.
+InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
+                                                 const InertialBundleOptions& options);
+InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
+                                                const InertialBundleOptions& options);
+// Pure computation; `abort` (may be null) is polled between iterations.
+InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
+                                         const InertialBundleOptions& options,
+                                         const std::atomic<bool>* abort = nullptr);
+// Requires the Atlas mutex (exclusive): ApplyBundle for the visual part, then velocities and
+// biases of free inertial keyframes, and re-linearises the preintegrations whose bias moved.
+void ApplyInertialBundle(const InertialBundleProblem& problem, const InertialBundleResult& result);
+
+// The temporal chain ending at `newest` (oldest first), at most `max_length` keyframes (0: all),
+// stopping at a retired keyframe or one without a preintegration to its predecessor.
+std::vector<KeyFrame*> InertialChain(KeyFrame* newest, int max_length);
+
+}  // namespace pkslam

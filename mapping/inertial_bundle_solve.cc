@@ -1,0 +1,278 @@
+// Solve phase of visual-inertial bundle adjustment: Ceres on a copy of the collected state.
+#include <ceres/iteration_callback.h>
+#include <ceres/loss_function.h>
+#include <ceres/ordered_groups.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "core/util/log.h"
+#include "imu/body_reprojection_error.h"
+#include "imu/imu_factors.h"
+#include "imu/imu_manifolds.h"
+#include "mapping/inertial_bundle.h"
+
+namespace pkslam {
+namespace {
+
+// Stops the solver once *abort is set, keeping the best iterate (see core/optim/bundle_solve.cc).
+class AbortCallback final : public ceres::IterationCallback {
+ public:
+  explicit AbortCallback(const std::atomic<bool>* abort) : abort_(abort) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override {
+    if (abort_ == nullptr || !abort_->load(std::memory_order_relaxed)) {
+      return ceres::SOLVER_CONTINUE;
+    }
+    fired_ = true;
+    return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+  }
+  bool fired() const { return fired_; }
+
+ private:
+  const std::atomic<bool>* abort_;
+  bool fired_ = false;
+};
+
+constexpr int kMaxFreePosesForDenseSchur = 40;
+
+struct State {
+  std::vector<double> poses;                                  // 7 per keyframe (world_from_body)
+  std::vector<double> points;                                 // 3 per point
+  std::vector<double> velocities, gyro_biases, accel_biases;  // 3 per keyframe
+  double* pose(int i) { return poses.data() + kBodyPoseBlockSize * i; }
+  double* point(int i) { return points.data() + 3 * i; }
+  double* v(int i) { return velocities.data() + 3 * i; }
+  double* bg(int i) { return gyro_biases.data() + 3 * i; }
+  double* ba(int i) { return accel_biases.data() + 3 * i; }
+};
+
+double ObservationChi2(const BodyCamera& camera, const BundleProblem::ObservationState& o,
+                       State& s) {
+  const SE3d world_from_body = BodyPoseFromBlock(s.pose(o.keyframe_index));
+  const Eigen::Map<const Eigen::Vector3d> p(s.point(o.point_index));
+  if (o.u_right >= 0) {
+    return BodyStereoChi2(camera, world_from_body, p,
+                          Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right), o.inv_sigma2);
+  }
+  return BodyMonoChi2(camera, world_from_body, p, o.uv, o.inv_sigma2);
+}
+
+}  // namespace
+
+InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
+                                         const InertialBundleOptions& options,
+                                         const std::atomic<bool>* abort) {
+  options.Check();
+  const BundleProblem& visual = problem.visual;
+  const int num_kf = static_cast<int>(visual.keyframes.size());
+  const int num_points = static_cast<int>(visual.points.size());
+  BodyCamera camera;
+  camera.fx = visual.fx;
+  camera.fy = visual.fy;
+  camera.cx = visual.cx;
+  camera.cy = visual.cy;
+  camera.bf = visual.bf;
+  camera.camera_from_body = problem.camera_from_body;
+  const SE3d body_from_camera = problem.camera_from_body.Inverse();
+
+  State s;
+  s.poses.resize(static_cast<std::size_t>(kBodyPoseBlockSize * num_kf));
+  s.points.resize(static_cast<std::size_t>(3 * num_points));
+  s.velocities.resize(static_cast<std::size_t>(3 * num_kf));
+  s.gyro_biases.resize(static_cast<std::size_t>(3 * num_kf));
+  s.accel_biases.resize(static_cast<std::size_t>(3 * num_kf));
+  for (int i = 0; i < num_kf; ++i) {
+    BodyPoseToBlock(visual.keyframes[i].camera_from_world.Inverse() * problem.camera_from_body,
+                    s.pose(i));
+    Eigen::Map<Eigen::Vector3d>(s.v(i)) = problem.velocities[i];
+    Eigen::Map<Eigen::Vector3d>(s.bg(i)) = problem.biases[i].gyro;
+    Eigen::Map<Eigen::Vector3d>(s.ba(i)) = problem.biases[i].accel;
+  }
+  for (int i = 0; i < num_points; ++i) {
+    Eigen::Map<Eigen::Vector3d>(s.point(i)) = visual.points[i].position_world;
+  }
+  // With shared biases every keyframe uses the blocks of the first inertial keyframe.
+  int shared_index = -1;
+  for (int i = 0; i < num_kf && problem.shared_bias; ++i) {
+    if (problem.inertial[i] != 0) {
+      shared_index = i;
+      break;
+    }
+  }
+  auto bg = [&](int i) { return s.bg(shared_index >= 0 ? shared_index : i); };
+  auto ba = [&](int i) { return s.ba(shared_index >= 0 ? shared_index : i); };
+
+  InertialBundleResult result;
+  auto write_result = [&]() {
+    result.visual.camera_from_world.clear();
+    result.visual.points_world.clear();
+    result.velocities.clear();
+    result.biases.clear();
+    for (int i = 0; i < num_kf; ++i) {
+      result.visual.camera_from_world.push_back(
+          visual.keyframes[i].fixed ? visual.keyframes[i].camera_from_world
+                                    : (BodyPoseFromBlock(s.pose(i)) * body_from_camera).Inverse());
+      result.velocities.emplace_back(Eigen::Map<const Eigen::Vector3d>(s.v(i)));
+      result.biases.emplace_back(Eigen::Map<const Eigen::Vector3d>(bg(i)),
+                                 Eigen::Map<const Eigen::Vector3d>(ba(i)));
+    }
+    for (int i = 0; i < num_points; ++i) {
+      result.visual.points_world.emplace_back(Eigen::Map<const Eigen::Vector3d>(s.point(i)));
+    }
+  };
+  if (problem.empty() || (abort != nullptr && abort->load())) {
+    result.visual.aborted = !problem.empty();
+    write_result();
+    return result;
+  }
+
+  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
+  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
+  ceres::LossFunctionWrapper loss_mono(&huber_mono, ceres::DO_NOT_TAKE_OWNERSHIP);
+  ceres::LossFunctionWrapper loss_stereo(&huber_stereo, ceres::DO_NOT_TAKE_OWNERSHIP);
+  BodyPoseManifold pose_manifold;
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.enable_fast_removal = true;
+  ceres::Problem ceres_problem(problem_options);
+
+  std::vector<std::uint8_t> pose_added(static_cast<std::size_t>(num_kf), 0);
+  auto add_pose = [&](int i) {
+    if (pose_added[i]) return;
+    ceres_problem.AddParameterBlock(s.pose(i), kBodyPoseBlockSize, &pose_manifold);
+    if (visual.keyframes[i].fixed) ceres_problem.SetParameterBlockConstant(s.pose(i));
+    pose_added[i] = 1;
+  };
+  // Inertial blocks: constant for anchors (inertial == 2).
+  std::vector<std::uint8_t> inertial_added(static_cast<std::size_t>(num_kf), 0);
+  auto add_inertial = [&](int i) {
+    add_pose(i);
+    if (inertial_added[i]) return;
+    inertial_added[i] = 1;
+    ceres_problem.AddParameterBlock(s.v(i), 3);
+    ceres_problem.AddParameterBlock(bg(i), 3);
+    ceres_problem.AddParameterBlock(ba(i), 3);
+    if (problem.inertial[i] == 2) {
+      ceres_problem.SetParameterBlockConstant(s.v(i));
+      if (shared_index < 0) {
+        ceres_problem.SetParameterBlockConstant(bg(i));
+        ceres_problem.SetParameterBlockConstant(ba(i));
+      }
+    }
+  };
+
+  for (const auto& e : problem.edges) {
+    add_inertial(e.from);
+    add_inertial(e.to);
+    ceres_problem.AddResidualBlock(
+        new InertialError(e.preintegration, problem.gravity_world), nullptr,
+        {s.pose(e.from), s.v(e.from), bg(e.from), ba(e.from), s.pose(e.to), s.v(e.to)});
+    if (shared_index < 0) {
+      ceres_problem.AddResidualBlock(BiasRandomWalkError::Gyro(e.preintegration).release(), nullptr,
+                                     bg(e.from), bg(e.to));
+      ceres_problem.AddResidualBlock(BiasRandomWalkError::Accel(e.preintegration).release(),
+                                     nullptr, ba(e.from), ba(e.to));
+    }
+  }
+  if (shared_index >= 0) {
+    if (problem.gyro_prior_information > 0) {
+      ceres_problem.AddResidualBlock(
+          new BiasPriorError(Eigen::Vector3d::Zero(), problem.gyro_prior_information), nullptr,
+          bg(shared_index));
+    }
+    if (problem.accel_prior_information > 0) {
+      ceres_problem.AddResidualBlock(
+          new BiasPriorError(Eigen::Vector3d::Zero(), problem.accel_prior_information), nullptr,
+          ba(shared_index));
+    }
+  }
+
+  const int num_obs = static_cast<int>(visual.observations.size());
+  std::vector<ceres::ResidualBlockId> blocks(static_cast<std::size_t>(num_obs), nullptr);
+  std::vector<std::uint8_t> point_added(static_cast<std::size_t>(num_points), 0);
+  for (int i = 0; i < num_obs; ++i) {
+    const BundleProblem::ObservationState& o = visual.observations[i];
+    if (!std::isfinite(ObservationChi2(camera, o, s))) continue;
+    add_pose(o.keyframe_index);
+    point_added[o.point_index] = 1;
+    double* pose = s.pose(o.keyframe_index);
+    double* point = s.point(o.point_index);
+    if (o.u_right >= 0) {
+      blocks[i] = ceres_problem.AddResidualBlock(
+          new BodyStereoReprojectionError(camera, Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right),
+                                          o.inv_sigma2),
+          &loss_stereo, pose, point);
+    } else {
+      blocks[i] = ceres_problem.AddResidualBlock(
+          new BodyMonoReprojectionError(camera, o.uv, o.inv_sigma2), &loss_mono, pose, point);
+    }
+  }
+
+  ceres::Solver::Options solver_options;
+  int free_poses = 0;
+  for (int i = 0; i < num_kf; ++i) free_poses += pose_added[i] && !visual.keyframes[i].fixed;
+  solver_options.linear_solver_type =
+      free_poses <= kMaxFreePosesForDenseSchur ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
+  solver_options.num_threads = options.num_threads;
+  solver_options.logging_type = ceres::SILENT;
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (int i = 0; i < num_points; ++i) {
+    if (point_added[i]) ordering->AddElementToGroup(s.point(i), 0);
+  }
+  for (int i = 0; i < num_kf; ++i) {
+    if (pose_added[i]) ordering->AddElementToGroup(s.pose(i), 1);
+    if (inertial_added[i]) {
+      ordering->AddElementToGroup(s.v(i), 1);
+      if (shared_index < 0 || i == shared_index) {
+        ordering->AddElementToGroup(bg(i), 1);
+        ordering->AddElementToGroup(ba(i), 1);
+      }
+    }
+  }
+  solver_options.linear_solver_ordering = ordering;
+  AbortCallback abort_callback(abort);
+  solver_options.callbacks.push_back(&abort_callback);
+
+  bool first = true;
+  auto solve = [&](int iterations) {
+    if (ceres_problem.NumResidualBlocks() == 0) return;
+    solver_options.max_num_iterations = iterations;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &ceres_problem, &summary);
+    if (first) result.visual.initial_cost = summary.initial_cost;
+    first = false;
+    result.visual.final_cost = summary.final_cost;
+    result.visual.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
+    result.visual.aborted = abort_callback.fired();
+    if (summary.termination_type == ceres::FAILURE) {
+      PKSLAM_LOG_WARN("inertial bundle adjustment: solver failure: {}", summary.message);
+    }
+  };
+
+  solve(options.iterations_first);
+  for (int i = 0; i < num_obs; ++i) {
+    const auto& o = visual.observations[i];
+    const bool outlier = !(ObservationChi2(camera, o, s) <=
+                           (o.u_right >= 0 ? options.chi2_stereo : options.chi2_mono));
+    if (!outlier) continue;
+    result.visual.outlier_observations.push_back(i);
+    if (blocks[i] != nullptr) {
+      ceres_problem.RemoveResidualBlock(blocks[i]);
+      blocks[i] = nullptr;
+    }
+  }
+  if (!result.visual.aborted && options.iterations_second > 0) {
+    loss_mono.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+    loss_stereo.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+    solve(options.iterations_second);
+  }
+  write_result();
+  return result;
+}
+
+}  // namespace pkslam

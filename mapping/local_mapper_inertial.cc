@@ -1,0 +1,248 @@
+// LocalMapper: IMU initialisation stages and local inertial BA (see mapping/inertial_mapping.h).
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <shared_mutex>
+
+#include "core/map/keyframe.h"
+#include "core/map/map.h"
+#include "core/map/map_point.h"
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "imu/inertial_initializer.h"
+#include "imu/preintegration.h"
+#include "mapping/local_mapper.h"
+
+namespace pkslam {
+namespace {
+
+SE3d WorldFromBody(const KeyFrame& kf) {
+  return kf.world_from_camera() * kf.rig().body_from_camera.Inverse();
+}
+
+// Rotates (world' = R * world) and scales (x' = s x) every keyframe and point of the map, as
+// ORB-SLAM3's Map::ApplyScaledRotation. Requires the Atlas mutex (exclusive).
+void ApplyScaledRotation(Map* map, const SO3d& new_from_old, double scale) {
+  for (const auto& [id, kf] : map->keyframes()) {
+    const SE3d& tcw = kf->camera_from_world();
+    SE3d updated(tcw.so3() * new_from_old.Inverse(), scale * tcw.translation());
+    kf->SetPose(updated);
+    kf->imu.state.velocity_world = scale * (new_from_old * kf->imu.state.velocity_world);
+  }
+  for (const auto& [id, point] : map->map_points()) {
+    if (point->IsBad()) continue;
+    point->SetPosition(scale * (new_from_old * point->position()));
+    point->UpdateNormalAndDepth();
+  }
+}
+
+}  // namespace
+
+void InertialMappingOptions::Check() const {
+  PKSLAM_CHECK_OPTION(min_keyframes >= 3, "inertial.min_keyframes", "{}", min_keyframes);
+  PKSLAM_CHECK_OPTION(min_time_stereo_s >= 0 && min_time_mono_s >= 0, "inertial.min_time",
+                      "{} / {}", min_time_stereo_s, min_time_mono_s);
+  PKSLAM_CHECK_OPTION(mono_min_travel >= 0, "inertial.mono_min_travel", "{}", mono_min_travel);
+  PKSLAM_CHECK_OPTION(init_gyro_prior >= 0 && init_accel_prior_mono >= 0 &&
+                          init_accel_prior_stereo >= 0 && viba1_gyro_prior >= 0 &&
+                          viba1_accel_prior >= 0,
+                      "inertial.priors", "{}", "negative");
+  PKSLAM_CHECK_OPTION(viba1_s > 0 && viba2_s > viba1_s, "inertial.viba", "{} / {}", viba1_s,
+                      viba2_s);
+  PKSLAM_CHECK_OPTION(full_ba_iterations >= 1, "inertial.full_ba_iterations", "{}",
+                      full_ba_iterations);
+  local_ba.Check();
+}
+
+void LocalMapper::InertialStep(const KeyFramePtr& kf) {
+  bool initialized = false;
+  bool ba1 = false;
+  bool ba2 = false;
+  std::int64_t init_t_ns = 0;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    if (kf->IsBad() || kf->map() == nullptr) return;
+    const Map* map = kf->map();
+    initialized = map->imu_initialized;
+    ba1 = map->inertial_ba1_done;
+    ba2 = map->inertial_ba2_done;
+    init_t_ns = map->imu_init_t_ns;
+  }
+  const InertialMappingOptions& o = options_.inertial;
+  const bool mono = IsMonocular(rig_->sensor);
+  if (!initialized) {
+    initializing_imu_.store(true);
+    InitializeImu(kf, o.init_gyro_prior, mono ? o.init_accel_prior_mono : o.init_accel_prior_stereo,
+                  false);
+    initializing_imu_.store(false);
+    return;
+  }
+  const double since = static_cast<double>(kf->t_ns() - init_t_ns) * 1e-9;
+  auto mark = [&](bool second) {
+    std::unique_lock lock(atlas_->mutex());
+    if (kf->map() == nullptr) return;
+    (second ? kf->map()->inertial_ba2_done : kf->map()->inertial_ba1_done) = true;
+  };
+  if (!ba1 && since > o.viba1_s) {
+    initializing_imu_.store(true);
+    if (InitializeImu(kf, o.viba1_gyro_prior, o.viba1_accel_prior, true)) mark(false);
+    initializing_imu_.store(false);
+  } else if (ba1 && !ba2 && since > o.viba2_s) {
+    initializing_imu_.store(true);
+    if (InitializeImu(kf, 0.0, 0.0, true)) mark(true);
+    initializing_imu_.store(false);
+  }
+}
+
+bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double accel_prior,
+                                bool refinement) {
+  const InertialMappingOptions& o = options_.inertial;
+  const bool mono = IsMonocular(rig_->sensor);
+  std::vector<InertialInitKeyFrame> keyframes;
+  std::vector<PreintegratedImu> preintegrations;
+  std::vector<KeyFrame*> chain;
+  ImuBias initial_bias;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    if (kf->IsBad() || kf->map() == nullptr) return false;
+    chain = InertialChain(kf.get(), 0);
+    PKSLAM_LOG_DEBUG("IMU initialisation check at kf {}: chain {}", kf->id(), chain.size());
+    if (static_cast<int>(chain.size()) < o.min_keyframes) return false;
+    const double span = static_cast<double>(chain.back()->t_ns() - chain.front()->t_ns()) * 1e-9;
+    if (span < (mono ? o.min_time_mono_s : o.min_time_stereo_s)) return false;
+    if (mono && !refinement) {
+      double travel = 0;
+      for (std::size_t i = 1; i < chain.size(); ++i) {
+        travel += (chain[i]->CameraCenter() - chain[i - 1]->CameraCenter()).norm();
+      }
+      // Scale is unobservable without motion: wait (documented in inertial_mapping.h).
+      PKSLAM_LOG_DEBUG("IMU initialisation check: travel {:.3f}", travel);
+      if (travel < o.mono_min_travel) return false;
+    }
+    for (std::size_t i = 0; i < chain.size(); ++i) {
+      keyframes.push_back({chain[i]->t_ns(), WorldFromBody(*chain[i])});
+      if (i > 0) preintegrations.push_back(*chain[i]->imu.from_previous);
+    }
+    initial_bias = kf->imu.state.bias;
+  }
+  InertialInitializerOptions init_options;
+  init_options.estimate_scale = mono;
+  init_options.gyro_bias_prior_information = gyro_prior;
+  init_options.accel_bias_prior_information = accel_prior;
+  init_options.gravity_magnitude = o.local_ba.gravity_magnitude;
+  const auto start = std::chrono::steady_clock::now();
+  const InertialInitResult r =
+      InitializeInertial(keyframes, preintegrations, initial_bias, init_options);
+  if (!r.success) {
+    PKSLAM_LOG_WARN("IMU initialisation at t = {:.2f} s failed: {}", kf->t_s(), r.message);
+    return false;
+  }
+  {
+    std::unique_lock lock(atlas_->mutex());
+    Map* map = kf->map();
+    if (map == nullptr || kf->IsBad()) return false;
+    const SO3d new_from_old = r.world_from_gravity.Inverse();
+    // Chain keyframes get the estimated velocities; keyframes added since the collection get
+    // the newest one's. Everything is rotated (and scaled) below.
+    for (std::size_t i = 0; i < chain.size(); ++i) {
+      if (chain[i]->IsBad()) continue;
+      chain[i]->imu.state.velocity_world = r.velocities_world[i];
+      chain[i]->imu.state.valid = true;
+    }
+    for (const auto& [id, other] : map->keyframes()) {
+      other->imu.state.bias = r.bias;
+      if (!other->imu.state.valid) {
+        other->imu.state.velocity_world = r.velocities_world.back();
+        other->imu.state.valid = true;
+      }
+      if (other->imu.from_previous) Reintegrate(r.bias, &*other->imu.from_previous);
+    }
+    ApplyScaledRotation(map, new_from_old, r.scale);
+    ++map->world_change_index;
+    map->last_world_rotation = new_from_old;
+    map->last_world_scale = r.scale;
+    map->imu_initialized = true;
+    if (!refinement) map->imu_init_t_ns = kf->t_ns();
+    map->applied_scale *= r.scale;
+    ++map->imu_change_index;
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  PKSLAM_LOG_INFO(
+      "IMU {} at t = {:.2f} s over {} keyframes: scale {:.4f}, gyro bias ({:.5f} "
+      "{:.5f} {:.5f}), accel bias ({:.4f} {:.4f} {:.4f}), {:.0f} ms",
+      refinement ? "refinement" : "initialisation", kf->t_s(), chain.size(), r.scale,
+      r.bias.gyro.x(), r.bias.gyro.y(), r.bias.gyro.z(), r.bias.accel.x(), r.bias.accel.y(),
+      r.bias.accel.z(), ms);
+  FullInertialBundleAdjustment(kf, gyro_prior, accel_prior);
+  return true;
+}
+
+void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyro_prior,
+                                               double accel_prior) {
+  InertialBundleProblem problem;
+  InertialBundleOptions ba = options_.inertial.local_ba;
+  ba.iterations_first = options_.inertial.full_ba_iterations;
+  ba.iterations_second = options_.inertial.full_ba_iterations;
+  ba.num_threads = options_.ba.num_threads;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    if (kf->IsBad() || kf->map() == nullptr) return;
+    problem = CollectFullInertialBundle(kf.get(), ba);
+  }
+  if (problem.empty()) return;
+  problem.shared_bias = true;
+  problem.gyro_prior_information = gyro_prior;
+  problem.accel_prior_information = accel_prior;
+  const InertialBundleResult result = SolveInertialBundle(problem, ba);
+  std::unique_lock lock(atlas_->mutex());
+  if (kf->map() == nullptr) return;
+  ApplyInertialBundle(problem, result);
+  // Keyframes newer than the problem take the estimated biases too.
+  if (!result.biases.empty()) {
+    for (const auto& [id, other] : kf->map()->keyframes()) {
+      if (other->id() > kf->id()) other->imu.state.bias = result.biases.front();
+    }
+  }
+  ++kf->map()->imu_change_index;
+}
+
+bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
+  InertialBundleProblem problem;
+  InertialBundleOptions ba = options_.inertial.local_ba;
+  ba.num_threads = options_.ba.num_threads;
+  {
+    std::unique_lock lock(atlas_->mutex());
+    if (kf->IsBad() || kf->map() == nullptr || !kf->map()->imu_initialized) return false;
+    // Keyframes created from frames tracked before the initialisation reached tracking have
+    // no estimated state yet: start them at their predecessor's.
+    std::vector<KeyFrame*> missing;
+    for (KeyFrame* k = kf.get(); k != nullptr && !k->imu.state.valid; k = k->imu.previous) {
+      missing.push_back(k);
+    }
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+      KeyFrame* k = *it;
+      if (k->imu.previous == nullptr || !k->imu.previous->imu.state.valid) break;
+      k->imu.state = k->imu.previous->imu.state;
+    }
+  }
+  {
+    std::shared_lock lock(atlas_->mutex());
+    if (kf->IsBad() || kf->map() == nullptr) return false;
+    problem = CollectLocalInertialBundle(kf.get(), ba);
+  }
+  if (problem.empty() || problem.edges.empty()) return false;
+  const InertialBundleResult result = SolveInertialBundle(problem, ba, &abort_ba_);
+  std::unique_lock lock(atlas_->mutex());
+  if (kf->map() == nullptr) return true;
+  ApplyInertialBundle(problem, result);
+  ++kf->map()->imu_change_index;
+  if (result.visual.aborted) {
+    lock.unlock();
+    std::lock_guard stats_lock(mutex_);
+    ++stats_.ba_aborted;
+  }
+  return true;
+}
+
+}  // namespace pkslam

@@ -1,0 +1,268 @@
+// Visual-inertial tracking (ORB-SLAM3's IMU paths of Tracking): preintegration between frames,
+// IMU prediction of the pose, visual-inertial pose optimisation against the last frame (with
+// the prior from its own optimisation) or the last keyframe (fixed, after the map changed),
+// IMU-only prediction while vision is weak (RECENTLY_LOST), and the IMU data handed to
+// keyframes and to the keyframe selector.
+#include <algorithm>
+#include <mutex>
+#include <shared_mutex>
+
+#include "core/map/keyframe.h"
+#include "core/map/map.h"
+#include "core/map/map_point.h"
+#include "core/matching/orb_matcher.h"
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "imu/preintegration.h"
+#include "tracking/tracker.h"
+
+namespace pkslam {
+namespace {
+
+SE3d WorldFromBody(const SE3d& camera_from_world, const CameraRig& rig) {
+  return camera_from_world.Inverse() * rig.body_from_camera.Inverse();
+}
+
+std::string V(const Eigen::Vector3d& v) {
+  return fmt::format("({:.3f} {:.3f} {:.3f})", v.x(), v.y(), v.z());
+}
+
+SE3d CameraFromWorld(const SE3d& world_from_body, const CameraRig& rig) {
+  return (world_from_body * rig.body_from_camera).Inverse();
+}
+
+}  // namespace
+
+void Tracker::AddImu(const std::vector<ImuMeasurement>& samples) {
+  PKSLAM_CHECK(imu_ != nullptr, "IMU samples given to a {} tracker", SensorName(rig_->sensor));
+  for (const ImuMeasurement& m : samples) {
+    if (!imu_->queue.empty() && m.t_ns <= imu_->queue.back().t_ns) {
+      throw Error(fmt::format("IMU sample at {} ns is not after the previous one ({} ns)", m.t_ns,
+                              imu_->queue.back().t_ns));
+    }
+    imu_->queue.push_back(m);
+  }
+}
+
+bool Tracker::ImuReady() const { return imu_ != nullptr && atlas_->current_map()->imu_initialized; }
+
+std::optional<PreintegratedImu> Tracker::PreintegrateBetween(std::int64_t t0_ns, std::int64_t t1_ns,
+                                                             const ImuBias& bias) const {
+  const auto& q = imu_->queue;
+  if (q.empty() || t1_ns <= t0_ns || q.front().t_ns > t0_ns || q.back().t_ns < t1_ns) {
+    return std::nullopt;
+  }
+  // The last sample at or before t0 through the first at or after t1.
+  auto first = std::upper_bound(q.begin(), q.end(), t0_ns,
+                                [](std::int64_t t, const ImuMeasurement& m) { return t < m.t_ns; });
+  if (first != q.begin()) --first;
+  auto last = std::lower_bound(q.begin(), q.end(), t1_ns,
+                               [](const ImuMeasurement& m, std::int64_t t) { return m.t_ns < t; });
+  const std::vector<ImuMeasurement> samples(first, last + 1);
+  PreintegratedImu pim = StartPreintegration(bias, *rig_->imu);
+  IntegrateSamples(samples, t0_ns, t1_ns, &pim);
+  return pim;
+}
+
+void Tracker::PreintegrateImu() {
+  SyncWithInertialMap();
+  // The bias tracking integrates with: the last frame's estimate, else the last keyframe's.
+  ImuBias bias;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    if (last_.imu.state.valid) {
+      bias = last_.imu.state.bias;
+    } else if (last_kf_) {
+      bias = last_kf_->imu.state.bias;
+    }
+  }
+  current_.imu.state.bias = bias;
+  if (imu_->last_frame_t_ns >= 0) {
+    current_.imu.from_last_frame =
+        PreintegrateBetween(imu_->last_frame_t_ns, current_.t_ns(), bias);
+  }
+  imu_->last_frame_t_ns = current_.t_ns();
+  // Keep what the oldest anchor still needs.
+  std::int64_t anchor = current_.t_ns();
+  if (last_kf_) anchor = std::min(anchor, last_kf_->t_ns());
+  if (init_frame_) anchor = std::min(anchor, init_frame_->t_ns());
+  auto& q = imu_->queue;
+  while (q.size() >= 2 && q[1].t_ns <= anchor) q.pop_front();
+}
+
+void Tracker::SyncWithInertialMap() {
+  std::shared_lock lock(atlas_->mutex());
+  SyncWithInertialMapLocked(false);
+}
+
+void Tracker::SyncWithInertialMapLocked(bool correct_current) {
+  const Map* map = atlas_->current_map();
+  if (map != imu_->map) {
+    imu_->map = map;
+    imu_->seen_change_index = map->imu_change_index;
+    imu_->seen_scale = map->applied_scale;
+    imu_->seen_world_change_index = map->world_change_index;
+    imu_->from_keyframe = true;
+    imu_->last_frame_information.reset();
+    return;
+  }
+  if (map->imu_change_index != imu_->seen_change_index) {
+    imu_->seen_change_index = map->imu_change_index;
+    imu_->from_keyframe = true;
+    imu_->last_frame_information.reset();
+  }
+  if (map->world_change_index != imu_->seen_world_change_index) {
+    // Local mapping rotated / rescaled the map after the current frame was tracked: its pose is
+    // in the old world. One change is carried across exactly; more cannot be (not observed).
+    if (correct_current && current_.HasPose() &&
+        map->world_change_index == imu_->seen_world_change_index + 1) {
+      const SE3d& tcw = current_.camera_from_world();
+      current_.SetPose(SE3d(tcw.so3() * map->last_world_rotation.Inverse(),
+                            map->last_world_scale * tcw.translation()));
+      current_.imu.state.velocity_world =
+          map->last_world_scale * (map->last_world_rotation * current_.imu.state.velocity_world);
+    }
+    imu_->seen_world_change_index = map->world_change_index;
+  }
+  if (map->applied_scale != imu_->seen_scale) {
+    // Monocular-inertial initialisation rescaled the map: what tracking keeps relative to its
+    // keyframes scales with it.
+    const double ratio = map->applied_scale / imu_->seen_scale;
+    imu_->seen_scale = map->applied_scale;
+    for (FrameRecord& r : records_) {
+      if (r.reference && r.reference->map() == map) r.camera_from_reference.translation() *= ratio;
+    }
+    if (velocity_) velocity_->translation() *= ratio;
+  }
+}
+
+bool Tracker::PredictWithImu() {
+  const Eigen::Vector3d g(0, 0, -imu_->gravity_magnitude);
+  NavState start;
+  ImuBias bias;
+  std::optional<PreintegratedImu> kf_pim;
+  const PreintegratedImu* pim = nullptr;
+  if (imu_->from_keyframe || !last_.imu.state.valid || !current_.imu.from_last_frame ||
+      !last_.HasPose()) {
+    if (!last_kf_ || last_kf_->IsBad() || !last_kf_->imu.state.valid) return false;
+    start = {WorldFromBody(last_kf_->camera_from_world(), *rig_),
+             last_kf_->imu.state.velocity_world};
+    bias = last_kf_->imu.state.bias;
+    kf_pim = PreintegrateBetween(last_kf_->t_ns(), current_.t_ns(), bias);
+    if (!kf_pim) return false;
+    pim = &*kf_pim;
+  } else {
+    start = {WorldFromBody(last_.camera_from_world(), *rig_), last_.imu.state.velocity_world};
+    bias = last_.imu.state.bias;
+    pim = &*current_.imu.from_last_frame;
+  }
+  const NavState predicted = PredictState(start, *pim, bias, g);
+  PKSLAM_LOG_DEBUG("imu predict frame {} from {} dt {:.3f}: p {} -> {} v {} -> {}", current_.id(),
+                   kf_pim ? "keyframe" : "frame", pim->dt, V(start.world_from_body.translation()),
+                   V(predicted.world_from_body.translation()), V(start.velocity_world),
+                   V(predicted.velocity_world));
+  current_.SetPose(CameraFromWorld(predicted.world_from_body, *rig_));
+  current_.imu.state.velocity_world = predicted.velocity_world;
+  current_.imu.state.bias = bias;
+  current_.imu.state.valid = true;
+  return true;
+}
+
+bool Tracker::TrackWithImu() {
+  UpdateLastFrame();
+  if (!PredictWithImu()) return false;
+  std::fill(current_.map_points.begin(), current_.map_points.end(), nullptr);
+  const bool mono = IsMonocular(rig_->sensor);
+  const double th = mono ? options_.motion_model_radius_mono : options_.motion_model_radius_stereo;
+  const OrbMatcher matcher(0.9, true);
+  int n = matcher.SearchByProjection(&current_, last_, th, mono);
+  if (n < options_.min_matches_motion_model) {
+    std::fill(current_.map_points.begin(), current_.map_points.end(), nullptr);
+    n = matcher.SearchByProjection(&current_, last_, 2 * th, mono);
+  }
+  current_.outliers.assign(current_.size(), 0);
+  // The IMU prediction stands: the matches are classified by the visual-inertial optimisation
+  // after the local map search (ORB-SLAM3 runs a visual-only optimisation here first; with the
+  // IMU prediction it only costs time).
+  return true;
+}
+
+void Tracker::OptimizeCurrentPose() {
+  if (!ImuReady() || !current_.imu.state.valid) {
+    OptimizePose(&current_, options_.pose);
+    return;
+  }
+  InertialPoseInput in;
+  in.gravity_world = Eigen::Vector3d(0, 0, -imu_->gravity_magnitude);
+  std::optional<PreintegratedImu> kf_pim;
+  const bool use_last_frame = !imu_->from_keyframe && imu_->last_frame_information &&
+                              imu_->information_frame_id == last_.id() && last_.imu.state.valid &&
+                              current_.imu.from_last_frame && last_.HasPose();
+  if (use_last_frame) {
+    in.previous_state = {WorldFromBody(last_.camera_from_world(), *rig_),
+                         last_.imu.state.velocity_world};
+    in.previous_bias = last_.imu.state.bias;
+    in.previous_information = *imu_->last_frame_information;
+    in.preintegration = &*current_.imu.from_last_frame;
+  } else {
+    if (!last_kf_ || last_kf_->IsBad() || !last_kf_->imu.state.valid) {
+      OptimizePose(&current_, options_.pose);
+      return;
+    }
+    in.previous_state = {WorldFromBody(last_kf_->camera_from_world(), *rig_),
+                         last_kf_->imu.state.velocity_world};
+    in.previous_bias = last_kf_->imu.state.bias;
+    kf_pim = PreintegrateBetween(last_kf_->t_ns(), current_.t_ns(), in.previous_bias);
+    if (!kf_pim) {
+      OptimizePose(&current_, options_.pose);
+      return;
+    }
+    in.preintegration = &*kf_pim;
+  }
+  const SE3d before = current_.camera_from_world();
+  const InertialPoseOutput out = OptimizeInertialPose(&current_, in, options_.pose);
+  PKSLAM_LOG_DEBUG(
+      "inertial pose frame {} ({}): inliers {}, moved {:.4f} m, v {}", current_.id(),
+      use_last_frame ? "last frame" : "keyframe", out.inliers,
+      (current_.camera_from_world().Inverse().translation() - before.Inverse().translation())
+          .norm(),
+      V(out.state.velocity_world));
+  imu_->last_frame_information = out.information;
+  imu_->information_frame_id = current_.id();
+  imu_->from_keyframe = false;
+}
+
+void Tracker::AttachImu(KeyFrame* kf, KeyFrame* previous, const Frame& frame) {
+  if (!imu_) return;
+  // A world change between tracking and keyframe creation: the keyframe takes the corrected
+  // pose (current_ is `frame` except at monocular initialisation, which precedes any change).
+  if (&frame == &current_) {
+    SyncWithInertialMapLocked(true);
+    kf->SetPose(current_.camera_from_world());
+  }
+  kf->imu.state = frame.imu.state;
+  if (previous == nullptr || previous->IsBad() || previous->map() != kf->map()) return;
+  kf->imu.previous = previous;
+  previous->imu.next = kf;
+  kf->imu.from_previous =
+      PreintegrateBetween(previous->t_ns(), kf->t_ns(), previous->imu.state.bias);
+  if (!kf->imu.state.valid) kf->imu.state.bias = previous->imu.state.bias;
+}
+
+void Tracker::FillImuSelectorInput(SelectorInput* in) const {
+  if (!imu_ || !current_.imu.from_last_frame) return;
+  const PreintegratedImu& pim = *current_.imu.from_last_frame;
+  SelectorImuInterval interval;
+  interval.dt = pim.dt;
+  interval.mean_accel = pim.average_accel;
+  interval.mean_gyro = pim.average_gyro;
+  if (ImuReady() && last_.HasPose()) {
+    // Specific force in the world frame plus gravity: the body's own acceleration.
+    const SO3d r_wb = WorldFromBody(last_.camera_from_world(), *rig_).so3();
+    interval.mean_accel_world_no_gravity =
+        r_wb * pim.average_accel + Eigen::Vector3d(0, 0, -imu_->gravity_magnitude);
+  }
+  in->imu_since_last_frame = interval;
+}
+
+}  // namespace pkslam
