@@ -63,7 +63,6 @@ class SlamSystem {
 
   const CameraRig& rig() const { return *setup_.rig; }
   const Tracker& tracker() const { return *tracker_; }
-  const Atlas& atlas() const { return atlas_; }
   LocalMappingStats mapping_stats() const { return mapper_->stats(); }
   // Keyframes and map points in the largest map; number of maps.
   int NumKeyFrames() const;
