@@ -10,5 +10,7 @@ void RegisterEvalCommand(CLI::App& app);
 void RegisterInfoCommand(CLI::App& app);
 void RegisterRunCommand(CLI::App& app);
 void RegisterVocabCommand(CLI::App& app);
+void RegisterRgbdOdometryCommand(CLI::App& app);
+void RegisterPlanarCommand(CLI::App& app);
 
 }  // namespace pkslam::apps

@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterInfoCommand(app);
   pkslam::apps::RegisterRunCommand(app);
   pkslam::apps::RegisterVocabCommand(app);
+  pkslam::apps::RegisterRgbdOdometryCommand(app);
+  pkslam::apps::RegisterPlanarCommand(app);
 
   try {
     app.parse(argc, argv);
