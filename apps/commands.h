@@ -12,5 +12,6 @@ void RegisterRunCommand(CLI::App& app);
 void RegisterVocabCommand(CLI::App& app);
 void RegisterRgbdOdometryCommand(CLI::App& app);
 void RegisterPlanarCommand(CLI::App& app);
+void RegisterSimulateCommand(CLI::App& app);
 
 }  // namespace pkslam::apps

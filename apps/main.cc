@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterVocabCommand(app);
   pkslam::apps::RegisterRgbdOdometryCommand(app);
   pkslam::apps::RegisterPlanarCommand(app);
+  pkslam::apps::RegisterSimulateCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "core/imu/imu_types.h"
+
 namespace pkslam {
 
 // One image of a sequence: its timestamp and the absolute path of its file.
@@ -36,12 +38,8 @@ struct ImageStream {
   std::vector<TimeGap> gaps;                   // between consecutive usable images
 };
 
-// One IMU reading, in the IMU sensor frame.
-struct ImuSample {
-  std::int64_t t_ns = 0;
-  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   // angular velocity [rad/s]
-  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // specific force [m/s^2]
-};
+// One IMU reading, in the IMU sensor frame (the core type; readers and algorithms share it).
+using ImuSample = ImuMeasurement;
 
 // Gaps of a strictly increasing time series: intervals > max_periods * nominal period.
 // nominal_period_ns <= 0 uses the median interval. Fewer than 2 samples: no gaps.

@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include "core/map/keyframe.h"
+#include "core/map/keyframe_database.h"
 #include "core/map/map_point.h"
 #include "core/matching/orb_matcher.h"
 #include "core/util/log.h"
@@ -78,6 +79,8 @@ void LocalMapper::ProcessNewKeyFrame(const KeyFramePtr& kf) {
     }
   }
   kf->UpdateConnections();
+  // Findable by relocalisation and place recognition from now on.
+  if (KeyFrameDatabase* database = atlas_->database()) database->Add(kf.get());
 }
 
 void LocalMapper::CullRecentPoints(const KeyFramePtr& kf) {

@@ -6,6 +6,7 @@
 #include <shared_mutex>
 
 #include "core/map/keyframe.h"
+#include "core/map/keyframe_database.h"
 #include "core/map/map_point.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -34,6 +35,7 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   for (const auto& [k, v] : options_.selector_parameters) selector_parameters[k] = v;
   auto selector = MakeKeyframeSelector(options_.selector, selector_parameters);
 
+  atlas_.SetDatabase(std::make_unique<KeyFrameDatabase>(*vocabulary_));
   mapper_ = std::make_unique<LocalMapper>(&atlas_, setup_.rig, options_.mapping);
   OrbOptions orb;
   orb.n_features = settings.orb.n_features;

@@ -16,8 +16,9 @@ struct PoseOptimizerOptions {
   // chi2 thresholds (95%, 2 and 3 DoF) for monocular and stereo residuals.
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
-  // Rounds (from the first) that use the Huber loss; later rounds use plain least squares.
-  int robust_rounds = 2;
+  // Rounds (from the first) that use the Huber loss; later rounds use plain least squares
+  // (ORB-SLAM removes the kernel after its third round).
+  int robust_rounds = 3;
   // Ceres threads (1 in deterministic mode).
   int num_threads = 1;
 

@@ -74,6 +74,7 @@ class Tracker {
   };
   const std::vector<TraceRow>& trace() const { return trace_; }
   void EnableTrace(bool on) { trace_enabled_ = on; }
+  int relocalisations() const { return relocalisations_; }
 
   // Drops the current map (a reset) and starts again from NOT_INITIALIZED.
   void Reset();
@@ -92,7 +93,7 @@ class Tracker {
   int SearchLocalPoints();
   SelectorInput BuildSelectorInput() const;
   void CreateNewKeyFrame(const SelectorInput& input);
-  // Issue 6 brings relocalisation; until then a lost camera cannot relocalise.
+  // Finds the frame's pose in the current map from BoW candidates (tracking/relocalization.cc).
   bool Relocalize();
   void HandleLost();
   // Back to NOT_INITIALIZED on the current (new or cleared) map.
@@ -119,6 +120,7 @@ class Tracker {
   FrameId last_reloc_frame_id_ = -1000000;
   int inliers_ = 0;
   std::int64_t lost_since_t_ns_ = 0;
+  int relocalisations_ = 0;
 
   // Local map (rebuilt every frame).
   std::vector<KeyFrame*> local_keyframes_;

@@ -218,6 +218,4 @@ int Tracker::SearchLocalPoints() {
   return matcher.SearchByProjection(&current_, projected, th);
 }
 
-bool Tracker::Relocalize() { return false; }
-
 }  // namespace pkslam

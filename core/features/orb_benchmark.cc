@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "core/camera/stereo_rectification.h"
+#include "core/camera/test_cameras.h"
 #include "core/features/keypoint_spread.h"
 #include "core/features/orb_extractor.h"
 #include "core/features/stereo_matcher.h"
@@ -234,24 +236,31 @@ void BM_PkslamOrbStereo_Euroc(benchmark::State& state) {
   state.counters["features"] = static_cast<double>(fl.keypoints.size() + fr.keypoints.size());
 }
 
-// Stereo matching alone on the real (unrectified: EuRoC's raw images are only roughly row
-// aligned, so the count is low) pair; EuRoC bf = 458.654 * 0.110078.
+// Stereo matching alone on the real pair, rectified with the EuRoC calibration.
 void BM_StereoMatch_Euroc(benchmark::State& state) {
-  cv::Mat left, right;
-  if (!LoadEurocPair(&left, &right)) {
+  cv::Mat raw_left, raw_right;
+  if (!LoadEurocPair(&raw_left, &raw_right)) {
     state.SkipWithError("EuRoC stereo pair not found (../shared/data/euroc/V1_01_easy_static)");
     return;
   }
+  const StereoRectification rectification(testing::EurocCam0(), testing::EurocCam1(),
+                                          testing::EurocCam1FromCam0());
+  const auto [left, right] = rectification.Rectify(raw_left, raw_right);
   const OrbExtractor extractor(PkslamOptions(true));
   OrbFeatures fl, fr;
   extractor.ExtractStereo(left, right, &fl, &fr);
-  const double fx = 458.654;
   StereoMatches matches;
   for (auto _ : state) {
-    matches = MatchStereo(fl, fr, fx * 0.110078, fx);
+    matches = MatchStereo(fl, fr, rectification.bf(), rectification.rectified_camera().fx());
     benchmark::DoNotOptimize(matches.num_matches);
   }
+  std::vector<double> depths;
+  for (float d : matches.depth) {
+    if (d > 0.0f) depths.push_back(d);
+  }
   state.counters["matches"] = matches.num_matches;
+  state.counters["left_keypoints"] = static_cast<double>(fl.keypoints.size());
+  state.counters["median_depth_m"] = depths.empty() ? 0.0 : Median(depths);
 }
 
 BENCHMARK(BM_PkslamOrb_Euroc)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(285);

@@ -51,6 +51,12 @@ bool IntensityRangeWithin(const cv::Mat& image, int range) {
   return true;
 }
 
+// The options after Check(), so that members built from them never see bad values.
+const OrbOptions& Checked(const OrbOptions& options) {
+  options.Check();
+  return options;
+}
+
 }  // namespace
 
 void OrbOptions::Check() const {
@@ -73,8 +79,9 @@ void OrbOptions::Check() const {
 }
 
 OrbExtractor::OrbExtractor(const OrbOptions& options)
-    : options_(options), orientation_(options.patch_size / 2), pattern_(options.patch_size) {
-  options_.Check();
+    : options_(Checked(options)),
+      orientation_(options.patch_size / 2),
+      pattern_(options.patch_size) {
   const int n = options_.n_levels;
   scale_.resize(n);
   inv_scale_.resize(n);

@@ -55,6 +55,7 @@ TEST(OrbOptions, CheckRejectsInconsistentValues) {
   // The rotated tests of a 31 patch reach 18.4 px: an 18 px edge leaves no room.
   EXPECT_THROW(bad([](OrbOptions& o) { o.edge_threshold = 18; }).Check(), OptionError);
   EXPECT_THROW(OrbExtractor(bad([](OrbOptions& o) { o.cell_size = 5; })), OptionError);
+  EXPECT_THROW(OrbExtractor(bad([](OrbOptions& o) { o.patch_size = -31; })), OptionError);
 }
 
 TEST(OrbExtractor, LevelTablesAndQuotas) {

@@ -4,12 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 
+#include "core/camera/stereo_rectification.h"
+#include "core/camera/test_cameras.h"
 #include "core/features/orb_extractor.h"
 #include "core/features/synthetic_texture.h"
 #include "core/util/error.h"
+#include "tests/support/test_data.h"
 
 namespace pkslam {
 namespace {
@@ -246,6 +251,44 @@ TEST_F(StereoMatcherTest, RejectsInconsistentInput) {
                                          right_.descriptors, right_.pyramid, kBf, kFx);
   EXPECT_TRUE(none.depth.empty());
   EXPECT_EQ(none.num_matches, 0);
+}
+
+// Real EuRoC pair (V1_01 static, rectified with the calibration): most keypoints find a
+// partner, and their depths are those of a room (no depth truth exists for these images).
+TEST(StereoMatcher, RealRectifiedEurocPair) {
+  PKSLAM_REQUIRE_SHARED_DATA(shared);
+  const std::filesystem::path mav = shared / "euroc" / "V1_01_easy_static" / "mav0";
+  const std::string name = "1403715273262142976.png";
+  const cv::Mat raw_left =
+      cv::imread((mav / "cam0" / "data" / name).string(), cv::IMREAD_GRAYSCALE);
+  const cv::Mat raw_right =
+      cv::imread((mav / "cam1" / "data" / name).string(), cv::IMREAD_GRAYSCALE);
+  if (raw_left.empty() || raw_right.empty()) GTEST_SKIP() << "EuRoC pair " << name << " absent";
+  const StereoRectification rectification(testing::EurocCam0(), testing::EurocCam1(),
+                                          testing::EurocCam1FromCam0());
+  const auto [left_image, right_image] = rectification.Rectify(raw_left, raw_right);
+  OrbFeatures left, right;
+  OrbExtractor().ExtractStereo(left_image, right_image, &left, &right);
+  const double fx = rectification.rectified_camera().fx();
+  const StereoMatches m = MatchStereo(left, right, rectification.bf(), fx);
+  std::vector<double> depths;
+  for (float d : m.depth) {
+    if (d > 0.0f) depths.push_back(d);
+  }
+  RecordProperty("euroc_matches",
+                 std::to_string(m.num_matches) + "/" + std::to_string(left.keypoints.size()));
+  ASSERT_GT(m.num_matches, 0.4 * left.keypoints.size());
+  const double median_depth = Median(depths);
+  RecordProperty("euroc_median_depth_m", std::to_string(median_depth));
+  EXPECT_GT(median_depth, 1.0);
+  EXPECT_LT(median_depth, 8.0);
+  // Rows agree: the matched right keypoint's band (+-2 scale, widened to whole rows) holds the
+  // left keypoint's row.
+  for (std::size_t i = 0; i < m.depth.size(); ++i) {
+    if (m.depth[i] < 0.0f) continue;
+    const cv::KeyPoint& kr = right.keypoints[m.right_index[i]];
+    EXPECT_LT(std::abs(kr.pt.y - left.keypoints[i].pt.y), 2.0 * std::pow(1.2, kr.octave) + 2.0);
+  }
 }
 
 }  // namespace

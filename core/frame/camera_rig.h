@@ -3,27 +3,17 @@
 // the body (IMU) extrinsics. Replaces ORB-SLAM's static Frame members.
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
 #include <optional>
-
-#include <Eigen/Core>
 
 #include "core/camera/camera_model.h"
 #include "core/frame/scale_pyramid.h"
 #include "core/frame/sensor.h"
 #include "core/geometry/se3.h"
+#include "core/imu/imu_types.h"  // ImuNoise
 
 namespace pkslam {
-
-// Noise model of the IMU (continuous-time densities, as in EuRoC's sensor.yaml / ORB-SLAM3's
-// settings) and its rate.
-struct ImuNoise {
-  double gyro_noise_density = 1.7e-4;   // rad/s/sqrt(Hz)
-  double accel_noise_density = 2.0e-3;  // m/s^2/sqrt(Hz)
-  double gyro_random_walk = 1.9393e-5;  // rad/s^2/sqrt(Hz)
-  double accel_random_walk = 3.0e-3;    // m/s^3/sqrt(Hz)
-  double rate_hz = 200.0;
-};
 
 struct ImageBounds {
   double min_x = 0, max_x = 0, min_y = 0, max_y = 0;

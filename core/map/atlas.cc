@@ -6,9 +6,21 @@ namespace pkslam {
 
 Atlas::Atlas() { CreateNewMap(); }
 
+Atlas::~Atlas() {
+  // Maps erase their keyframes from the database while clearing; the database goes last.
+  for (auto& m : maps_) m->Clear();
+  maps_.clear();
+}
+
+void Atlas::SetDatabase(std::unique_ptr<KeyFrameDatabase> database) {
+  database_ = std::move(database);
+  for (auto& m : maps_) m->set_database(database_.get());
+}
+
 Map* Atlas::CreateNewMap() {
   maps_.push_back(std::make_unique<Map>(next_map_id_++));
   current_ = maps_.back().get();
+  current_->set_database(database_.get());
   return current_;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/map/ids.h"
+#include "core/map/keyframe_database.h"
 #include "core/map/map.h"
 
 namespace pkslam {
@@ -16,6 +17,7 @@ namespace pkslam {
 class Atlas {
  public:
   Atlas();
+  ~Atlas();
   Atlas(const Atlas&) = delete;
   Atlas& operator=(const Atlas&) = delete;
 
@@ -35,6 +37,11 @@ class Atlas {
   std::vector<Map*> maps() const;
   int NumMaps() const { return static_cast<int>(maps_.size()); }
 
+  // The keyframe database over all maps (place recognition); null until set. Guarded by the
+  // Atlas mutex like the rest of the map model. Every map created afterwards uses it.
+  void SetDatabase(std::unique_ptr<KeyFrameDatabase> database);
+  KeyFrameDatabase* database() const { return database_.get(); }
+
   // Id counters (thread-safe, deterministic: ids increase by one per call).
   FrameId NextFrameId() { return next_frame_id_.fetch_add(1); }
   KeyFrameId NextKeyFrameId() { return next_kf_id_.fetch_add(1); }
@@ -42,6 +49,7 @@ class Atlas {
 
  private:
   mutable std::shared_mutex mutex_;
+  std::unique_ptr<KeyFrameDatabase> database_;  // declared before maps_: outlives them
   std::vector<std::unique_ptr<Map>> maps_;
   Map* current_ = nullptr;
   MapId next_map_id_ = 0;

@@ -1,6 +1,7 @@
 #include "core/map/map.h"
 
 #include "core/map/keyframe.h"
+#include "core/map/keyframe_database.h"
 #include "core/map/map_point.h"
 
 namespace pkslam {
@@ -20,6 +21,7 @@ void Map::EraseMapPoint(const MapPoint* point) { map_points_.erase(point->id());
 void Map::RetireKeyFrame(const KeyFrame* kf) {
   auto it = keyframes_.find(kf->id());
   if (it == keyframes_.end()) return;
+  if (database_ != nullptr) database_->Erase(kf);
   retired_[kf->id()] = std::move(it->second);
   keyframes_.erase(it);
 }
@@ -62,6 +64,7 @@ MapPointPtr Map::Share(const MapPoint* point) const {
 }
 
 void Map::Clear() {
+  if (database_ != nullptr) database_->Clear(this);
   // Keyframes hold points and points point back at keyframes: unlink before releasing so
   // nothing outlives the map holding a dangling back reference.
   for (auto& [id, point] : map_points_) point->set_map(nullptr);

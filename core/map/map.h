@@ -12,6 +12,8 @@
 
 namespace pkslam {
 
+class KeyFrameDatabase;
+
 class Map {
  public:
   explicit Map(MapId id) : id_(id) {}
@@ -58,6 +60,10 @@ class Map {
   // Drops everything (used on reset). Breaks every keyframe<->point link first.
   void Clear();
 
+  // The place-recognition index keyframes are erased from when retired (owned by the Atlas).
+  void set_database(KeyFrameDatabase* database) { database_ = database; }
+  KeyFrameDatabase* database() const { return database_; }
+
  private:
   MapId id_;
   std::map<KeyFrameId, KeyFramePtr> keyframes_;
@@ -66,6 +72,7 @@ class Map {
   KeyFrame* origin_ = nullptr;
   KeyFrameId max_kf_id_ = kInvalidId;
   int change_index_ = 0;
+  KeyFrameDatabase* database_ = nullptr;
 };
 
 }  // namespace pkslam

@@ -21,17 +21,15 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "core/geometry/pinhole_intrinsics.h"
 #include "core/geometry/se3.h"
 
 namespace pkslam {
 
 inline constexpr double kMinReprojectionDepth = 1e-6;
 
-// Intrinsics of the rectified / undistorted pinhole camera the keypoints live in; bf is the
-// stereo (or RGB-D virtual) baseline times fx, used by stereo residuals only.
-struct PinholeIntrinsics {
-  double fx = 0, fy = 0, cx = 0, cy = 0, bf = 0;
-};
+// Intrinsics (core/geometry/pinhole_intrinsics.h) of the rectified / undistorted pinhole camera
+// the keypoints live in; bf is used by stereo residuals only.
 
 // Squared whitened errors (chi2) at a given pose; +infinity when the point is not in front of
 // the camera (depth <= kMinReprojectionDepth).

@@ -1,0 +1,212 @@
+#include "sim/euroc_writer.h"
+
+#include <fmt/format.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/util/error.h"
+
+namespace pkslam::sim {
+
+CameraRig EurocCam0() {
+  CameraRig c;
+  c.name = "cam0";
+  c.camera = CameraModel::Pinhole(752, 480, 458.654, 457.296, 367.215, 248.375,
+                                  {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05});
+  Eigen::Matrix4d t;
+  t << 0.0148655429818, -0.999880929698, 0.00414029679422, -0.0216401454975,  //
+      0.999557249008, 0.0149672133247, 0.025715529948, -0.064676986768,       //
+      -0.0257744366974, 0.00375618835797, 0.999660727178, 0.00981073058949,   //
+      0.0, 0.0, 0.0, 1.0;
+  c.body_from_camera = SE3d(t);
+  return c;
+}
+
+CameraRig EurocCam1() {
+  CameraRig c;
+  c.name = "cam1";
+  c.camera = CameraModel::Pinhole(752, 480, 457.587, 456.134, 379.999, 255.238,
+                                  {-0.28368365, 0.07451284, -0.00010473, -3.55590700e-05});
+  Eigen::Matrix4d t;
+  t << 0.0125552670891, -0.999755099723, 0.0182237714554, -0.0198435579556,  //
+      0.999598781151, 0.0130119051815, 0.0251588363115, 0.0453689425024,     //
+      -0.0253898008918, 0.0179005838253, 0.999517347078, 0.00786212447038,   //
+      0.0, 0.0, 0.0, 1.0;
+  c.body_from_camera = SE3d(t);
+  return c;
+}
+
+std::string FormatDouble(double v) {
+  std::string s = fmt::format("{}", v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+namespace {
+
+std::ofstream OpenOut(const std::filesystem::path& file) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  return out;
+}
+
+void WriteText(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream out = OpenOut(file);
+  out << text;
+  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+}
+
+std::string MatrixYaml(const Eigen::Matrix4d& m) {
+  // EuRoC's layout: rows continued under the opening bracket.
+  std::string s = "T_BS:\n  cols: 4\n  rows: 4\n  data: [";
+  for (int r = 0; r < 4; ++r) {
+    if (r > 0) s += ",\n         ";
+    for (int c = 0; c < 4; ++c) {
+      s += (c > 0 ? ", " : "") + FormatDouble(m(r, c));
+    }
+  }
+  return s + "]\n";
+}
+
+std::string CameraYaml(const CameraRig& c) {
+  const CameraModel& cam = c.camera;
+  std::string dist;
+  for (std::size_t i = 0; i < cam.distortion().size(); ++i) {
+    dist += (i > 0 ? ", " : "") + FormatDouble(cam.distortion()[i]);
+  }
+  if (cam.distortion().empty()) dist = "0.0, 0.0, 0.0, 0.0";
+  return fmt::format(
+      "%YAML:1.0\n# General sensor definitions.\nsensor_type: camera\n"
+      "comment: pkslam simulated {} (EuRoC VI-Sensor geometry)\n\n"
+      "# Sensor extrinsics wrt. the body-frame.\n{}\n"
+      "# Camera specific definitions.\nrate_hz: {}\nresolution: [{}, {}]\n"
+      "camera_model: pinhole\nintrinsics: [{}, {}, {}, {}] #fu, fv, cu, cv\n"
+      "distortion_model: radial-tangential\ndistortion_coefficients: [{}]\n\n",
+      c.name, MatrixYaml(c.body_from_camera.Matrix()), fmt::format("{}", c.rate_hz), cam.width(),
+      cam.height(), FormatDouble(cam.fx()), FormatDouble(cam.fy()), FormatDouble(cam.cx()),
+      FormatDouble(cam.cy()), dist);
+}
+
+std::string ImuYaml(const ImuOptions& imu) {
+  return fmt::format(
+      "%YAML:1.0\n#Default imu sensor yaml file\nsensor_type: imu\n"
+      "comment: pkslam simulated IMU (ADIS16448 noise model)\n\n"
+      "# Sensor extrinsics wrt. the body-frame.\n{}rate_hz: {}\n\n"
+      "# inertial sensor noise model parameters (static)\n"
+      "gyroscope_noise_density: {:.4e}     # [ rad / s / sqrt(Hz) ]   ( gyro \"white noise\" )\n"
+      "gyroscope_random_walk: {:.4e}       # [ rad / s^2 / sqrt(Hz) ] ( gyro bias diffusion )\n"
+      "accelerometer_noise_density: {:.4e}  # [ m / s^2 / sqrt(Hz) ]   ( accel \"white noise\" )\n"
+      "accelerometer_random_walk: {:.4e}    # [ m / s^3 / sqrt(Hz) ].  ( accel bias diffusion "
+      ")\n\n",
+      MatrixYaml(Eigen::Matrix4d::Identity()), fmt::format("{}", imu.rate_hz),
+      imu.gyro_noise_density, imu.gyro_random_walk, imu.accel_noise_density, imu.accel_random_walk);
+}
+
+constexpr const char* kGroundTruthYaml =
+    "%YAML:1.0\n# General sensor definitions.\nsensor_type: visual-inertial\n"
+    "comment: pkslam simulator ground truth (the exact spline trajectory of the body/IMU "
+    "frame, true IMU biases).\n\n"
+    "# Sensor extrinsics wrt. the body-frame. This is the transformation of the\n"
+    "# tracking prima to the body frame.\nT_BS:\n  cols: 4\n  rows: 4\n"
+    "  data: [1.0, 0.0, 0.0, 0.0,\n         0.0, 1.0, 0.0, 0.0,\n"
+    "         0.0, 0.0, 1.0, 0.0,\n         0.0, 0.0, 0.0, 1.0]\n";
+
+}  // namespace
+
+void WritePng(const std::filesystem::path& file, const cv::Mat& image) {
+  const std::vector<int> params{cv::IMWRITE_PNG_COMPRESSION, 1};
+  if (!cv::imwrite(file.string(), image, params)) {
+    throw Error(fmt::format("cannot write image {}", file.string()));
+  }
+}
+
+EurocWriter::EurocWriter(const std::filesystem::path& dir, const std::vector<CameraRig>& cameras,
+                         const ImuOptions& imu, bool write_imu)
+    : dir_(dir) {
+  const std::filesystem::path mav = dir / "mav0";
+  std::error_code ec;
+  for (const CameraRig& c : cameras) {
+    std::filesystem::create_directories(mav / c.name / "data", ec);
+    if (ec) throw Error(fmt::format("cannot create {}: {}", (mav / c.name).string(), ec.message()));
+    WriteText(mav / c.name / "sensor.yaml", CameraYaml(c));
+    camera_csv_.push_back(OpenOut(mav / c.name / "data.csv"));
+    camera_csv_.back() << "#timestamp [ns],filename\n";
+  }
+  std::filesystem::create_directories(mav / "state_groundtruth_estimate0", ec);
+  if (ec) throw Error(fmt::format("cannot create {}: {}", mav.string(), ec.message()));
+  WriteText(mav / "body.yaml", "%YAML:1.0\ncomment: pkslam simulated MAV (body = IMU frame)\n");
+  WriteText(mav / "state_groundtruth_estimate0" / "sensor.yaml", kGroundTruthYaml);
+  gt_csv_ = OpenOut(mav / "state_groundtruth_estimate0" / "data.csv");
+  gt_csv_ << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], "
+             "q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], "
+             "b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], "
+             "b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n";
+  if (write_imu) {
+    std::filesystem::create_directories(mav / "imu0", ec);
+    if (ec) throw Error(fmt::format("cannot create {}: {}", mav.string(), ec.message()));
+    WriteText(mav / "imu0" / "sensor.yaml", ImuYaml(imu));
+    imu_csv_ = OpenOut(mav / "imu0" / "data.csv");
+    imu_csv_ << "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
+                "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
+  }
+  timestamps_ = OpenOut(dir / "timestamps.txt");
+}
+
+void EurocWriter::WriteImage(int camera, std::int64_t t_ns, const cv::Mat& image) {
+  WritePng(AddImage(camera, t_ns), image);
+}
+
+std::filesystem::path EurocWriter::AddImage(int camera, std::int64_t t_ns) {
+  const std::string name = fmt::format("{}.png", t_ns);
+  camera_csv_.at(camera) << t_ns << ',' << name << '\n';
+  if (t_ns != last_timestamp_) {
+    timestamps_ << t_ns << '\n';
+    last_timestamp_ = t_ns;
+  }
+  return dir_ / "mav0" / fmt::format("cam{}", camera) / "data" / name;
+}
+
+void EurocWriter::WriteImu(const ImuSample& s) {
+  imu_csv_ << s.t_ns;
+  for (int i = 0; i < 3; ++i) imu_csv_ << ',' << FormatDouble(s.gyro[i]);
+  for (int i = 0; i < 3; ++i) imu_csv_ << ',' << FormatDouble(s.accel[i]);
+  imu_csv_ << '\n';
+}
+
+void EurocWriter::WriteGroundTruth(const GroundTruthRow& r) {
+  const Eigen::Vector3d& p = r.world_from_body.translation();
+  Eigen::Quaterniond q = r.world_from_body.quaternion();
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // EuRoC keeps w >= 0
+  gt_csv_ << fmt::format(
+      "{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9e},{:.9e},"
+      "{:.9e},{:.9e},{:.9e},{:.9e}\n",
+      r.t_ns, p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), r.velocity_world.x(),
+      r.velocity_world.y(), r.velocity_world.z(), r.gyro_bias.x(), r.gyro_bias.y(), r.gyro_bias.z(),
+      r.accel_bias.x(), r.accel_bias.y(), r.accel_bias.z());
+}
+
+void EurocWriter::Close() {
+  if (closed_) return;
+  closed_ = true;
+  for (auto& f : camera_csv_) f.close();
+  bool ok = true;
+  for (auto& f : camera_csv_) ok = ok && !f.fail();
+  if (imu_csv_.is_open()) {
+    imu_csv_.close();
+    ok = ok && !imu_csv_.fail();
+  }
+  gt_csv_.close();
+  timestamps_.close();
+  ok = ok && !gt_csv_.fail() && !timestamps_.fail();
+  if (!ok) throw Error(fmt::format("writing the EuRoC files under {} failed", dir_.string()));
+}
+
+EurocWriter::~EurocWriter() {
+  try {
+    Close();
+  } catch (const Error&) {
+    // Destructors must not throw; Close() reports errors to callers that call it.
+  }
+}
+
+}  // namespace pkslam::sim

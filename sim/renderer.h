@@ -1,0 +1,109 @@
+// Ray-casting renderer. Per-pixel bearing vectors come from CameraModel::Unproject (so lens
+// distortion is exact); shapes are culled per 16x16 tile against the tile's cone of rays;
+// shading = albedo (mip-mapped texture, footprint from distance, incidence and the pixel's
+// angular size) x (ambient + soft point lights). Output is linear radiance (sensor effects
+// are in sensor_model.h) and optionally depth along the optical axis.
+//
+// Threads: Render() parallelises over tiles with TBB; the Renderer, Scene and CameraRays are
+// read-only during a call, so one Renderer may serve several threads.
+#pragma once
+
+#include <Eigen/Core>
+#include <atomic>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "core/camera/camera_model.h"
+#include "core/geometry/se3.h"
+#include "sim/scene.h"
+
+namespace pkslam::sim {
+
+// Precomputed per-camera ray geometry (built once per camera model).
+class CameraRays {
+ public:
+  // supersample: s x s rays per pixel (s >= 1) on a regular sub-pixel grid.
+  CameraRays(const CameraModel& camera, int supersample = 1);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int supersample() const { return supersample_; }
+  // Unit bearing (camera frame) of sub-sample k of pixel (x, y).
+  const Eigen::Vector3f& Ray(int x, int y, int k = 0) const {
+    return rays_[(static_cast<std::size_t>(y) * width_ + x) * samples_ + k];
+  }
+  // Angular size (rad) of a pixel at (x, y) (geometric mean of its two sides).
+  float PixelAngle(int x, int y) const { return pixel_angle_[y * width_ + x]; }
+
+  struct Tile {
+    int x0, y0, x1, y1;        // pixel range [x0, x1) x [y0, y1)
+    Eigen::Vector3f axis;      // unit, camera frame
+    float cos_half, sin_half;  // cone half-angle containing every ray of the tile
+  };
+  const std::vector<Tile>& tiles() const { return tiles_; }
+  static constexpr int kTileSize = 16;
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  int supersample_ = 1;
+  int samples_ = 1;
+  std::vector<Eigen::Vector3f> rays_;
+  std::vector<float> pixel_angle_;
+  std::vector<Tile> tiles_;
+};
+
+// Marks which parts of which faces were seen (for the reference point cloud): per face a
+// grid of cells; set bits are seen. Thread-safe marking (atomic OR); see reference_cloud.h.
+class SurfaceVisibility {
+ public:
+  SurfaceVisibility(const Scene& scene, float cell_m);
+  void Mark(int shape, int face, const Eigen::Vector2f& uv);
+  bool Seen(int shape, int face, const Eigen::Vector2f& uv) const;
+  float cell_m() const { return cell_m_; }
+
+ private:
+  struct FaceGrid {
+    int cols = 0;
+    int rows = 0;
+    std::size_t first_word = 0;
+  };
+  bool Index(int shape, int face, const Eigen::Vector2f& uv, std::size_t* word,
+             std::uint64_t* bit) const;
+
+  float cell_m_ = 0.05f;
+  std::vector<std::vector<FaceGrid>> faces_;  // [shape][face]
+  std::vector<std::atomic<std::uint64_t>> bits_;
+};
+
+struct RenderOptions {
+  float lod_bias = 0.0f;        // added to the mip level (> 0 blurs, < 0 sharpens/aliases)
+  bool colour = false;          // render RGB radiance (CV_32FC3) instead of grey (CV_32FC1)
+  bool depth = false;           // also output depth along the optical axis (CV_32F, 0 = none)
+  float max_distance = 200.0f;  // metres
+
+  void Check() const;
+};
+
+struct RenderBuffers {
+  cv::Mat radiance;  // CV_32FC1 (grey) or CV_32FC3 (RGB), linear, ~[0, 1]
+  cv::Mat depth;     // CV_32F metres along the camera z axis (only with options.depth)
+};
+
+class Renderer {
+ public:
+  Renderer(const Scene& scene, const RenderOptions& options);
+
+  // Renders the view of a camera at world_from_camera (optical frame: z forward, y down).
+  void Render(const CameraRays& rays, const SE3d& world_from_camera, RenderBuffers* out,
+              SurfaceVisibility* visibility = nullptr) const;
+
+  const RenderOptions& options() const { return options_; }
+
+ private:
+  const Scene& scene_;
+  RenderOptions options_;
+};
+
+}  // namespace pkslam::sim

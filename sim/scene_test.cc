@@ -1,0 +1,119 @@
+#include "sim/scene.h"
+
+#include <gtest/gtest.h>
+
+#include "core/util/error.h"
+#include "sim/intersect.h"
+#include "sim/scene_builder.h"
+#include "sim/scene_description.h"
+
+namespace pkslam::sim {
+namespace {
+
+constexpr const char* kSmallRoom = R"(
+name: small
+room: {size: [6, 6, 3], materials: {walls: w, floor: w, ceiling: w}}
+materials:
+  w: {texture: {kind: noise}, tile: 1.0}
+objects:
+  - {type: box, name: crate, position: [1.0, 0.0, 0.0], size: [0.5, 0.5, 0.5], material: w}
+  - {type: cylinder, name: pole, position: [-2.0, -2.0, 0.0], radius: 0.2, height: 2.0, material: w}
+  - {type: shelf, name: shelf, position: [0.0, 2.5, 0.0], size: [1.5, 0.4, 1.8], levels: 3, material: [w, w]}
+)";
+
+SceneBuildOptions Tiny() {
+  SceneBuildOptions o;
+  o.texture_size = 16;
+  return o;
+}
+
+int CountNamed(const Scene& scene, const std::string& name) {
+  int n = 0;
+  for (const Shape& s : scene.shapes) n += s.name == name ? 1 : 0;
+  return n;
+}
+
+TEST(SceneDescription, BuiltinsParseAndExtend) {
+  for (const std::string& name : BuiltinSceneNames()) {
+    const SceneDescription d = LoadSceneDescription(name);
+    EXPECT_FALSE(d.materials.empty()) << name;
+  }
+  EXPECT_EQ(LoadSceneDescription("weak_texture").texture_mode, "weak");
+  EXPECT_EQ(LoadSceneDescription("repetitive").texture_mode, "repetitive");
+  EXPECT_EQ(LoadSceneDescription("weak_texture").objects.size(),
+            LoadSceneDescription("vicon_room").objects.size());
+}
+
+TEST(SceneDescription, ErrorsNameTheLine) {
+  const std::string bad =
+      std::string(kSmallRoom) + "  - {type: box, position: [0, 0, 0], size: [1, 1], material: w}\n";
+  try {
+    ParseSceneYaml(bad, "bad.yaml");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 10u);
+    EXPECT_NE(std::string(e.what()).find("size"), std::string::npos);
+  }
+  EXPECT_THROW(ParseSceneYaml("room: {size: [6, 6, 3]}\nmaterials: {}\n", "x.yaml"), InputError);
+  EXPECT_THROW(ParseSceneYaml(std::string(kSmallRoom) + "  - {type: box, material: nope}\n", "y"),
+               InputError);
+  EXPECT_THROW(ParseSceneYaml("{unclosed", "z.yaml"), InputError);
+  EXPECT_THROW(LoadSceneDescription("/nonexistent/scene.yaml"), InputError);
+}
+
+TEST(SceneBuilder, RoomGrowsAroundThePathAndNearbyObjectsGo) {
+  const SceneDescription d = ParseSceneYaml(kSmallRoom, "small");
+  SceneBuildReport nominal;
+  const Scene a = BuildScene(d, Tiny(), {}, &nominal);
+  EXPECT_EQ(nominal.objects_removed, 0);
+  EXPECT_EQ(CountNamed(a, "crate"), 1);
+  EXPECT_GT(CountNamed(a, "shelf"), 5);  // sides, back, boards, goods
+  // A path through the crate (inside the room): the crate goes, the room stays.
+  std::vector<Eigen::Vector3d> path;
+  for (double x = -1.0; x <= 1.2; x += 0.05) path.emplace_back(x, 0.0, 0.3);
+  SceneBuildReport report;
+  const Scene b = BuildScene(d, Tiny(), path, &report);
+  EXPECT_EQ(CountNamed(b, "crate"), 0);
+  EXPECT_EQ(CountNamed(b, "pole"), 1);
+  EXPECT_EQ(report.objects_removed, 1);
+  EXPECT_EQ(report.room_max, nominal.room_max);
+  for (const auto& p : path) EXPECT_GT(b.ObjectClearance(p.cast<float>()), 0.6f);
+  // A path leaving the room: the room grows to hold it with the margins (objects scale in
+  // x, y with the room, so the crate moves out of the way and is kept).
+  const std::vector<Eigen::Vector3d> far = {{0.0, 0.0, 1.0}, {5.0, 0.0, 2.9}};
+  const Scene c = BuildScene(d, Tiny(), far, &report);
+  EXPECT_GE(report.room_max.x(), 5.0 + 1.0);  // wall margin
+  EXPECT_GE(report.room_max.z(), 2.9 + 0.5);  // ceiling margin
+  EXPECT_EQ(report.room_min.x(), nominal.room_min.x());
+  for (const auto& p : far) EXPECT_GT(c.RoomClearance(p.cast<float>()), 0.29f);
+}
+
+TEST(Scene, IntersectionsAndDistancesAgree) {
+  const Scene scene = BuildScene(ParseSceneYaml(kSmallRoom, "small"), Tiny(), {});
+  // From the room centre towards +x: the crate's -x face at x = 0.75, 0.25 m up.
+  Hit hit;
+  ASSERT_TRUE(scene.Intersect({-1.0f, 0.0f, 0.25f}, {1.0f, 0.0f, 0.0f}, 100.0f, &hit));
+  EXPECT_NEAR(hit.t, 1.75f, 1e-5f);
+  EXPECT_EQ(scene.shapes[hit.shape].name, "crate");
+  EXPECT_NEAR(hit.normal.x(), -1.0f, 1e-6f);
+  // Straight up: the ceiling at z = 3.
+  ASSERT_TRUE(scene.Intersect({-1.0f, 0.0f, 0.25f}, {0.0f, 0.0f, 1.0f}, 100.0f, &hit));
+  EXPECT_NEAR(hit.t, 2.75f, 1e-5f);
+  EXPECT_EQ(scene.shapes[hit.shape].type, ShapeType::kRoom);
+  EXPECT_NEAR(hit.normal.z(), -1.0f, 1e-6f);
+  // Towards the pole (cylinder at (-2, -2), r = 0.2).
+  const Eigen::Vector3f from(-1.0f, -2.0f, 1.0f);
+  ASSERT_TRUE(scene.Intersect(from, {-1.0f, 0.0f, 0.0f}, 100.0f, &hit));
+  EXPECT_NEAR(hit.t, 0.8f, 1e-5f);
+  EXPECT_NEAR(scene.ObjectClearance(from), 0.8f, 1e-5f);
+  // Every hit point of random rays lies on a surface: signed distance ~ 0 for its shape.
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector3f dir(std::cos(0.1f * i), std::sin(0.37f * i), std::sin(0.11f * i) - 0.3f);
+    ASSERT_TRUE(scene.Intersect(from, dir.normalized(), 100.0f, &hit));
+    const Eigen::Vector3f p = from + hit.t * dir.normalized();
+    EXPECT_NEAR(SignedDistance(scene.shapes[hit.shape], p), 0.0f, 2e-4f);
+  }
+}
+
+}  // namespace
+}  // namespace pkslam::sim

@@ -1,0 +1,375 @@
+#include "sim/simulator.h"
+
+#include <tbb/task_group.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <opencv2/imgproc.hpp>
+
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "core/util/progress.h"
+#include "io/settings.h"
+#include "io/trajectory.h"
+#include "sim/euroc_writer.h"
+#include "sim/random.h"
+#include "sim/reference_cloud.h"
+#include "sim/tum_rgbd_writer.h"
+
+namespace pkslam::sim {
+namespace {
+
+// Random flights start at this clock (2020-09-13T12:26:40Z): a plausible EuRoC-like epoch.
+constexpr std::int64_t kRandomEpochNs = 1'600'000'000'000'000'000;
+
+struct QualitySettings {
+  int texture_size;
+  int supersample;
+  int motion_blur_samples;
+};
+
+QualitySettings SettingsFor(Quality q) {
+  switch (q) {
+    case Quality::kFast:
+      return {512, 1, 3};
+    case Quality::kDefault:
+      return {1024, 1, 5};
+    case Quality::kHigh:
+      return {2048, 2, 9};
+  }
+  return {1024, 1, 5};
+}
+
+std::int64_t Ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
+
+// The colour camera of RGB-D output: TUM's default Kinect intrinsics, mounted like cam0.
+CameraRig RgbdCamera(double rate_hz) {
+  CameraRig c = EurocCam0();
+  c.name = "rgb";
+  c.camera = CameraModel::Pinhole(640, 480, 525.0, 525.0, 319.5, 239.5);
+  c.rate_hz = rate_hz;
+  return c;
+}
+
+// Renders the radiance seen by a camera at time t, averaged over the exposure (motion blur).
+void RenderFrame(const Renderer& renderer, const CameraRays& rays, const SplineTrajectory& traj,
+                 const SE3d& body_from_camera, std::int64_t t_ns, double exposure_s, int samples,
+                 RenderBuffers* out, SurfaceVisibility* visibility) {
+  if (exposure_s <= 0.0 || samples <= 1) {
+    renderer.Render(rays, traj.WorldFromBody(t_ns) * body_from_camera, out, visibility);
+    return;
+  }
+  RenderBuffers sub;
+  cv::Mat sum;
+  for (int i = 0; i < samples; ++i) {
+    const std::int64_t ti = std::clamp(t_ns + Ns(exposure_s * ((i + 0.5) / samples - 0.5)),
+                                       traj.begin_ns(), traj.end_ns());
+    const bool centre = i == samples / 2;
+    renderer.Render(rays, traj.WorldFromBody(ti) * body_from_camera, &sub,
+                    centre ? visibility : nullptr);
+    if (i == 0) {
+      sum = sub.radiance.clone();
+    } else {
+      sum += sub.radiance;
+    }
+    if (centre && !sub.depth.empty()) out->depth = sub.depth.clone();
+  }
+  out->radiance = sum / samples;
+}
+
+// ORB-SLAM3-format settings of the simulated rig (io/settings.h writes the file).
+void WriteSettings(const std::filesystem::path& file, const std::vector<CameraRig>& cameras,
+                   const SimulationOptions& o) {
+  Settings settings;
+  settings.camera1 = cameras[0].camera;
+  settings.fps = cameras[0].rate_hz;
+  if (o.rgbd) {
+    settings.depth_map_factor = 5000.0;
+    settings.stereo_baseline_m = 0.07;  // ORB-SLAM3's virtual RGB-D baseline (TUM files)
+    settings.th_depth = 40.0;
+  } else {
+    settings.camera2 = cameras[1].camera;
+    settings.right_from_left = cameras[1].body_from_camera.Inverse() * cameras[0].body_from_camera;
+    if (o.write_imu) {
+      settings.body_from_cam0 = cameras[0].body_from_camera;
+      ImuNoise noise;
+      noise.gyro_noise_density = o.imu.gyro_noise_density;
+      noise.accel_noise_density = o.imu.accel_noise_density;
+      noise.gyro_random_walk = o.imu.gyro_random_walk;
+      noise.accel_random_walk = o.imu.accel_random_walk;
+      noise.rate_hz = o.imu.rate_hz;
+      settings.imu = noise;
+    }
+  }
+  WriteOrbSlam3Settings(settings, file);
+}
+
+bool InBlackout(const SimulationOptions& o, std::int64_t t_ns, std::int64_t begin_ns) {
+  if (o.blackout_begin_s < 0.0) return false;
+  const double t = 1e-9 * static_cast<double>(t_ns - begin_ns);
+  return t >= o.blackout_begin_s && t <= o.blackout_end_s;
+}
+
+// Kinect-like depth: noise sigma = 1.425e-3 z^2 (Khoshelham & Elberink 2012), valid range
+// 0.4-8 m, stored as uint16 metres * factor.
+cv::Mat DepthImage(const cv::Mat& depth_m, double noise_scale, const PixelNoise& noise,
+                   std::uint64_t key, double factor) {
+  cv::Mat out(depth_m.size(), CV_16U);
+  for (int y = 0; y < depth_m.rows; ++y) {
+    for (int x = 0; x < depth_m.cols; ++x) {
+      const float z = depth_m.at<float>(y, x);
+      if (z < 0.4f || z > 8.0f) {
+        out.at<std::uint16_t>(y, x) = 0;
+        continue;
+      }
+      const double sigma = noise_scale * 1.425e-3 * z * z;
+      const double zn =
+          z + sigma * noise.Sample(key, static_cast<std::uint64_t>(y) * depth_m.cols + x);
+      out.at<std::uint16_t>(y, x) =
+          static_cast<std::uint16_t>(std::clamp(std::lround(zn * factor), 0L, 65535L));
+    }
+  }
+  return out;
+}
+
+void MotionStatistics(const SplineTrajectory& traj, std::int64_t begin, std::int64_t end,
+                      std::int64_t step, SimulationSummary* s) {
+  std::vector<Eigen::Vector3d> p;
+  double rate_sum = 0.0;
+  int n = 0;
+  for (std::int64_t t = begin; t <= end; t += step) {
+    const BodyState st = traj.State(t);
+    p.push_back(st.world_from_body.translation());
+    const double rate = st.omega_body.norm() * 180.0 / M_PI;
+    rate_sum += rate;
+    s->max_angular_rate_dps = std::max(s->max_angular_rate_dps, rate);
+    ++n;
+  }
+  s->path_length_m = PathLength(p);
+  const double duration = 1e-9 * static_cast<double>(end - begin);
+  s->mean_speed_mps = duration > 0.0 ? s->path_length_m / duration : 0.0;
+  s->mean_angular_rate_dps = n > 0 ? rate_sum / n : 0.0;
+}
+
+}  // namespace
+
+SimulationSummary RunSimulation(const SimulationOptions& options) {
+  options.Check();
+  SimulationOptions o = options;  // resolved copy (recorded in sim.yaml)
+  const QualitySettings quality = SettingsFor(o.quality);
+  if (o.motion_blur_samples == 0) o.motion_blur_samples = quality.motion_blur_samples;
+  const SceneDescription description = LoadSceneDescription(o.scene);
+  o.scene_build.texture_size = quality.texture_size;
+  o.scene_build.colour = o.rgbd;
+  o.scene_build.texture_mode =
+      ParseTextureMode(o.texture_mode.empty() ? description.texture_mode : o.texture_mode);
+  o.scene_build.seed = o.seed;
+
+  std::vector<CameraRig> cameras;
+  if (o.rgbd) {
+    cameras.push_back(RgbdCamera(o.rgbd_rate_hz));
+  } else {
+    cameras = {EurocCam0(), EurocCam1()};
+    for (auto& c : cameras) c.rate_hz = o.camera_rate_hz;
+  }
+
+  // Motion.
+  SimulationSummary summary;
+  SplineTrajectory traj;
+  std::int64_t begin_ns = 0;
+  std::int64_t end_ns = 0;
+  if (!o.trajectory.empty()) {
+    const std::vector<StampedPose> samples = ReadTrajectory(o.trajectory).poses;
+    begin_ns = samples.front().t_ns + Ns(o.start_s);
+    end_ns = o.duration_s > 0.0 ? begin_ns + Ns(o.duration_s) : samples.back().t_ns;
+    if (end_ns > samples.back().t_ns || begin_ns >= end_ns) {
+      throw InputError(
+          o.trajectory,
+          fmt::format("window --start {} --duration {} is outside the {:.3f} s "
+                      "trajectory",
+                      o.start_s, o.duration_s,
+                      1e-9 * static_cast<double>(samples.back().t_ns - samples.front().t_ns)));
+    }
+    traj = FitTrajectory(samples, begin_ns, end_ns, o.replay);
+  } else {
+    if (o.duration_s > 0.0) o.motion.duration_s = o.duration_s;
+    const Scene nominal = BuildScene(description, o.scene_build, {});
+    begin_ns = kRandomEpochNs;
+    end_ns = begin_ns + Ns(o.motion.duration_s);
+    traj = GenerateMotion(nominal, o.motion, cameras[0].body_from_camera, o.seed, begin_ns);
+  }
+  summary.begin_ns = begin_ns;
+  summary.end_ns = end_ns;
+  MotionStatistics(traj, begin_ns, end_ns, o.imu.period_ns(), &summary);
+
+  // Scene around the path of the body and the cameras.
+  std::vector<Eigen::Vector3d> path;
+  for (std::int64_t t = begin_ns; t <= end_ns; t += Ns(0.05)) {
+    const SE3d pose = traj.WorldFromBody(t);
+    path.push_back(pose.translation());
+    for (const auto& c : cameras) path.push_back((pose * c.body_from_camera).translation());
+  }
+  const Scene scene = BuildScene(description, o.scene_build, path, &summary.scene);
+  PKSLAM_LOG_INFO(
+      "simulate: scene '{}' room [{:.1f} {:.1f} {:.1f}]..[{:.1f} {:.1f} {:.1f}] m, "
+      "{} objects ({} removed near the path)",
+      scene.name, summary.scene.room_min.x(), summary.scene.room_min.y(),
+      summary.scene.room_min.z(), summary.scene.room_max.x(), summary.scene.room_max.y(),
+      summary.scene.room_max.z(), summary.scene.objects_placed - summary.scene.objects_removed,
+      summary.scene.objects_removed);
+
+  // IMU and ground truth (EuRoC layout only).
+  std::unique_ptr<EurocWriter> euroc;
+  std::unique_ptr<TumRgbdWriter> tum;
+  if (!o.bench) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.output_dir, ec);
+    if (ec) throw Error(fmt::format("cannot create {}: {}", o.output_dir.string(), ec.message()));
+    if (o.rgbd) {
+      tum = std::make_unique<TumRgbdWriter>(o.output_dir);
+    } else {
+      // Without images (IMU + ground truth only) there are no camera folders at all.
+      euroc = std::make_unique<EurocWriter>(
+          o.output_dir, o.write_images ? cameras : std::vector<CameraRig>{}, o.imu, o.write_imu);
+    }
+  }
+  if (!o.rgbd) {
+    const std::vector<ImuSample> imu = SimulateImu(traj, begin_ns, end_ns, o.imu, o.seed);
+    summary.imu_samples = static_cast<int>(imu.size());
+    if (euroc) {
+      for (const ImuSample& s : imu) {
+        if (o.write_imu) euroc->WriteImu(s);
+        const BodyState st = traj.State(s.t_ns);
+        euroc->WriteGroundTruth(
+            {s.t_ns, st.world_from_body, st.velocity_world, s.gyro_bias, s.accel_bias});
+      }
+    }
+  }
+
+  // Camera frames.
+  const double rate = o.rgbd ? o.rgbd_rate_hz : o.camera_rate_hz;
+  std::int64_t period = Ns(1.0 / rate);
+  std::int64_t first = begin_ns;
+  if (o.rgbd) {
+    period = (period + 500) / 1000 * 1000;  // TUM timestamps are whole microseconds
+    first = (begin_ns + 999) / 1000 * 1000;
+  }
+  int frames = o.write_images ? static_cast<int>((end_ns - first) / period) + 1 : 0;
+  if (o.bench && o.bench_frames > 0) frames = std::min(frames, o.bench_frames);
+  RenderOptions render_options;
+  render_options.colour = o.rgbd;
+  render_options.depth = o.rgbd;
+  const Renderer renderer(scene, render_options);
+  std::vector<CameraRays> rays;
+  std::vector<SensorModel> sensors;
+  for (std::size_t c = 0; c < cameras.size() && frames > 0; ++c) {
+    rays.emplace_back(cameras[c].camera, quality.supersample);
+  }
+  for (std::size_t c = 0; c < rays.size(); ++c) {
+    sensors.emplace_back(o.sensor, rays[c], DeriveSeed(o.seed, 0x43414D00 + c));
+  }
+  std::unique_ptr<SurfaceVisibility> visibility;
+  if (o.write_cloud && !o.bench && frames > 0) {
+    visibility =
+        std::make_unique<SurfaceVisibility>(scene, static_cast<float>(o.visibility_cell_m));
+  }
+  const PixelNoise depth_noise;
+  const double exposure = o.motion_blur_exposure_s;
+  Progress progress(o.bench ? "bench" : "simulate", static_cast<std::size_t>(frames), o.quiet);
+  double render_seconds = 0.0;
+  double render_cpu = 0.0;
+  std::vector<RenderBuffers> buffers(cameras.size());
+  tbb::task_group writers;
+  // On an exception below, let running PNG tasks finish before the group goes away.
+  struct WaitOnExit {
+    tbb::task_group& group;
+    ~WaitOnExit() {
+      try {
+        group.wait();
+      } catch (...) {  // the first error is already propagating
+      }
+    }
+  } wait_on_exit{writers};
+  const auto loop_start = std::chrono::steady_clock::now();
+  for (int k = 0; k < frames; ++k) {
+    const std::int64_t t = first + k * period;
+    const bool black = InBlackout(o, t, begin_ns);
+    std::vector<cv::Mat> images(cameras.size());
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::clock_t cpu0 = std::clock();
+    if (!black) {
+      for (std::size_t c = 0; c < cameras.size(); ++c) {
+        RenderFrame(renderer, rays[c], traj, cameras[c].body_from_camera, t, exposure,
+                    o.motion_blur_samples, &buffers[c], c == 0 ? visibility.get() : nullptr);
+      }
+      // One exposure for the rig (the VI-Sensor shares it between cameras).
+      const double gain = sensors[0].NextGain(buffers[0].radiance, 1.0 / rate);
+      for (std::size_t c = 0; c < cameras.size(); ++c) {
+        images[c] =
+            sensors[c].Develop(buffers[c].radiance, gain, static_cast<std::uint64_t>(k) * 8 + c);
+      }
+    } else {
+      for (std::size_t c = 0; c < cameras.size(); ++c) {
+        images[c] = cv::Mat::zeros(cameras[c].camera.height(), cameras[c].camera.width(),
+                                   o.rgbd ? CV_8UC3 : CV_8UC1);
+      }
+    }
+    render_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    render_cpu += static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+    // PNG encoding of this frame overlaps the rendering of the next one (a second core's
+    // worth of work); list files are written here, in order.
+    writers.wait();
+    if (euroc) {
+      for (std::size_t c = 0; c < cameras.size(); ++c) {
+        const std::filesystem::path file = euroc->AddImage(static_cast<int>(c), t);
+        writers.run([file, image = images[c]] { WritePng(file, image); });
+      }
+    }
+    if (tum) {
+      const cv::Mat depth = black ? cv::Mat::zeros(images[0].size(), CV_16U)
+                                  : DepthImage(buffers[0].depth, o.depth_noise, depth_noise,
+                                               DeriveSeed(o.seed, 0x44455054 + k), 5000.0);
+      const auto files = tum->AddFrame(t);
+      writers.run([files, colour = images[0], depth] {
+        TumRgbdWriter::WriteImages(files.first, files.second, colour, depth);
+      });
+    }
+    progress.Add();
+  }
+  writers.wait();
+  progress.Finish();
+  summary.frames = frames;
+  summary.total_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
+  summary.render_seconds = render_seconds;
+  summary.render_cpu_seconds = render_cpu;
+  summary.frames_per_second = render_seconds > 0.0 ? frames / render_seconds : 0.0;
+
+  if (o.bench) {
+    summary.layout = "bench";
+    return summary;
+  }
+  if (tum) {
+    // Ground truth of the colour camera at 100 Hz (TUM's motion-capture rate).
+    for (std::int64_t t = first; t <= end_ns; t += 10'000'000) {
+      tum->WriteGroundTruth(t, traj.WorldFromBody(t) * cameras[0].body_from_camera);
+    }
+    tum->Close();
+    WriteSettings(o.output_dir / "settings.yaml", cameras, o);
+    summary.layout = "tum_rgbd";
+  } else {
+    euroc->Close();
+    WriteSettings(o.output_dir / "settings.yaml", cameras, o);
+    summary.layout = "euroc";
+  }
+  if (o.write_cloud) {
+    summary.cloud_points = WriteReferenceCloud(scene, visibility.get(), o.cloud_spacing_m,
+                                               o.output_dir / "reference_cloud.ply");
+  }
+  WriteSimYaml(o.output_dir / "sim.yaml", o, summary);
+  return summary;
+}
+
+}  // namespace pkslam::sim

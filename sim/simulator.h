@@ -1,0 +1,90 @@
+// `pkslam simulate`: one call produces a complete sequence with exact ground truth.
+//   EuRoC mode (default): DIR/mav0/... (stereo + IMU + ground truth, see euroc_writer.h),
+//     DIR/settings.yaml (ORB-SLAM3 format), DIR/timestamps.txt.
+//   RGB-D mode: TUM RGB-D layout (rgb/, depth/, rgb.txt, depth.txt, associations.txt,
+//     groundtruth.txt of the colour camera), DIR/settings.yaml.
+//   Both: DIR/reference_cloud.ply (seen surfaces), DIR/sim.yaml (every option + seed).
+// Same options and seed -> identical bytes.
+//
+// Threads: RunSimulation drives frames sequentially on the calling thread; rendering and
+// image formation use TBB inside each frame, and the PNG files of frame k are encoded by a
+// TBB task while frame k+1 renders (list files are written in order by the calling thread).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "sim/imu_simulator.h"
+#include "sim/motion_generator.h"
+#include "sim/renderer.h"
+#include "sim/scene_builder.h"
+#include "sim/sensor_model.h"
+#include "sim/trajectory.h"
+
+namespace pkslam::sim {
+
+enum class Quality { kFast, kDefault, kHigh };
+Quality ParseQuality(const std::string& name);  // fast|default|high; OptionError
+std::string QualityName(Quality quality);
+
+struct SimulationOptions {
+  std::filesystem::path output_dir;  // created if missing
+  std::filesystem::path trajectory;  // replay this ground truth (TUM/EuRoC); empty: random
+  MotionOptions motion;              // random motion (level, duration, clearances)
+  double start_s = 0.0;              // replay: start offset into the trajectory file
+  double duration_s = 0.0;           // 0: replay to the file's end / random: motion.duration_s
+  std::string scene = "vicon_room";  // built-in name or YAML file
+  std::string texture_mode;          // rich|weak|repetitive; empty: the scene's default
+  std::uint64_t seed = 1;
+  Quality quality = Quality::kDefault;
+  ReplayOptions replay;
+  SceneBuildOptions scene_build;  // texture_size and colour follow quality / rgbd
+  ImuOptions imu;
+  bool write_imu = true;
+  bool write_images = true;      // false: IMU + ground truth only (no rendering)
+  double camera_rate_hz = 20.0;  // stereo cameras (EuRoC: 20)
+  SensorOptions sensor;
+  double motion_blur_exposure_s = 0.0;  // > 0: average sub-renders over this exposure
+  int motion_blur_samples = 0;          // sub-renders (0: by quality: 3 / 5 / 9)
+  bool rgbd = false;                    // TUM RGB-D output instead of EuRoC
+  double rgbd_rate_hz = 30.0;
+  double depth_noise = 1.0;        // x the Kinect depth noise model (0: exact depth)
+  double blackout_begin_s = -1.0;  // images in [begin, end] (s from start) are black
+  double blackout_end_s = -1.0;
+  bool write_cloud = true;          // reference_cloud.ply
+  double cloud_spacing_m = 0.01;    // point spacing on the surfaces
+  double visibility_cell_m = 0.05;  // granularity of "seen" surface cells
+  bool bench = false;               // render and develop only; write nothing
+  int bench_frames = 200;           // frames rendered by bench (0: the whole sequence)
+  bool quiet = false;               // no progress bar
+
+  void Check() const;
+};
+
+struct SimulationSummary {
+  std::string layout;  // "euroc" | "tum_rgbd" | "bench"
+  std::int64_t begin_ns = 0;
+  std::int64_t end_ns = 0;
+  int frames = 0;  // camera frames (stereo pairs or RGB-D frames)
+  int imu_samples = 0;
+  double path_length_m = 0.0;  // of the body over [begin, end] at the IMU rate
+  double mean_speed_mps = 0.0;
+  double mean_angular_rate_dps = 0.0;
+  double max_angular_rate_dps = 0.0;
+  double render_seconds = 0.0;      // rendering + image formation only
+  double frames_per_second = 0.0;   // frames / render_seconds
+  double render_cpu_seconds = 0.0;  // process CPU time (all threads) of the same work; in
+                                    // file-writing runs it includes overlapping PNG encoding
+  double total_seconds = 0.0;       // wall time of the frame loop including image files
+  std::size_t cloud_points = 0;
+  SceneBuildReport scene;
+};
+
+SimulationSummary RunSimulation(const SimulationOptions& options);
+
+// Writes DIR/sim.yaml (all options, seed, summary, version).
+void WriteSimYaml(const std::filesystem::path& file, const SimulationOptions& options,
+                  const SimulationSummary& summary);
+
+}  // namespace pkslam::sim
