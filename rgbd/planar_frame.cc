@@ -104,6 +104,9 @@ std::vector<std::vector<int>> MergeSegments(const std::vector<MergeInput>& segme
         }
         const auto plane = candidate.Fit(options.fit);
         if (!plane || candidate.RmsDistance(*plane) > options.merge_max_fit_rms_m) continue;
+        // The union's RMS is dominated by the larger part: a small segment off the plane of a
+        // large merged one hardly raises it. The newcomer must fit the merged plane itself.
+        if (segments[b].moments.RmsDistance(*plane) > options.merge_max_fit_rms_m) continue;
         merged = candidate;
         group_of[b] = g;
         groups[g].push_back(b);

@@ -7,9 +7,9 @@
 //      bounding boxes, grown by one pixel, intersect; a stack-driven flood over neighbours
 //      merges a neighbour when the normals agree within merge_angle_deg, each segment's own fit
 //      is good (RMS below merge_max_fit_rms_m) and the merged segment stays within the limits
-//      (its refitted RMS below merge_max_fit_rms_m -- which also keeps parallel planes at
-//      different depths apart -- and at most merge_max_points points); merged segments are
-//      refitted;
+//      (its refitted RMS, and the RMS of the newcomer's points to the refitted plane, below
+//      merge_max_fit_rms_m -- which also keeps parallel planes at different depths apart --
+//      and at most merge_max_points points); merged segments are refitted;
 //   4. every point of a plane is projected onto it and N of them are drawn at random (all when
 //      fewer), the points ICP registers.
 #pragma once

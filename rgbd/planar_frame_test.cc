@@ -64,6 +64,21 @@ TEST(MergeSegments, ParallelPlanesAtDifferentDepthsStayApart) {
   EXPECT_EQ(MergeSegments(segments, options).size(), 2u);
 }
 
+TEST(MergeSegments, SmallSegmentOffALargePlaneStaysApart) {
+  // A large wall (100 x the points of the small one) and a small parallel patch 5 cm in front:
+  // the union's RMS stays below 2 cm (the wall dominates it) but the patch is off the plane.
+  MergeInput wall = Segment(Tilted(0), {0, 0, 2}, cv::Rect(0, 0, 10, 10));
+  for (int k = 0; k < 99; ++k) wall.moments.Add(Segment(Tilted(0), {0, 0, 2}, {}).moments);
+  const MergeInput patch = Segment(Tilted(0), {0.2, 0, 1.95}, cv::Rect(10, 0, 10, 10));
+  PointMoments both = wall.moments;
+  both.Add(patch.moments);
+  PlanarFrameOptions options;
+  ASSERT_LT(both.RmsDistance(*both.Fit(options.fit)), options.merge_max_fit_rms_m);
+  EXPECT_EQ(MergeSegments({wall, patch}, options).size(), 2u);
+  options.merge_max_fit_rms_m = 0.06;  // a 5 cm step is within this tolerance
+  EXPECT_EQ(MergeSegments({wall, patch}, options).size(), 1u);
+}
+
 TEST(MergeSegments, BoxesTouchingOnlyAtACornerAreNeighbours) {
   const std::vector<MergeInput> segments = {
       Segment(Tilted(0), {0, 0, 2}, cv::Rect(0, 0, 10, 10)),
