@@ -16,14 +16,17 @@ void RegisterPlanarCommand(CLI::App& app) {
   auto gap = std::make_shared<int>(1);
   auto gaps = std::make_shared<std::vector<int>>();
   auto* cmd = app.add_subcommand(
-      "planar", "Planar RGB-D modelling: Lab segmentation, plane fits, plane-sampled ICP (TUM folder)");
+      "planar",
+      "Planar RGB-D modelling: Lab segmentation, plane fits, plane-sampled ICP (TUM folder)");
   auto& o = *options;
-  cmd->add_option("--dataset", o.input.dataset, "TUM RGB-D folder (rgb.txt, depth.txt)")->required();
+  cmd->add_option("--dataset", o.input.dataset, "TUM RGB-D folder (rgb.txt, depth.txt)")
+      ->required();
   cmd->add_option("--settings", *settings,
                   "ORB-SLAM3 settings file for the camera (default: DIR/settings.yaml, or TUM's "
                   "calibration for freiburg1/2/3 folders)");
   cmd->add_option("--out", o.out, "Output directory")->capture_default_str();
-  cmd->add_option("--lab-threshold", o.frame.lab_threshold, "Region growing: Lab distance threshold")
+  cmd->add_option("--lab-threshold", o.frame.lab_threshold,
+                  "Region growing: Lab distance threshold")
       ->capture_default_str();
   cmd->add_option("--merge-angle", o.frame.merge_angle_deg, "Merging: largest normal angle [deg]")
       ->capture_default_str();
@@ -34,6 +37,9 @@ void RegisterPlanarCommand(CLI::App& app) {
                   "Merging: largest merged segment [points] (0: no limit)")
       ->capture_default_str();
   cmd->add_option("--samples", o.frame.samples_per_plane, "Points sampled per plane (N)")
+      ->capture_default_str();
+  cmd->add_option("--min-plane-points", o.frame.min_sampled_plane_points,
+                  "Sample only planes with at least this many points (0: all, as the paper)")
       ->capture_default_str();
   cmd->add_option("--gap", *gap, "Frame gap k: register frames i and i+k")->capture_default_str();
   cmd->add_option("--gaps", *gaps, "Several gaps, e.g. --gaps 1 2 3 4 5 (overrides --gap)");
@@ -47,23 +53,30 @@ void RegisterPlanarCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--full-stride", o.full_stride, "Full-ICP reference: pixel stride (1: all)")
       ->capture_default_str();
-  cmd->add_option("--icp-iterations", o.icp.max_iterations, "ICP iteration limit")->capture_default_str();
+  cmd->add_option("--icp-iterations", o.icp.max_iterations, "ICP iteration limit")
+      ->capture_default_str();
   cmd->add_option("--icp-max-distance", o.icp.max_correspondence_m,
                   "ICP: ignore pairs farther apart [m] (0: keep all)")
       ->capture_default_str();
-  cmd->add_flag("--no-accelerate", [&o](std::int64_t) { o.icp.accelerate = false; },
-                "Plain ICP without Besl-McKay's extrapolation");
-  cmd->add_option("--min-depth", o.min_depth_m, "Depth gate minimum [m] (0: none)")->capture_default_str();
-  cmd->add_option("--max-depth", o.max_depth_m, "Depth gate maximum [m] (0: none)")->capture_default_str();
+  cmd->add_flag(
+      "--no-accelerate", [&o](std::int64_t) { o.icp.accelerate = false; },
+      "Plain ICP without Besl-McKay's extrapolation");
+  cmd->add_option("--min-depth", o.min_depth_m, "Depth gate minimum [m] (0: none)")
+      ->capture_default_str();
+  cmd->add_option("--max-depth", o.max_depth_m, "Depth gate maximum [m] (0: none)")
+      ->capture_default_str();
   cmd->add_option("--voxel", o.voxel_m, "Map voxel size [m]")->capture_default_str();
-  cmd->add_flag("--no-map", [&o](std::int64_t) { o.write_map = false; }, "Do not build map.ply");
+  cmd->add_flag(
+      "--no-map", [&o](std::int64_t) { o.write_map = false; }, "Do not build map.ply");
   cmd->add_flag("--threshold-table", o.threshold_table,
                 "Segments/planes of the first frame for Lab thresholds 10..30 x angles 15..60");
-  cmd->add_option("--depth-factor", o.input.depth_factor, "Depth PNG units per metre (0: dataset's)")
+  cmd->add_option("--depth-factor", o.input.depth_factor,
+                  "Depth PNG units per metre (0: dataset's)")
       ->capture_default_str();
   cmd->add_option("--max-frames", o.input.max_frames, "Process at most N frames (0: all)");
   cmd->add_option("--first-frame", o.input.first_frame, "Start at this frame");
-  cmd->add_flag("--skip-missing", o.input.skip_missing, "Skip listed images whose files are missing");
+  cmd->add_flag("--skip-missing", o.input.skip_missing,
+                "Skip listed images whose files are missing");
   cmd->add_option("--seed", o.frame.seed, "Sampling / K-Means seed")->capture_default_str();
   cmd->add_flag("--quiet", o.quiet, "No progress line");
   cmd->callback([options, settings, segmentation, fit, reference, gap, gaps] {
@@ -82,9 +95,10 @@ void RegisterPlanarCommand(CLI::App& app) {
       fmt::print("segments and planes of the first frame:\n{}", rgbd::FormatThresholdTable(r));
     }
     fmt::print("{}", rgbd::FormatGapTable(r));
-    fmt::print("wall {:.1f} s; outputs: {}/{{trajectory.txt, trajectory_gap*.txt, map.ply, "
-               "pairs.csv, stats.json}}\n",
-               r.wall_s, o.out.string());
+    fmt::print(
+        "wall {:.1f} s; outputs: {}/{{trajectory.txt, trajectory_gap*.txt, map.ply, "
+        "pairs.csv, stats.json}}\n",
+        r.wall_s, o.out.string());
   });
 }
 

@@ -1,7 +1,6 @@
 #include "rgbd/depth_cloud.h"
 
 #include <limits>
-
 #include <opencv2/imgproc.hpp>
 
 #include "core/util/error.h"
@@ -75,8 +74,9 @@ ColouredCloud LiftDepthImage(const cv::Mat& depth_m, const cv::Mat& colour_bgr,
                    depth_m.rows == lifter.height(),
                "depth {}x{} type {} vs camera {}x{}", depth_m.cols, depth_m.rows, depth_m.type(),
                lifter.width(), lifter.height());
-  PKSLAM_CHECK(colour_bgr.empty() || (colour_bgr.type() == CV_8UC3 && colour_bgr.size() == depth_m.size()),
-               "colour image must be CV_8UC3 of the depth's size");
+  PKSLAM_CHECK(
+      colour_bgr.empty() || (colour_bgr.type() == CV_8UC3 && colour_bgr.size() == depth_m.size()),
+      "colour image must be CV_8UC3 of the depth's size");
   PKSLAM_CHECK(stride >= 1, "stride {}", stride);
   ColouredCloud cloud;
   const std::size_t expected = static_cast<std::size_t>(depth_m.total()) / (stride * stride);
@@ -88,7 +88,8 @@ ColouredCloud LiftDepthImage(const cv::Mat& depth_m, const cv::Mat& colour_bgr,
     for (int u = 0; u < depth_m.cols; u += stride) {
       if (!(d[u] > 0)) continue;
       cloud.points.push_back(lifter.LiftPixel(u, v, d[u]));
-      cloud.colours.push_back(colour_bgr.empty() ? cv::Vec3b(0, 0, 0) : colour_bgr.at<cv::Vec3b>(v, u));
+      cloud.colours.push_back(colour_bgr.empty() ? cv::Vec3b(0, 0, 0)
+                                                 : colour_bgr.at<cv::Vec3b>(v, u));
       cloud.pixels.push_back(v * depth_m.cols + u);
     }
   }

@@ -14,9 +14,9 @@ namespace {
 
 TEST(PreprocessDepth, GatesTheRangeAndKeepsInvalidPixelsInvalid) {
   cv::Mat depth(20, 20, CV_32FC1, cv::Scalar(2.0f));
-  depth.at<float>(5, 5) = 0.5f;   // too close
-  depth.at<float>(6, 6) = 4.0f;   // too far
-  depth.at<float>(7, 7) = 0.0f;   // no measurement
+  depth.at<float>(5, 5) = 0.5f;  // too close
+  depth.at<float>(6, 6) = 4.0f;  // too far
+  depth.at<float>(7, 7) = 0.0f;  // no measurement
   DepthFilterOptions options;
   const cv::Mat out = PreprocessDepth(depth, options);
   EXPECT_EQ(out.at<float>(5, 5), 0.0f);
@@ -62,8 +62,8 @@ TEST(DepthLifter, LiftsWithThePinholeFormula) {
 }
 
 TEST(DepthLifter, DistortedCameraPointsReprojectToTheirPixel) {
-  const CameraModel camera =
-      CameraModel::Pinhole(640, 480, 517.3, 516.5, 318.6, 255.3, {0.2624, -0.9531, -0.0054, 0.0026, 1.1633});
+  const CameraModel camera = CameraModel::Pinhole(640, 480, 517.3, 516.5, 318.6, 255.3,
+                                                  {0.2624, -0.9531, -0.0054, 0.0026, 1.1633});
   const DepthLifter lifter(camera);
   for (const auto& [u, v] : {std::pair{10, 10}, std::pair{600, 400}, std::pair{320, 240}}) {
     const Eigen::Vector3f p = lifter.LiftPixel(u, v, 1.7f);

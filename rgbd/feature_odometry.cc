@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
 #include <opencv2/imgproc.hpp>
 
 #include "core/util/error.h"
@@ -33,12 +32,18 @@ void FeatureOdometryOptions::Check() const {
 
 const char* OdometryStatusName(OdometryStatus status) {
   switch (status) {
-    case OdometryStatus::kFirst: return "first";
-    case OdometryStatus::kTracked: return "tracked";
-    case OdometryStatus::kTooFewMatches: return "too_few_matches";
-    case OdometryStatus::kRansacFailed: return "ransac_failed";
-    case OdometryStatus::kMotionGate: return "motion_gate";
-    case OdometryStatus::kReset: return "reset";
+    case OdometryStatus::kFirst:
+      return "first";
+    case OdometryStatus::kTracked:
+      return "tracked";
+    case OdometryStatus::kTooFewMatches:
+      return "too_few_matches";
+    case OdometryStatus::kRansacFailed:
+      return "ransac_failed";
+    case OdometryStatus::kMotionGate:
+      return "motion_gate";
+    case OdometryStatus::kReset:
+      return "reset";
   }
   return "?";
 }
@@ -76,8 +81,9 @@ std::vector<HammingMatch> MatchBruteForce(const std::vector<Descriptor>& query,
     if (cross_check && best_query[t] != q) continue;
     matches.push_back({q, t, best_train_distance[q]});
   }
-  std::stable_sort(matches.begin(), matches.end(),
-                   [](const HammingMatch& a, const HammingMatch& b) { return a.distance < b.distance; });
+  std::stable_sort(
+      matches.begin(), matches.end(),
+      [](const HammingMatch& a, const HammingMatch& b) { return a.distance < b.distance; });
   if (static_cast<int>(matches.size()) > max_matches) matches.resize(max_matches);
   return matches;
 }

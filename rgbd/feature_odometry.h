@@ -65,12 +65,12 @@ struct StageTimesMs {
 };
 
 enum class OdometryStatus {
-  kFirst,           // the first frame: pose = initial pose, becomes the reference
-  kTracked,         // pose estimated and accepted
-  kTooFewMatches,   // rejected: fewer matches than RANSAC's min_inliers
-  kRansacFailed,    // rejected: too few inliers
-  kMotionGate,      // rejected: step larger than the motion limits
-  kReset,           // too many rejections: reference replaced, pose carried over
+  kFirst,          // the first frame: pose = initial pose, becomes the reference
+  kTracked,        // pose estimated and accepted
+  kTooFewMatches,  // rejected: fewer matches than RANSAC's min_inliers
+  kRansacFailed,   // rejected: too few inliers
+  kMotionGate,     // rejected: step larger than the motion limits
+  kReset,          // too many rejections: reference replaced, pose carried over
 };
 const char* OdometryStatusName(OdometryStatus status);
 // Whether the frame has a pose (kFirst, kTracked, kReset).
@@ -78,11 +78,11 @@ bool HasPose(OdometryStatus status);
 
 struct OdometryStep {
   OdometryStatus status = OdometryStatus::kFirst;
-  SE3d world_from_camera;      // valid when HasPose(status)
-  SE3d reference_from_current; // the RANSAC estimate (identity when none)
-  int keypoints = 0;           // ORB keypoints detected
+  SE3d world_from_camera;       // valid when HasPose(status)
+  SE3d reference_from_current;  // the RANSAC estimate (identity when none)
+  int keypoints = 0;            // ORB keypoints detected
   int keypoints_with_depth = 0;
-  int matches = 0;             // after the max_matches cut
+  int matches = 0;  // after the max_matches cut
   int inliers = 0;
   int ransac_iterations = 0;
   double step_rotation_deg = 0;

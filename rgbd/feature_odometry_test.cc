@@ -42,8 +42,8 @@ TEST(MatchBruteForce, CrossCheckDropsNonMutualMatches) {
   std::mt19937 rng(4);
   const Descriptor a = RandomDescriptor(rng);
   Descriptor a1 = a, a2 = a;
-  a1.bytes[0] ^= 1;   // distance 1 from a
-  a2.bytes[0] ^= 3;   // distance 2 from a
+  a1.bytes[0] ^= 1;  // distance 1 from a
+  a2.bytes[0] ^= 3;  // distance 2 from a
   const std::vector<Descriptor> train = {a};
   const std::vector<Descriptor> query = {a1, a2};  // both prefer train 0, which prefers a1
   EXPECT_EQ(MatchBruteForce(query, train, true, 256, 500).size(), 1u);

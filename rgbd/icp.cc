@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-
 #include <nanoflann.hpp>
 
 #include "core/util/error.h"
@@ -23,8 +22,9 @@ struct CloudAdaptor {
   }
 };
 
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, CloudAdaptor>,
-                                                   CloudAdaptor, 3, int>;
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, CloudAdaptor>,
+                                        CloudAdaptor, 3, int>;
 
 }  // namespace
 
@@ -106,9 +106,10 @@ IcpResult IcpPointToPoint(const std::vector<Eigen::Vector3f>& source, const Poin
   IcpResult result;
   result.target_from_source = initial_target_from_source;
   if (source.size() < 3 || target.size() < 3) return result;
-  const float max_d2 = options.max_correspondence_m > 0
-                           ? static_cast<float>(options.max_correspondence_m * options.max_correspondence_m)
-                           : std::numeric_limits<float>::infinity();
+  const float max_d2 =
+      options.max_correspondence_m > 0
+          ? static_cast<float>(options.max_correspondence_m * options.max_correspondence_m)
+          : std::numeric_limits<float>::infinity();
   const auto& target_points = target.points();
   double previous_mse = std::numeric_limits<double>::infinity();
   SE3d estimate = initial_target_from_source;
@@ -148,7 +149,8 @@ IcpResult IcpPointToPoint(const std::vector<Eigen::Vector3f>& source, const Poin
     // Stalled: the error decreased, but by less than the tolerance (with pair rejection the
     // error can also rise while the pairs change; that is not convergence).
     const double decrease = previous_mse - mse;
-    const bool stalled = decrease >= 0 && decrease < options.min_relative_mse_decrease * previous_mse;
+    const bool stalled =
+        decrease >= 0 && decrease < options.min_relative_mse_decrease * previous_mse;
     if (small_update || (std::isfinite(previous_mse) && stalled)) {
       result.converged = true;
       break;

@@ -57,13 +57,13 @@ struct IcpOptions {
 };
 
 struct IcpResult {
-  bool success = false;        // a solution from at least 3 pairs in every iteration
-  bool converged = false;      // stopped by a tolerance, not by max_iterations
+  bool success = false;    // a solution from at least 3 pairs in every iteration
+  bool converged = false;  // stopped by a tolerance, not by max_iterations
   SE3d target_from_source;
   int iterations = 0;
-  int accelerations = 0;       // extrapolation jumps taken
-  int correspondences = 0;     // pairs in the last iteration
-  double rmse_m = 0;           // RMS pair distance in the last iteration (before its update)
+  int accelerations = 0;    // extrapolation jumps taken
+  int correspondences = 0;  // pairs in the last iteration
+  double rmse_m = 0;        // RMS pair distance in the last iteration (before its update)
 };
 
 IcpResult IcpPointToPoint(const std::vector<Eigen::Vector3f>& source, const PointCloudIndex& target,

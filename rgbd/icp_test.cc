@@ -45,17 +45,26 @@ std::vector<Eigen::Vector3f> RandomCorner(int n, unsigned seed) {
   for (int i = 0; i < n; ++i) {
     const float a = u(rng), b = u(rng);
     switch (i % 4) {
-      case 0: points.emplace_back(-1.5f + 3 * a, 1.0f, 1.0f + 2 * b); break;   // floor
-      case 1: points.emplace_back(-1.5f + 3 * a, -1.0f + 2 * b, 3.0f); break;  // front wall
-      case 2: points.emplace_back(-1.5f, -1.0f + 2 * a, 1.0f + 2 * b); break;  // left wall
-      default: points.emplace_back(0.2f + 0.4f * a, 0.6f + 0.4f * b, 2.0f); break;  // box face
+      case 0:
+        points.emplace_back(-1.5f + 3 * a, 1.0f, 1.0f + 2 * b);
+        break;  // floor
+      case 1:
+        points.emplace_back(-1.5f + 3 * a, -1.0f + 2 * b, 3.0f);
+        break;  // front wall
+      case 2:
+        points.emplace_back(-1.5f, -1.0f + 2 * a, 1.0f + 2 * b);
+        break;  // left wall
+      default:
+        points.emplace_back(0.2f + 0.4f * a, 0.6f + 0.4f * b, 2.0f);
+        break;  // box face
     }
   }
   return points;
 }
 
 TEST(Icp, ConvergesToAKnownMotionOnSyntheticClouds) {
-  const SE3d truth(SO3d::Exp(Eigen::Vector3d(0.01, -0.03, 0.02)), Eigen::Vector3d(0.03, -0.02, 0.04));
+  const SE3d truth(SO3d::Exp(Eigen::Vector3d(0.01, -0.03, 0.02)),
+                   Eigen::Vector3d(0.03, -0.02, 0.04));
   const PointCloudIndex target(RandomCorner(40000, 1));
   std::vector<Eigen::Vector3f> source;  // another sample of the same surfaces, moved
   for (const auto& p : RandomCorner(4000, 2)) {

@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <limits>
-#include <random>
-
 #include <opencv2/core.hpp>
+#include <random>
 
 #include "core/util/error.h"
 
@@ -36,7 +35,8 @@ int NearestCentre(const float* x, const cv::Mat& centres) {
 
 }  // namespace
 
-Segmentation SegmentKMeans(const ColouredCloud& cloud, cv::Size size, const KMeansOptions& options) {
+Segmentation SegmentKMeans(const ColouredCloud& cloud, cv::Size size,
+                           const KMeansOptions& options) {
   options.Check();
   Segmentation seg;
   seg.labels = cv::Mat(size, CV_32SC1, cv::Scalar(-1));
@@ -100,9 +100,10 @@ Segmentation SegmentKMeans(const ColouredCloud& cloud, cv::Size size, const KMea
   for (int j = 0; j < samples.rows; ++j) {
     labels.at<int>(j) = NearestCentre(samples.ptr<float>(j), centres);
   }
-  cv::kmeans(samples, k, labels,
-             cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, options.iterations, 1e-4),
-             1, cv::KMEANS_USE_INITIAL_LABELS, centres);
+  cv::kmeans(
+      samples, k, labels,
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, options.iterations, 1e-4),
+      1, cv::KMEANS_USE_INITIAL_LABELS, centres);
 
   int* out = seg.labels.ptr<int>(0);
   for (std::size_t j = 0; j < subset.size(); ++j) {

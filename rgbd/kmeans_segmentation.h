@@ -14,10 +14,10 @@
 namespace pkslam::rgbd {
 
 struct KMeansOptions {
-  int clusters = 400;           // K
-  double geometry_weight = 2.0; // multiplies the normalised x, y, z columns
-  int stride = 2;               // cluster every stride-th pixel; the rest join the nearest centre
-  int iterations = 10;          // Lloyd iterations
+  int clusters = 400;            // K
+  double geometry_weight = 2.0;  // multiplies the normalised x, y, z columns
+  int stride = 2;                // cluster every stride-th pixel; the rest join the nearest centre
+  int iterations = 10;           // Lloyd iterations
   std::uint64_t seed = 1;
 
   void Check() const;

@@ -1,16 +1,16 @@
 #include "rgbd/odometry_run.h"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <fstream>
 
-#include <fmt/format.h>
-
 #include "core/util/error.h"
-#include "rgbd/cpu_time.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
 #include "core/util/progress.h"
 #include "io/trajectory.h"
+#include "rgbd/cpu_time.h"
 #include "rgbd/voxel_map.h"
 
 namespace pkslam::rgbd {
@@ -78,12 +78,23 @@ OdometryRunResult RunRgbdOdometry(const OdometryRunOptions& options) {
     const OdometryStep step = odometry.Process(frame.colour_bgr, frame.depth_m);
     ++result.frames;
     switch (step.status) {
-      case OdometryStatus::kFirst: break;
-      case OdometryStatus::kTracked: ++result.tracked; break;
-      case OdometryStatus::kTooFewMatches: ++result.rejected_too_few_matches; break;
-      case OdometryStatus::kRansacFailed: ++result.rejected_ransac; break;
-      case OdometryStatus::kMotionGate: ++result.rejected_motion_gate; break;
-      case OdometryStatus::kReset: ++result.resets; break;
+      case OdometryStatus::kFirst:
+        break;
+      case OdometryStatus::kTracked:
+        ++result.tracked;
+        break;
+      case OdometryStatus::kTooFewMatches:
+        ++result.rejected_too_few_matches;
+        break;
+      case OdometryStatus::kRansacFailed:
+        ++result.rejected_ransac;
+        break;
+      case OdometryStatus::kMotionGate:
+        ++result.rejected_motion_gate;
+        break;
+      case OdometryStatus::kReset:
+        ++result.resets;
+        break;
     }
     if (step.status != OdometryStatus::kFirst) {
       sum_times.preprocessing += step.times.preprocessing;

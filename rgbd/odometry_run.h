@@ -38,7 +38,7 @@ struct OdometryRunResult {
   int rejected_ransac = 0;
   int rejected_motion_gate = 0;
   int resets = 0;
-  int poses = 0;  // lines in trajectory.txt
+  int poses = 0;            // lines in trajectory.txt
   StageTimesMs mean_times;  // over frames after the first
   double mean_matches = 0;
   double mean_inliers = 0;

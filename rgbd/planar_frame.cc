@@ -1,10 +1,10 @@
 #include "rgbd/planar_frame.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <numeric>
 #include <random>
-
-#include <fmt/format.h>
 
 #include "core/util/error.h"
 #include "rgbd/cpu_time.h"
@@ -29,7 +29,8 @@ std::vector<std::vector<int>> TouchingNeighbours(const std::vector<MergeInput>& 
   std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return segments[a].bbox.x != segments[b].bbox.x ? segments[a].bbox.x < segments[b].bbox.x : a < b;
+    return segments[a].bbox.x != segments[b].bbox.x ? segments[a].bbox.x < segments[b].bbox.x
+                                                    : a < b;
   });
   std::vector<std::vector<int>> neighbours(n);
   for (int i = 0; i < n; ++i) {
@@ -72,6 +73,8 @@ void PlanarFrameOptions::Check() const {
   PKSLAM_CHECK_OPTION(merge_max_fit_rms_m > 0, "merge_max_fit_rms_m", "{}", merge_max_fit_rms_m);
   PKSLAM_CHECK_OPTION(merge_max_points >= 0, "merge_max_points", "{}", merge_max_points);
   PKSLAM_CHECK_OPTION(samples_per_plane >= 1, "samples_per_plane", "{}", samples_per_plane);
+  PKSLAM_CHECK_OPTION(min_sampled_plane_points >= 0, "min_sampled_plane_points", "{}",
+                      min_sampled_plane_points);
 }
 
 std::vector<std::vector<int>> MergeSegments(const std::vector<MergeInput>& segments,
@@ -95,7 +98,8 @@ std::vector<std::vector<int>> MergeSegments(const std::vector<MergeInput>& segme
       for (const int b : neighbours[a]) {
         if (group_of[b] >= 0) continue;
         if (segments[b].rms_m > options.merge_max_fit_rms_m) continue;
-        if (NormalAngleDeg(segments[a].plane, segments[b].plane) > options.merge_angle_deg) continue;
+        if (NormalAngleDeg(segments[a].plane, segments[b].plane) > options.merge_angle_deg)
+          continue;
         PointMoments candidate = merged;
         candidate.Add(segments[b].moments);
         if (options.merge_max_points > 0 &&
@@ -188,8 +192,8 @@ PlanarFrame BuildPlanarFrame(const cv::Mat& colour_bgr, const cv::Mat& depth_m,
       out.point_ids.insert(out.point_ids.end(), ids.begin(), ids.end());
       out.bbox = out.bbox.area() == 0 ? fitted[f].bbox : (out.bbox | fitted[f].bbox);
     }
-    const auto plane = group.size() == 1 ? std::optional<Plane>(fitted[group[0]].plane)
-                                         : merged.Fit(options.fit);
+    const auto plane =
+        group.size() == 1 ? std::optional<Plane>(fitted[group[0]].plane) : merged.Fit(options.fit);
     if (!plane) continue;  // cannot happen for accepted merges; kept for safety
     out.plane = *plane;
     out.rms_m = merged.RmsDistance(*plane);
@@ -198,7 +202,8 @@ PlanarFrame BuildPlanarFrame(const cv::Mat& colour_bgr, const cv::Mat& depth_m,
     frame.planar.push_back(std::move(out));
   }
   frame.planes = static_cast<int>(frame.planar.size());
-  frame.dropped_fraction = num_pixels > 0 ? 1.0 - static_cast<double>(planar_points) / num_pixels : 0;
+  frame.dropped_fraction =
+      num_pixels > 0 ? 1.0 - static_cast<double>(planar_points) / num_pixels : 0;
   frame.fitting_ms = MsSince(start);
 
   // --- 4. projection and sampling ---
@@ -206,6 +211,8 @@ PlanarFrame BuildPlanarFrame(const cv::Mat& colour_bgr, const cv::Mat& depth_m,
   std::mt19937_64 rng(options.seed);
   std::vector<int> ids;
   for (const PlanarSegment& s : frame.planar) {
+    if (static_cast<int>(s.point_ids.size()) < options.min_sampled_plane_points) continue;
+    ++frame.sampled_planes;
     ids = s.point_ids;
     const int n = static_cast<int>(ids.size());
     const int take = std::min(n, options.samples_per_plane);

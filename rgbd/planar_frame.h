@@ -11,7 +11,7 @@
 //      merge_max_fit_rms_m -- which also keeps parallel planes at different depths apart --
 //      and at most merge_max_points points); merged segments are refitted;
 //   4. every point of a plane is projected onto it and N of them are drawn at random (all when
-//      fewer), the points ICP registers.
+//      fewer; optionally only planes of a minimum size), the points ICP registers.
 #pragma once
 
 #include <Eigen/Core>
@@ -54,6 +54,11 @@ struct PlanarFrameOptions {
   int merge_max_points = 0;
   // Points drawn per plane (the paper: N = 200).
   int samples_per_plane = 200;
+  // Planes with fewer points are not sampled (0 = every plane, as the paper). Colour region
+  // growing on textured surfaces leaves hundreds of slivers along colour edges: each gives all
+  // its few points, so together they can supply most of the samples while holding a few
+  // percent of the points, and their normals are unreliable.
+  int min_sampled_plane_points = 0;
   // Seed of the sampler and of K-Means (frame results are a function of image and seed).
   std::uint64_t seed = 1;
 
@@ -62,23 +67,24 @@ struct PlanarFrameOptions {
 
 struct PlanarSegment {
   Plane plane;
-  double rms_m = 0;              // fit RMS of its points
-  int points = 0;                // valid-depth points
-  cv::Rect bbox;                 // pixel bounding box
-  std::vector<int> point_ids;    // indices into PlanarFrame::cloud
+  double rms_m = 0;            // fit RMS of its points
+  int points = 0;              // valid-depth points
+  cv::Rect bbox;               // pixel bounding box
+  std::vector<int> point_ids;  // indices into PlanarFrame::cloud
 };
 
 struct PlanarFrame {
-  ColouredCloud cloud;                  // every valid-depth pixel, camera frame
-  int segments = 0;                     // segmentation output (before dropping)
-  int segments_fitted = 0;              // with a plane
-  int planes = 0;                       // after merging
-  double dropped_fraction = 0;          // pixels without a plane (zero depth or dropped)
-  std::vector<PlanarSegment> planar;    // the final planes
-  std::vector<Eigen::Vector3f> samples; // projected, sampled points (camera frame)
-  double segmentation_ms = 0;           // Lab conversion + segmentation
-  double fitting_ms = 0;                // plane fits, merging, refits
-  double sampling_ms = 0;               // projection and sampling
+  ColouredCloud cloud;                   // every valid-depth pixel, camera frame
+  int segments = 0;                      // segmentation output (before dropping)
+  int segments_fitted = 0;               // with a plane
+  int planes = 0;                        // after merging
+  double dropped_fraction = 0;           // pixels without a plane (zero depth or dropped)
+  std::vector<PlanarSegment> planar;     // the final planes
+  std::vector<Eigen::Vector3f> samples;  // projected, sampled points (camera frame)
+  int sampled_planes = 0;                // planes that gave samples
+  double segmentation_ms = 0;            // Lab conversion + segmentation
+  double fitting_ms = 0;                 // plane fits, merging, refits
+  double sampling_ms = 0;                // projection and sampling
   double time_ms() const { return segmentation_ms + fitting_ms + sampling_ms; }
 };
 

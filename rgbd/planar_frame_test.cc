@@ -3,11 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <set>
 
 #include "core/util/error.h"
-
 #include "rgbd/test_scene.h"
 
 namespace pkslam::rgbd {
@@ -19,7 +17,8 @@ MergeInput Segment(const Eigen::Vector3d& normal, const Eigen::Vector3d& centre,
   const Eigen::Vector3d a = n.unitOrthogonal(), b = n.cross(a);
   MergeInput s;
   for (int i = 0; i < 10; ++i) {
-    for (int j = 0; j < 10; ++j) s.moments.Add(centre + 0.02 * (i - 4.5) * a + 0.02 * (j - 4.5) * b);
+    for (int j = 0; j < 10; ++j)
+      s.moments.Add(centre + 0.02 * (i - 4.5) * a + 0.02 * (j - 4.5) * b);
   }
   s.plane = *s.moments.Fit(PlaneFitMethod::kPca);
   s.rms_m = s.moments.RmsDistance(s.plane);
@@ -94,8 +93,9 @@ TEST(BuildPlanarFrame, RoomViewGivesPlanesAndSamplesOnThem) {
   const CameraModel camera = testing::TestCamera();
   const auto view = testing::RenderRoom(camera, testing::PathPose(0), 0.003, 5);
   PlanarFrameOptions options;
-  const PlanarFrame frame = BuildPlanarFrame(view.colour_bgr, view.depth_m, DepthLifter(camera), options);
-  EXPECT_GT(frame.segments, 20);               // one per colour block at least
+  const PlanarFrame frame =
+      BuildPlanarFrame(view.colour_bgr, view.depth_m, DepthLifter(camera), options);
+  EXPECT_GT(frame.segments, 20);                   // one per colour block at least
   EXPECT_LT(frame.planes, frame.segments_fitted);  // merging joined blocks of the same face
   EXPECT_GT(frame.planes, 3);
   EXPECT_LT(frame.dropped_fraction, 0.05);
@@ -116,10 +116,35 @@ TEST(BuildPlanarFrame, RoomViewGivesPlanesAndSamplesOnThem) {
     EXPECT_LT(best, 1e-5);
   }
   // The largest plane is flat (a wall of the room).
-  const auto largest = std::max_element(frame.planar.begin(), frame.planar.end(),
-                                        [](const auto& a, const auto& b) { return a.points < b.points; });
+  const auto largest =
+      std::max_element(frame.planar.begin(), frame.planar.end(),
+                       [](const auto& a, const auto& b) { return a.points < b.points; });
   EXPECT_LT(largest->rms_m, 0.01);
   EXPECT_GT(frame.segmentation_ms, 0.0);
+}
+
+TEST(BuildPlanarFrame, SmallPlanesCanBeLeftOutOfTheSamples) {
+  const CameraModel camera = testing::TestCamera();
+  const auto view = testing::RenderRoom(camera, testing::PathPose(0), 0.003, 5);
+  PlanarFrameOptions options;
+  const PlanarFrame all =
+      BuildPlanarFrame(view.colour_bgr, view.depth_m, DepthLifter(camera), options);
+  options.min_sampled_plane_points = 500;
+  const PlanarFrame large =
+      BuildPlanarFrame(view.colour_bgr, view.depth_m, DepthLifter(camera), options);
+  EXPECT_EQ(all.planes, large.planes);  // the same planes; only the sampling differs
+  EXPECT_EQ(all.sampled_planes, all.planes);
+  std::size_t expected = 0;
+  int sampled = 0;
+  for (const PlanarSegment& s : large.planar) {
+    if (s.point_ids.size() < 500) continue;
+    expected += std::min<std::size_t>(s.point_ids.size(), 200);
+    ++sampled;
+  }
+  EXPECT_GT(sampled, 0);
+  EXPECT_LT(sampled, large.planes);
+  EXPECT_EQ(large.sampled_planes, sampled);
+  EXPECT_EQ(large.samples.size(), expected);
 }
 
 TEST(BuildPlanarFrame, KMeansBaselineProducesPlanesWithoutMerging) {
@@ -129,7 +154,8 @@ TEST(BuildPlanarFrame, KMeansBaselineProducesPlanesWithoutMerging) {
   options.segmentation = SegmentationMethod::kKMeans;
   options.kmeans_clusters = 40;
   options.kmeans_stride = 4;
-  const PlanarFrame frame = BuildPlanarFrame(view.colour_bgr, view.depth_m, DepthLifter(camera), options);
+  const PlanarFrame frame =
+      BuildPlanarFrame(view.colour_bgr, view.depth_m, DepthLifter(camera), options);
   EXPECT_EQ(frame.segments, 40);
   EXPECT_EQ(frame.planes, frame.segments_fitted);
   EXPECT_GT(frame.planes, 30);

@@ -1,20 +1,20 @@
 #include "rgbd/planar_run.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 
-#include <fmt/format.h>
-
 #include "core/util/error.h"
-#include "rgbd/cpu_time.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
 #include "core/util/progress.h"
 #include "evaluation/evaluate.h"
 #include "evaluation/statistics.h"
 #include "io/trajectory.h"
+#include "rgbd/cpu_time.h"
 #include "rgbd/voxel_map.h"
 
 namespace pkslam::rgbd {
@@ -54,7 +54,9 @@ double Rms(const std::vector<double>& v) {
   return std::sqrt(s / static_cast<double>(v.size()));
 }
 
-double Max(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
+double Max(const std::vector<double>& v) {
+  return v.empty() ? 0 : *std::max_element(v.begin(), v.end());
+}
 
 double Mean(const std::vector<double>& v) {
   if (v.empty()) return 0;
@@ -163,7 +165,8 @@ GapResult RunGap(const RgbdSequence& sequence, const DepthLifter& lifter,
         sequence.ground_truth ? InterpolatePose(*sequence.ground_truth, frame.t_ns) : std::nullopt;
 
     // --- planar: segmentation, planes, samples; ICP against the previous frame ---
-    const PlanarFrame planar_frame = BuildPlanarFrame(frame.colour_bgr, depth, lifter, options.frame);
+    const PlanarFrame planar_frame =
+        BuildPlanarFrame(frame.colour_bgr, depth, lifter, options.frame);
     planar.segmentation_ms += planar_frame.segmentation_ms;
     planar.fitting_ms += planar_frame.fitting_ms;
     planar.sampling_ms += planar_frame.sampling_ms;
@@ -174,7 +177,8 @@ GapResult RunGap(const RgbdSequence& sequence, const DepthLifter& lifter,
     PointCloudIndex planar_index(planar_frame.samples);
     std::optional<SE3d> planar_step;
     if (chain.planar_target) {
-      const IcpResult icp = IcpPointToPoint(planar_frame.samples, *chain.planar_target, SE3d(), options.icp);
+      const IcpResult icp =
+          IcpPointToPoint(planar_frame.samples, *chain.planar_target, SE3d(), options.icp);
       if (icp.success) planar_step = icp.target_from_source;
       sum_planar_iterations += icp.iterations;
       sum_planar_points += static_cast<double>(planar_frame.samples.size());
@@ -207,7 +211,8 @@ GapResult RunGap(const RgbdSequence& sequence, const DepthLifter& lifter,
       if (options.reference_full_icp) ++full.pairs;
       // A failed registration (too few pairs) keeps the previous pose: counted as an error.
       chain.world_from_planar = chain.world_from_planar * planar_step.value_or(SE3d());
-      if (options.reference_full_icp) chain.world_from_full = chain.world_from_full * full_step.value_or(SE3d());
+      if (options.reference_full_icp)
+        chain.world_from_full = chain.world_from_full * full_step.value_or(SE3d());
       if (truth && chain.world_from_truth_previous) {
         const SE3d truth_step = chain.world_from_truth_previous->Inverse() * *truth;
         result.motion_m.push_back(truth_step.translation().norm());
@@ -221,11 +226,10 @@ GapResult RunGap(const RgbdSequence& sequence, const DepthLifter& lifter,
           full.rotation_errors_deg.push_back(f.rotation_deg);
         }
       }
-      *pairs_csv += fmt::format("{},{},{:.6f},{},{},{:.3f},{:.3f}", gap, k,
-                                static_cast<double>(frame.t_ns) * 1e-9, planar_frame.planes,
-                                planar_frame.samples.size(), planar_frame.time_ms(),
-                                planar.translation_errors_m.empty() ? NAN
-                                                                    : planar.translation_errors_m.back());
+      *pairs_csv += fmt::format(
+          "{},{},{:.6f},{},{},{:.3f},{:.3f}", gap, k, static_cast<double>(frame.t_ns) * 1e-9,
+          planar_frame.planes, planar_frame.samples.size(), planar_frame.time_ms(),
+          planar.translation_errors_m.empty() ? NAN : planar.translation_errors_m.back());
       *pairs_csv += options.reference_full_icp && !full.translation_errors_m.empty()
                         ? fmt::format(",{:.6f}\n", full.translation_errors_m.back())
                         : std::string(",\n");
@@ -266,7 +270,8 @@ GapResult RunGap(const RgbdSequence& sequence, const DepthLifter& lifter,
       full.mean_icp_iterations = sum_full_iterations / full.pairs;
     }
     full.ate_rmse_m = AteRmse(sequence.ground_truth, full_trajectory);
-    WriteTrajectoryTum(full_trajectory, options.out / fmt::format("trajectory_full_icp_gap{}.txt", gap));
+    WriteTrajectoryTum(full_trajectory,
+                       options.out / fmt::format("trajectory_full_icp_gap{}.txt", gap));
     result.full = full;
     result.model_error_m = Rms(model_differences);
     if (full.total_ms() > 0) {
@@ -294,6 +299,7 @@ void WriteStats(const PlanarRunOptions& options, const RgbdSequence& sequence,
   json.Member("merge_angle_deg", options.frame.merge_angle_deg);
   json.Member("merge_max_fit_rms_m", options.frame.merge_max_fit_rms_m);
   json.Member("samples_per_plane", options.frame.samples_per_plane);
+  json.Member("min_sampled_plane_points", options.frame.min_sampled_plane_points);
   json.Member("icp_max_iterations", options.icp.max_iterations);
   json.Member("icp_max_correspondence_m", options.icp.max_correspondence_m);
   json.Member("icp_accelerate", options.icp.accelerate);
@@ -339,7 +345,8 @@ void WriteStats(const PlanarRunOptions& options, const RgbdSequence& sequence,
     json.Member("segments", row.segments);
     json.Member("segmentation_ms", row.segmentation_ms);
     json.Key("planes_per_merge_angle").BeginObject();
-    for (const auto& [angle, planes] : row.planes_per_angle) json.Member(fmt::format("{:g}", angle), planes);
+    for (const auto& [angle, planes] : row.planes_per_angle)
+      json.Member(fmt::format("{:g}", angle), planes);
     json.EndObject();
     json.EndObject();
   }
@@ -378,17 +385,19 @@ PlanarRunResult RunPlanar(const PlanarRunOptions& options) {
 
 std::string FormatGapTable(const PlanarRunResult& result) {
   std::string s = fmt::format(
-      "{:>3} {:>5} {:>7} | {:>10} {:>10} {:>10} {:>8} {:>8} | {:>8} {:>8} {:>8} {:>8} | {:>8} "
-      "{:>8} {:>8}\n",
-      "gap", "pairs", "planes", "planar[s]", "w/o seg[s]", "full[s]", "speedup%", "w/o seg%",
-      "motion", "err[cm]", "max[cm]", "full[cm]", "ATE[cm]", "fullATE", "model");
+      "{:>3} {:>5} {:>7} {:>7} {:>7} | {:>10} {:>10} {:>10} {:>8} {:>8} | {:>8} {:>8} {:>8} "
+      "{:>8} | {:>8} {:>8} {:>8}\n",
+      "gap", "pairs", "planes", "samples", "full pts", "planar[s]", "w/o seg[s]", "full[s]",
+      "speedup%", "w/o seg%", "motion", "err[cm]", "max[cm]", "full[cm]", "ATE[cm]", "fullATE",
+      "model");
   const auto cm = [](double m) { return fmt::format("{:.2f}", 100 * m); };
   for (const GapResult& g : result.gaps) {
     const bool gt = !g.planar.translation_errors_m.empty();
     s += fmt::format(
-        "{:>3} {:>5} {:>7.0f} | {:>10.3f} {:>10.3f} {:>10} {:>8} {:>8} | {:>8} {:>8} {:>8} {:>8} | "
-        "{:>8} {:>8} {:>8}\n",
-        g.gap, g.planar.pairs, g.mean_planes, g.planar.total_ms() / 1000,
+        "{:>3} {:>5} {:>7.0f} {:>7.0f} {:>7} | {:>10.3f} {:>10.3f} {:>10} {:>8} {:>8} | {:>8} "
+        "{:>8} {:>8} {:>8} | {:>8} {:>8} {:>8}\n",
+        g.gap, g.planar.pairs, g.mean_planes, g.planar.mean_points,
+        g.full ? fmt::format("{:.0f}", g.full->mean_points) : "-", g.planar.total_ms() / 1000,
         g.planar.without_segmentation_ms() / 1000,
         g.full ? fmt::format("{:.3f}", g.full->total_ms() / 1000) : "-",
         g.speedup_percent ? fmt::format("{:.1f}", *g.speedup_percent) : "-",
@@ -402,7 +411,8 @@ std::string FormatGapTable(const PlanarRunResult& result) {
         g.full && g.full->ate_rmse_m ? cm(*g.full->ate_rmse_m) : "-",
         g.model_error_m ? cm(*g.model_error_m) : "-");
   }
-  s += "times: CPU s over the chain; motion: mean true step (the error of assuming no motion);\n"
+  s += "planes: per frame; samples / full pts: ICP source points per pair (planar / full);\n"
+       "times: CPU s over the chain; motion: mean true step (the error of assuming no motion);\n"
        "err/max: per-pair translation error vs ground truth (mean/max), full: the same for\n"
        "full-point ICP, ATE: chained trajectory RMSE (SE(3)-aligned), model: RMS distance\n"
        "between planar and full-ICP camera positions; speed-up = (T_full - T) / T_full.\n";
@@ -417,7 +427,8 @@ std::string FormatThresholdTable(const PlanarRunResult& result) {
   }
   s += "\n";
   for (const ThresholdRow& row : result.threshold_table) {
-    s += fmt::format("{:>9.0f} {:>9} {:>8.1f}", row.lab_threshold, row.segments, row.segmentation_ms);
+    s += fmt::format("{:>9.0f} {:>9} {:>8.1f}", row.lab_threshold, row.segments,
+                     row.segmentation_ms);
     for (const auto& [angle, planes] : row.planes_per_angle) s += fmt::format(" {:>9}", planes);
     s += "\n";
   }

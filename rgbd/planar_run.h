@@ -57,11 +57,11 @@ struct RegistrationTotals {
   double segmentation_ms = 0;  // planar: all frames of the chain
   double fitting_ms = 0;
   double sampling_ms = 0;
-  double icp_ms = 0;           // k-d tree + ICP
-  double cloud_ms = 0;         // reference: lifting the full clouds
+  double icp_ms = 0;    // k-d tree + ICP
+  double cloud_ms = 0;  // reference: lifting the full clouds
   double total_ms() const { return segmentation_ms + fitting_ms + sampling_ms + icp_ms + cloud_ms; }
   double without_segmentation_ms() const { return total_ms() - segmentation_ms; }
-  double mean_points = 0;            // ICP source points per pair
+  double mean_points = 0;  // ICP source points per pair
   double mean_icp_iterations = 0;
   std::vector<double> translation_errors_m;  // per pair vs ground truth (empty without it)
   std::vector<double> rotation_errors_deg;
@@ -70,8 +70,8 @@ struct RegistrationTotals {
 
 struct GapResult {
   int gap = 1;
-  int frames = 0;                        // frames in the chain
-  double mean_segments = 0;              // per frame
+  int frames = 0;            // frames in the chain
+  double mean_segments = 0;  // per frame
   double mean_planes = 0;
   double mean_dropped_fraction = 0;
   RegistrationTotals planar;

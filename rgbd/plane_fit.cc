@@ -1,11 +1,11 @@
 #include "rgbd/plane_fit.h"
 
+#include <fmt/format.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "core/util/error.h"
 
@@ -62,7 +62,7 @@ std::optional<Plane> PointMoments::Fit(PlaneFitMethod method) const {
     normal = Eigen::Vector3d(a, b, -1.0).normalized();
   } else {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    const Eigen::Vector3d values = eig.eigenvalues();  // ascending
+    const Eigen::Vector3d values = eig.eigenvalues();       // ascending
     if (!(values(1) > 1e-12 * scale)) return std::nullopt;  // collinear
     normal = eig.eigenvectors().col(0);
   }

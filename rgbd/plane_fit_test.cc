@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <random>
 #include <vector>
 
@@ -30,7 +29,8 @@ PointMoments NoisyPlane(const Eigen::Vector3d& n, double d, int count, double no
 }
 
 TEST(PlaneFit, LeastSquaresAndPcaAgreeOnNoisyPlanes) {
-  const Eigen::Vector3d normals[] = {Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(0.3, -0.2, -1).normalized(),
+  const Eigen::Vector3d normals[] = {Eigen::Vector3d(0, 0, -1),
+                                     Eigen::Vector3d(0.3, -0.2, -1).normalized(),
                                      Eigen::Vector3d(0, -1, -0.6).normalized()};
   unsigned seed = 1;
   for (const Eigen::Vector3d& n : normals) {

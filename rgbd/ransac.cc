@@ -10,7 +10,8 @@
 namespace pkslam::rgbd {
 
 void RansacOptions::Check() const {
-  PKSLAM_CHECK_OPTION(inlier_threshold_m > 0, "ransac.inlier_threshold_m", "{}", inlier_threshold_m);
+  PKSLAM_CHECK_OPTION(inlier_threshold_m > 0, "ransac.inlier_threshold_m", "{}",
+                      inlier_threshold_m);
   PKSLAM_CHECK_OPTION(confidence > 0 && confidence < 1, "ransac.confidence", "{}", confidence);
   PKSLAM_CHECK_OPTION(max_iterations >= 1, "ransac.max_iterations", "{}", max_iterations);
   PKSLAM_CHECK_OPTION(min_inliers >= 3, "ransac.min_inliers", "{}", min_inliers);
@@ -23,8 +24,8 @@ int RansacIterationCount(double confidence, double inlier_ratio, int sample_size
   if (inlier_ratio >= 1) return 1;
   if (inlier_ratio <= 0) return max_iterations;
   const double all_good = std::pow(inlier_ratio, sample_size);  // w^k
-  const double denominator = std::log1p(-all_good);               // log(1 - w^k)
-  if (denominator >= 0) return max_iterations;                    // w^k below double precision
+  const double denominator = std::log1p(-all_good);             // log(1 - w^k)
+  if (denominator >= 0) return max_iterations;                  // w^k below double precision
   const double n = std::ceil(std::log1p(-confidence) / denominator);
   if (!(n < max_iterations)) return max_iterations;
   return std::max(1, static_cast<int>(n));
@@ -33,8 +34,9 @@ int RansacIterationCount(double confidence, double inlier_ratio, int sample_size
 namespace {
 
 // Indices of pairs whose residual under `t` is below the threshold.
-void CollectInliers(std::span<const Eigen::Vector3d> source, std::span<const Eigen::Vector3d> target,
-                    const SE3d& t, double threshold, std::vector<int>* inliers) {
+void CollectInliers(std::span<const Eigen::Vector3d> source,
+                    std::span<const Eigen::Vector3d> target, const SE3d& t, double threshold,
+                    std::vector<int>* inliers) {
   inliers->clear();
   const double threshold2 = threshold * threshold;
   const Eigen::Matrix3d r = t.RotationMatrix();

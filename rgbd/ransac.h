@@ -37,7 +37,7 @@ int RansacIterationCount(double confidence, double inlier_ratio, int sample_size
 
 struct RansacResult {
   bool success = false;
-  SE3d target_from_source;  // identity when !success
+  SE3d target_from_source;   // identity when !success
   std::vector<int> inliers;  // indices into the correspondences
   int iterations = 0;        // samples drawn
 };

@@ -1,8 +1,8 @@
 #include "rgbd/rgbd_sequence.h"
 
-#include <algorithm>
-
 #include <fmt/format.h>
+
+#include <algorithm>
 
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -57,11 +57,11 @@ RgbdSequence OpenRgbdSequence(const RgbdSequenceOptions& options) {
 
   for (const ImageStream* stream : {&seq.dataset.rgb(), &seq.dataset.depth()}) {
     if (!stream->missing.empty() && !options.skip_missing) {
-      throw InputError(stream->missing.front(),
-                       fmt::format("{} image listed in {} is missing ({} missing in all; "
-                                   "--skip-missing processes the rest)",
-                                   stream->name, stream->list_file.filename().string(),
-                                   stream->missing.size()));
+      throw InputError(
+          stream->missing.front(),
+          fmt::format("{} image listed in {} is missing ({} missing in all; "
+                      "--skip-missing processes the rest)",
+                      stream->name, stream->list_file.filename().string(), stream->missing.size()));
     }
   }
 
@@ -88,15 +88,17 @@ RgbdSequence OpenRgbdSequence(const RgbdSequenceOptions& options) {
 
   const auto& associations = seq.dataset.associations();
   if (associations.empty()) {
-    throw InputError(options.dataset / "depth.txt", "no colour image has a depth image within 20 ms");
+    throw InputError(options.dataset / "depth.txt",
+                     "no colour image has a depth image within 20 ms");
   }
   const std::size_t first = static_cast<std::size_t>(options.first_frame);
   if (first >= associations.size()) {
-    throw OptionError(fmt::format("--first-frame {}: the sequence has {} frames", first,
-                                  associations.size()));
+    throw OptionError(
+        fmt::format("--first-frame {}: the sequence has {} frames", first, associations.size()));
   }
   std::size_t end = associations.size();
-  if (options.max_frames > 0) end = std::min(end, first + static_cast<std::size_t>(options.max_frames));
+  if (options.max_frames > 0)
+    end = std::min(end, first + static_cast<std::size_t>(options.max_frames));
   for (std::size_t i = first; i < end; ++i) seq.frames.push_back(i);
   PKSLAM_LOG_INFO("rgbd: {} frames from {}; camera {} ({})", seq.frames.size(),
                   options.dataset.string(), seq.camera.ToString(), seq.camera_source);
@@ -134,7 +136,8 @@ std::optional<SE3d> InterpolatePose(const Trajectory& trajectory, std::int64_t t
   const StampedPose& before = *(it - 1);
   const StampedPose& after = *it;
   if (after.t_ns - before.t_ns > max_gap_ns) return std::nullopt;
-  const double s = static_cast<double>(t_ns - before.t_ns) / static_cast<double>(after.t_ns - before.t_ns);
+  const double s =
+      static_cast<double>(t_ns - before.t_ns) / static_cast<double>(after.t_ns - before.t_ns);
   return SE3d::Interpolate(before.pose, after.pose, s);
 }
 

@@ -39,9 +39,9 @@ struct RgbdSequenceOptions {
 struct RgbdSequence {
   TumRgbdDataset dataset;
   CameraModel camera;
-  std::string camera_source;              // where the intrinsics came from (for logs, stats)
-  std::optional<Trajectory> ground_truth; // world_from_camera, when groundtruth.txt exists
-  std::vector<std::size_t> frames;        // association indices to process, in order
+  std::string camera_source;               // where the intrinsics came from (for logs, stats)
+  std::optional<Trajectory> ground_truth;  // world_from_camera, when groundtruth.txt exists
+  std::vector<std::size_t> frames;         // association indices to process, in order
 
   std::size_t size() const { return frames.size(); }
 };

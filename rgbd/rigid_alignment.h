@@ -34,8 +34,8 @@ class RigidAlignmentAccumulator {
   Eigen::Vector3d sum_source_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d sum_target_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d sum_outer_ = Eigen::Matrix3d::Zero();  // sum source target^T
-  double sum_source_sq_ = 0;  // sum |source|^2
-  double sum_target_sq_ = 0;  // sum |target|^2
+  double sum_source_sq_ = 0;                             // sum |source|^2
+  double sum_target_sq_ = 0;                             // sum |target|^2
 };
 
 // target_from_source from equally long point lists (see RigidAlignmentAccumulator::Solve).

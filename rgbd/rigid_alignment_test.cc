@@ -54,7 +54,8 @@ TEST(RigidAlignment, MirroredDataIsFittedByARotationNotAReflection) {
   ms /= source.size();
   mt /= source.size();
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < source.size(); ++i) h += (source[i] - ms) * (target[i] - mt).transpose();
+  for (std::size_t i = 0; i < source.size(); ++i)
+    h += (source[i] - ms) * (target[i] - mt).transpose();
   const Eigen::Matrix3d r = RotationFromCrossCovariance(h);
   EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
   EXPECT_LT((r * r.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-12);

@@ -101,7 +101,8 @@ TEST(RgbdInput, MissingDepthFileIsAnInputErrorUnlessSkipped) {
     OpenRgbdSequence(options);
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(removed.filename().string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(removed.filename().string()), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("--skip-missing"), std::string::npos);
   }
   options.skip_missing = true;

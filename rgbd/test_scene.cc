@@ -1,11 +1,11 @@
 #include "rgbd/test_scene.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <fstream>
-#include <random>
-
-#include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
+#include <random>
 
 namespace pkslam::rgbd::testing {
 namespace fs = std::filesystem;
@@ -38,8 +38,8 @@ cv::Vec3b FaceColour(int face, double a, double b) {
   const auto ia = static_cast<std::int64_t>(std::floor(a / 0.12));
   const auto ib = static_cast<std::int64_t>(std::floor(b / 0.12));
   const std::uint32_t h = Hash(face, ia, ib);
-  static constexpr unsigned char kPalette[6][3] = {{40, 40, 200}, {200, 60, 40}, {40, 180, 60},
-                                                   {220, 220, 220}, {30, 30, 30}, {60, 200, 220}};
+  static constexpr unsigned char kPalette[6][3] = {{40, 40, 200},   {200, 60, 40}, {40, 180, 60},
+                                                   {220, 220, 220}, {30, 30, 30},  {60, 200, 220}};
   const auto& c = kPalette[h % 6];
   return {c[0], c[1], c[2]};
 }
@@ -66,8 +66,8 @@ bool CastRay(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double* t_hit, 
         t = (box_plane - o[axis]) / d[axis];
         if (t > 1e-6 && t < best) {
           const Eigen::Vector3d p = o + t * d;
-          if (p[a1] >= kBoxMin[box][a1] && p[a1] <= kBoxMax[box][a1] &&
-              p[a2] >= kBoxMin[box][a2] && p[a2] <= kBoxMax[box][a2]) {
+          if (p[a1] >= kBoxMin[box][a1] && p[a1] <= kBoxMax[box][a1] && p[a2] >= kBoxMin[box][a2] &&
+              p[a2] <= kBoxMax[box][a2]) {
             best = t;
             best_colour = FaceColour(10 + 6 * box + axis * 2 + side, p[a1], p[a2]);
           }
@@ -94,13 +94,13 @@ RenderedView RenderRoom(const CameraModel& camera, const SE3d& world_from_camera
   const Eigen::Vector3d o = world_from_camera.translation();
   for (int v = 0; v < camera.height(); ++v) {
     for (int u = 0; u < camera.width(); ++u) {
-      const Eigen::Vector3d ray((u - camera.cx()) / camera.fx(), (v - camera.cy()) / camera.fy(), 1);
+      const Eigen::Vector3d ray((u - camera.cx()) / camera.fx(), (v - camera.cy()) / camera.fy(),
+                                1);
       double t = 0;
       cv::Vec3b colour;
       if (!CastRay(o, r * ray, &t, &colour)) continue;  // z of the hit in the camera is t
       view.colour_bgr.at<cv::Vec3b>(v, u) = colour;
-      view.depth_m.at<float>(v, u) =
-          static_cast<float>(t + (depth_noise_m > 0 ? noise(rng) : 0.0));
+      view.depth_m.at<float>(v, u) = static_cast<float>(t + (depth_noise_m > 0 ? noise(rng) : 0.0));
     }
   }
   return view;
@@ -124,7 +124,8 @@ std::vector<std::int64_t> WriteTumRoom(const fs::path& dir, int frames, double d
   std::vector<std::int64_t> stamps;
   for (int k = 0; k < frames; ++k) {
     const std::int64_t t_ns = 1'000'000'000'000'000'000 / 1000 + k * 33'333'000LL;
-    const std::string t = fmt::format("{}.{:06d}", t_ns / 1'000'000'000, (t_ns % 1'000'000'000) / 1000);
+    const std::string t =
+        fmt::format("{}.{:06d}", t_ns / 1'000'000'000, (t_ns % 1'000'000'000) / 1000);
     const SE3d pose = PathPose(k);
     const RenderedView view = RenderRoom(camera, pose, depth_noise_m, 100 + k);
     cv::Mat depth16;
@@ -135,14 +136,15 @@ std::vector<std::int64_t> WriteTumRoom(const fs::path& dir, int frames, double d
     depth << t << " depth/" << t << ".png\n";
     const auto& q = pose.quaternion();
     const auto& p = pose.translation();
-    gt << fmt::format("{} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n", t, p.x(), p.y(), p.z(),
-                      q.x(), q.y(), q.z(), q.w());
+    gt << fmt::format("{} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n", t, p.x(), p.y(),
+                      p.z(), q.x(), q.y(), q.z(), q.w());
     stamps.push_back(t_ns);
   }
   std::ofstream settings(dir / "settings.yaml");
-  settings << "%YAML:1.0\nFile.version: \"1.0\"\nCamera.type: \"PinHole\"\n"
-              "Camera1.fx: 260.0\nCamera1.fy: 260.0\nCamera1.cx: 159.5\nCamera1.cy: 119.5\n"
-              "Camera.width: 320\nCamera.height: 240\nCamera.fps: 30\nRGBD.DepthMapFactor: 5000.0\n";
+  settings
+      << "%YAML:1.0\nFile.version: \"1.0\"\nCamera.type: \"PinHole\"\n"
+         "Camera1.fx: 260.0\nCamera1.fy: 260.0\nCamera1.cx: 159.5\nCamera1.cy: 119.5\n"
+         "Camera.width: 320\nCamera.height: 240\nCamera.fps: 30\nRGBD.DepthMapFactor: 5000.0\n";
   return stamps;
 }
 

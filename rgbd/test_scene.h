@@ -22,8 +22,8 @@ struct RenderedView {
 };
 
 // The room seen from world_from_camera (camera optical frame: x right, y down, z forward;
-// the world is the room's frame, the room spans x in [-1.6, 1.6], y in [-1.5, 1.2], z in [-2.5, 2.0]).
-// depth_noise_m: Gaussian noise sigma added to depth (seeded by `seed`).
+// the world is the room's frame, the room spans x in [-1.6, 1.6], y in [-1.5, 1.2], z in
+// [-2.5, 2.0]). depth_noise_m: Gaussian noise sigma added to depth (seeded by `seed`).
 RenderedView RenderRoom(const CameraModel& camera, const SE3d& world_from_camera,
                         double depth_noise_m = 0.0, unsigned seed = 1);
 

@@ -1,10 +1,10 @@
 #include "rgbd/voxel_map.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-
-#include <fmt/format.h>
 
 #include "core/util/error.h"
 
@@ -23,8 +23,8 @@ std::uint64_t VoxelMap::Key(const Eigen::Vector3d& p) const {
   std::uint64_t key = 0;
   for (int axis = 0; axis < 3; ++axis) {
     const double cell = std::floor(p[axis] * inverse_voxel_);
-    PKSLAM_CHECK(std::abs(cell) < static_cast<double>(kHalfRange), "point {} m outside the map range",
-                 p[axis]);
+    PKSLAM_CHECK(std::abs(cell) < static_cast<double>(kHalfRange),
+                 "point {} m outside the map range", p[axis]);
     key = (key << 21) | static_cast<std::uint64_t>(static_cast<std::int64_t>(cell) + kHalfRange);
   }
   return key;
@@ -65,7 +65,8 @@ std::vector<VoxelMap::Point> VoxelMap::Points() const {
 }
 
 void VoxelMap::WritePly(const std::filesystem::path& file) const {
-  WriteColouredPly(Points(), file, fmt::format("pkslam rgbd map, world frame, voxel {} m", voxel_m_));
+  WriteColouredPly(Points(), file,
+                   fmt::format("pkslam rgbd map, world frame, voxel {} m", voxel_m_));
 }
 
 void WriteColouredPly(const std::vector<VoxelMap::Point>& points, const std::filesystem::path& file,
