@@ -59,8 +59,8 @@ void RegisterPlanarCommand(CLI::App& app) {
                   "ICP: ignore pairs farther apart [m] (0: keep all)")
       ->capture_default_str();
   cmd->add_flag(
-      "--no-accelerate", [&o](std::int64_t) { o.icp.accelerate = false; },
-      "Plain ICP without Besl-McKay's extrapolation");
+      "--accelerate", [&o](std::int64_t) { o.icp.accelerate = true; },
+      "Besl-McKay's extrapolation in ICP (off: plain ICP)");
   cmd->add_option("--min-depth", o.min_depth_m, "Depth gate minimum [m] (0: none)")
       ->capture_default_str();
   cmd->add_option("--max-depth", o.max_depth_m, "Depth gate maximum [m] (0: none)")

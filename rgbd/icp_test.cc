@@ -82,6 +82,27 @@ TEST(Icp, ConvergesToAKnownMotionOnSyntheticClouds) {
   EXPECT_EQ(r.correspondences, 4000);
 }
 
+TEST(Icp, AccelerationIsOptInAndJumpsAlongConsistentUpdates) {
+  const SE3d truth(SO3d::Exp(Eigen::Vector3d(0.01, -0.03, 0.02)),
+                   Eigen::Vector3d(0.03, -0.02, 0.04));
+  const PointCloudIndex target(RandomCorner(40000, 1));
+  std::vector<Eigen::Vector3f> source;
+  for (const auto& p : RandomCorner(4000, 2)) {
+    source.push_back((truth.Inverse() * p.cast<double>()).cast<float>());
+  }
+  IcpOptions options;
+  options.max_iterations = 100;
+  EXPECT_FALSE(options.accelerate);  // plain Besl-McKay ICP unless asked
+  const IcpResult plain = IcpPointToPoint(source, target, SE3d(), options);
+  EXPECT_EQ(plain.accelerations, 0);
+  options.accelerate = true;
+  const IcpResult accelerated = IcpPointToPoint(source, target, SE3d(), options);
+  ASSERT_TRUE(accelerated.success);
+  EXPECT_GT(accelerated.accelerations, 0);
+  const SE3d error = truth.Inverse() * accelerated.target_from_source;
+  EXPECT_LT(error.translation().norm(), 0.003);
+}
+
 TEST(Icp, ReducesTheErrorBetweenRenderedRoomViews) {
   // Different viewpoints: partial overlap and pixel grids that do not coincide.
   const SE3d world_from_a = testing::PathPose(0);
