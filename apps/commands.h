@@ -13,6 +13,8 @@ void RegisterVocabCommand(CLI::App& app);
 void RegisterDenseCommand(CLI::App& app);
 void RegisterCloudCompareCommand(CLI::App& app);
 void RegisterExportColmapCommand(CLI::App& app);
+void RegisterRgbdOdometryCommand(CLI::App& app);
+void RegisterPlanarCommand(CLI::App& app);
 void RegisterSimulateCommand(CLI::App& app);
 void RegisterBenchCommand(CLI::App& app);
 

@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterDenseCommand(app);
   pkslam::apps::RegisterCloudCompareCommand(app);
   pkslam::apps::RegisterExportColmapCommand(app);
+  pkslam::apps::RegisterRgbdOdometryCommand(app);
+  pkslam::apps::RegisterPlanarCommand(app);
   pkslam::apps::RegisterSimulateCommand(app);
   pkslam::apps::RegisterBenchCommand(app);
 
