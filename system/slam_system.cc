@@ -17,6 +17,7 @@ namespace pkslam {
 void SystemOptions::Check() const {
   tracking.Check();
   mapping.Check();
+  loop.Check();
 }
 
 SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabulary> vocabulary,
@@ -29,6 +30,9 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
     options_.tracking.lockstep = true;
     options_.tracking.pose.num_threads = 1;
     options_.mapping.ba.num_threads = 1;
+    options_.loop.synchronous = true;
+    options_.loop.num_threads = 1;
+    options_.loop.global_ba_options.num_threads = 1;
   }
   options_.Check();
   std::map<std::string, double> selector_parameters = settings.keyframe;
@@ -43,14 +47,25 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   orb.n_levels = settings.orb.n_levels;
   orb.ini_th_fast = settings.orb.ini_th_fast;
   orb.min_th_fast = settings.orb.min_th_fast;
-  tracker_ = std::make_unique<Tracker>(&atlas_, vocabulary_.get(), setup_.rig,
-                                       std::move(selector), mapper_.get(), options_.tracking, orb);
+  tracker_ = std::make_unique<Tracker>(&atlas_, vocabulary_.get(), setup_.rig, std::move(selector),
+                                       mapper_.get(), options_.tracking, orb);
   tracker_->EnableTrace(options_.trace);
+  if (!options_.no_loop) {
+    LocalMapper* mapper = mapper_.get();
+    MappingControl control;
+    control.request_stop = [mapper] { mapper->RequestStop(); };
+    control.is_stopped = [this, mapper] { return mapper_finished_.load() || mapper->IsStopped(); };
+    control.release = [mapper] { mapper->Release(); };
+    loop_ =
+        std::make_unique<LoopClosing>(&atlas_, options_.sensor, std::move(control), options_.loop);
+    LoopClosing* loop = loop_.get();
+    mapper_->SetKeyFrameConsumer([loop](const KeyFramePtr& kf) { loop->InsertKeyFrame(kf); });
+    loop_->Start();
+  }
   mapper_->Start();
   PKSLAM_LOG_INFO("sensor {}, camera {}, baseline {:.4f} m, selector {}{}",
-                  SensorName(options_.sensor), setup_.rig->camera.ToString(),
-                  setup_.rig->baseline, options_.selector,
-                  options_.deterministic ? ", deterministic" : "");
+                  SensorName(options_.sensor), setup_.rig->camera.ToString(), setup_.rig->baseline,
+                  options_.selector, options_.deterministic ? ", deterministic" : "");
 }
 
 SlamSystem::~SlamSystem() { Shutdown(); }
@@ -59,10 +74,11 @@ void SlamSystem::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   mapper_->Finish();
+  mapper_finished_.store(true);
+  if (loop_) loop_->Finish();
 }
 
-TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right,
-                                    std::int64_t t_ns) {
+TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
   if (setup_.rectification) {
     const auto [l, r] = setup_.rectification->Rectify(left, right);
     return tracker_->TrackStereo(l, r, t_ns);
@@ -70,8 +86,7 @@ TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right,
   return tracker_->TrackStereo(left, right, t_ns);
 }
 
-TrackResult SlamSystem::TrackRgbd(const cv::Mat& image, const cv::Mat& depth,
-                                  std::int64_t t_ns) {
+TrackResult SlamSystem::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns) {
   return tracker_->TrackRgbd(image, depth, t_ns);
 }
 
@@ -133,8 +148,7 @@ void SlamSystem::WriteMapPly(const std::filesystem::path& file) const {
   if (!out) throw Error(fmt::format("cannot write {}", file.string()));
   const std::size_t n = map != nullptr ? map->map_points().size() : 0;
   out << "ply\nformat binary_little_endian 1.0\ncomment pkslam map points (world frame)\n"
-      << "element vertex " << n
-      << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << "element vertex " << n << "\nproperty float x\nproperty float y\nproperty float z\n"
       << "property uchar observations\nend_header\n";
   if (map == nullptr) return;
   for (const auto& [id, mp] : map->map_points()) {
@@ -142,7 +156,8 @@ void SlamSystem::WriteMapPly(const std::filesystem::path& file) const {
                           static_cast<float>(mp->position().y()),
                           static_cast<float>(mp->position().z())};
     out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
-    const auto obs = static_cast<unsigned char>(std::min<std::size_t>(255, mp->observations().size()));
+    const auto obs =
+        static_cast<unsigned char>(std::min<std::size_t>(255, mp->observations().size()));
     out.put(static_cast<char>(obs));
   }
 }
