@@ -38,8 +38,8 @@ void WriteTrace(const Tracker& tracker, const std::filesystem::path& file) {
   out << '\n';
   const std::string selector(tracker.selector().name());
   for (const auto& row : tracker.trace()) {
-    out << fmt::format("{:.9f},{},{},{},{},{}", static_cast<double>(row.t_ns) * 1e-9, row.frame_id,
-                       selector, row.decision.insert ? 1 : 0, row.decision.reason,
+    out << fmt::format("{:.9f},{},{},{},{},{}", static_cast<double>(row.t_ns) * 1e-9,
+                       row.frame_id, selector, row.decision.insert ? 1 : 0, row.decision.reason,
                        row.frames_since_keyframe);
     for (const auto& k : keys) {
       out << ',';

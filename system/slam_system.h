@@ -6,9 +6,10 @@
 #include <filesystem>
 #include <map>
 #include <memory>
-#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+
+#include <opencv2/core.hpp>
 
 #include "core/bow/vocabulary.h"
 #include "core/map/atlas.h"
