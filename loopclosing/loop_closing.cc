@@ -233,11 +233,12 @@ std::optional<CommonRegion> LoopClosing::Detect(const KeyFramePtr& kf, double* v
             ConfirmByCovisibles(*region, options_.confirming_covisibles, options_.verifier);
       }
       *verification_ms += MsSince(t);
-      if (!region) continue;
       {
         std::lock_guard stats_lock(mutex_);
-        ++stats_.verified_regions;
+        ++stats_.tested_candidates;
+        if (region) ++stats_.verified_regions;
       }
+      if (!region) continue;
       PKSLAM_LOG_DEBUG("{} candidate: keyframe {} <-> {}, {} matches, {} confirmations",
                        merge ? "merge" : "loop", kf->id(), region->matched->id(), region->matches,
                        region->confirmations);

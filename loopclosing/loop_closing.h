@@ -86,6 +86,7 @@ struct LoopClosingStats {
   std::vector<LoopEvent> merges;
   std::vector<double> detection_ms;  // per processed keyframe
   int keyframes = 0;                 // processed keyframes
+  int tested_candidates = 0;         // database candidates put through verification
   int verified_regions = 0;          // candidates that passed verification (before confirmation)
   int rejected_regions = 0;          // pending regions dropped unconfirmed
   int global_ba_started = 0;

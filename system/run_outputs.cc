@@ -96,6 +96,7 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
   WriteLoopEvents(json, "merges", stats.merges);
   WriteArray(json, "relocalisation_times_s", relocalisations);
   WriteArray(json, "lost_times_s", lost);
+  json->Member("tested_candidates", stats.tested_candidates);
   json->Member("verified_candidates", stats.verified_regions);
   json->Member("unconfirmed_candidates", stats.rejected_regions);
   json->Member("global_ba_started", stats.global_ba_started);

@@ -70,7 +70,7 @@ int JsonInt(const std::string& json, const std::string& key) {
 
 TEST(LoopClosingEndToEnd, TwoLapsCloseTheLoopInOneMap) {
   const auto dir = testing::MakeTempDir("loop_e2e");
-  WriteCircleTrajectory(dir / "circle.txt", 0.8, 9.0, 2.0);
+  WriteCircleTrajectory(dir / "circle.txt", 0.8, 7.0, 2.0);
   const auto sim = RunPkslam(fmt::format(
       "--log-level warn simulate --out '{}' --trajectory '{}' --quality fast --quiet --no-cloud",
       (dir / "seq").string(), (dir / "circle.txt").string()));
