@@ -71,7 +71,7 @@ void WriteLoopEvents(JsonWriter* json, std::string_view key, const std::vector<L
 }
 
 // Loops, merges (loop closing's record) and relocalisations / new maps (tracking states:
-// RECENTLY_LOST -> OK is a relocalisation, LOST starts a new map or resets).
+// RECENTLY_LOST -> OK is a relocalisation; giving up starts a new map or resets).
 void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonWriter* json) {
   const LoopClosingStats stats = system.loop_stats();
   std::vector<double> relocalisations;
@@ -83,9 +83,12 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
         records[i - 1].state == TrackingState::kRecentlyLost) {
       relocalisations.push_back(t);
     }
-    if (records[i].state == TrackingState::kLost && records[i - 1].state != TrackingState::kLost) {
-      lost.push_back(t);
-    }
+    // Lost for good: the tracker starts a new map (or resets) and is NOT_INITIALIZED again.
+    const bool was_tracking = records[i - 1].state == TrackingState::kOk ||
+                              records[i - 1].state == TrackingState::kRecentlyLost;
+    const bool gave_up = records[i].state == TrackingState::kLost ||
+                         records[i].state == TrackingState::kNotInitialized;
+    if (was_tracking && gave_up) lost.push_back(t);
   }
   json->Key("loop_closing").BeginObject();
   json->Member("enabled", !options.system.no_loop);
@@ -95,7 +98,7 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
   WriteLoopEvents(json, "loops", stats.loops);
   WriteLoopEvents(json, "merges", stats.merges);
   WriteArray(json, "relocalisation_times_s", relocalisations);
-  WriteArray(json, "lost_times_s", lost);
+  WriteArray(json, "new_map_or_reset_times_s", lost);
   json->Member("tested_candidates", stats.tested_candidates);
   json->Member("verified_candidates", stats.verified_regions);
   json->Member("unconfirmed_candidates", stats.rejected_regions);
