@@ -3,9 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cmath>
 #include <mutex>
 #include <random>
 #include <shared_mutex>
+#include <thread>
+#include <tuple>
 
 #include "core/bow/bow_test_utils.h"
 #include "core/map/keyframe_database.h"
@@ -111,13 +115,16 @@ TEST_F(RevisitTest, RejectsTheSameLooksInADifferentGeometry) {
   }
 }
 
-// The whole LoopClosing pipeline on the same data (synchronous mode): the second visit is
-// detected as a loop (same map) and corrected, or merged (other map) and moved into the first
-// visit's map; either way the second visit's keyframes end near their true poses.
-class LoopClosingRevisitTest : public RevisitTest, public ::testing::WithParamInterface<bool> {};
+// The whole LoopClosing pipeline on the same data: the second visit is detected as a loop
+// (same map) and corrected, or merged (other map) and moved into the first visit's map; either
+// way the second visit's keyframes end near their true poses. Threaded mode runs the loop and
+// global-BA threads while a reader (standing in for tracking) reads the map under the shared
+// lock and a fake local mapping answers the pause handshake.
+class LoopClosingRevisitTest : public RevisitTest,
+                               public ::testing::WithParamInterface<std::tuple<bool, bool>> {};
 
 TEST_P(LoopClosingRevisitTest, ClosesTheLoopOrMergesTheMaps) {
-  const bool merge = GetParam();
+  const auto [merge, synchronous] = GetParam();
   Map* first_map = atlas_.current_map();
   Map* second_map = first_map;
   if (merge) {
@@ -130,15 +137,42 @@ TEST_P(LoopClosingRevisitTest, ClosesTheLoopOrMergesTheMaps) {
     std::shared_lock lock(atlas_.mutex());
     EXPECT_GT(CentreError(*second.back(), poses_.back()), 0.1);  // drifted before
   }
+  std::atomic<bool> stop_requested{false};
+  std::atomic<int> pauses{0};
+  MappingControl control;
+  control.request_stop = [&] {
+    stop_requested = true;
+    ++pauses;
+  };
+  control.is_stopped = [&] { return stop_requested.load(); };
+  control.release = [&] { stop_requested = false; };
   LoopClosingOptions options;
-  options.synchronous = true;
-  LoopClosing loop(&atlas_, Sensor::kStereo, MappingControl{}, options);
+  options.synchronous = synchronous;
+  LoopClosing loop(&atlas_, Sensor::kStereo, control, options);
+  loop.Start();
+  std::atomic<bool> done{false};
+  std::thread reader([&] {
+    double sum = 0;
+    while (!done.load()) {
+      std::shared_lock lock(atlas_.mutex());
+      for (const Map* map : atlas_.maps()) {
+        for (const auto& [id, kf] : map->keyframes()) sum += kf->CameraCenter().x();
+        for (const auto& [id, mp] : map->map_points()) sum += mp->position().x();
+      }
+    }
+    EXPECT_TRUE(std::isfinite(sum));
+  });
   for (const auto& kf : second) loop.InsertKeyFrame(kf);
   loop.Finish();
+  done = true;
+  reader.join();
   const LoopClosingStats stats = loop.stats();
   ASSERT_EQ(stats.loops.size(), merge ? 0u : 1u);
   ASSERT_EQ(stats.merges.size(), merge ? 1u : 0u);
   EXPECT_EQ(stats.global_ba_finished, 1);
+  // Threaded: local mapping was paused for the correction and for the BA write-back.
+  EXPECT_EQ(pauses.load(), synchronous ? 0 : 2);
+  EXPECT_FALSE(stop_requested.load());  // and released again
   std::shared_lock lock(atlas_.mutex());
   EXPECT_EQ(atlas_.NumMaps(), 1);
   EXPECT_EQ(atlas_.current_map(), first_map);
@@ -148,7 +182,8 @@ TEST_P(LoopClosingRevisitTest, ClosesTheLoopOrMergesTheMaps) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(LoopOrMerge, LoopClosingRevisitTest, ::testing::Values(false, true));
+INSTANTIATE_TEST_SUITE_P(LoopOrMerge, LoopClosingRevisitTest,
+                         ::testing::Combine(::testing::Bool(), ::testing::Bool()));
 
 }  // namespace
 }  // namespace pkslam
