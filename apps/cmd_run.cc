@@ -74,6 +74,8 @@ void RegisterRunCommand(CLI::App& app) {
                   "Selector parameter NAME=VALUE (overrides the settings' Keyframe.NAME)");
   cmd->add_flag("--deterministic", args->options.system.deterministic,
                 "Fixed seeds; local mapping in lock-step: identical output run to run");
+  cmd->add_flag("--no-loop", args->options.system.no_loop,
+                "Disable loop closing and map merging (for experiments)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_option("--max-frames", args->options.max_frames, "Stop after N frames (0: all)");
   cmd->add_flag("--trace", args->options.system.trace, "Write OUT/keyframe_trace.csv");

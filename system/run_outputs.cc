@@ -53,6 +53,64 @@ void WriteTrace(const Tracker& tracker, const std::filesystem::path& file) {
   }
 }
 
+void WriteLoopEvents(JsonWriter* json, std::string_view key, const std::vector<LoopEvent>& events) {
+  json->Key(key).BeginArray();
+  for (const LoopEvent& e : events) {
+    json->BeginObject();
+    json->Member("time_s", static_cast<double>(e.t_ns) * 1e-9);
+    json->Member("keyframe", static_cast<int>(e.query));
+    json->Member("matched_keyframe", static_cast<int>(e.matched));
+    json->Member("map", static_cast<int>(e.map));
+    json->Member("matched_map", static_cast<int>(e.matched_map));
+    json->Member("matches", e.matches);
+    json->Member("correction_m", e.correction_m);
+    json->Member("detection_ms", e.detection_ms);
+    json->Member("correction_ms", e.correction_ms);
+    json->Member("global_ba_ms", e.global_ba_ms);
+    json->EndObject();
+  }
+  json->EndArray();
+}
+
+// Loops, merges (loop closing's record) and relocalisations / new maps (tracking states:
+// RECENTLY_LOST -> OK is a relocalisation; giving up starts a new map or resets).
+void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonWriter* json) {
+  const LoopClosingStats stats = system.loop_stats();
+  std::vector<double> relocalisations;
+  std::vector<double> lost;
+  const auto& records = system.tracker().records();
+  for (std::size_t i = 1; i < records.size(); ++i) {
+    const double t = static_cast<double>(records[i].t_ns) * 1e-9;
+    if (records[i].state == TrackingState::kOk &&
+        records[i - 1].state == TrackingState::kRecentlyLost) {
+      relocalisations.push_back(t);
+    }
+    // Lost for good: the tracker starts a new map (or resets) and is NOT_INITIALIZED again.
+    const bool was_tracking = records[i - 1].state == TrackingState::kOk ||
+                              records[i - 1].state == TrackingState::kRecentlyLost;
+    const bool gave_up = records[i].state == TrackingState::kLost ||
+                         records[i].state == TrackingState::kNotInitialized;
+    if (was_tracking && gave_up) lost.push_back(t);
+  }
+  json->Key("loop_closing").BeginObject();
+  json->Member("enabled", !options.system.no_loop);
+  json->Member("num_loops", static_cast<int>(stats.loops.size()));
+  json->Member("num_merges", static_cast<int>(stats.merges.size()));
+  json->Member("num_relocalisations", static_cast<int>(relocalisations.size()));
+  WriteLoopEvents(json, "loops", stats.loops);
+  WriteLoopEvents(json, "merges", stats.merges);
+  WriteArray(json, "relocalisation_times_s", relocalisations);
+  WriteArray(json, "new_map_or_reset_times_s", lost);
+  json->Member("tested_candidates", stats.tested_candidates);
+  json->Member("verified_candidates", stats.verified_regions);
+  json->Member("unconfirmed_candidates", stats.rejected_regions);
+  json->Member("global_ba_started", stats.global_ba_started);
+  json->Member("global_ba_finished", stats.global_ba_finished);
+  json->Member("global_ba_aborted", stats.global_ba_aborted);
+  json->Member("median_detection_ms", Median(stats.detection_ms));
+  json->EndObject();
+}
+
 }  // namespace
 
 double PeakMemoryMiB() {
@@ -121,6 +179,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   json.Member("median_local_mapping_ms", Median(mapping.keyframe_ms));
   json.Member("local_ba_aborted", mapping.ba_aborted);
   json.Member("peak_memory_mib", PeakMemoryMiB());
+  WriteLoopClosing(system, options, &json);
   WriteArray(&json, "tracking_ms", tracking_ms);
   WriteArray(&json, "local_mapping_ms", mapping.keyframe_ms);
   WriteArray(&json, "local_ba_ms", mapping.ba_ms);

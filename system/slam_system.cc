@@ -17,6 +17,7 @@ namespace pkslam {
 void SystemOptions::Check() const {
   tracking.Check();
   mapping.Check();
+  loop.Check();
 }
 
 SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabulary> vocabulary,
@@ -29,6 +30,9 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
     options_.tracking.lockstep = true;
     options_.tracking.pose.num_threads = 1;
     options_.mapping.ba.num_threads = 1;
+    options_.loop.synchronous = true;
+    options_.loop.num_threads = 1;
+    options_.loop.global_ba_options.num_threads = 1;
   }
   options_.Check();
   std::map<std::string, double> selector_parameters = settings.keyframe;
@@ -46,6 +50,18 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   tracker_ = std::make_unique<Tracker>(&atlas_, vocabulary_.get(), setup_.rig,
                                        std::move(selector), mapper_.get(), options_.tracking, orb);
   tracker_->EnableTrace(options_.trace);
+  if (!options_.no_loop) {
+    LocalMapper* mapper = mapper_.get();
+    MappingControl control;
+    control.request_stop = [mapper] { mapper->RequestStop(); };
+    control.is_stopped = [this, mapper] { return mapper_finished_.load() || mapper->IsStopped(); };
+    control.release = [mapper] { mapper->Release(); };
+    loop_ =
+        std::make_unique<LoopClosing>(&atlas_, options_.sensor, std::move(control), options_.loop);
+    LoopClosing* loop = loop_.get();
+    mapper_->SetKeyFrameConsumer([loop](const KeyFramePtr& kf) { loop->InsertKeyFrame(kf); });
+    loop_->Start();
+  }
   mapper_->Start();
   PKSLAM_LOG_INFO("sensor {}, camera {}, baseline {:.4f} m, selector {}{}",
                   SensorName(options_.sensor), setup_.rig->camera.ToString(),
@@ -59,6 +75,8 @@ void SlamSystem::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   mapper_->Finish();
+  mapper_finished_.store(true);
+  if (loop_) loop_->Finish();
 }
 
 TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right,

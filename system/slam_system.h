@@ -2,6 +2,7 @@
 // (later) loop closing, and turns the map into outputs. One instance per run.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -14,6 +15,7 @@
 #include "core/map/atlas.h"
 #include "io/settings.h"
 #include "io/trajectory.h"
+#include "loopclosing/loop_closing.h"
 #include "mapping/local_mapper.h"
 #include "system/rig_factory.h"
 #include "tracking/tracker.h"
@@ -31,6 +33,9 @@ struct SystemOptions {
   bool trace = false;
   TrackingOptions tracking;
   LocalMappingOptions mapping;
+  // --no-loop: no loop closing and no map merging.
+  bool no_loop = false;
+  LoopClosingOptions loop;
 
   void Check() const;
 };
@@ -64,6 +69,8 @@ class SlamSystem {
   const CameraRig& rig() const { return *setup_.rig; }
   const Tracker& tracker() const { return *tracker_; }
   LocalMappingStats mapping_stats() const { return mapper_->stats(); }
+  // Empty stats with --no-loop.
+  LoopClosingStats loop_stats() const { return loop_ ? loop_->stats() : LoopClosingStats{}; }
   // Keyframes and map points in the largest map; number of maps.
   int NumKeyFrames() const;
   int NumMapPoints() const;
@@ -81,6 +88,8 @@ class SlamSystem {
   std::shared_ptr<const Vocabulary> vocabulary_;
   Atlas atlas_;
   std::unique_ptr<LocalMapper> mapper_;
+  std::unique_ptr<LoopClosing> loop_;
+  std::atomic<bool> mapper_finished_{false};  // read by loop closing's MappingControl
   std::unique_ptr<Tracker> tracker_;
   bool shut_down_ = false;
 };

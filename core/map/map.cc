@@ -14,6 +14,11 @@ void Map::AddKeyFrame(const KeyFramePtr& kf) {
   if (kf->id() > max_kf_id_) max_kf_id_ = kf->id();
 }
 
+void Map::AddRetiredKeyFrame(const KeyFramePtr& kf) {
+  retired_[kf->id()] = kf;
+  if (kf->id() > max_kf_id_) max_kf_id_ = kf->id();
+}
+
 void Map::AddMapPoint(const MapPointPtr& point) { map_points_[point->id()] = point; }
 
 void Map::EraseMapPoint(const MapPoint* point) { map_points_.erase(point->id()); }

@@ -25,6 +25,8 @@ class Map {
   MapId id() const { return id_; }
 
   void AddKeyFrame(const KeyFramePtr& kf);
+  // Takes over a keyframe retired in another map (map merging).
+  void AddRetiredKeyFrame(const KeyFramePtr& kf);
   void AddMapPoint(const MapPointPtr& point);
   // Removes the point from the live set (callers mark it bad first).
   void EraseMapPoint(const MapPoint* point);

@@ -1,0 +1,59 @@
+#include "loopclosing/global_bundle.h"
+
+#include <deque>
+#include <map>
+#include <set>
+
+#include "core/map/keyframe.h"
+#include "core/map/map.h"
+#include "core/map/map_point.h"
+
+namespace pkslam {
+
+void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResult& result) {
+  if (map == nullptr || map->origin() == nullptr) return;
+  // Poses before the write-back: what everything outside the problem is relative to.
+  std::map<KeyFrameId, SE3d> before;
+  for (const auto& [id, kf] : map->keyframes()) before[id] = kf->camera_from_world();
+  std::set<KeyFrameId> in_problem;
+  for (const auto& k : problem.keyframes) {
+    if (k.keyframe->map() == map) in_problem.insert(k.keyframe->id());
+  }
+  std::set<MapPointId> points_in_problem;
+  for (const auto& p : problem.points) points_in_problem.insert(p.point->id());
+
+  ApplyBundle(problem, result);
+
+  // Keyframes created while the BA ran: breadth-first down the spanning tree, each keeps its
+  // pose relative to its (already updated) parent.
+  std::deque<KeyFrame*> open{map->origin()};
+  std::set<KeyFrameId> seen{map->origin()->id()};
+  while (!open.empty()) {
+    KeyFrame* parent = open.front();
+    open.pop_front();
+    for (const auto& [child_id, child] : parent->children()) {
+      if (!seen.insert(child_id).second) continue;
+      open.push_back(child);
+      if (child->IsBad() || child->map() != map || in_problem.count(child_id) > 0) continue;
+      const auto child_before = before.find(child_id);
+      const auto parent_before = before.find(parent->id());
+      if (child_before == before.end() || parent_before == before.end()) continue;
+      const SE3d child_from_parent = child_before->second * parent_before->second.Inverse();
+      child->SetPose(child_from_parent * parent->camera_from_world());
+    }
+  }
+
+  // Points created meanwhile move rigidly with their reference keyframe.
+  for (const auto& [id, mp] : map->map_points()) {
+    if (mp->IsBad() || points_in_problem.count(id) > 0) continue;
+    KeyFrame* ref = mp->reference_keyframe();
+    if (ref == nullptr) continue;
+    const auto ref_before = before.find(ref->id());
+    if (ref_before == before.end()) continue;
+    mp->SetPosition(ref->world_from_camera() * (ref_before->second * mp->position()));
+    mp->UpdateNormalAndDepth();
+  }
+  map->IncreaseChangeIndex();
+}
+
+}  // namespace pkslam

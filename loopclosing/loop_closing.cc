@@ -1,0 +1,315 @@
+// LoopClosing: the thread, its queue and place detection (verification and confirmation).
+#include "loopclosing/loop_closing.h"
+
+#include <chrono>
+#include <mutex>
+#include <shared_mutex>
+
+#include "core/map/keyframe.h"
+#include "core/map/keyframe_database.h"
+#include "core/map/map.h"
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "loopclosing/global_bundle.h"
+
+namespace pkslam {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+void LoopClosingOptions::Check() const {
+  verifier.Check();
+  PKSLAM_CHECK_OPTION(candidates > 0, "LoopClosing.candidates", "{}", candidates);
+  PKSLAM_CHECK_OPTION(min_keyframes_mono > 0 && min_keyframes_stereo > 0,
+                      "LoopClosing.min_keyframes", "{} / {}", min_keyframes_mono,
+                      min_keyframes_stereo);
+  PKSLAM_CHECK_OPTION(confirmations >= 1, "LoopClosing.confirmations", "{}", confirmations);
+  PKSLAM_CHECK_OPTION(
+      confirming_covisibles >= 0 && max_unconfirmed >= 0 && keyframes_after_loop >= 0,
+      "LoopClosing.confirming_covisibles", "{} / {} / {}", confirming_covisibles, max_unconfirmed,
+      keyframes_after_loop);
+  PKSLAM_CHECK_OPTION(fuse_radius > 0, "LoopClosing.fuse_radius", "{}", fuse_radius);
+  PKSLAM_CHECK_OPTION(num_threads > 0, "LoopClosing.num_threads", "{}", num_threads);
+  global_ba_options.Check();
+}
+
+LoopClosing::LoopClosing(Atlas* atlas, Sensor sensor, MappingControl mapping,
+                         LoopClosingOptions options)
+    : atlas_(atlas), sensor_(sensor), mapping_(std::move(mapping)), options_(options) {
+  PKSLAM_CHECK(atlas_ != nullptr, "loop closing needs an atlas");
+  options_.verifier.fix_scale = !IsMonocular(sensor_);
+  options_.Check();
+}
+
+LoopClosing::~LoopClosing() { Finish(); }
+
+void LoopClosing::Start() {
+  if (options_.synchronous) return;
+  PKSLAM_CHECK(!thread_.joinable(), "loop closing already started");
+  thread_ = std::thread([this] { Run(); });
+}
+
+void LoopClosing::Finish() {
+  {
+    std::lock_guard lock(mutex_);
+    finish_requested_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  // A global BA still running finishes and is merged back (the outputs should have it).
+  if (gba_thread_.joinable()) gba_thread_.join();
+}
+
+void LoopClosing::InsertKeyFrame(const KeyFramePtr& kf) {
+  if (options_.synchronous) {
+    Process(kf);
+    return;
+  }
+  {
+    std::lock_guard lock(mutex_);
+    queue_.push_back(kf);
+  }
+  wake_.notify_all();
+}
+
+void LoopClosing::WaitUntilIdle() {
+  if (options_.synchronous) return;
+  std::unique_lock lock(mutex_);
+  idle_.wait(lock, [this] { return (queue_.empty() && !busy_) || !thread_.joinable(); });
+}
+
+LoopClosingStats LoopClosing::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+void LoopClosing::Run() {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_.wait(lock, [this] { return finish_requested_ || !queue_.empty(); });
+    if (queue_.empty()) {
+      if (finish_requested_) break;
+      continue;
+    }
+    const KeyFramePtr kf = queue_.front();
+    queue_.pop_front();
+    busy_ = true;
+    lock.unlock();
+    Process(kf);
+    lock.lock();
+    busy_ = false;
+    idle_.notify_all();
+  }
+  idle_.notify_all();
+}
+
+void LoopClosing::PauseMapping() {
+  if (options_.synchronous || !mapping_.request_stop) return;
+  mapping_.request_stop();
+  while (!mapping_.is_stopped()) std::this_thread::sleep_for(std::chrono::microseconds(500));
+}
+
+void LoopClosing::ReleaseMapping() {
+  if (options_.synchronous || !mapping_.release) return;
+  mapping_.release();
+}
+
+void LoopClosing::Process(const KeyFramePtr& kf) {
+  const auto start = std::chrono::steady_clock::now();
+  double verification_ms = 0;
+  std::optional<CommonRegion> region = Detect(kf, &verification_ms);
+  {
+    std::lock_guard lock(mutex_);
+    stats_.detection_ms.push_back(MsSince(start));
+    ++stats_.keyframes;
+  }
+  if (!region) return;
+  pending_loop_.reset();
+  pending_merge_.reset();
+  LoopEvent event;
+  event.t_ns = region->query->t_ns();
+  event.query = region->query->id();
+  event.matched = region->matched->id();
+  event.matches = region->matches;
+  event.detection_ms = verification_ms;
+  bool merge = false;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    if (region->query->map() == nullptr || region->matched->map() == nullptr) return;
+    event.map = region->query->map()->id();
+    event.matched_map = region->matched->map()->id();
+    merge = region->query->map() != region->matched->map();
+  }
+  const auto correct_start = std::chrono::steady_clock::now();
+  Map* corrected = merge ? MergeMaps(*region, &event) : CorrectLoop(*region, &event);
+  if (corrected == nullptr) return;
+  last_loop_kf_id_ = event.query;
+  event.correction_ms = MsSince(correct_start);
+  PKSLAM_LOG_INFO(
+      "{} at t = {:.3f} s: keyframe {} (map {}) <-> keyframe {} (map {}), {} matches, "
+      "keyframe moved {:.3f} m, {:.1f} ms",
+      merge ? "map merge" : "loop closed", static_cast<double>(event.t_ns) * 1e-9, event.query,
+      event.map, event.matched, event.matched_map, event.matches, event.correction_m,
+      event.correction_ms);
+  std::size_t index = 0;
+  {
+    std::lock_guard lock(mutex_);
+    auto& events = merge ? stats_.merges : stats_.loops;
+    index = events.size();
+    events.push_back(event);
+  }
+  StartGlobalBundle(corrected, merge, index);
+}
+
+std::optional<CommonRegion> LoopClosing::Detect(const KeyFramePtr& kf, double* verification_ms) {
+  std::shared_lock lock(atlas_->mutex());
+  KeyFrameDatabase* database = atlas_->database();
+  Map* map = kf->map();
+  if (database == nullptr || map == nullptr || kf->IsBad()) return std::nullopt;
+  // Inertial maps wait for their second inertial BA (ORB-SLAM3); small maps are not searched.
+  if (IsInertial(sensor_) && !map->inertial_ba2_done) return std::nullopt;
+  const int min_keyframes =
+      IsMonocular(sensor_) ? options_.min_keyframes_mono : options_.min_keyframes_stereo;
+  if (map->NumKeyFrames() < min_keyframes) return std::nullopt;
+
+  // Pending regions: does this keyframe see them too?
+  for (const bool merge : {true, false}) {
+    std::optional<CommonRegion>& pending = merge ? pending_merge_ : pending_loop_;
+    int& failures = merge ? pending_merge_failures_ : pending_loop_failures_;
+    if (!pending) continue;
+    const Map* matched_map = pending->matched->map();
+    const bool still_valid = pending->query->map() == map && matched_map != nullptr &&
+                             !pending->matched->IsBad() && (matched_map != map) == merge;
+    if (!still_valid) {
+      pending.reset();
+      continue;
+    }
+    const auto t = std::chrono::steady_clock::now();
+    std::vector<MapPointPtr> matched;
+    const Sim3d carried = CarryOver(*pending, *kf);
+    const int n = CountRegionMatches(*pending, *kf, carried, options_.verifier, &matched);
+    *verification_ms += MsSince(t);
+    if (n >= options_.verifier.min_confirmation_matches) {
+      pending->query = kf;
+      pending->query_camera_from_world = carried;
+      pending->matched_points = std::move(matched);
+      pending->matches = n;
+      ++pending->confirmations;
+      failures = 0;
+      if (pending->confirmations >= options_.confirmations) {
+        std::optional<CommonRegion> accepted = std::move(pending);
+        pending.reset();
+        return accepted;
+      }
+    } else if (++failures > options_.max_unconfirmed) {
+      PKSLAM_LOG_DEBUG("dropped an unconfirmed {} candidate (keyframe {})",
+                       merge ? "merge" : "loop", pending->matched->id());
+      pending.reset();
+      failures = 0;
+      std::lock_guard stats_lock(mutex_);
+      ++stats_.rejected_regions;
+    }
+  }
+
+  const bool search_loops =
+      !pending_loop_ && (last_loop_kf_id_ == kInvalidId ||
+                         kf->id() >= last_loop_kf_id_ + options_.keyframes_after_loop);
+  const bool search_merges = !pending_merge_ && options_.merge_maps && map == atlas_->current_map();
+  if (!search_loops && !search_merges) return std::nullopt;
+  const LoopAndMergeCandidates candidates =
+      database->DetectLoopAndMergeCandidates(kf.get(), options_.candidates);
+  for (const bool merge : {true, false}) {
+    if (merge ? !search_merges : !search_loops) continue;
+    for (const PlaceCandidate& c : merge ? candidates.merge : candidates.loop) {
+      const auto t = std::chrono::steady_clock::now();
+      std::optional<CommonRegion> region =
+          VerifyCandidate(kf, c.keyframe, options_.verifier, seed_++);
+      if (region) {
+        region->confirmations +=
+            ConfirmByCovisibles(*region, options_.confirming_covisibles, options_.verifier);
+      }
+      *verification_ms += MsSince(t);
+      {
+        std::lock_guard stats_lock(mutex_);
+        ++stats_.tested_candidates;
+        if (region) ++stats_.verified_regions;
+      }
+      if (!region) continue;
+      PKSLAM_LOG_DEBUG("{} candidate: keyframe {} <-> {}, {} matches, {} confirmations",
+                       merge ? "merge" : "loop", kf->id(), region->matched->id(), region->matches,
+                       region->confirmations);
+      if (region->confirmations >= options_.confirmations) return region;
+      (merge ? pending_merge_ : pending_loop_) = std::move(region);
+      (merge ? pending_merge_failures_ : pending_loop_failures_) = 0;
+      break;
+    }
+  }
+  return std::nullopt;
+}
+
+void LoopClosing::StartGlobalBundle(Map* map, bool merge, std::size_t index) {
+  if (!options_.global_ba) return;
+  StopGlobalBundle();
+  {
+    std::lock_guard lock(mutex_);
+    ++stats_.global_ba_started;
+  }
+  if (options_.synchronous) {
+    RunGlobalBundle(map, merge, index);
+    return;
+  }
+  gba_running_.store(true);
+  gba_thread_ = std::thread([this, map, merge, index] { RunGlobalBundle(map, merge, index); });
+}
+
+void LoopClosing::StopGlobalBundle() {
+  if (!gba_thread_.joinable()) return;
+  gba_abort_.store(true);
+  gba_thread_.join();
+  gba_abort_.store(false);
+}
+
+void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
+  const auto start = std::chrono::steady_clock::now();
+  BundleProblem problem;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    problem = CollectGlobalBundle(*map);
+  }
+  PKSLAM_LOG_INFO("global BA of map {} started: {} keyframes, {} points", map->id(),
+                  problem.keyframes.size(), problem.points.size());
+  const BundleResult result = SolveBundle(problem, options_.global_ba_options,
+                                          options_.synchronous ? nullptr : &gba_abort_);
+  bool applied = false;
+  if (!result.aborted && !gba_abort_.load()) {
+    PauseMapping();
+    {
+      std::unique_lock lock(atlas_->mutex());
+      // A newer loop or merge may have aborted us in the meantime (then it owns the map).
+      if (!gba_abort_.load()) {
+        MergeGlobalBundle(map, problem, result);
+        applied = true;
+      }
+    }
+    ReleaseMapping();
+  }
+  const double ms = MsSince(start);
+  {
+    std::lock_guard lock(mutex_);
+    if (applied) {
+      ++stats_.global_ba_finished;
+      auto& events = merge ? stats_.merges : stats_.loops;
+      if (index < events.size()) events[index].global_ba_ms = ms;
+    } else {
+      ++stats_.global_ba_aborted;
+    }
+  }
+  PKSLAM_LOG_INFO("global BA {} after {:.0f} ms", applied ? "merged back" : "aborted", ms);
+  gba_running_.store(false);
+}
+
+}  // namespace pkslam

@@ -1,0 +1,248 @@
+// LoopClosing: loop correction (ORB-SLAM3's CorrectLoop) and map merging (a simplified
+// MergeLocal: the whole current map is moved into the recognised map, then welded).
+#include <mutex>
+#include <set>
+#include <shared_mutex>
+
+#include "core/map/keyframe.h"
+#include "core/map/map.h"
+#include "core/map/map_point.h"
+#include "core/matching/orb_matcher.h"
+#include "core/optim/essential_graph.h"
+#include "core/util/log.h"
+#include "loopclosing/loop_closing.h"
+
+namespace pkslam {
+namespace {
+
+// Follows fusion forwards to the surviving point (nullptr if it died without a successor).
+MapPointPtr Surviving(MapPointPtr mp) {
+  while (mp && mp->IsBad()) mp = mp->replaced_by();
+  return mp;
+}
+
+std::vector<KeyFrame*> Neighbourhood(KeyFrame* query) {
+  std::vector<KeyFrame*> out = query->ConnectedKeyFrames();
+  out.push_back(query);
+  return out;
+}
+
+}  // namespace
+
+std::map<KeyFrameId, std::vector<KeyFrameId>> LoopClosing::FuseRegion(
+    const CommonRegion& region, const std::vector<KeyFrame*>& neighbourhood,
+    const std::map<KeyFrameId, Sim3d>& camera_from_world) {
+  std::map<KeyFrameId, std::set<KeyFrameId>> before;
+  std::set<KeyFrameId> in_neighbourhood;
+  for (KeyFrame* kf : neighbourhood) {
+    in_neighbourhood.insert(kf->id());
+    for (KeyFrame* c : kf->ConnectedKeyFrames()) before[kf->id()].insert(c->id());
+  }
+
+  // The query's own matches: the other side's point takes over the keypoint.
+  KeyFrame* query = region.query.get();
+  for (int i = 0; i < query->size(); ++i) {
+    const MapPointPtr other = Surviving(region.matched_points[static_cast<std::size_t>(i)]);
+    if (!other) continue;
+    const MapPointPtr mine = query->map_point(i);
+    if (mine && !mine->IsBad()) {
+      if (mine != other) mine->Replace(other);
+    } else if (!other->IsInKeyFrame(query)) {
+      query->AddMapPoint(other, i);
+      other->AddObservation(query, i);
+      other->ComputeDistinctiveDescriptor();
+    }
+  }
+
+  // Every keyframe of the neighbourhood: the other side's points projected with its corrected
+  // pose replace what the keyframe has at the same place (ORB-SLAM3's SearchAndFuse).
+  std::vector<MapPointPtr> others;
+  for (const auto& mp : region.window_points) {
+    if (MapPointPtr s = Surviving(mp)) others.push_back(std::move(s));
+  }
+  const OrbMatcher matcher(0.8, true);
+  for (KeyFrame* kf : neighbourhood) {
+    if (kf->IsBad()) continue;
+    std::vector<MapPointPtr> replace;
+    matcher.Fuse(kf, camera_from_world.at(kf->id()), others, options_.fuse_radius, &replace);
+    for (std::size_t i = 0; i < others.size(); ++i) {
+      if (replace[i] && !replace[i]->IsBad() && !others[i]->IsBad() && replace[i] != others[i]) {
+        replace[i]->Replace(others[i]);
+      }
+    }
+  }
+
+  std::map<KeyFrameId, std::vector<KeyFrameId>> links;
+  for (KeyFrame* kf : neighbourhood) {
+    if (kf->IsBad()) continue;
+    kf->UpdateConnections();
+  }
+  for (KeyFrame* kf : neighbourhood) {
+    if (kf->IsBad()) continue;
+    for (KeyFrame* c : kf->ConnectedKeyFrames()) {
+      if (before[kf->id()].count(c->id()) > 0 || in_neighbourhood.count(c->id()) > 0) continue;
+      links[kf->id()].push_back(c->id());
+    }
+  }
+  return links;
+}
+
+Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
+  StopGlobalBundle();
+  PauseMapping();
+  Map* map = nullptr;
+  {
+    std::unique_lock lock(atlas_->mutex());
+    KeyFrame* query = region.query.get();
+    map = query->map();
+    if (query->IsBad() || map == nullptr || region.matched->IsBad() ||
+        region.matched->map() != map) {
+      lock.unlock();
+      ReleaseMapping();
+      return nullptr;
+    }
+    query->UpdateConnections();
+    const std::vector<KeyFrame*> neighbourhood = Neighbourhood(query);
+
+    // Corrected poses: every neighbour keeps its pose relative to the query.
+    LoopCorrection correction;
+    correction.current_keyframe = query->id();
+    correction.loop_keyframe = region.matched->id();
+    const Sim3d world_from_query(query->world_from_camera());
+    const Eigen::Vector3d query_centre_before = query->CameraCenter();
+    for (KeyFrame* kf : neighbourhood) {
+      const Sim3d non_corrected(kf->camera_from_world());
+      correction.non_corrected_camera_from_world[kf->id()] = non_corrected;
+      correction.corrected_camera_from_world[kf->id()] =
+          non_corrected * world_from_query * region.query_camera_from_world;
+    }
+    // Points move with the first neighbour that sees them; then the poses.
+    std::vector<MapPoint*> moved;
+    for (KeyFrame* kf : neighbourhood) {
+      const Sim3d& corrected = correction.corrected_camera_from_world.at(kf->id());
+      const Sim3d& non_corrected = correction.non_corrected_camera_from_world.at(kf->id());
+      const Sim3d world_correction = corrected.Inverse() * non_corrected;
+      for (const auto& mp : kf->map_points()) {
+        if (!mp || mp->IsBad() || correction.corrected_points.count(mp->id()) > 0) continue;
+        mp->SetPosition(world_correction * mp->position());
+        correction.corrected_points[mp->id()] = kf->id();
+        moved.push_back(mp.get());
+      }
+    }
+    for (KeyFrame* kf : neighbourhood) {
+      kf->SetPose(correction.corrected_camera_from_world.at(kf->id()).ToSE3ScaledTranslation());
+    }
+    for (MapPoint* mp : moved) mp->UpdateNormalAndDepth();
+    event->correction_m = (query->CameraCenter() - query_centre_before).norm();
+
+    correction.loop_connections =
+        FuseRegion(region, neighbourhood, correction.corrected_camera_from_world);
+
+    EssentialGraphOptions graph;
+    graph.dof = options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3;
+    graph.num_threads = options_.num_threads;
+    const EssentialGraphProblem problem = CollectEssentialGraph(map, correction, graph);
+    ApplyEssentialGraph(problem, SolveEssentialGraph(problem, graph));
+    query->AddLoopEdge(region.matched.get());
+    region.matched->AddLoopEdge(query);
+  }
+  ReleaseMapping();
+  return map;
+}
+
+Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
+  StopGlobalBundle();
+  PauseMapping();
+  Map* merged = nullptr;
+  {
+    std::unique_lock lock(atlas_->mutex());
+    KeyFrame* query = region.query.get();
+    Map* current = query->map();
+    merged = region.matched->map();
+    if (query->IsBad() || region.matched->IsBad() || current == nullptr || merged == nullptr ||
+        current == merged || current != atlas_->current_map()) {
+      lock.unlock();
+      ReleaseMapping();
+      return nullptr;
+    }
+    // The current map's world in the recognised map's world.
+    const Sim3d merged_from_current =
+        region.query_camera_from_world.Inverse() * Sim3d(query->camera_from_world());
+    const Sim3d current_from_merged = merged_from_current.Inverse();
+    const Eigen::Vector3d query_centre_before = query->CameraCenter();
+    for (const auto& [id, kf] : current->keyframes()) {
+      kf->SetPose((Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
+    }
+    for (const auto& [id, kf] : current->retired_keyframes()) {
+      kf->SetPose((Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
+    }
+    for (const auto& [id, mp] : current->map_points()) {
+      mp->SetPosition(merged_from_current * mp->position());
+    }
+    event->correction_m = (query->CameraCenter() - query_centre_before).norm();
+
+    // Ownership moves to the recognised map.
+    std::vector<KeyFramePtr> live;
+    std::vector<KeyFramePtr> retired;
+    std::vector<MapPointPtr> points;
+    for (const auto& [id, kf] : current->keyframes()) live.push_back(kf);
+    for (const auto& [id, kf] : current->retired_keyframes()) retired.push_back(kf);
+    for (const auto& [id, mp] : current->map_points()) points.push_back(mp);
+    for (const auto& kf : live) {
+      current->TakeKeyFrame(kf.get());
+      kf->set_map(merged);
+      merged->AddKeyFrame(kf);
+    }
+    for (const auto& kf : retired) {
+      current->TakeKeyFrame(kf.get());
+      kf->set_map(merged);
+      merged->AddRetiredKeyFrame(kf);
+    }
+    for (const auto& mp : points) {
+      current->TakeMapPoint(mp.get());
+      mp->set_map(merged);
+      merged->AddMapPoint(mp);
+    }
+    for (const auto& mp : points) mp->UpdateNormalAndDepth();
+
+    // Re-root the moved spanning tree at the query and hang it from the matched keyframe.
+    KeyFrame* new_parent = region.matched.get();
+    for (KeyFrame* kf = query; kf != nullptr;) {
+      KeyFrame* old_parent = kf->parent();
+      if (old_parent != nullptr) old_parent->EraseChild(kf);
+      kf->ChangeParent(new_parent);
+      new_parent = kf;
+      kf = old_parent;
+    }
+
+    // Weld: fuse the two sides around the query and optimise the merged essential graph.
+    query->UpdateConnections();
+    const std::vector<KeyFrame*> neighbourhood = Neighbourhood(query);
+    LoopCorrection correction;
+    correction.current_keyframe = query->id();
+    correction.loop_keyframe = region.matched->id();
+    for (KeyFrame* kf : neighbourhood) {
+      const Sim3d pose(kf->camera_from_world());
+      correction.corrected_camera_from_world[kf->id()] = pose;
+      correction.non_corrected_camera_from_world[kf->id()] = pose;
+    }
+    correction.loop_connections =
+        FuseRegion(region, neighbourhood, correction.corrected_camera_from_world);
+    EssentialGraphOptions graph;
+    graph.dof = options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3;
+    graph.num_threads = options_.num_threads;
+    const EssentialGraphProblem problem = CollectEssentialGraph(merged, correction, graph);
+    ApplyEssentialGraph(problem, SolveEssentialGraph(problem, graph));
+    query->AddLoopEdge(region.matched.get());
+    region.matched->AddLoopEdge(query);
+
+    merged->imu_initialized = merged->imu_initialized && current->imu_initialized;
+    atlas_->SetCurrentMap(merged);
+    atlas_->RemoveMap(current);
+    merged->IncreaseChangeIndex();
+  }
+  ReleaseMapping();
+  return merged;
+}
+
+}  // namespace pkslam
