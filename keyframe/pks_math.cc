@@ -1,11 +1,10 @@
 #include "keyframe/pks_math.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <numeric>
-
-#include <Eigen/Geometry>
 #include <nanoflann.hpp>
+#include <numeric>
 
 namespace pkslam::pks {
 namespace {
@@ -21,16 +20,15 @@ struct PointCloud {
   }
 };
 
-using KdTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>,
-                                        PointCloud, 3, std::size_t>;
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>,
+                                                   PointCloud, 3, std::size_t>;
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
 }  // namespace
 
 std::vector<Eigen::Vector3d> EstimateNormals(const std::vector<Eigen::Vector3d>& points, int k,
-                                             bool align_signs) {
+                                             bool align_signs, std::span<const std::size_t> only) {
   const std::size_t n = points.size();
   std::vector<Eigen::Vector3d> normals(n, Eigen::Vector3d::Zero());
   if (k < 2 || n < static_cast<std::size_t>(k) + 1) return normals;
@@ -43,7 +41,9 @@ std::vector<Eigen::Vector3d> EstimateNormals(const std::vector<Eigen::Vector3d>&
   std::vector<std::pair<double, std::size_t>> candidates;
   std::vector<Eigen::Vector3d> offsets(k);
   std::vector<Eigen::Vector3d> crosses;
-  for (std::size_t i = 0; i < n; ++i) {
+  const std::size_t count = only.empty() ? n : only.size();
+  for (std::size_t q = 0; q < count; ++q) {
+    const std::size_t i = only.empty() ? q : only[q];
     nanoflann::KNNResultSet<double, std::size_t> result(want);
     result.init(indices.data(), distances.data());
     tree.findNeighbors(result, points[i].data(), nanoflann::SearchParams());
@@ -103,9 +103,9 @@ AdaptiveThreshold ComputeAdaptiveThreshold(int a_c, int m_c, int d_c, int a_r, i
   t.valid = true;
   const double mc = m_c, dc = d_c, ac = a_c, mr = m_r, dr = d_r, ar = a_r;
   t.th_initial = (mc * dr / mr + ac * dr / ar) / 2.0;  // Eq. 2
-  t.theta = 1.0 - mc / mr;                              // Eq. 4
-  t.beta = dc / mc - dr / mr;                           // Eq. 6
-  t.alpha = dc / mc - 0.5;                              // Eq. 8
+  t.theta = 1.0 - mc / mr;                             // Eq. 4
+  t.beta = dc / mc - dr / mr;                          // Eq. 6
+  t.alpha = dc / mc - 0.5;                             // Eq. 8
   if (released && 2 * m_c < m_r) t.gamma = (mr - 2 * mc) / (mr + 2 * mc);
   t.th_adaptive = t.th_initial * (1.0 + t.theta - t.beta - t.alpha - t.gamma);  // Eq. 1, 9
   if (released && t.theta < 0.1) t.th_adaptive = 1.1 * t.th_initial;

@@ -2,9 +2,9 @@
 // equation can be tested on hand-worked numbers.
 #pragma once
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <span>
+#include <vector>
 
 namespace pkslam::pks {
 
@@ -14,9 +14,11 @@ namespace pkslam::pks {
 // neighbourhoods (+x, -x, +y, -y gives 0); with align_signs each cross product is first
 // turned into the hemisphere of the largest one, which keeps the normal an (unoriented) axis
 // and never cancels on a surface. A point gets a zero normal when fewer than k other points
-// exist or the sum vanishes. k-d tree (nanoflann).
+// exist or the sum vanishes. k-d tree (nanoflann). With `only` non-empty, normals are computed
+// for those indices alone (neighbours still come from all points); the others stay zero.
 std::vector<Eigen::Vector3d> EstimateNormals(const std::vector<Eigen::Vector3d>& points, int k = 5,
-                                             bool align_signs = true);
+                                             bool align_signs = true,
+                                             std::span<const std::size_t> only = {});
 
 // Angle (degrees) between a point's normal and the ray from the point to the camera centre.
 // fold = true treats the normal as an unoriented axis (angle in [0, 90]); the released code
@@ -32,7 +34,7 @@ int ConeRegion(double angle_deg, double width_deg, int regions);
 // (r: the first frame after the last keyframe). A = tracked points, M = points matched to the
 // last keyframe, D = matched points whose cone region changed.
 struct AdaptiveThreshold {
-  bool valid = false;  // false when M_r, A_r or M_c is 0 (ratios undefined)
+  bool valid = false;      // false when M_r, A_r or M_c is 0 (ratios undefined)
   double th_initial = 0;   // Eq. 2
   double theta = 0;        // Eq. 4
   double beta = 0;         // Eq. 6

@@ -9,8 +9,8 @@
 namespace pkslam {
 
 void PksOptions::Check() const {
-  PKSLAM_CHECK_OPTION(region_width_deg > 0 && region_width_deg < 90, "Keyframe.region_width",
-                      "{}", region_width_deg);
+  PKSLAM_CHECK_OPTION(region_width_deg > 0 && region_width_deg < 90, "Keyframe.region_width", "{}",
+                      region_width_deg);
   PKSLAM_CHECK_OPTION(regions >= 2, "Keyframe.regions", "{}", regions);
   PKSLAM_CHECK_OPTION(delta_deg > 0 && delta_deg < 180, "Keyframe.delta", "{}", delta_deg);
   PKSLAM_CHECK_OPTION(grid >= 2, "Keyframe.grid", "{}", grid);
@@ -73,7 +73,8 @@ void PksSelector::ExtendSnapshot(const SelectorInput& input) {
   std::vector<Eigen::Vector3d> positions;
   positions.reserve(input.points.size());
   for (const auto& p : input.points) positions.push_back(p.position_world);
-  const auto normals = pks::EstimateNormals(positions, options_.normal_neighbours, true);
+  // Per-frame path: normals only for the newcomers (usually a handful), not every tracked point.
+  const auto normals = pks::EstimateNormals(positions, options_.normal_neighbours, true, missing);
   const Eigen::Vector3d kf_center = input.last_keyframe_camera_from_world.Inverse().translation();
   for (const std::size_t i : missing) {
     const double angle = pks::ViewAngleDeg(normals[i], positions[i], kf_center, false);
@@ -126,7 +127,8 @@ bool PksSelector::CameraCriterion(const SelectorInput& input, SelectorTrace* tra
   if (!released_ && input.points.size() > static_cast<std::size_t>(options_.normal_neighbours)) {
     ExtendSnapshot(input);
   }
-  if (!has_snapshot_ || input.points.size() < static_cast<std::size_t>(options_.normal_neighbours) + 1) {
+  if (!has_snapshot_ ||
+      input.points.size() < static_cast<std::size_t>(options_.normal_neighbours) + 1) {
     return false;  // too few points for a surface normal: no camera decision
   }
   const Counts c = Measure(input);
@@ -201,19 +203,21 @@ SelectorDecision PksSelector::Decide(const SelectorInput& in) {
   SelectorTrace trace;
   const bool camera = CameraCriterion(in, &trace);
   const int frames = in.FramesSinceLastKeyFrame();
-  const bool forced = released_ && options_.forced_interval > 0 && frames == options_.forced_interval;
+  const bool forced =
+      released_ && options_.forced_interval > 0 && frames == options_.forced_interval;
   const auto accel_change = AccelerationChange(in);
   if (accel_change) trace["delta_a"] = *accel_change;
-  const bool imu = options_.imu_threshold > 0 && accel_change && *accel_change > options_.imu_threshold;
+  const bool imu =
+      options_.imu_threshold > 0 && accel_change && *accel_change > options_.imu_threshold;
 
   const Sensor s = in.sensor;
   const bool need_close = !IsMonocular(s) && in.tracked_close < options_.close_tracked_max &&
                           in.untracked_close > options_.close_untracked_min;
   const bool c3 = need_close && in.inliers > 15;
   const bool c1 = IsInertial(s) ? in.SecondsSinceLastKeyFrame() >= options_.inertial_interval_s
-                                 : in.SecondsSinceLastKeyFrame() >= options_.visual_interval_s;
-  const bool c2 = s == Sensor::kMonocularInertial &&
-                  ((in.inliers > 15 && in.inliers < 75) || in.recently_lost);
+                                : in.SecondsSinceLastKeyFrame() >= options_.visual_interval_s;
+  const bool c2 =
+      s == Sensor::kMonocularInertial && ((in.inliers > 15 && in.inliers < 75) || in.recently_lost);
   const bool weak = !IsInertial(s) && options_.weak_tracking_ratio > 0 &&
                     in.inliers < options_.weak_tracking_ratio * in.reference_tracked_points;
 
