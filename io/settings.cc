@@ -86,6 +86,10 @@ void Settings::Check() const {
   if (depth_map_factor) {
     PKSLAM_CHECK_OPTION(*depth_map_factor > 0, "depth_map_factor", "{}", *depth_map_factor);
   }
+  if (depth_noise_k) {
+    PKSLAM_CHECK_OPTION(*depth_noise_k > 0 && std::isfinite(*depth_noise_k), "depth_noise_k", "{}",
+                        *depth_noise_k);
+  }
   PKSLAM_CHECK_OPTION(orb.n_features > 0, "orb.n_features", "{}", orb.n_features);
   PKSLAM_CHECK_OPTION(orb.scale_factor > 1.0, "orb.scale_factor", "{}", orb.scale_factor);
   PKSLAM_CHECK_OPTION(orb.n_levels >= 1, "orb.n_levels", "{}", orb.n_levels);
@@ -226,6 +230,7 @@ Settings ReadOrbSlam3Settings(const std::filesystem::path& file) {
     s.body_from_cam0 = SE3d(yaml.RigidTransform("IMU.T_b_c1"));
   }
   if (yaml.Has("RGBD.DepthMapFactor")) s.depth_map_factor = Positive(yaml, "RGBD.DepthMapFactor");
+  if (yaml.Has("RGBD.DepthNoise")) s.depth_noise_k = Positive(yaml, "RGBD.DepthNoise");
 
   if (const auto v = yaml.OptionalInt("ORBextractor.nFeatures")) s.orb.n_features = *v;
   if (const auto v = yaml.OptionalDouble("ORBextractor.scaleFactor")) s.orb.scale_factor = *v;

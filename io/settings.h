@@ -68,6 +68,9 @@ struct Settings {
   std::optional<ImuNoise> imu;
   // RGBD.DepthMapFactor: depth image value per metre (TUM: 5000). Optional.
   std::optional<double> depth_map_factor;
+  // RGBD.DepthNoise (pkslam): k of the depth noise sigma_z = k z^2 [1/m]; optional, default
+  // Kinect v1 (core/frame/camera_rig.h).
+  std::optional<double> depth_noise_k;
   OrbExtractorSettings orb;                // ORBextractor.*: optional, defaults above
   std::map<std::string, double> keyframe;  // Keyframe.<name>: selector parameters, free-form
 

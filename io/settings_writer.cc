@@ -114,6 +114,10 @@ void WriteOrbSlam3Settings(const Settings& s, const std::filesystem::path& file)
     w.RealKey("IMU.Frequency", s.imu->rate_hz);
     w.Blank();
   }
+  if (s.depth_noise_k) {
+    w.Comment("Depth noise sigma_z = DepthNoise * z^2 (m)");
+    w.RealKey("RGBD.DepthNoise", *s.depth_noise_k);
+  }
   if (s.depth_map_factor) {
     w.RealKey("RGBD.DepthMapFactor", *s.depth_map_factor);
     w.Blank();

@@ -26,6 +26,12 @@ bool ReprojectionOk(const KeyFrame& kf, int index, const Eigen::Vector3d& p_worl
   const double ey = v - kp.pt.y;
   const float u_right = kf.right_u().empty() ? -1.0f : kf.right_u()[index];
   if (u_right < 0) return ex * ex + ey * ey <= kChi2Mono * sigma2;
+  const double disparity_info = kf.DisparityInformation(index);
+  if (disparity_info > 0) {
+    // RGB-D: the depth reading has its own sigma (core/optim/reprojection_error.h).
+    const double ed = rig.bf * inv_z - (kp.pt.x - u_right);
+    return (ex * ex + ey * ey) / sigma2 + disparity_info * ed * ed <= kChi2Stereo;
+  }
   const double er = (u - rig.bf * inv_z) - u_right;
   return ex * ex + ey * ey + er * er <= kChi2Stereo * sigma2;
 }

@@ -42,6 +42,9 @@ QualitySettings SettingsFor(Quality q) {
   return {1024, 1, 5};
 }
 
+// Kinect v1 depth noise: sigma_z = k z^2 (m).
+constexpr double kKinectDepthNoiseK = 1.425e-3;
+
 std::int64_t Ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 
 // The colour camera of RGB-D output: TUM's default Kinect intrinsics, mounted like cam0.
@@ -89,6 +92,8 @@ void WriteSettings(const std::filesystem::path& file, const std::vector<CameraRi
     settings.depth_map_factor = 5000.0;
     settings.stereo_baseline_m = 0.07;  // ORB-SLAM3's virtual RGB-D baseline (TUM files)
     settings.th_depth = 40.0;
+    // The noise DepthImage draws, so runs weight the depth the way it was simulated.
+    if (o.depth_noise > 0) settings.depth_noise_k = kKinectDepthNoiseK * o.depth_noise;
   } else {
     settings.camera2 = cameras[1].camera;
     settings.right_from_left = cameras[1].body_from_camera.Inverse() * cameras[0].body_from_camera;
@@ -112,8 +117,8 @@ bool InBlackout(const SimulationOptions& o, std::int64_t t_ns, std::int64_t begi
   return t >= o.blackout_begin_s && t <= o.blackout_end_s;
 }
 
-// Kinect-like depth: noise sigma = 1.425e-3 z^2 (Khoshelham & Elberink 2012), valid range
-// 0.4-8 m, stored as uint16 metres * factor.
+// Kinect-like depth: noise sigma = kKinectDepthNoiseK z^2 (Khoshelham & Elberink 2012),
+// valid range 0.4-8 m, stored as uint16 metres * factor.
 cv::Mat DepthImage(const cv::Mat& depth_m, double noise_scale, const PixelNoise& noise,
                    std::uint64_t key, double factor) {
   cv::Mat out(depth_m.size(), CV_16U);
@@ -124,7 +129,7 @@ cv::Mat DepthImage(const cv::Mat& depth_m, double noise_scale, const PixelNoise&
         out.at<std::uint16_t>(y, x) = 0;
         continue;
       }
-      const double sigma = noise_scale * 1.425e-3 * z * z;
+      const double sigma = noise_scale * kKinectDepthNoiseK * z * z;
       const double zn =
           z + sigma * noise.Sample(key, static_cast<std::uint64_t>(y) * depth_m.cols + x);
       out.at<std::uint16_t>(y, x) =

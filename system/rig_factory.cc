@@ -46,6 +46,7 @@ RigSetup MakeRig(const Settings& settings, Sensor sensor) {
         throw OptionError("RGB-D sensor needs RGBD.DepthMapFactor in the settings");
       }
       rig->depth_factor = *settings.depth_map_factor;
+      if (settings.depth_noise_k) rig->depth_noise_k = *settings.depth_noise_k;
       // The virtual baseline only scales the close/far split and the virtual right
       // coordinate; ORB-SLAM's TUM settings use about 8 cm.
       rig->baseline = settings.stereo_baseline_m.value_or(0.08);

@@ -1,7 +1,9 @@
 #include "tracking/frame_builder.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/frame/depth_uncertainty.h"
 #include "core/util/error.h"
 
 namespace pkslam {
@@ -49,18 +51,21 @@ Frame FrameBuilder::BuildRgbd(FrameId id, std::int64_t t_ns, const cv::Mat& grey
   FrameFeatures f = ToFrameFeatures(extractor_.Extract(grey));
   const std::size_t n = f.keypoints.size();
   f.depth.assign(n, -1.0f);
+  f.depth_sigma.assign(n, -1.0f);
   const bool metric = depth.type() == CV_32F;
   PKSLAM_CHECK(metric || depth.type() == CV_16U, "depth image type {} (want CV_16U or CV_32F)",
                depth.type());
   const double scale = metric ? 1.0 : 1.0 / rig_->depth_factor;
+  const ScalePyramid& pyramid = rig_->pyramid;
   for (std::size_t i = 0; i < n; ++i) {
-    // Depth is looked up at the raw (distorted) keypoint, where the registered depth lives.
-    const int x = static_cast<int>(std::lround(f.keypoints[i].pt.x));
-    const int y = static_cast<int>(std::lround(f.keypoints[i].pt.y));
-    if (x < 0 || y < 0 || x >= depth.cols || y >= depth.rows) continue;
-    const double d = metric ? static_cast<double>(depth.at<float>(y, x))
-                            : static_cast<double>(depth.at<std::uint16_t>(y, x));
-    if (d > 0 && std::isfinite(d)) f.depth[i] = static_cast<float>(d * scale);
+    // Depth is looked up at the raw (distorted) keypoint, where the registered depth lives;
+    // the keypoint's location sigma is its octave's scale (ORB-SLAM's sigma per level).
+    const cv::KeyPoint& kp = f.keypoints[i];
+    const int octave = std::clamp(kp.octave, 0, static_cast<int>(pyramid.scale.size()) - 1);
+    const DepthReading r = ReadKeypointDepth(depth, scale, kp.pt.x, kp.pt.y, rig_->depth_noise_k,
+                                             pyramid.scale[octave], rig_->bf);
+    f.depth[i] = r.depth;
+    f.depth_sigma[i] = r.sigma;
   }
   return Frame(id, t_ns, rig_, std::move(f));
 }

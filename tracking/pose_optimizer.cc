@@ -22,12 +22,14 @@ struct Correspondence {
   Eigen::Vector3d p_world;
   Eigen::Vector3d obs;  // u, v, u_right (u_right unused for monocular)
   double inv_sigma2 = 1.0;
+  double disparity_inv_sigma2 = 0.0;  // RGB-D depth reading's information (0: stereo form)
   std::unique_ptr<ceres::CostFunction> cost;
   ceres::ResidualBlockId block = nullptr;  // null while classified as outlier
 };
 
 double Chi2(const PinholeIntrinsics& k, const SE3d& camera_from_world, const Correspondence& c) {
-  return c.stereo ? StereoChi2(k, camera_from_world, c.p_world, c.obs, c.inv_sigma2)
+  return c.stereo ? StereoChi2(k, camera_from_world, c.p_world, c.obs, c.inv_sigma2,
+                               c.disparity_inv_sigma2)
                   : MonoChi2(k, camera_from_world, c.p_world, c.obs.head<2>(), c.inv_sigma2);
 }
 
@@ -69,6 +71,7 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
     c.p_world = point->position();
     c.obs = Eigen::Vector3d(kp.pt.x, kp.pt.y, c.stereo ? right_u[i] : -1.0);
     c.inv_sigma2 = inv_sigma2[kp.octave];
+    if (c.stereo) c.disparity_inv_sigma2 = frame->DisparityInformation(i);
   }
   const int num_correspondences = static_cast<int>(corrs.size());
   if (num_correspondences < 3) return 0;
@@ -95,7 +98,8 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
   auto add = [&](Correspondence& c) {
     if (!c.cost) {
       if (c.stereo) {
-        c.cost = std::make_unique<StereoPoseOnlyError>(k, c.p_world, c.obs, c.inv_sigma2);
+        c.cost = std::make_unique<StereoPoseOnlyError>(k, c.p_world, c.obs, c.inv_sigma2,
+                                                       c.disparity_inv_sigma2);
       } else {
         c.cost = std::make_unique<MonoPoseOnlyError>(k, c.p_world, c.obs.head<2>(), c.inv_sigma2);
       }

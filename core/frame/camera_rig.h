@@ -35,6 +35,9 @@ struct CameraRig {
   double th_depth = 0;
   // RGB-D depth image factor (pixel value / factor = metres).
   double depth_factor = 5000.0;
+  // RGB-D depth noise: sigma_z = depth_noise_k * z^2 (m); Kinect v1 by default (Khoshelham &
+  // Elberink 2012). Weights the depth (virtual disparity) residuals: depth_uncertainty.h.
+  double depth_noise_k = 1.425e-3;
   ScalePyramid pyramid;
   // Bounds of the undistorted image (keypoint coordinates live in here).
   ImageBounds bounds;

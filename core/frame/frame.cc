@@ -1,6 +1,7 @@
 #include "core/frame/frame.h"
 
 #include "core/bow/vocabulary.h"
+#include "core/frame/depth_uncertainty.h"
 #include "core/map/map_point.h"
 #include "core/util/error.h"
 
@@ -14,6 +15,7 @@ Frame::Frame(FrameId id, std::int64_t t_ns, std::shared_ptr<const CameraRig> rig
       keypoints_(std::move(features.keypoints)),
       right_u_(std::move(features.right_u)),
       depth_(std::move(features.depth)),
+      depth_sigma_(std::move(features.depth_sigma)),
       descriptors_(std::move(features.descriptors)) {
   PKSLAM_CHECK(descriptors_.size() == keypoints_.size(), "{} descriptors for {} keypoints",
                descriptors_.size(), keypoints_.size());
@@ -38,6 +40,10 @@ Frame::Frame(FrameId id, std::int64_t t_ns, std::shared_ptr<const CameraRig> rig
       }
     }
   }
+  if (!depth_sigma_.empty()) {
+    PKSLAM_CHECK(depth_sigma_.size() == n, "{} depth sigmas for {} keypoints", depth_sigma_.size(),
+                 n);
+  }
   if (!right_u_.empty()) {
     PKSLAM_CHECK(right_u_.size() == n, "{} right coordinates for {} keypoints", right_u_.size(),
                  n);
@@ -56,6 +62,11 @@ void Frame::ComputeBoW(const Vocabulary& vocabulary) {
 void Frame::SetPose(const SE3d& camera_from_world) {
   camera_from_world_ = camera_from_world;
   world_from_camera_ = camera_from_world.Inverse();
+}
+
+double Frame::DisparityInformation(int i) const {
+  if (depth_sigma_.empty() || !HasDepth(i)) return 0.0;
+  return pkslam::DisparityInformation(rig_->bf, depth_[i], depth_sigma_[i]);
 }
 
 std::optional<Eigen::Vector3d> Frame::UnprojectToCamera(int i) const {

@@ -30,6 +30,9 @@ struct FrameFeatures {
   std::vector<Descriptor> descriptors;  // one per keypoint
   std::vector<float> right_u;           // stereo/RGB-D: right-image u per keypoint, or -1
   std::vector<float> depth;             // stereo/RGB-D: depth (m) per keypoint, or -1
+  // RGB-D: sigma (m) of each depth reading (depth_uncertainty.h); empty for stereo, whose
+  // right coordinate is a measurement of its own.
+  std::vector<float> depth_sigma;
 };
 
 class Frame {
@@ -83,6 +86,11 @@ class Frame {
   // Camera-frame point of keypoint i from its depth, if it has one.
   std::optional<Eigen::Vector3d> UnprojectToCamera(int i) const;
   bool HasDepth(int i) const { return !depth_.empty() && depth_[i] > 0; }
+  // RGB-D: information (1/px^2) of keypoint i's virtual disparity bf / depth from its depth
+  // sigma; 0 for stereo keypoints and keypoints without depth (their residual is then on the
+  // right coordinate, weighted like u). core/frame/depth_uncertainty.h.
+  double DisparityInformation(int i) const;
+  const std::vector<float>& depth_sigma() const { return depth_sigma_; }
 
   // --- tracking's working state (tracking thread only) ---
   std::vector<MapPointPtr> map_points;  // matched map point per keypoint, or nullptr
@@ -100,6 +108,7 @@ class Frame {
   std::vector<cv::KeyPoint> keypoints_un_;
   std::vector<float> right_u_;
   std::vector<float> depth_;
+  std::vector<float> depth_sigma_;
   std::vector<Descriptor> descriptors_;
   FeatureGrid grid_;
   bool bow_computed_ = false;

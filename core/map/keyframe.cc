@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/frame/depth_uncertainty.h"
 #include "core/frame/frame.h"
 #include "core/map/map.h"
 #include "core/map/map_point.h"
@@ -30,12 +31,18 @@ KeyFrame::KeyFrame(KeyFrameId id, const Frame& frame, Map* map)
       keypoints_un_(frame.keypoints_undistorted()),
       right_u_(frame.right_u()),
       depth_(frame.depth()),
+      depth_sigma_(frame.depth_sigma()),
       descriptors_(frame.descriptors()),
       grid_(frame.grid()),
       bow_(frame.bow()),
       feature_vector_(frame.feature_vector()),
       map_points_(frame.map_points) {
   if (frame.HasPose()) SetPose(frame.camera_from_world());
+}
+
+double KeyFrame::DisparityInformation(int i) const {
+  if (depth_sigma_.empty() || !HasDepth(i)) return 0.0;
+  return pkslam::DisparityInformation(rig_->bf, depth_[i], depth_sigma_[i]);
 }
 
 std::optional<Eigen::Vector3d> KeyFrame::UnprojectStereo(int i) const {

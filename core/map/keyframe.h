@@ -61,6 +61,8 @@ class KeyFrame {
     grid_.FeaturesInArea(keypoints_un_, x, y, radius, min_level, max_level, out);
   }
   bool HasDepth(int i) const { return !depth_.empty() && depth_[i] > 0; }
+  // As Frame::DisparityInformation (RGB-D depth information; 0 for stereo / no depth).
+  double DisparityInformation(int i) const;
   std::optional<Eigen::Vector3d> UnprojectStereo(int i) const;
 
   // --- pose ---
@@ -134,6 +136,7 @@ class KeyFrame {
   std::vector<cv::KeyPoint> keypoints_un_;
   std::vector<float> right_u_;
   std::vector<float> depth_;
+  std::vector<float> depth_sigma_;
   std::vector<Descriptor> descriptors_;
   FeatureGrid grid_;
   BowVector bow_;

@@ -46,7 +46,8 @@ bool AddPoint(const MapPointPtr& point, const KeyFrameIndex& index, BundleProble
     const double u_right = kf.right_u().empty() ? -1.0 : kf.right_u()[obs.index];
     problem->observations.push_back({it->second, point_index, obs.index,
                                      Eigen::Vector2d(kp.pt.x, kp.pt.y),
-                                     u_right >= 0 ? u_right : -1.0, inv_sigma2[kp.octave]});
+                                     u_right >= 0 ? u_right : -1.0, inv_sigma2[kp.octave],
+                                     u_right >= 0 ? kf.DisparityInformation(obs.index) : 0.0});
     any = true;
   }
   if (any) problem->points.push_back({point, point->position()});

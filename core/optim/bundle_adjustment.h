@@ -48,6 +48,8 @@ struct BundleProblem {
     Eigen::Vector2d uv;  // undistorted pixel
     double u_right;      // < 0 for monocular observations
     double inv_sigma2;   // 1 / sigma^2 of the keypoint octave
+    // RGB-D: information of the depth reading's disparity (reprojection_error.h); 0: stereo.
+    double disparity_inv_sigma2 = 0.0;
   };
   std::vector<KeyFrameState> keyframes;
   std::vector<PointState> points;

@@ -58,7 +58,7 @@ double ObservationChi2(const PinholeIntrinsics& k, const BundleProblem::Observat
   const Eigen::Map<const Eigen::Vector3d> p(s.point(o.point_index));
   if (o.u_right >= 0) {
     return StereoChi2(k, camera_from_world, p, Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right),
-                      o.inv_sigma2);
+                      o.inv_sigma2, o.disparity_inv_sigma2);
   }
   return MonoChi2(k, camera_from_world, p, o.uv, o.inv_sigma2);
 }
@@ -145,7 +145,7 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
     if (o.u_right >= 0) {
       blocks[i] = ceres_problem.AddResidualBlock(
           new StereoReprojectionError(k, Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right),
-                                      o.inv_sigma2),
+                                      o.inv_sigma2, o.disparity_inv_sigma2),
           &loss_stereo, pose, point);
     } else {
       blocks[i] = ceres_problem.AddResidualBlock(new MonoReprojectionError(k, o.uv, o.inv_sigma2),

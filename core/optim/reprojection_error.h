@@ -6,6 +6,12 @@
 //   mono:   (u, v)          = (fx x/z + cx, fy y/z + cy)
 //   stereo: (u, v, u_right) with u_right = u - bf / z
 // with p_camera = (x, y, z) = camera_from_world * p_world.
+// RGB-D observations (a keypoint plus a depth reading) pass the information of the measured
+// disparity d = u - u_right = bf / depth (disparity_inv_sigma2 > 0, from the depth noise;
+// core/frame/depth_uncertainty.h): the third residual is then on the disparity,
+//   sqrt(disparity_inv_sigma2) * (bf / z - d),
+// independent of u (the depth reading does not share the keypoint's pixel error the way a
+// stereo match's right coordinate does). disparity_inv_sigma2 = 0 keeps the stereo form.
 //
 // Pose Jacobians follow the [I6; 0] convention of se3_manifold.h: columns 0..5 hold
 // d r / d delta for camera_from_world <- Exp(delta) * camera_from_world (delta = [rho; phi]),
@@ -37,7 +43,7 @@ double MonoChi2(const PinholeIntrinsics& k, const SE3d& camera_from_world,
                 const Eigen::Vector3d& p_world, const Eigen::Vector2d& uv, double inv_sigma2);
 double StereoChi2(const PinholeIntrinsics& k, const SE3d& camera_from_world,
                   const Eigen::Vector3d& p_world, const Eigen::Vector3d& uv_right,
-                  double inv_sigma2);
+                  double inv_sigma2, double disparity_inv_sigma2 = 0.0);
 
 // Pose + point: parameters {pose[7], p_world[3]}.
 class MonoReprojectionError final : public ceres::SizedCostFunction<2, 7, 3> {
@@ -57,8 +63,11 @@ class MonoReprojectionError final : public ceres::SizedCostFunction<2, 7, 3> {
 class StereoReprojectionError final : public ceres::SizedCostFunction<3, 7, 3> {
  public:
   StereoReprojectionError(const PinholeIntrinsics& k, const Eigen::Vector3d& uv_right,
-                          double inv_sigma2)
-      : k_(k), obs_(uv_right), sqrt_info_(std::sqrt(inv_sigma2)) {}
+                          double inv_sigma2, double disparity_inv_sigma2 = 0.0)
+      : k_(k),
+        obs_(uv_right),
+        sqrt_info_(std::sqrt(inv_sigma2)),
+        sqrt_info_disparity_(std::sqrt(disparity_inv_sigma2)) {}
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
@@ -66,6 +75,7 @@ class StereoReprojectionError final : public ceres::SizedCostFunction<3, 7, 3> {
   PinholeIntrinsics k_;
   Eigen::Vector3d obs_;
   double sqrt_info_;
+  double sqrt_info_disparity_;
 };
 
 // Pose only (the point is a constant): parameters {pose[7]}.
@@ -88,8 +98,13 @@ class MonoPoseOnlyError final : public ceres::SizedCostFunction<2, 7> {
 class StereoPoseOnlyError final : public ceres::SizedCostFunction<3, 7> {
  public:
   StereoPoseOnlyError(const PinholeIntrinsics& k, const Eigen::Vector3d& p_world,
-                      const Eigen::Vector3d& uv_right, double inv_sigma2)
-      : k_(k), p_world_(p_world), obs_(uv_right), sqrt_info_(std::sqrt(inv_sigma2)) {}
+                      const Eigen::Vector3d& uv_right, double inv_sigma2,
+                      double disparity_inv_sigma2 = 0.0)
+      : k_(k),
+        p_world_(p_world),
+        obs_(uv_right),
+        sqrt_info_(std::sqrt(inv_sigma2)),
+        sqrt_info_disparity_(std::sqrt(disparity_inv_sigma2)) {}
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
@@ -98,6 +113,7 @@ class StereoPoseOnlyError final : public ceres::SizedCostFunction<3, 7> {
   Eigen::Vector3d p_world_;
   Eigen::Vector3d obs_;
   double sqrt_info_;
+  double sqrt_info_disparity_;
 };
 
 }  // namespace pkslam

@@ -28,6 +28,7 @@ struct PerturbedResidual {
   SE3d base;
   Eigen::Matrix<double, kRes, 1> obs;
   double sqrt_info;
+  double sqrt_info_disparity = 0.0;  // > 0: RGB-D disparity form of the third residual
 
   template <typename T>
   bool operator()(const T* delta, const T* point, T* residual) const {
@@ -39,7 +40,9 @@ struct PerturbedResidual {
     residual[0] = T(sqrt_info) * (u - T(obs(0)));
     residual[1] = T(sqrt_info) * (v - T(obs(1)));
     if constexpr (kRes == 3) {
-      residual[2] = T(sqrt_info) * (u - T(kIntrinsics.bf) / p.z() - T(obs(2)));
+      residual[2] = sqrt_info_disparity > 0.0
+                        ? T(sqrt_info_disparity) * (T(kIntrinsics.bf) / p.z() - T(obs(0) - obs(2)))
+                        : T(sqrt_info) * (u - T(kIntrinsics.bf) / p.z() - T(obs(2)));
     }
     return true;
   }
@@ -69,7 +72,8 @@ Scenario MakeScenario(std::mt19937& rng) {
 // Checks an analytic cost function (pose block through the manifold [+ point]) against
 // AutoDiff of PerturbedResidual and against central differences of r(Plus(x, delta)).
 template <int kRes>
-void CheckJacobians(const ceres::CostFunction& analytic, const Scenario& s, bool with_point) {
+void CheckJacobians(const ceres::CostFunction& analytic, const Scenario& s, bool with_point,
+                    double disparity_inv_sigma2 = 0.0) {
   double pose[7];
   PoseToBlock(s.camera_from_world, pose);
   double point[3] = {s.p_world.x(), s.p_world.y(), s.p_world.z()};
@@ -88,7 +92,8 @@ void CheckJacobians(const ceres::CostFunction& analytic, const Scenario& s, bool
   const Eigen::Matrix<double, kRes, 6> j_tangent = j_pose_ambient * plus_jacobian;
 
   // Reference 1: AutoDiff of the generic residual.
-  PerturbedResidual<kRes> functor{s.camera_from_world, s.obs.head<kRes>(), std::sqrt(s.inv_sigma2)};
+  PerturbedResidual<kRes> functor{s.camera_from_world, s.obs.head<kRes>(), std::sqrt(s.inv_sigma2),
+                                  std::sqrt(disparity_inv_sigma2)};
   ceres::AutoDiffCostFunction<PerturbedResidual<kRes>, kRes, 6, 3> autodiff(
       new PerturbedResidual<kRes>(functor));
   const Vec6 zero = Vec6::Zero();
@@ -172,6 +177,48 @@ TEST(ReprojectionError, SquaredResidualIsChi2) {
     EXPECT_NEAR(r3.squaredNorm(),
                 StereoChi2(kIntrinsics, s.camera_from_world, s.p_world, s.obs, s.inv_sigma2), 1e-9);
     EXPECT_GT(r2.squaredNorm(), 0.0);
+  }
+}
+
+// RGB-D: the third residual is on the depth reading's disparity, with its own information.
+TEST(ReprojectionError, RgbdDisparityJacobians) {
+  std::mt19937 rng(16);
+  for (int i = 0; i < 30; ++i) {
+    const Scenario s = MakeScenario(rng);
+    const double info = 1.0 / std::pow(0.05 + 0.1 * static_cast<double>(i % 3), 2);
+    CheckJacobians<3>(StereoReprojectionError(kIntrinsics, s.obs, s.inv_sigma2, info), s, true,
+                      info);
+    CheckJacobians<3>(StereoPoseOnlyError(kIntrinsics, s.p_world, s.obs, s.inv_sigma2, info), s,
+                      false, info);
+  }
+}
+
+TEST(ReprojectionError, RgbdDisparityResidualIgnoresTheKeypointError) {
+  // A depth reading gives d = bf / z whatever the keypoint's u error: moving u (and the
+  // virtual right coordinate derived from it) changes the first residual only, and the chi2
+  // weighs the disparity error with the depth's information.
+  const SE3d identity;
+  const Eigen::Vector3d p(0.3, -0.2, 2.5);
+  const double u = kIntrinsics.fx * p.x() / p.z() + kIntrinsics.cx;
+  const double v = kIntrinsics.fy * p.y() / p.z() + kIntrinsics.cy;
+  const double d = kIntrinsics.bf / p.z() + 0.1;  // depth reading 0.1 px of disparity off
+  const double info = 1.0 / (0.05 * 0.05);
+  double pose[7];
+  PoseToBlock(identity, pose);
+  const double* params[1] = {pose};
+  for (const double du : {0.0, 1.5}) {
+    const Eigen::Vector3d obs(u + du, v, u + du - d);
+    Eigen::Vector3d r;
+    ASSERT_TRUE(
+        StereoPoseOnlyError(kIntrinsics, p, obs, 1.0, info).Evaluate(params, r.data(), nullptr));
+    EXPECT_NEAR(r(0), -du, 1e-9);
+    EXPECT_NEAR(r(2), -0.1 / 0.05, 1e-9);
+    EXPECT_NEAR(StereoChi2(kIntrinsics, identity, p, obs, 1.0, info), r.squaredNorm(), 1e-9);
+    // The stereo form would charge the keypoint's u error to the right coordinate too.
+    Eigen::Vector3d r_stereo;
+    ASSERT_TRUE(
+        StereoPoseOnlyError(kIntrinsics, p, obs, 1.0).Evaluate(params, r_stereo.data(), nullptr));
+    EXPECT_NEAR(r_stereo(2), 0.1 - du, 1e-9);
   }
 }
 
