@@ -13,6 +13,7 @@
 #include "core/util/progress.h"
 #include "io/settings.h"
 #include "io/trajectory.h"
+#include "sim/depth_sensor.h"
 #include "sim/euroc_writer.h"
 #include "sim/random.h"
 #include "sim/reference_cloud.h"
@@ -41,9 +42,6 @@ QualitySettings SettingsFor(Quality q) {
   }
   return {1024, 1, 5};
 }
-
-// Kinect v1 depth noise: sigma_z = k z^2 (m).
-constexpr double kKinectDepthNoiseK = 1.425e-3;
 
 std::int64_t Ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 
@@ -92,8 +90,10 @@ void WriteSettings(const std::filesystem::path& file, const std::vector<CameraRi
     settings.depth_map_factor = 5000.0;
     settings.stereo_baseline_m = 0.07;  // ORB-SLAM3's virtual RGB-D baseline (TUM files)
     settings.th_depth = 40.0;
-    // The noise DepthImage draws, so runs weight the depth the way it was simulated.
-    if (o.depth_noise > 0) settings.depth_noise_k = kKinectDepthNoiseK * o.depth_noise;
+    // The noise the depth images carry, so runs weight the depth the way it was simulated.
+    if (o.depth_noise > 0) {
+      settings.depth_noise_k = KinectDepthModel().EffectiveNoiseK(o.depth_noise);
+    }
   } else {
     settings.camera2 = cameras[1].camera;
     settings.right_from_left = cameras[1].body_from_camera.Inverse() * cameras[0].body_from_camera;
@@ -115,28 +115,6 @@ bool InBlackout(const SimulationOptions& o, std::int64_t t_ns, std::int64_t begi
   if (o.blackout_begin_s < 0.0) return false;
   const double t = 1e-9 * static_cast<double>(t_ns - begin_ns);
   return t >= o.blackout_begin_s && t <= o.blackout_end_s;
-}
-
-// Kinect-like depth: noise sigma = kKinectDepthNoiseK z^2 (Khoshelham & Elberink 2012),
-// valid range 0.4-8 m, stored as uint16 metres * factor.
-cv::Mat DepthImage(const cv::Mat& depth_m, double noise_scale, const PixelNoise& noise,
-                   std::uint64_t key, double factor) {
-  cv::Mat out(depth_m.size(), CV_16U);
-  for (int y = 0; y < depth_m.rows; ++y) {
-    for (int x = 0; x < depth_m.cols; ++x) {
-      const float z = depth_m.at<float>(y, x);
-      if (z < 0.4f || z > 8.0f) {
-        out.at<std::uint16_t>(y, x) = 0;
-        continue;
-      }
-      const double sigma = noise_scale * kKinectDepthNoiseK * z * z;
-      const double zn =
-          z + sigma * noise.Sample(key, static_cast<std::uint64_t>(y) * depth_m.cols + x);
-      out.at<std::uint16_t>(y, x) =
-          static_cast<std::uint16_t>(std::clamp(std::lround(zn * factor), 0L, 65535L));
-    }
-  }
-  return out;
 }
 
 void MotionStatistics(const SplineTrajectory& traj, std::int64_t begin, std::int64_t end,
@@ -334,8 +312,9 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     }
     if (tum) {
       const cv::Mat depth = black ? cv::Mat::zeros(images[0].size(), CV_16U)
-                                  : DepthImage(buffers[0].depth, o.depth_noise, depth_noise,
-                                               DeriveSeed(o.seed, 0x44455054 + k), 5000.0);
+                                  : KinectDepthImage(buffers[0].depth, KinectDepthModel(),
+                                                     o.depth_noise, depth_noise,
+                                                     DeriveSeed(o.seed, 0x44455054 + k), 5000.0);
       const auto files = tum->AddFrame(t);
       writers.run([files, colour = images[0], depth] {
         TumRgbdWriter::WriteImages(files.first, files.second, colour, depth);
