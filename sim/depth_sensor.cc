@@ -13,9 +13,8 @@ double KinectDepthModel::EffectiveNoiseK(double noise_scale) const {
   return std::sqrt(gaussian * gaussian + step * step / 12.0);
 }
 
-cv::Mat KinectDepthImage(const cv::Mat& depth_m, const KinectDepthModel& model,
-                         double noise_scale, const PixelNoise& noise, std::uint64_t key,
-                         double factor) {
+cv::Mat KinectDepthImage(const cv::Mat& depth_m, const KinectDepthModel& model, double noise_scale,
+                         const PixelNoise& noise, std::uint64_t key, double factor) {
   PKSLAM_CHECK(depth_m.type() == CV_32F, "rendered depth type {} (want CV_32F)", depth_m.type());
   cv::Mat out(depth_m.size(), CV_16U);
   const double steps_fb = model.disparity_steps * model.disparity_fb;

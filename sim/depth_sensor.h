@@ -7,7 +7,6 @@
 #pragma once
 
 #include <cstdint>
-
 #include <opencv2/core.hpp>
 
 #include "sim/random.h"
@@ -15,10 +14,10 @@
 namespace pkslam::sim {
 
 struct KinectDepthModel {
-  double noise_k = 1.425e-3;     // Gaussian sigma_z = noise_k z^2 (m), times the noise scale
+  double noise_k = 1.425e-3;            // Gaussian sigma_z = noise_k z^2 (m), times the noise scale
   double disparity_fb = 580.0 * 0.075;  // f * b of the IR camera-projector pair (px m)
-  double disparity_steps = 8.0;  // disparity resolution: 1 / steps pixels
-  double min_m = 0.4;            // valid range; outside it the pixel is 0 (invalid)
+  double disparity_steps = 8.0;         // disparity resolution: 1 / steps pixels
+  double min_m = 0.4;                   // valid range; outside it the pixel is 0 (invalid)
   double max_m = 8.0;
 
   // Depth level spacing at z: z^2 / (steps * fb).
@@ -30,8 +29,7 @@ struct KinectDepthModel {
 
 // Metric depth (CV_32F, rendered) -> CV_16U depth image in metres * factor. noise_scale 0
 // gives the exact depth (no noise, no quantisation). Deterministic in (noise, key, pixel).
-cv::Mat KinectDepthImage(const cv::Mat& depth_m, const KinectDepthModel& model,
-                         double noise_scale, const PixelNoise& noise, std::uint64_t key,
-                         double factor);
+cv::Mat KinectDepthImage(const cv::Mat& depth_m, const KinectDepthModel& model, double noise_scale,
+                         const PixelNoise& noise, std::uint64_t key, double factor);
 
 }  // namespace pkslam::sim

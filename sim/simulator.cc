@@ -311,10 +311,10 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
       }
     }
     if (tum) {
-      const cv::Mat depth = black ? cv::Mat::zeros(images[0].size(), CV_16U)
-                                  : KinectDepthImage(buffers[0].depth, KinectDepthModel(),
-                                                     o.depth_noise, depth_noise,
-                                                     DeriveSeed(o.seed, 0x44455054 + k), 5000.0);
+      const cv::Mat depth =
+          black ? cv::Mat::zeros(images[0].size(), CV_16U)
+                : KinectDepthImage(buffers[0].depth, KinectDepthModel(), o.depth_noise, depth_noise,
+                                   DeriveSeed(o.seed, 0x44455054 + k), 5000.0);
       const auto files = tum->AddFrame(t);
       writers.run([files, colour = images[0], depth] {
         TumRgbdWriter::WriteImages(files.first, files.second, colour, depth);
