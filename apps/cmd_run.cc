@@ -74,6 +74,9 @@ void RegisterRunCommand(CLI::App& app) {
                   "Selector parameter NAME=VALUE (overrides the settings' Keyframe.NAME)");
   cmd->add_flag("--deterministic", args->options.system.deterministic,
                 "Fixed seeds; local mapping in lock-step: identical output run to run");
+  cmd->add_option("--seed", args->options.system.seed,
+                  "Run seed for RANSAC sampling (benchmarks: one per repeated run)")
+      ->capture_default_str();
   cmd->add_flag("--no-loop", args->options.system.no_loop,
                 "Disable loop closing and map merging (for experiments)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");

@@ -29,6 +29,9 @@ struct SystemOptions {
   std::map<std::string, double> selector_parameters;
   // Fixed seeds, local mapping in lock-step with tracking, single-threaded solvers.
   bool deterministic = false;
+  // Run seed (--seed): passed to tracking and loop closing, so repeated research runs draw
+  // different RANSAC samples; combined with `deterministic` each seed is reproducible.
+  std::uint64_t seed = 0;
   // Record per-frame keyframe decisions (keyframe_trace.csv).
   bool trace = false;
   TrackingOptions tracking;

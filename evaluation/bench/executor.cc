@@ -115,7 +115,8 @@ std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
   const DatasetSpec& d = DatasetOf(suite, run);
   std::vector<std::string> a = {
       "run",      "--dataset", dataset.string(), "--out",      run_dir.string(),
-      "--sensor", run.sensor,  "--selector",     run.selector, "--quiet"};
+      "--sensor", run.sensor,  "--selector",     run.selector, "--seed",
+      std::to_string(run.seed), "--quiet"};
   for (const auto& [k, v] : run.params) a.insert(a.end(), {"--param", k + "=" + FormatNumber(v)});
   if (d.settings) a.insert(a.end(), {"--settings", d.settings->string()});
   if (d.max_frames > 0) a.insert(a.end(), {"--max-frames", std::to_string(d.max_frames)});

@@ -1,9 +1,12 @@
 #include "evaluation/bench/suite.h"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
 #include "core/util/error.h"
+#include "evaluation/bench/executor.h"
 #include "evaluation/bench/matrix.h"
 
 namespace pkslam::bench {
@@ -50,6 +53,19 @@ TEST(Suite, ParsesAllFields) {
   ASSERT_EQ(s.datasets.size(), 2u);
   EXPECT_EQ(*s.datasets[0].path, std::filesystem::absolute("dir/data/real"));
   EXPECT_EQ(*s.datasets[1].path, std::filesystem::path("/abs/path"));
+}
+
+// Repeated runs must differ by more than thread timing: each passes its own --seed to run.
+TEST(Suite, RunArgumentsCarryTheRunSeed) {
+  const Suite s = ParseSuite(kSuite, "dir/suite.yaml");
+  const auto runs = ExpandSuite(s);
+  for (int k = 0; k < 3; ++k) {
+    const auto a = RunArguments(s, runs[static_cast<std::size_t>(k)], "data", "out");
+    const auto it = std::find(a.begin(), a.end(), "--seed");
+    ASSERT_NE(it, a.end());
+    ASSERT_NE(it + 1, a.end());
+    EXPECT_EQ(*(it + 1), std::to_string(10 + k));
+  }
 }
 
 TEST(Suite, ExpandsTheMatrixInOrderWithDistinctSeeds) {
