@@ -53,9 +53,15 @@ std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
                                       const std::filesystem::path& dataset,
                                       const std::filesystem::path& run_dir);
 
+// The `pkslam dense` command line of a run with `dense` (without the executable).
+std::vector<std::string> DenseArguments(const Suite& suite, const RunSpec& run,
+                                        const std::filesystem::path& dataset,
+                                        const std::filesystem::path& run_dir);
+
 // The recorded result of a finished run, if its folder has a readable result.csv.
 std::optional<RunResult> ReadFinished(const std::filesystem::path& run_dir);
-// Whether a run still has to be executed (no result, or failed and retry_failed).
+// Whether a run still has to be executed (no result, failed and retry_failed, or finished
+// without the dense cloud its suite now asks for - then only the cloud is built).
 bool NeedsExecution(const HarnessOptions& options, const RunSpec& run);
 
 // Renders (if needed), runs and evaluates one run; writes its result.csv. Failures of the run

@@ -1,5 +1,6 @@
 #include "evaluation/bench/results.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -87,7 +88,8 @@ std::vector<std::string> ResultColumns() {
           "map_points",
           "lost_frames",
           "wall_s",
-          "median_tracking_ms"};
+          "median_tracking_ms",
+          "dense_points"};
 }
 
 std::string CsvField(const std::string& text) {
@@ -161,7 +163,8 @@ std::string ResultCsvRow(const RunResult& r) {
                                       std::to_string(r.map_points),
                                       std::to_string(r.lost_frames),
                                       Num(r.wall_s),
-                                      Num(r.median_tracking_ms)};
+                                      Num(r.median_tracking_ms),
+                                      Num(r.dense_points)};
   std::string out;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (i > 0) out.push_back(',');
@@ -188,7 +191,11 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
   std::string line;
   if (!std::getline(in, line)) throw InputError(file, "empty file (expected a results.csv header)");
   const auto header = SplitCsvLine(line);
-  if (header != ResultColumns()) {
+  const auto columns = ResultColumns();
+  // Files from before the dense_points column: the same columns without the last one.
+  const bool without_dense = header.size() + 1 == columns.size() &&
+                             std::equal(header.begin(), header.end(), columns.begin());
+  if (header != columns && !without_dense) {
     throw InputError(file, 1,
                      "header does not match results.csv columns (" + ResultCsvHeader() + ")");
   }
@@ -235,6 +242,7 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
     r.lost_frames = static_cast<int>(ParseInt(next(), file, n, "lost_frames"));
     r.wall_s = ParseDouble(next(), file, n, "wall_s");
     r.median_tracking_ms = ParseDouble(next(), file, n, "median_tracking_ms");
+    if (!without_dense) r.dense_points = ParseDouble(next(), file, n, "dense_points");
     out.push_back(std::move(r));
   }
   return out;

@@ -42,6 +42,9 @@ struct RunResult {
   int lost_frames = 0;
   double wall_s = kNaN;
   double median_tracking_ms = kNaN;
+  // Points of the run's dense cloud (runs with `dense`; empty otherwise). The last column:
+  // results.csv files written before it existed still read.
+  double dense_points = kNaN;
 };
 
 // The headline alignment of a run: `suite_choice` when "se3"/"sim3"; for "auto" "sim3" for

@@ -68,6 +68,22 @@ TEST(Suite, RunArgumentsCarryTheRunSeed) {
   }
 }
 
+TEST(Suite, DenseCloudsForTheSweepOrTheWholeSuite) {
+  std::string text = kSuite;
+  text.replace(text.find("values: [10, 20]}"), 17, "values: [10, 20], dense: true}");
+  const Suite s = ParseSuite(text, "dir/suite.yaml");
+  ASSERT_TRUE(s.sweeps[0].dense);
+  const auto runs = ExpandSuite(s);
+  EXPECT_FALSE(runs[0].dense);                             // real/stereo/orbslam3
+  EXPECT_TRUE(runs[6].dense) << runs[6].id;                // real/stereo/pks@delta_deg=10
+  const auto a = DenseArguments(s, runs[6], "data", "out/run");
+  EXPECT_EQ(a[0], "dense");
+  EXPECT_NE(std::find(a.begin(), a.end(), "out/run/dense.json"), a.end());
+  const Suite all = ParseSuite("dense: true\n" + std::string(kSuite), "dir/suite.yaml");
+  EXPECT_TRUE(ExpandSuite(all)[0].dense);
+  ExpectError("dense: maybe\n" + std::string(kSuite), 1, "dense");
+}
+
 TEST(Suite, ExpandsTheMatrixInOrderWithDistinctSeeds) {
   const Suite s = ParseSuite(kSuite, "dir/suite.yaml");
   const auto runs = ExpandSuite(s);

@@ -42,8 +42,13 @@ struct GroupSummary {
   MeanStd coverage;  // fraction of frames with a pose in the evaluated trajectory
   MeanStd wall_s;
   MeanStd median_tracking_ms;
+  MeanStd dense_points;  // runs with dense clouds
   double ate_median_m = kNaN;
   double improvement_pct = kNaN;  // vs the baseline group of the same dataset and sensor
+  // Sweep points with dense clouds: the PKS paper's Eq. 13 criterion, mean density and mean
+  // ATE each min-max normalised over the sweep's values, density_n - ATE_n (the paper picks
+  // the value with the largest score).
+  double sweep_score = kNaN;
 };
 
 // Groups in matrix order (by their first run's index).
