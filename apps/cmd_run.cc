@@ -1,8 +1,8 @@
 // pkslam run: SLAM over a EuRoC or TUM RGB-D dataset.
+#include <fmt/format.h>
+
 #include <atomic>
 #include <csignal>
-
-#include <fmt/format.h>
 
 #include "apps/commands.h"
 #include "core/util/error.h"
@@ -97,11 +97,12 @@ void RegisterRunCommand(CLI::App& app) {
     const RunSummary s = RunDataset(o, &interrupted);
     fmt::print("frames {} tracked {} lost {} keyframes {} map points {} maps {}\n", s.frames,
                s.tracked, s.lost, s.keyframes, s.map_points, s.maps);
-    fmt::print("wall {:.2f} s for {:.2f} s of data ({:.2f}x real time), median tracking {:.2f} ms\n",
-               s.wall_s, s.sequence_s, s.wall_s > 0 ? s.sequence_s / s.wall_s : 0.0,
-               s.median_tracking_ms);
-    fmt::print("outputs: {}/{{trajectory.txt, keyframes.txt, map_points.ply, stats.json, run.log}}\n",
-               o.out.string());
+    fmt::print(
+        "wall {:.2f} s for {:.2f} s of data ({:.2f}x real time), median tracking {:.2f} ms\n",
+        s.wall_s, s.sequence_s, s.wall_s > 0 ? s.sequence_s / s.wall_s : 0.0, s.median_tracking_ms);
+    fmt::print(
+        "outputs: {}/{{trajectory.txt, keyframes.txt, map_points.ply, stats.json, run.log}}\n",
+        o.out.string());
     if (s.interrupted) throw Error("interrupted (partial outputs written)");
   });
 }

@@ -6,10 +6,9 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
-
-#include <opencv2/core.hpp>
 
 #include "core/bow/vocabulary.h"
 #include "core/map/atlas.h"
@@ -85,7 +84,6 @@ class SlamSystem {
   const Map* LargestMap() const;  // requires the Atlas lock
 
  private:
-
   SystemOptions options_;
   RigSetup setup_;
   std::shared_ptr<const Vocabulary> vocabulary_;

@@ -159,9 +159,8 @@ std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
                                       const fs::path& dataset, const fs::path& run_dir) {
   const DatasetSpec& d = DatasetOf(suite, run);
   std::vector<std::string> a = {
-      "run",      "--dataset", dataset.string(), "--out",      run_dir.string(),
-      "--sensor", run.sensor,  "--selector",     run.selector, "--seed",
-      std::to_string(run.seed), "--quiet"};
+      "run",      "--dataset",  dataset.string(), "--out",  run_dir.string(),         "--sensor",
+      run.sensor, "--selector", run.selector,     "--seed", std::to_string(run.seed), "--quiet"};
   for (const auto& [k, v] : run.params) a.insert(a.end(), {"--param", k + "=" + FormatNumber(v)});
   if (d.settings) a.insert(a.end(), {"--settings", d.settings->string()});
   if (d.max_frames > 0) a.insert(a.end(), {"--max-frames", std::to_string(d.max_frames)});
@@ -195,6 +194,25 @@ std::optional<RunResult> ReadFinished(const fs::path& run_dir) {
   } catch (const InputError&) {
   }
   return std::nullopt;  // unreadable: run again
+}
+
+std::optional<RunResult> ReevaluateRun(const Suite& suite, const RunSpec& run,
+                                       const HarnessOptions& options) {
+  const fs::path run_dir = RunDir(options.out, run);
+  const auto done = ReadFinished(run_dir);
+  if (!done || !done->ok) return std::nullopt;
+  RunResult result = ResultSkeleton(run, suite);
+  result.dense_points = done->dense_points;
+  try {
+    const fs::path dataset = PrepareDataset(suite, run, options);
+    const DatasetSpec& d = DatasetOf(suite, run);
+    EvaluateRun({run_dir, dataset, d.ground_truth, suite.rpe_delta_m}, &result);
+  } catch (const Error& e) {
+    result.ok = false;
+    result.error = std::string("evaluation: ") + e.what();
+  }
+  WriteResult(run_dir, result);
+  return result;
 }
 
 bool NeedsExecution(const HarnessOptions& options, const RunSpec& run) {

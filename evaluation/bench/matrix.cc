@@ -36,8 +36,12 @@ std::vector<Config> Configurations(const Suite& suite, const std::string& datase
     }
     PKSLAM_CHECK(base != nullptr, "sweep selector {} not in the suite", sw.selector);
     for (double v : sw.values) {
-      Config c{base->label + "@" + sw.param + "=" + FormatNumber(v), base->name, suite.params,
-               sw.param, v, suite.dense || sw.dense};
+      Config c{base->label + "@" + sw.param + "=" + FormatNumber(v),
+               base->name,
+               suite.params,
+               sw.param,
+               v,
+               suite.dense || sw.dense};
       for (const auto& [k, x] : base->params) c.params[k] = x;
       c.params[sw.param] = v;
       out.push_back(c);

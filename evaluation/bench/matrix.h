@@ -25,7 +25,7 @@ struct RunSpec {
   std::string sweep_param;               // empty unless a sweep point
   double sweep_value = 0.0;
   bool dense = false;  // build the run's dense cloud after it
-  int run = 0;  // 0 .. runs-1
+  int run = 0;         // 0 .. runs-1
   std::uint64_t seed = 0;
   std::optional<SimRecipe> sim;  // with the seed of this run's rendering
 };

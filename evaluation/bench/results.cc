@@ -89,7 +89,9 @@ std::vector<std::string> ResultColumns() {
           "lost_frames",
           "wall_s",
           "median_tracking_ms",
-          "dense_points"};
+          "dense_points",
+          "gyro_bias_err_pct",
+          "accel_bias_err_pct"};
 }
 
 std::string CsvField(const std::string& text) {
@@ -164,7 +166,9 @@ std::string ResultCsvRow(const RunResult& r) {
                                       std::to_string(r.lost_frames),
                                       Num(r.wall_s),
                                       Num(r.median_tracking_ms),
-                                      Num(r.dense_points)};
+                                      Num(r.dense_points),
+                                      Num(r.gyro_bias_err_pct),
+                                      Num(r.accel_bias_err_pct)};
   std::string out;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (i > 0) out.push_back(',');
@@ -192,10 +196,14 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
   if (!std::getline(in, line)) throw InputError(file, "empty file (expected a results.csv header)");
   const auto header = SplitCsvLine(line);
   const auto columns = ResultColumns();
-  // Files from before the dense_points column: the same columns without the last one.
-  const bool without_dense = header.size() + 1 == columns.size() &&
-                             std::equal(header.begin(), header.end(), columns.begin());
-  if (header != columns && !without_dense) {
+  // Files from before the optional trailing columns: a prefix of the columns that holds at
+  // least every required one (through median_tracking_ms).
+  const std::size_t required =
+      static_cast<std::size_t>(std::find(columns.begin(), columns.end(), "median_tracking_ms") -
+                               columns.begin()) +
+      1;
+  if (header.size() < required || header.size() > columns.size() ||
+      !std::equal(header.begin(), header.end(), columns.begin())) {
     throw InputError(file, 1,
                      "header does not match results.csv columns (" + ResultCsvHeader() + ")");
   }
@@ -242,7 +250,11 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
     r.lost_frames = static_cast<int>(ParseInt(next(), file, n, "lost_frames"));
     r.wall_s = ParseDouble(next(), file, n, "wall_s");
     r.median_tracking_ms = ParseDouble(next(), file, n, "median_tracking_ms");
-    if (!without_dense) r.dense_points = ParseDouble(next(), file, n, "dense_points");
+    double* optional[] = {&r.dense_points, &r.gyro_bias_err_pct, &r.accel_bias_err_pct};
+    PKSLAM_CHECK(required + std::size(optional) == columns.size(), "optional columns");
+    for (std::size_t k = 0; required + k < header.size(); ++k) {
+      *optional[k] = ParseDouble(next(), file, n, header[required + k]);
+    }
     out.push_back(std::move(r));
   }
   return out;

@@ -1,9 +1,9 @@
 #include "evaluation/bench/suite.h"
 
-#include <algorithm>
-
 #include <gtest/gtest.h>
 #include <stdlib.h>
+
+#include <algorithm>
 
 #include "core/util/error.h"
 #include "evaluation/bench/executor.h"
@@ -74,8 +74,8 @@ TEST(Suite, DenseCloudsForTheSweepOrTheWholeSuite) {
   const Suite s = ParseSuite(text, "dir/suite.yaml");
   ASSERT_TRUE(s.sweeps[0].dense);
   const auto runs = ExpandSuite(s);
-  EXPECT_FALSE(runs[0].dense);                             // real/stereo/orbslam3
-  EXPECT_TRUE(runs[6].dense) << runs[6].id;                // real/stereo/pks@delta_deg=10
+  EXPECT_FALSE(runs[0].dense);               // real/stereo/orbslam3
+  EXPECT_TRUE(runs[6].dense) << runs[6].id;  // real/stereo/pks@delta_deg=10
   const auto a = DenseArguments(s, runs[6], "data", "out/run");
   EXPECT_EQ(a[0], "dense");
   EXPECT_NE(std::find(a.begin(), a.end(), "out/run/dense.json"), a.end());

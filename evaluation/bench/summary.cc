@@ -103,7 +103,8 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
     g.baseline = first.baseline;
     g.alignment = first.alignment;
     g.runs = static_cast<int>(runs.size());
-    std::vector<double> ate, se3, sim3, scale, rpe, kf, mp, lost, wall, track, coverage, dense;
+    std::vector<double> ate, se3, sim3, scale, rpe, kf, mp, lost, wall, track, coverage, dense, bg,
+        ba;
     for (const RunResult* r : runs) {
       g.order = std::min(g.order, r->index);
       if (!r->ok) continue;
@@ -120,6 +121,8 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
       track.push_back(r->median_tracking_ms);
       coverage.push_back(r->coverage);
       dense.push_back(r->dense_points);
+      bg.push_back(r->gyro_bias_err_pct);
+      ba.push_back(r->accel_bias_err_pct);
     }
     g.ate_m = ComputeMeanStd(ate);
     g.ate_se3_m = ComputeMeanStd(se3);
@@ -133,6 +136,8 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
     g.median_tracking_ms = ComputeMeanStd(track);
     g.coverage = ComputeMeanStd(coverage);
     g.dense_points = ComputeMeanStd(dense);
+    g.gyro_bias_err_pct = ComputeMeanStd(bg);
+    g.accel_bias_err_pct = ComputeMeanStd(ba);
     g.ate_median_m = Median(ate);
     groups.push_back(std::move(g));
   }
@@ -156,18 +161,17 @@ void WriteSummaryCsv(const fs::path& file, const std::vector<GroupSummary>& grou
          "ate_mean_m,ate_std_m,ate_median_m,ate_se3_mean_m,ate_sim3_mean_m,scale_mean,"
          "rpe_trans_mean_m,improvement_pct,keyframes_mean,keyframes_std,map_points_mean,"
          "lost_frames_mean,coverage_mean,wall_mean_s,median_tracking_mean_ms,dense_points_mean,"
-         "sweep_score\n";
+         "sweep_score,gyro_bias_err_mean_pct,accel_bias_err_mean_pct\n";
   for (const auto& g : groups) {
     out << fmt::format(
-        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-                       CsvField(g.dataset), CsvField(g.sensor), CsvField(g.config),
-                       CsvField(g.selector), CsvField(g.sweep_param), Num(g.sweep_value), g.runs,
-                       g.ok, g.alignment, Num(g.ate_m.mean), Num(g.ate_m.std), Num(g.ate_median_m),
-                       Num(g.ate_se3_m.mean), Num(g.ate_sim3_m.mean), Num(g.scale.mean),
-                       Num(g.rpe_trans_m.mean), Num(g.improvement_pct), Num(g.keyframes.mean),
-                       Num(g.keyframes.std), Num(g.map_points.mean), Num(g.lost_frames.mean),
-                       Num(g.coverage.mean), Num(g.wall_s.mean), Num(g.median_tracking_ms.mean),
-                       Num(g.dense_points.mean), Num(g.sweep_score));
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+        CsvField(g.dataset), CsvField(g.sensor), CsvField(g.config), CsvField(g.selector),
+        CsvField(g.sweep_param), Num(g.sweep_value), g.runs, g.ok, g.alignment, Num(g.ate_m.mean),
+        Num(g.ate_m.std), Num(g.ate_median_m), Num(g.ate_se3_m.mean), Num(g.ate_sim3_m.mean),
+        Num(g.scale.mean), Num(g.rpe_trans_m.mean), Num(g.improvement_pct), Num(g.keyframes.mean),
+        Num(g.keyframes.std), Num(g.map_points.mean), Num(g.lost_frames.mean), Num(g.coverage.mean),
+        Num(g.wall_s.mean), Num(g.median_tracking_ms.mean), Num(g.dense_points.mean),
+        Num(g.sweep_score), Num(g.gyro_bias_err_pct.mean), Num(g.accel_bias_err_pct.mean));
   }
   if (!out) throw Error("cannot write " + file.string());
 }
@@ -328,6 +332,20 @@ std::vector<Table> SweepTables(const std::vector<GroupSummary>& groups) {
     tables.push_back(t);
   }
   return tables;
+}
+
+Table BiasTable(const std::vector<GroupSummary>& groups) {
+  Table t;
+  t.title =
+      "IMU bias estimates: relative error [%] of the keyframes' gyro and accelerometer biases "
+      "from 15 s after the first keyframe, mean ± std over runs";
+  t.header = {"dataset", "sensor", "config", "gyro bias error [%]", "accel bias error [%]"};
+  for (const auto& g : groups) {
+    if (g.gyro_bias_err_pct.n == 0) continue;
+    t.rows.push_back({g.dataset, g.sensor, g.config, FormatMeanStd(g.gyro_bias_err_pct, 1),
+                      FormatMeanStd(g.accel_bias_err_pct, 1)});
+  }
+  return t;
 }
 
 Table FailureTable(const std::vector<RunResult>& results) {

@@ -81,8 +81,8 @@ TEST(Summary, SweepScoreFollowsEquation13) {
   const double ates[] = {0.010, 0.020, 0.012};
   const double dense[] = {1000, 3000, 2500};
   for (int i = 0; i < 3; ++i) {
-    RunResult r = Result(i, "V1", "pks@delta=" + std::to_string(static_cast<int>(deltas[i])),
-                         ates[i], 20);
+    RunResult r =
+        Result(i, "V1", "pks@delta=" + std::to_string(static_cast<int>(deltas[i])), ates[i], 20);
     r.selector = "pks";
     r.sweep_param = "delta";
     r.sweep_value = deltas[i];
