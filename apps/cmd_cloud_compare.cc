@@ -36,6 +36,7 @@ struct CompareArgs {
   std::string dataset;
   std::string settings;
   std::string write_aligned;
+  std::string observed_ref;
   double max_diff_s = 0.01;
   dense::CompareOptions compare;
   dense::VisibilityOptions visibility;
@@ -140,6 +141,18 @@ void RunCompare(const CompareArgs& args) {
         args.visibility.min_depth_m, args.visibility.max_depth_m);
   }
 
+  std::optional<double> observed_completeness;
+  std::size_t observed_points = 0;
+  if (!args.observed_ref.empty()) {
+    const dense::PointCloud observed = dense::ReadPly(args.observed_ref);
+    if (observed.empty()) throw InputError(args.observed_ref, "the reference cloud has no points");
+    observed_points = observed.size();
+    observed_completeness =
+        dense::Completeness(cloud.points, observed.points, args.compare.completeness_m);
+    fmt::print("completeness  {:.1f}% of the {} points of {} (observed surfaces)\n",
+               100 * *observed_completeness, observed_points, args.observed_ref);
+  }
+
   if (!args.json.empty()) {
     JsonWriter json;
     json.BeginObject();
@@ -184,6 +197,16 @@ void RunCompare(const CompareArgs& args) {
     } else {
       json.Null();
     }
+    json.Key("completeness_observed");
+    if (observed_completeness) {
+      json.BeginObject();
+      json.Member("ref", args.observed_ref);
+      json.Member("ref_points", static_cast<std::uint64_t>(observed_points));
+      json.Member("completeness", *observed_completeness);
+      json.EndObject();
+    } else {
+      json.Null();
+    }
     json.EndObject();
     std::ofstream out(args.json);
     out << json.str();
@@ -222,6 +245,9 @@ void RegisterCloudCompareCommand(CLI::App& app) {
   cmd->add_option("--dataset", args->dataset,
                   "With --align-run: also report completeness over the reference points visible "
                   "from the run's keyframes (this dataset's camera)");
+  cmd->add_option("--observed-ref", args->observed_ref,
+                  "Also report completeness against this reference (the simulator's "
+                  "reference_observed.ply: the surfaces the sequence observed)");
   cmd->add_option("--settings", args->settings, "The settings file the run used (if any)");
   cmd->add_option("--max-depth", args->visibility.max_depth_m,
                   "Visibility: largest depth (m; use the dense cloud's)")
