@@ -115,8 +115,9 @@ void RegisterDenseCommand(CLI::App& app) {
   auto args = std::make_shared<DenseArgs>();
   auto* cmd = app.add_subcommand(
       "dense",
-      "Dense point cloud from a run's keyframes: stereo SGBM (rectified, left-right checked) or "
-      "RGB-D depth, kept where >= --min-views keyframes agree, fused in a voxel grid");
+      "Dense point cloud from a run's keyframes: stereo SGBM (full-view rectified, left-right "
+      "checked) or RGB-D depth; depths >= --min-views keyframes agree on are averaged, "
+      "single-view depths no keyframe contradicts are kept (views 1); fused in a voxel grid");
   cmd->add_option("--run", args->run, "Run directory of `pkslam run` (keyframes.txt)")->required();
   cmd->add_option("--dataset", args->dataset, "The dataset the run used (EuRoC or TUM RGB-D)")
       ->required();

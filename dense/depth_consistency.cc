@@ -85,7 +85,8 @@ ConsistencyResult FilterByConsistency(const cv::Mat& depth, const SE3d& world_fr
       int confirmations = 0;
       int contradictions = 0;
       bool closer_view = false;
-      float ratio_sum = 1.0f;
+      float ratio_sum = 1.0f;  // weighted, the own estimate with weight 1
+      float weight_sum = 1.0f;
       for (const Neighbour& n : views) {
         const Eigen::Vector3f q = n.rotation * p + n.translation;
         const auto uv = project(q);
@@ -97,7 +98,11 @@ ConsistencyResult FilterByConsistency(const cv::Mat& depth, const SE3d& world_fr
         if (!(zj > 0)) continue;
         if (std::abs(zj - q.z()) <= tolerance * q.z()) {
           ++confirmations;
-          ratio_sum += zj / q.z();
+          // Inverse-variance weight of j's estimate z * zj / q.z relative to z: stereo depth
+          // variance grows with depth^4, so var ~ (z / q.z)^2 zj^4 ~ z^2 zj^2 against z^4.
+          const float w = (z * z) / (zj * zj);
+          ratio_sum += w * zj / q.z();
+          weight_sum += w;
           if (defer && zj * defer_ratio < z) closer_view = true;
         } else if (zj > q.z()) {
           ++contradictions;  // (a) j sees through p
@@ -129,7 +134,7 @@ ConsistencyResult FilterByConsistency(const cv::Mat& depth, const SE3d& world_fr
         continue;
       }
       if (confirmed) {
-        out[c] = options.average ? z * ratio_sum / static_cast<float>(confirmations + 1) : z;
+        out[c] = options.average ? z * ratio_sum / weight_sum : z;
         out_views[c] = static_cast<std::uint8_t>(std::min(confirmations + 1, 255));
       } else {
         out[c] = z;

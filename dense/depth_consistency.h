@@ -5,10 +5,12 @@
 // confirms it when p, moved into camera j (camera_from_world_j * world_from_camera_i),
 // projects inside j's image with depth z_proj > 0, j has a depth z_j at the nearest pixel,
 // and |z_j - z_proj| <= tolerance_rel * z_proj. The pixel is kept when itself plus its
-// confirming views number at least min_views. Its depth becomes z_i * mean(1, z_j / z_proj
-// over the confirming j): each confirmation read back along i's ray (exact for a surface
-// patch facing the cameras, and within the tolerance's square otherwise), so independent
-// stereo errors average down.
+// confirming views number at least min_views. Its depth becomes z_i * the weighted mean of
+// (1, z_j / z_proj over the confirming j): each confirmation read back along i's ray (exact
+// for a surface patch facing the cameras, and within the tolerance's square otherwise),
+// weighted by inverse stereo variance (weight (z_i / z_j)^2 against 1 for z_i, as the depth
+// error grows with depth squared), so independent stereo errors average down and a far
+// confirming view does not spoil a near one.
 //
 // Views that do not see the point (outside the image, no depth there) neither confirm nor
 // reject it: occlusions and holes in other views cost confirmations, not points already

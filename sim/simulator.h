@@ -58,9 +58,10 @@ struct SimulationOptions {
   bool write_cloud = true;          // reference_cloud.ply (+ reference_observed.ply)
   double cloud_spacing_m = 0.01;    // point spacing on the surfaces
   double visibility_cell_m = 0.05;  // granularity of "seen" surface cells
-  // reference_observed.ply: surfaces cam0 saw at a depth (optical axis) <= this, in every
-  // frame (0: not written). 4 m is the dense tool's default depth range.
-  double observed_range_m = 4.0;
+  // reference_observed.ply: surfaces cam0 saw at a depth (optical axis) <= this, in any
+  // frame (0: not written): the surveyed area. Below the dense tool's 4 m depth limit, as
+  // keyframes see what the frames between them saw from a little farther away.
+  double observed_range_m = 3.0;
   double observed_cell_m = 0.02;  // granularity of its "seen" cells
   // Render cam0 only for the reference clouds; write no images, IMU or sim.yaml.
   bool reference_only = false;
