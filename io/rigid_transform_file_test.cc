@@ -51,7 +51,7 @@ TEST_F(RigidTransformFileTest, BadContentNamesTheLine) {
   EXPECT_EQ(ErrorLine("# c\n" + identity), -1);
   EXPECT_EQ(ErrorLine("# c\n1 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"), 2);  // three fields
   EXPECT_EQ(ErrorLine("1 0 0 0\n0 x 0 0\n0 0 1 0\n0 0 0 1\n"), 2);     // not a number
-  EXPECT_EQ(ErrorLine(identity + "0 0 0 1\n"), 5);                    // a fifth row
+  EXPECT_EQ(ErrorLine(identity + "0 0 0 1\n"), 5);                     // a fifth row
   EXPECT_EQ(ErrorLine("1 0 0 0\n0 1 0 0\n0 0 1 0\n"), 0);              // three rows
   EXPECT_EQ(ErrorLine("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 1 1\n"), 4);     // not 0 0 0 1
   EXPECT_EQ(ErrorLine("2 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"), 0);     // not a rotation
