@@ -81,7 +81,8 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
       const auto& images = euroc->cam0().images;
       for (std::size_t i = 0; i < images.size(); ++i) sources.push_back({images[i].t_ns, i, 0});
     }
-    settings = options.settings ? ReadOrbSlam3Settings(*options.settings) : SettingsFromEuroc(*euroc);
+    settings =
+        options.settings ? ReadOrbSlam3Settings(*options.settings) : SettingsFromEuroc(*euroc);
   } else if (TumRgbdDataset::LooksLikeTumRgbd(options.dataset)) {
     tum = TumRgbdDataset::Open(options.dataset);
     if (IsStereo(sensor)) throw OptionError("a TUM RGB-D dataset has no stereo pair");
@@ -116,7 +117,14 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   PKSLAM_LOG_INFO("loading vocabulary {}", vocabulary_path.string());
   auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary_path));
 
-  SlamSystem system(settings, vocabulary, options.system);
+  SystemOptions system_options = options.system;
+  // Offline visual-only monocular runs keep tracking in lock-step with local mapping (each
+  // keyframe is mapped before the next frame is tracked). A monocular map gets its points only
+  // from local mapping, and ORB-SLAM's rule refuses monocular keyframes while local mapping is
+  // busy; fed frames faster than it maps (no --realtime, or a loaded machine) the map starves
+  // of keyframes and tracking is lost in fast turns. Offline there is no deadline to meet.
+  if (!options.realtime && sensor == Sensor::kMonocular) system_options.tracking.lockstep = true;
+  SlamSystem system(settings, vocabulary, system_options);
 
   // --- the frame loop ---
   RunSummary summary;
@@ -170,10 +178,11 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   summary.sequence_s =
       static_cast<double>(sources[std::max(0, summary.frames - 1)].t_ns - t0) * 1e-9;
   WriteRunOutputs(system, options, &summary);
-  PKSLAM_LOG_INFO("{} frames ({} tracked), {} keyframes, {} map points, {} map(s); "
-                  "{:.1f} s wall for {:.1f} s of data; outputs in {}",
-                  summary.frames, summary.tracked, summary.keyframes, summary.map_points,
-                  summary.maps, summary.wall_s, summary.sequence_s, options.out.string());
+  PKSLAM_LOG_INFO(
+      "{} frames ({} tracked), {} keyframes, {} map points, {} map(s); "
+      "{:.1f} s wall for {:.1f} s of data; outputs in {}",
+      summary.frames, summary.tracked, summary.keyframes, summary.map_points, summary.maps,
+      summary.wall_s, summary.sequence_s, options.out.string());
   return summary;
 }
 

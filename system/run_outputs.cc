@@ -8,8 +8,9 @@
 
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
-#include "system/sparse_model_builder.h"
+#include "io/rigid_transform_file.h"
 #include "system/inertial_outputs.h"
+#include "system/sparse_model_builder.h"
 
 namespace pkslam {
 namespace {
@@ -40,8 +41,8 @@ void WriteTrace(const Tracker& tracker, const std::filesystem::path& file) {
   out << '\n';
   const std::string selector(tracker.selector().name());
   for (const auto& row : tracker.trace()) {
-    out << fmt::format("{:.9f},{},{},{},{},{}", static_cast<double>(row.t_ns) * 1e-9,
-                       row.frame_id, selector, row.decision.insert ? 1 : 0, row.decision.reason,
+    out << fmt::format("{:.9f},{},{},{},{},{}", static_cast<double>(row.t_ns) * 1e-9, row.frame_id,
+                       selector, row.decision.insert ? 1 : 0, row.decision.reason,
                        row.frames_since_keyframe);
     for (const auto& k : keys) {
       out << ',';
@@ -128,6 +129,12 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   const SE3d camera_from_body = system.rig().body_from_camera.Inverse();
   for (auto& p : body.poses) p.pose = p.pose * camera_from_body;
   WriteTrajectory(body, out / "trajectory_body.txt", TrajectoryFormat::kTum);
+  // That applies the metric camera-body lever arm to map units: right for metric maps, wrong
+  // for visual-only monocular ones (after a Sim(3) alignment of scale s the lever arm counts s
+  // times). Those are evaluated on camera poses against the ground truth moved into the camera
+  // (pkslam eval --body-from-camera, the bench), which needs the extrinsic.
+  WriteRigidTransform(system.rig().body_from_camera, out / "body_from_camera.txt",
+                      "body_from_camera (row-major 4x4, metres)");
   WriteTrajectory(system.KeyFrameTrajectory(), out / "keyframes.txt", TrajectoryFormat::kTum);
   system.WriteMapPly(out / "map_points.ply");
   WriteSparseModel(BuildSparseModel(system), out / "sparse_model.txt");
