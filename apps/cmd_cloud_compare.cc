@@ -20,6 +20,8 @@
 #include "dense/point_cloud.h"
 #include "dense/visibility.h"
 #include "evaluation/evaluate.h"
+#include "io/rigid_transform_file.h"
+#include "io/trajectory.h"
 
 namespace pkslam::apps {
 namespace {
@@ -57,7 +59,14 @@ Alignment AlignRun(const CompareArgs& args) {
   fs::path estimate = run / "trajectory_body.txt";
   if (!fs::exists(estimate)) estimate = run / "trajectory.txt";
   const Trajectory est = ReadTrajectory(estimate, TrajectoryFormat::kTum);
-  const Trajectory gt = ReadTrajectory(args.gt);
+  Trajectory gt = ReadTrajectory(args.gt);
+  // Monocular runs have camera poses only (no metric lever arm): compare them with the
+  // EuRoC body ground truth moved into the camera.
+  const fs::path extrinsic = run / "body_from_camera.txt";
+  if (estimate.filename() == "trajectory.txt" && fs::exists(extrinsic) &&
+      DetectTrajectoryFormat(args.gt) == TrajectoryFormat::kEuroc) {
+    gt = ChangeSensorFrame(gt, ReadRigidTransform(extrinsic));
+  }
   EvaluationOptions options;
   options.alignment = ParseAlignmentMethod(args.align);
   if (options.alignment != AlignmentMethod::kSE3 && options.alignment != AlignmentMethod::kSim3) {

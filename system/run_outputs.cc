@@ -124,15 +124,18 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   const auto& out = options.out;
   const Trajectory frames = system.FrameTrajectory();
   WriteTrajectory(frames, out / "trajectory.txt", TrajectoryFormat::kTum);
-  // The same poses for the body (IMU) frame, comparable with EuRoC ground truth.
-  Trajectory body = frames;
-  const SE3d camera_from_body = system.rig().body_from_camera.Inverse();
-  for (auto& p : body.poses) p.pose = p.pose * camera_from_body;
-  WriteTrajectory(body, out / "trajectory_body.txt", TrajectoryFormat::kTum);
-  // That applies the metric camera-body lever arm to map units: right for metric maps, wrong
-  // for visual-only monocular ones (after a Sim(3) alignment of scale s the lever arm counts s
-  // times). Those are evaluated on camera poses against the ground truth moved into the camera
-  // (pkslam eval --body-from-camera, the bench), which needs the extrinsic.
+  // The same poses for the body (IMU) frame, comparable with EuRoC ground truth. That applies
+  // the metric camera-body lever arm to map units: right for metric maps, wrong for
+  // visual-only monocular ones (after a Sim(3) alignment of scale s the lever arm counts s
+  // times), so those get no body trajectory. They are evaluated on camera poses against the
+  // ground truth moved into the camera (pkslam eval --body-from-camera, the bench,
+  // cloud-compare), which needs the extrinsic.
+  if (options.system.sensor != Sensor::kMonocular) {
+    Trajectory body = frames;
+    const SE3d camera_from_body = system.rig().body_from_camera.Inverse();
+    for (auto& p : body.poses) p.pose = p.pose * camera_from_body;
+    WriteTrajectory(body, out / "trajectory_body.txt", TrajectoryFormat::kTum);
+  }
   WriteRigidTransform(system.rig().body_from_camera, out / "body_from_camera.txt",
                       "body_from_camera (row-major 4x4, metres)");
   WriteTrajectory(system.KeyFrameTrajectory(), out / "keyframes.txt", TrajectoryFormat::kTum);
