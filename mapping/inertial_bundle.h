@@ -31,9 +31,11 @@ struct InertialBundleOptions {
   int window = 10;
   // Local window: at most this many fixed visual-only keyframes (most shared points first).
   int max_fixed_keyframes = 15;
-  // Solver passes as BundleAdjustmentOptions (robust pass, outliers removed, refinement).
-  int iterations_first = 4;
-  int iterations_second = 4;
+  // Solver passes as BundleAdjustmentOptions: a robust (Huber) pass, then, if
+  // iterations_second > 0, a refinement without the outliers. 0 is ORB-SLAM3's local inertial
+  // BA: one robust pass whose outliers are only classified (half the Ceres set-up cost).
+  int iterations_first = 8;
+  int iterations_second = 0;
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
   int num_threads = 1;

@@ -46,6 +46,10 @@ struct LocalMappingOptions {
 struct LocalMappingStats {
   std::vector<double> keyframe_ms;  // processing time per keyframe
   std::vector<double> ba_ms;        // local BA time per keyframe (0 when skipped)
+  // CPU time of the mapping thread per keyframe, all of it and local BA alone (the wall-clock
+  // times above also count lock waits and preemption on a busy machine).
+  std::vector<double> keyframe_cpu_ms;
+  std::vector<double> ba_cpu_ms;
   int ba_aborted = 0;
   int keyframes_culled = 0;
   int points_created = 0;

@@ -10,6 +10,7 @@
 #include "core/map/keyframe_database.h"
 #include "core/map/map_point.h"
 #include "core/matching/orb_matcher.h"
+#include "core/util/cpu_time.h"
 #include "core/util/log.h"
 #include "mapping/local_mapper.h"
 #include "mapping/triangulation.h"
@@ -32,11 +33,13 @@ void LocalMapper::ProcessNext() {
     queue_.pop_front();
   }
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = ThreadCpuSeconds();
   abort_ba_.store(false);
   ProcessNewKeyFrame(kf);
   CullRecentPoints(kf);
   CreateNewMapPoints(kf);
   double ba_ms = 0;
+  double ba_cpu_ms = 0;
   if (!HasQueued()) {
     SearchInNeighbours(kf);
   }
@@ -48,10 +51,12 @@ void LocalMapper::ProcessNext() {
     }
     if (keyframes > 2) {
       const auto ba_start = std::chrono::steady_clock::now();
+      const double ba_cpu_start = ThreadCpuSeconds();
       if (!IsInertial(rig_->sensor) || !LocalInertialBundleAdjustment(kf)) {
         LocalBundleAdjustment(kf);
       }
       ba_ms = MsSince(ba_start);
+      ba_cpu_ms = 1e3 * (ThreadCpuSeconds() - ba_cpu_start);
     }
     // Inertial maps keep every keyframe: the preintegration chain needs them (not culled).
     if (options_.cull_keyframes && !IsInertial(rig_->sensor)) CullKeyFrames(kf);
@@ -61,6 +66,8 @@ void LocalMapper::ProcessNext() {
     std::lock_guard lock(mutex_);
     stats_.keyframe_ms.push_back(MsSince(start));
     stats_.ba_ms.push_back(ba_ms);
+    stats_.keyframe_cpu_ms.push_back(1e3 * (ThreadCpuSeconds() - cpu_start));
+    stats_.ba_cpu_ms.push_back(ba_cpu_ms);
   }
   if (consumer_) consumer_(kf);
 }
