@@ -14,6 +14,7 @@
 #pragma once
 
 #include "mapping/inertial_bundle.h"
+#include "mapping/inertial_culling.h"
 
 namespace pkslam {
 
@@ -38,6 +39,8 @@ struct InertialMappingOptions {
   int full_ba_iterations = 15;
   // Local inertial BA.
   InertialBundleOptions local_ba;
+  // Keyframe culling with the time-spacing rules of the temporal chain.
+  InertialCullingOptions culling;
 
   void Check() const;
 };

@@ -52,6 +52,7 @@ void InertialMappingOptions::Check() const {
   PKSLAM_CHECK_OPTION(full_ba_iterations >= 1, "inertial.full_ba_iterations", "{}",
                       full_ba_iterations);
   local_ba.Check();
+  culling.Check();
 }
 
 void LocalMapper::InertialStep(const KeyFramePtr& kf) {
