@@ -215,6 +215,7 @@ void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
     if (imu_) SyncWithInertialMapLocked(/*correct_current=*/true);
     r.reference = ref;
     r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
+    r.camera_from_world_online = current_.camera_from_world();
   }
   records_.push_back(std::move(r));
 }

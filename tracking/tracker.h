@@ -35,6 +35,9 @@ struct FrameRecord {
   TrackingState state = TrackingState::kNotInitialized;
   KeyFramePtr reference;  // null when the frame has no pose
   SE3d camera_from_reference;
+  // The pose as tracking estimated it then, in the world of that moment (later map
+  // optimisation does not move it): what a live user saw; inertial runs write it out.
+  std::optional<SE3d> camera_from_world_online;
   bool keyframe = false;
   double tracking_ms = 0;
   // CPU time of the tracking thread: building the frame (ORB, stereo matching) and tracking it
