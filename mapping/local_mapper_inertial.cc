@@ -46,7 +46,7 @@ void InertialMappingOptions::Check() const {
   PKSLAM_CHECK_OPTION(mono_min_travel >= 0, "inertial.mono_min_travel", "{}", mono_min_travel);
   PKSLAM_CHECK_OPTION(init_gyro_prior >= 0 && init_accel_prior_mono >= 0 &&
                           init_accel_prior_stereo >= 0 && viba1_gyro_prior >= 0 &&
-                          viba1_accel_prior >= 0,
+                          viba1_accel_prior >= 0 && viba2_gyro_prior >= 0 && viba2_accel_prior >= 0,
                       "inertial.priors", "{}", "negative");
   PKSLAM_CHECK_OPTION(viba1_s > 0 && viba2_s > viba1_s, "inertial.viba", "{} / {}", viba1_s,
                       viba2_s);
@@ -113,7 +113,7 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
     initializing_imu_.store(false);
   } else if (ba1 && !ba2 && since > o.viba2_s) {
     initializing_imu_.store(true);
-    if (InitializeImu(kf, 0.0, 0.0, 2)) mark(true);
+    if (InitializeImu(kf, o.viba2_gyro_prior, o.viba2_accel_prior, 2)) mark(true);
     initializing_imu_.store(false);
   }
 }

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "core/util/error.h"
+#include "evaluation/bench/bias_evaluation.h"
 #include "evaluation/evaluate.h"
 #include "io/trajectory.h"
 
@@ -136,6 +137,10 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   } catch (const OptionError&) {
   }
   result->coverage = stats.frames > 0 ? static_cast<double>(se3.pairs.size()) / stats.frames : 0.0;
+  if (const auto bias = EvaluateBiases(files.run_dir / "keyframes_imu.csv", gt, 15.0)) {
+    result->gyro_bias_err_pct = bias->gyro_pct;
+    result->accel_bias_err_pct = bias->accel_pct;
+  }
   WritePlotFiles(files.run_dir, gt, est, keyframes, use_sim3 ? sim3 : se3);
   result->ok = true;
   result->error.clear();
