@@ -9,8 +9,9 @@
 //
 // Local window: the newest `window` keyframes of the chain ending at the new keyframe are free
 // (pose, velocity, biases with random walks); the keyframe just before the window is fixed and
-// joined by its inertial edge: it anchors the window like a marginalisation prior with the
-// previous state held at its estimate (ORB-SLAM3's choice). Other keyframes observing the
+// joined by its inertial edge: it anchors the window in place of a marginalisation prior, the
+// previous state held at its estimate (ORB-SLAM3's choice; no Schur-complement prior is kept, so
+// information of states that left the window is dropped). Other keyframes observing the
 // window's points are fixed, visual only. Full: every chain keyframe, the first pose fixed;
 // optionally one bias pair shared by all with zero-mean priors (the BA right after the
 // inertial-only initialisation).
