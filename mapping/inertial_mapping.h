@@ -51,7 +51,7 @@ struct InertialMappingOptions {
   // moving_max_interval_s) when the body moved more than moving_distance (map units) or turned
   // more than moving_angle_rad over it. Off by default: on the simulated MH_01 replay (4 s of
   // motion, a 24 s stand-still) it delays VIBA1 to after the stand-still, and the accelerometer
-  // bias at 15 s is then the initialisation's (50% off instead of 14%).
+  // bias at 15 s is then the initialisation's (48% off instead of 28%, orbslam3 selector).
   bool viba_motion_time = false;
   double moving_distance = 0.02;
   double moving_angle_rad = 0.035;
