@@ -11,6 +11,7 @@
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
+#include "core/util/prefetch.h"
 #include "core/util/progress.h"
 #include "io/euroc_dataset.h"
 #include "io/settings_euroc.h"
@@ -139,6 +140,23 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     throw InputError(options.dataset,
                      fmt::format("sensor {} needs IMU data (mav0/imu0)", SensorName(sensor)));
   }
+  // Images are decoded in a thread of their own, a couple of frames ahead of tracking.
+  struct LoadedImages {
+    cv::Mat a;  // left / rgb
+    cv::Mat b;  // right / depth (empty for monocular)
+  };
+  Prefetcher<LoadedImages> images(
+      sources.size(),
+      [&](std::size_t k) {
+        const FrameSource& s = sources[k];
+        if (euroc) {
+          return LoadedImages{euroc->LoadCam0(s.a),
+                              IsStereo(sensor) ? euroc->LoadCam1(s.b) : cv::Mat()};
+        }
+        if (IsRgbd(sensor)) return LoadedImages{tum->LoadRgbGrey(s.a), tum->LoadDepthRaw(s.b)};
+        return LoadedImages{tum->LoadRgbGrey(s.a), cv::Mat()};
+      },
+      2);
   for (const FrameSource& s : sources) {
     if (interrupt != nullptr && interrupt->load()) {
       summary.interrupted = true;
@@ -154,17 +172,13 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
       system.AddImu(euroc->ImuBetween(imu_fed_ns, s.t_ns + kImuLookaheadNs));
       imu_fed_ns = s.t_ns + kImuLookaheadNs;
     }
-    if (euroc) {
-      const cv::Mat left = euroc->LoadCam0(s.a);
-      if (IsStereo(sensor)) {
-        r = system.TrackStereo(left, euroc->LoadCam1(s.b), s.t_ns);
-      } else {
-        r = system.TrackMonocular(left, s.t_ns);
-      }
+    const LoadedImages loaded = *images.Next();
+    if (IsStereo(sensor)) {
+      r = system.TrackStereo(loaded.a, loaded.b, s.t_ns);
     } else if (IsRgbd(sensor)) {
-      r = system.TrackRgbd(tum->LoadRgbGrey(s.a), tum->LoadDepthRaw(s.b), s.t_ns);
+      r = system.TrackRgbd(loaded.a, loaded.b, s.t_ns);
     } else {
-      r = system.TrackMonocular(tum->LoadRgbGrey(s.a), s.t_ns);
+      r = system.TrackMonocular(loaded.a, s.t_ns);
     }
     ++summary.frames;
     if (r.state == TrackingState::kOk) ++summary.tracked;

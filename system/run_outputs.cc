@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <fstream>
+#include <numeric>
 #include <set>
 
+#include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "io/rigid_transform_file.h"
@@ -146,11 +148,15 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
 
   const auto& records = system.tracker().records();
   std::vector<double> tracking_ms;
+  std::vector<double> tracking_cpu_ms;
+  std::vector<double> build_cpu_ms;
   std::map<std::string, int> states;
   bool initialised = false;
   int lost = 0;
   for (const FrameRecord& r : records) {
     tracking_ms.push_back(r.tracking_ms);
+    tracking_cpu_ms.push_back(r.tracking_cpu_ms);
+    build_cpu_ms.push_back(r.build_cpu_ms);
     ++states[TrackingStateName(r.state)];
     if (r.state != TrackingState::kNotInitialized) initialised = true;
     if (initialised && r.state != TrackingState::kOk) ++lost;
@@ -188,11 +194,26 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   json.Member("median_tracking_ms", summary->median_tracking_ms);
   json.Member("median_local_mapping_ms", Median(mapping.keyframe_ms));
   json.Member("local_ba_aborted", mapping.ba_aborted);
+  // CPU time (independent of the machine's load): per-thread sums and medians.
+  const auto sum = [](const std::vector<double>& v) {
+    return std::accumulate(v.begin(), v.end(), 0.0);
+  };
+  json.Member("process_cpu_s", ProcessCpuSeconds());
+  json.Member("tracking_cpu_s", 1e-3 * (sum(tracking_cpu_ms) + sum(build_cpu_ms)));
+  json.Member("median_tracking_cpu_ms", Median(tracking_cpu_ms));
+  json.Member("median_build_cpu_ms", Median(build_cpu_ms));
+  json.Member("local_mapping_cpu_s", 1e-3 * sum(mapping.keyframe_cpu_ms));
+  json.Member("median_local_mapping_cpu_ms", Median(mapping.keyframe_cpu_ms));
+  json.Member("median_local_ba_cpu_ms", Median(mapping.ba_cpu_ms));
   json.Member("peak_memory_mib", PeakMemoryMiB());
   WriteLoopClosing(system, options, &json);
   WriteArray(&json, "tracking_ms", tracking_ms);
   WriteArray(&json, "local_mapping_ms", mapping.keyframe_ms);
   WriteArray(&json, "local_ba_ms", mapping.ba_ms);
+  WriteArray(&json, "tracking_cpu_ms", tracking_cpu_ms);
+  WriteArray(&json, "build_cpu_ms", build_cpu_ms);
+  WriteArray(&json, "local_mapping_cpu_ms", mapping.keyframe_cpu_ms);
+  WriteArray(&json, "local_ba_cpu_ms", mapping.ba_cpu_ms);
   json.EndObject();
   std::ofstream file(out / "stats.json");
   if (!file) throw Error(fmt::format("cannot write {}", (out / "stats.json").string()));
