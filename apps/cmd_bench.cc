@@ -39,6 +39,7 @@ struct BenchArgs {
   std::string python = "/usr/bin/python3";
   int jobs = 1;
   bool retry_failed = false;
+  bool reevaluate = false;
   bool no_plots = false;
   bool list = false;
   bool quiet = false;
@@ -101,6 +102,7 @@ void Run(const BenchArgs& a) {
   h.jobs = a.jobs;
   h.quiet = a.quiet;
   h.retry_failed = a.retry_failed;
+  h.reevaluate = a.reevaluate;
   if (!a.emit_jobs.empty()) {
     const auto e = bench::EmitJobs(suite, runs, h);
     std::cout << fmt::format(
@@ -152,6 +154,8 @@ void RegisterBenchCommand(CLI::App& app) {
                   "the first folder)");
   cmd->add_option("--run-id", args->run_ids, "Execute only these runs (ids as --list prints)");
   cmd->add_flag("--retry-failed", args->retry_failed, "Run failed runs again");
+  cmd->add_flag("--reevaluate", args->reevaluate,
+                "Measure finished runs again against ground truth (no SLAM re-run)");
   cmd->add_flag("--list", args->list, "Print the run ids of the matrix and exit");
   cmd->add_flag("--no-plots", args->no_plots, "Tables only (no matplotlib)");
   cmd->add_option("--python", args->python, "Python with matplotlib and numpy for the plots")

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "apps/commands.h"
 #include "core/util/error.h"
@@ -19,6 +20,8 @@
 #include "dense/point_cloud.h"
 #include "dense/visibility.h"
 #include "evaluation/evaluate.h"
+#include "io/rigid_transform_file.h"
+#include "io/trajectory.h"
 
 namespace pkslam::apps {
 namespace {
@@ -36,6 +39,7 @@ struct CompareArgs {
   std::string dataset;
   std::string settings;
   std::string write_aligned;
+  std::vector<std::string> observed_refs;
   double max_diff_s = 0.01;
   dense::CompareOptions compare;
   dense::VisibilityOptions visibility;
@@ -55,7 +59,14 @@ Alignment AlignRun(const CompareArgs& args) {
   fs::path estimate = run / "trajectory_body.txt";
   if (!fs::exists(estimate)) estimate = run / "trajectory.txt";
   const Trajectory est = ReadTrajectory(estimate, TrajectoryFormat::kTum);
-  const Trajectory gt = ReadTrajectory(args.gt);
+  Trajectory gt = ReadTrajectory(args.gt);
+  // Monocular runs have camera poses only (no metric lever arm): compare them with the
+  // EuRoC body ground truth moved into the camera.
+  const fs::path extrinsic = run / "body_from_camera.txt";
+  if (estimate.filename() == "trajectory.txt" && fs::exists(extrinsic) &&
+      DetectTrajectoryFormat(args.gt) == TrajectoryFormat::kEuroc) {
+    gt = ChangeSensorFrame(gt, ReadRigidTransform(extrinsic));
+  }
   EvaluationOptions options;
   options.alignment = ParseAlignmentMethod(args.align);
   if (options.alignment != AlignmentMethod::kSE3 && options.alignment != AlignmentMethod::kSim3) {
@@ -140,6 +151,22 @@ void RunCompare(const CompareArgs& args) {
         args.visibility.min_depth_m, args.visibility.max_depth_m);
   }
 
+  struct ObservedCompleteness {
+    std::string ref;
+    std::size_t points = 0;
+    double completeness = 0;
+  };
+  std::vector<ObservedCompleteness> observed;
+  for (const std::string& file : args.observed_refs) {
+    const dense::PointCloud ref_observed = dense::ReadPly(file);
+    if (ref_observed.empty()) throw InputError(file, "the reference cloud has no points");
+    observed.push_back(
+        {file, ref_observed.size(),
+         dense::Completeness(cloud.points, ref_observed.points, args.compare.completeness_m)});
+    fmt::print("completeness  {:.1f}% of the {} points of {} (observed surfaces)\n",
+               100 * observed.back().completeness, observed.back().points, file);
+  }
+
   if (!args.json.empty()) {
     JsonWriter json;
     json.BeginObject();
@@ -184,6 +211,15 @@ void RunCompare(const CompareArgs& args) {
     } else {
       json.Null();
     }
+    json.Key("completeness_observed").BeginArray();
+    for (const ObservedCompleteness& o : observed) {
+      json.BeginObject();
+      json.Member("ref", o.ref);
+      json.Member("ref_points", static_cast<std::uint64_t>(o.points));
+      json.Member("completeness", o.completeness);
+      json.EndObject();
+    }
+    json.EndArray();
     json.EndObject();
     std::ofstream out(args.json);
     out << json.str();
@@ -222,6 +258,9 @@ void RegisterCloudCompareCommand(CLI::App& app) {
   cmd->add_option("--dataset", args->dataset,
                   "With --align-run: also report completeness over the reference points visible "
                   "from the run's keyframes (this dataset's camera)");
+  cmd->add_option("--observed-ref", args->observed_refs,
+                  "Also report completeness against these references (the simulator's "
+                  "reference_observed.ply: the surfaces the sequence observed)");
   cmd->add_option("--settings", args->settings, "The settings file the run used (if any)");
   cmd->add_option("--max-depth", args->visibility.max_depth_m,
                   "Visibility: largest depth (m; use the dense cloud's)")

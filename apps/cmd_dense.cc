@@ -35,7 +35,8 @@ void RunDense(const DenseArgs& args) {
   }
   const Trajectory keyframes = ReadTrajectory(keyframes_file, TrajectoryFormat::kTum);
   const auto source = dense::KeyframeImageSource::Open(
-      args.dataset, args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings));
+      args.dataset, args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings),
+      args.options.full_view);
   dense::DenseStats stats;
   const dense::PointCloud cloud = BuildDenseCloud(keyframes, source, args.options, &stats);
   if (cloud.empty()) {
@@ -49,14 +50,20 @@ void RunDense(const DenseArgs& args) {
              stats.keyframes, stats.keyframes_used, stats.missing_t_ns.size(),
              source.source() == dense::DepthSource::kStereo ? "stereo SGBM" : "RGB-D",
              args.options.MaxDepth());
+  auto share = [&](std::size_t n) {
+    return stats.depth_points > 0
+               ? 100.0 * static_cast<double>(n) / static_cast<double>(stats.depth_points)
+               : 0.0;
+  };
   fmt::print(
-      "depth points {} (valid depth {:.1f}% of pixels), {} ({:.1f}%) confirmed by >= {} "
-      "keyframes, {} voxels of {} m\n",
+      "depth points {} (valid depth {:.1f}% of pixels), {} ({:.1f}%) kept: {} confirmed by >= "
+      "{} keyframes, {} ({:.1f}%) uncontradicted single-view; {} ({:.1f}%) contradicted; {} "
+      "({:.1f}%) deferred to a closer keyframe; {} voxels of {} m\n",
       stats.depth_points, 100.0 * stats.mean_valid_depth_share, stats.consistent_points,
-      stats.depth_points > 0 ? 100.0 * static_cast<double>(stats.consistent_points) /
-                                   static_cast<double>(stats.depth_points)
-                             : 0.0,
-      args.options.min_views, stats.points, args.options.voxel_m);
+      share(stats.consistent_points), stats.consistent_points - stats.unconfirmed_points,
+      args.options.min_views, stats.unconfirmed_points, share(stats.unconfirmed_points),
+      stats.contradicted_points, share(stats.contradicted_points), stats.deferred_points,
+      share(stats.deferred_points), stats.points, args.options.voxel_m);
   fmt::print("{:.1f} s; cloud: {}\n", stats.seconds, args.out);
   if (!args.json.empty()) {
     JsonWriter json;
@@ -69,11 +76,28 @@ void RunDense(const DenseArgs& args) {
     json.Member("keyframes_missing", static_cast<int>(stats.missing_t_ns.size()));
     json.Member("voxel_m", args.options.voxel_m);
     json.Member("max_depth_m", args.options.MaxDepth());
+    json.Member("neighbour_max_depth_m", args.options.NeighbourMaxDepth());
     json.Member("min_views", args.options.min_views);
     json.Member("consistency_rel", args.options.consistency_rel);
     json.Member("window", args.options.window);
     json.Member("depth_points", static_cast<std::uint64_t>(stats.depth_points));
+    json.Member("keep_unconfirmed", args.options.keep_unconfirmed);
+    json.Member("majority_veto", args.options.majority_veto);
     json.Member("consistent_points", static_cast<std::uint64_t>(stats.consistent_points));
+    json.Member("unconfirmed_points", static_cast<std::uint64_t>(stats.unconfirmed_points));
+    json.Member("contradicted_points", static_cast<std::uint64_t>(stats.contradicted_points));
+    json.Member("deferred_points", static_cast<std::uint64_t>(stats.deferred_points));
+    json.Member("defer_ratio", args.options.defer_ratio);
+    json.Member("occluder_radius_px", args.options.occluder_radius_px);
+    json.Member("unconfirmed_max_depth_m", args.options.unconfirmed_max_depth_m);
+    json.Member("p1", args.options.stereo.p1);
+    json.Member("p2", args.options.stereo.p2);
+    json.Member("block_size", args.options.stereo.block_size);
+    json.Member("uniqueness", args.options.stereo.uniqueness_ratio);
+    json.Member("pad_borders", args.options.stereo.pad_borders);
+    json.Member("full_view", args.options.full_view);
+    json.Member("image_width", source.camera().width());
+    json.Member("image_height", source.camera().height());
     json.Member("valid_depth_share", stats.mean_valid_depth_share);
     json.Member("voxels", static_cast<std::uint64_t>(stats.voxels));
     json.Member("points", static_cast<std::uint64_t>(stats.points));
@@ -91,8 +115,9 @@ void RegisterDenseCommand(CLI::App& app) {
   auto args = std::make_shared<DenseArgs>();
   auto* cmd = app.add_subcommand(
       "dense",
-      "Dense point cloud from a run's keyframes: stereo SGBM (rectified, left-right checked) or "
-      "RGB-D depth, kept where >= --min-views keyframes agree, fused in a voxel grid");
+      "Dense point cloud from a run's keyframes: stereo SGBM (full-view rectified, left-right "
+      "checked) or RGB-D depth; depths >= --min-views keyframes agree on are averaged, "
+      "single-view depths no keyframe contradicts are kept (views 1); fused in a voxel grid");
   cmd->add_option("--run", args->run, "Run directory of `pkslam run` (keyframes.txt)")->required();
   cmd->add_option("--dataset", args->dataset, "The dataset the run used (EuRoC or TUM RGB-D)")
       ->required();
@@ -103,11 +128,31 @@ void RegisterDenseCommand(CLI::App& app) {
   cmd->add_option("--max-depth", o.max_depth_m, "Largest depth used (m; 0: 4 m)")
       ->capture_default_str();
   cmd->add_option("--min-depth", o.min_depth_m, "Smallest depth used (m)")->capture_default_str();
+  cmd->add_option("--neighbour-max-depth", o.neighbour_max_depth_m,
+                  "Depths up to this (m) still confirm or contradict other keyframes' depths")
+      ->capture_default_str();
   cmd->add_option("--min-views", o.min_views,
                   "Keep depths at least N keyframes agree on (itself included; 1: no filter)")
       ->capture_default_str();
   cmd->add_option("--consistency", o.consistency_rel,
                   "Relative depth agreement of a confirming keyframe")
+      ->capture_default_str();
+  cmd->add_flag("!--strict-views", o.keep_unconfirmed,
+                "Drop every depth fewer than --min-views keyframes agree on (default: keep "
+                "those no keyframe that should see them contradicts)");
+  cmd->add_flag("!--no-majority-veto", o.majority_veto,
+                "Keep confirmed depths even when more keyframes contradict than confirm them");
+  cmd->add_option("--unconfirmed-max-depth", o.unconfirmed_max_depth_m,
+                  "Keep depths no other keyframe confirms only up to this depth (m; 0: any)")
+      ->capture_default_str();
+  cmd->add_option("--occluder-radius", o.occluder_radius_px,
+                  "A keyframe's surface this close (px) to a depth's line of sight, in front of "
+                  "it, contradicts it")
+      ->capture_default_str();
+  cmd->add_option(
+         "--defer-ratio", o.defer_ratio,
+         "Drop a depth a confirming keyframe sees from closer than depth / R (its estimate "
+         "is better; 0: off)")
       ->capture_default_str();
   cmd->add_option("--window", o.window,
                   "Keyframes on each side (in keyframe order) that may confirm a depth")
@@ -121,6 +166,18 @@ void RegisterDenseCommand(CLI::App& app) {
   cmd->add_option("--block-size", o.stereo.block_size, "SGBM block size (odd)")
       ->capture_default_str();
   cmd->add_option("--uniqueness", o.stereo.uniqueness_ratio, "SGBM uniqueness ratio (%)")
+      ->capture_default_str();
+  cmd->add_option("--p1", o.stereo.p1, "SGBM penalty for 1-px disparity changes (0: 8 x block^2)")
+      ->capture_default_str();
+  cmd->add_option("--p2", o.stereo.p2, "SGBM penalty for larger changes (0: 32 x block^2)")
+      ->capture_default_str();
+  cmd->add_flag("!--no-full-view", o.full_view,
+                "Stereo: use the run's cropped rectified images (default: rectify onto the full "
+                "view of the raw cameras)");
+  cmd->add_flag("!--no-pad", o.stereo.pad_borders,
+                "Do not pad the stereo pair (SGBM then leaves the image sides without depth)");
+  cmd->add_option("--speckle-window", o.stereo.speckle_window_size,
+                  "SGBM speckle filter region size (px; 0: off)")
       ->capture_default_str();
   cmd->add_option("--lr-max-diff", o.stereo.lr_max_difference,
                   "Left-right check tolerance (px; < 0: off)")

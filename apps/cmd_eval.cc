@@ -9,6 +9,7 @@
 #include "apps/commands.h"
 #include "core/util/error.h"
 #include "evaluation/evaluate.h"
+#include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
 
 namespace pkslam::apps {
@@ -27,6 +28,7 @@ struct EvalArgs {
   std::string rpe_unit = "frames";
   bool rpe_consecutive = false;
   std::string json_file;
+  std::string body_from_camera_file;
 };
 
 void RunEval(const EvalArgs& args) {
@@ -42,7 +44,10 @@ void RunEval(const EvalArgs& args) {
   const TrajectoryFormat gt_format = ParseTrajectoryFormat(args.gt_format);
   const TrajectoryFormat est_format = ParseTrajectoryFormat(args.est_format);
 
-  const Trajectory gt = ReadTrajectory(args.gt_file, gt_format);
+  Trajectory gt = ReadTrajectory(args.gt_file, gt_format);
+  if (!args.body_from_camera_file.empty()) {
+    gt = ChangeSensorFrame(gt, ReadRigidTransform(args.body_from_camera_file));
+  }
   const Trajectory est = ReadTrajectory(args.est_file, est_format);
   const EvaluationResult result = EvaluateTrajectories(gt, est, options);
 
@@ -87,6 +92,11 @@ void RegisterEvalCommand(CLI::App& app) {
   cmd->add_flag("--rpe-consecutive", args->rpe_consecutive,
                 "RPE on non-overlapping consecutive pairs (evo's default) instead of all pairs");
   cmd->add_option("--json", args->json_file, "Also write the results as JSON to this file");
+  cmd->add_option("--body-from-camera", args->body_from_camera_file,
+                  "Move the ground truth (body poses) into the camera with this rigid transform "
+                  "(a run's body_from_camera.txt) and compare the camera trajectory.txt: needed "
+                  "for monocular runs, whose unknown scale makes trajectory_body.txt wrong")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--gt-format", args->gt_format, "Ground-truth format: auto|tum|euroc|orbslam3")
       ->capture_default_str();
   cmd->add_option("--est-format", args->est_format, "Estimate format: auto|tum|euroc|orbslam3")

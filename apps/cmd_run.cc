@@ -1,8 +1,8 @@
 // pkslam run: SLAM over a EuRoC or TUM RGB-D dataset.
+#include <fmt/format.h>
+
 #include <atomic>
 #include <csignal>
-
-#include <fmt/format.h>
 
 #include "apps/commands.h"
 #include "core/util/error.h"
@@ -74,6 +74,9 @@ void RegisterRunCommand(CLI::App& app) {
                   "Selector parameter NAME=VALUE (overrides the settings' Keyframe.NAME)");
   cmd->add_flag("--deterministic", args->options.system.deterministic,
                 "Fixed seeds; local mapping in lock-step: identical output run to run");
+  cmd->add_option("--seed", args->options.system.seed,
+                  "Run seed for RANSAC sampling (benchmarks: one per repeated run)")
+      ->capture_default_str();
   cmd->add_flag("--no-loop", args->options.system.no_loop,
                 "Disable loop closing and map merging (for experiments)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
@@ -94,11 +97,12 @@ void RegisterRunCommand(CLI::App& app) {
     const RunSummary s = RunDataset(o, &interrupted);
     fmt::print("frames {} tracked {} lost {} keyframes {} map points {} maps {}\n", s.frames,
                s.tracked, s.lost, s.keyframes, s.map_points, s.maps);
-    fmt::print("wall {:.2f} s for {:.2f} s of data ({:.2f}x real time), median tracking {:.2f} ms\n",
-               s.wall_s, s.sequence_s, s.wall_s > 0 ? s.sequence_s / s.wall_s : 0.0,
-               s.median_tracking_ms);
-    fmt::print("outputs: {}/{{trajectory.txt, keyframes.txt, map_points.ply, stats.json, run.log}}\n",
-               o.out.string());
+    fmt::print(
+        "wall {:.2f} s for {:.2f} s of data ({:.2f}x real time), median tracking {:.2f} ms\n",
+        s.wall_s, s.sequence_s, s.wall_s > 0 ? s.sequence_s / s.wall_s : 0.0, s.median_tracking_ms);
+    fmt::print(
+        "outputs: {}/{{trajectory.txt, keyframes.txt, map_points.ply, stats.json, run.log}}\n",
+        o.out.string());
     if (s.interrupted) throw Error("interrupted (partial outputs written)");
   });
 }

@@ -72,11 +72,13 @@ void Run(SimulateArgs& a) {
   std::cout << fmt::format(
       "simulate: {} -> {} ({})\n  {} frames, {} IMU samples, {:.3f} s, path {:.3f} m, "
       "mean speed {:.2f} m/s, angular rate mean {:.1f} / max {:.1f} deg/s\n"
-      "  scene: {} objects ({} removed near the path), cloud {} points\n",
+      "  scene: {} objects ({} removed near the path), cloud {} points, observed cloud {} "
+      "points\n",
       o.trajectory.empty() ? "random " + a.motion : o.trajectory.string(), o.output_dir.string(),
       s.layout, s.frames, s.imu_samples, duration, s.path_length_m, s.mean_speed_mps,
       s.mean_angular_rate_dps, s.max_angular_rate_dps,
-      s.scene.objects_placed - s.scene.objects_removed, s.scene.objects_removed, s.cloud_points);
+      s.scene.objects_placed - s.scene.objects_removed, s.scene.objects_removed, s.cloud_points,
+      s.observed_points);
   if (s.frames > 0 && s.total_seconds > 0.0) {
     std::cout << fmt::format(
         "  {:.1f} frames/s end to end (rendering, image formation and PNG files)\n",
@@ -142,6 +144,16 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_flag("--no-images", args->no_images, "IMU and ground truth only (no rendering)");
   cmd->add_option("--cloud-spacing", o.cloud_spacing_m, "Reference cloud point spacing (m)")
       ->capture_default_str();
+  cmd->add_option("--observed-range", o.observed_range_m,
+                  "reference_observed.ply: the surfaces cam0 saw within this depth (m) in any "
+                  "frame (0: not written)")
+      ->capture_default_str();
+  cmd->add_option("--observed-cell", o.observed_cell_m,
+                  "Granularity of the observed surface cells (m)")
+      ->capture_default_str();
+  cmd->add_flag("--reference-only", o.reference_only,
+                "Only render cam0 and write the two reference clouds (same options as an "
+                "earlier run add them to it; write into another folder)");
   cmd->add_flag("--bench", o.bench, "Only render (no files) and report frames/s");
   cmd->add_option("--bench-frames", o.bench_frames, "Frames rendered by --bench (0: all)")
       ->capture_default_str();

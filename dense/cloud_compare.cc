@@ -152,6 +152,15 @@ CompareResult CompareClouds(const std::vector<Eigen::Vector3f>& cloud,
   return r;
 }
 
+double Completeness(const std::vector<Eigen::Vector3f>& cloud,
+                    const std::vector<Eigen::Vector3f>& reference, double threshold_m) {
+  PKSLAM_CHECK(!cloud.empty() && !reference.empty(), "completeness of an empty cloud");
+  PKSLAM_CHECK(threshold_m > 0, "completeness threshold {}", threshold_m);
+  const std::vector<float> d = NearestDistances(reference, cloud);
+  const auto covered = std::count_if(d.begin(), d.end(), [&](float x) { return x <= threshold_m; });
+  return static_cast<double>(covered) / static_cast<double>(reference.size());
+}
+
 void WriteDistanceStatsJson(const DistanceStats& stats, JsonWriter& json) {
   json.BeginObject();
   json.Member("count", static_cast<std::uint64_t>(stats.count));

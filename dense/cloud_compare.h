@@ -75,6 +75,12 @@ CompareResult CompareClouds(const std::vector<Eigen::Vector3f>& cloud,
                             const std::vector<std::uint8_t>& ref_subset = {},
                             const std::vector<Eigen::Vector3f>& ref_normals = {});
 
+// Completeness against another reference (e.g. the simulator's reference_observed.ply, the
+// surfaces the sequence observed): the share of `reference` points with a `cloud` point within
+// threshold_m. Throws Error on empty clouds or threshold <= 0.
+double Completeness(const std::vector<Eigen::Vector3f>& cloud,
+                    const std::vector<Eigen::Vector3f>& reference, double threshold_m);
+
 // {"count", "mean", "median", "rms", "max", "within": {"0.01": share, ...}}
 void WriteDistanceStatsJson(const DistanceStats& stats, JsonWriter& json);
 

@@ -91,5 +91,21 @@ TEST(CloudCompareTest, NearestDistancesAreExact) {
   EXPECT_THROW(CompareClouds(target, target, bad), OptionError);
 }
 
+TEST(CloudCompareTest, CompletenessAgainstAnotherReference) {
+  // A 1 m x 1 m reference at 1 cm; the cloud covers its left 30 cm (within 5 cm: 35 cm).
+  std::vector<Eigen::Vector3f> reference, cloud;
+  for (int i = 0; i < 100; ++i) {
+    for (int j = 0; j < 100; ++j) {
+      const Eigen::Vector3f p(0.005f + 0.01f * i, 0.005f + 0.01f * j, 0.0f);
+      reference.push_back(p);
+      if (p.x() < 0.3f) cloud.push_back(p + Eigen::Vector3f(0, 0, 0.01f));
+    }
+  }
+  EXPECT_NEAR(Completeness(cloud, reference, 0.05), 0.35, 0.011);
+  EXPECT_NEAR(Completeness(cloud, reference, 0.005), 0.0, 1e-9);
+  EXPECT_THROW(Completeness({}, reference, 0.05), Error);
+  EXPECT_THROW(Completeness(cloud, reference, 0.0), Error);
+}
+
 }  // namespace
 }  // namespace pkslam::dense

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 
 #include "core/util/error.h"
@@ -35,7 +36,11 @@ void FilterDisparityEdges(double max_step, cv::Mat* disparity) {
 struct ViewPoints {
   std::vector<Eigen::Vector3f> points;
   std::vector<Rgb> colours;
+  std::vector<std::uint8_t> support;
   std::size_t candidates = 0;
+  std::size_t unconfirmed = 0;
+  std::size_t contradicted = 0;
+  std::size_t deferred = 0;
   double valid_share = 0;
 };
 
@@ -52,6 +57,8 @@ void DenseOptions::Check() const {
   PKSLAM_CHECK_OPTION(max_depth_m >= 0, "--max-depth", "{}", max_depth_m);
   PKSLAM_CHECK_OPTION(min_depth_m >= 0 && min_depth_m < MaxDepth(), "--min-depth",
                       "{} (max depth {})", min_depth_m, MaxDepth());
+  PKSLAM_CHECK_OPTION(neighbour_max_depth_m >= 0, "--neighbour-max-depth", "{}",
+                      neighbour_max_depth_m);
   PKSLAM_CHECK_OPTION(window >= 0, "--window", "{}", window);
   PKSLAM_CHECK_OPTION(min_views <= 2 * window + 1, "--min-views",
                       "{} needs a window of at least {} keyframes each side", min_views,
@@ -67,27 +74,42 @@ ConsistencyOptions DenseOptions::Consistency() const {
   ConsistencyOptions c;
   c.tolerance_rel = consistency_rel;
   c.min_views = min_views;
+  c.keep_unconfirmed = keep_unconfirmed;
+  c.majority_veto = majority_veto;
+  c.defer_ratio = defer_ratio;
+  c.occluder_radius_px = occluder_radius_px;
+  c.unconfirmed_max_depth_m = unconfirmed_max_depth_m;
+  c.max_depth_m = MaxDepth();
   return c;
 }
 
 cv::Mat KeyframeDepth(const KeyframeImages& images, const KeyframeImageSource& source,
-                      const DenseOptions& options) {
+                      const DenseOptions& options, double max_depth_m) {
+  const double max_depth = max_depth_m > 0 ? max_depth_m : options.MaxDepth();
   cv::Mat depth;
   if (source.source() == DepthSource::kStereo) {
     cv::Mat disparity = ComputeDisparity(images.grey, images.right, options.stereo);
     if (options.edge_disparity_px > 0) FilterDisparityEdges(options.edge_disparity_px, &disparity);
-    depth = DisparityToDepth(disparity, source.bf(), options.MaxDepth());
+    depth = DisparityToDepth(disparity, source.bf(), max_depth);
   } else {
     depth = images.depth_m.clone();
     PKSLAM_CHECK(depth.type() == CV_32FC1 && depth.size() == images.grey.size(),
                  "depth image does not match the colour image");
   }
   const int b = options.border_px;
+  cv::Mat valid;  // the raw footprint shrunk by the border
+  if (!source.valid_mask().empty()) {
+    PKSLAM_CHECK(source.valid_mask().size() == depth.size(), "valid mask does not match");
+    cv::erode(source.valid_mask(), valid,
+              cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * b + 1, 2 * b + 1)));
+  }
   for (int r = 0; r < depth.rows; ++r) {
     float* z = depth.ptr<float>(r);
+    const std::uint8_t* ok = valid.empty() ? nullptr : valid.ptr<std::uint8_t>(r);
     for (int c = 0; c < depth.cols; ++c) {
-      const bool inside = r >= b && r < depth.rows - b && c >= b && c < depth.cols - b;
-      if (!inside || !(z[c] >= options.min_depth_m && z[c] <= options.MaxDepth())) z[c] = 0;
+      const bool inside = r >= b && r < depth.rows - b && c >= b && c < depth.cols - b &&
+                          (ok == nullptr || ok[c] != 0);
+      if (!inside || !(z[c] >= options.min_depth_m && z[c] <= max_depth)) z[c] = 0;
     }
   }
   return depth;
@@ -109,7 +131,11 @@ cv::Mat RayTable(const CameraModel& camera) {
 
 void BackProject(const cv::Mat& depth_m, const cv::Mat& rays, const SE3d& world_from_camera,
                  const cv::Mat& grey, const cv::Mat& colour_bgr, int pixel_step,
-                 std::vector<Eigen::Vector3f>* points, std::vector<Rgb>* colours) {
+                 std::vector<Eigen::Vector3f>* points, std::vector<Rgb>* colours,
+                 const cv::Mat& views, std::vector<std::uint8_t>* support) {
+  PKSLAM_CHECK(views.empty() || (views.type() == CV_8UC1 && views.size() == depth_m.size()),
+               "views map does not match the depth map");
+  if (support != nullptr) support->clear();
   PKSLAM_CHECK(depth_m.size() == rays.size() && grey.size() == depth_m.size(),
                "depth, rays and image sizes differ");
   const Eigen::Matrix3f rotation = world_from_camera.RotationMatrix().cast<float>();
@@ -121,12 +147,14 @@ void BackProject(const cv::Mat& depth_m, const cv::Mat& rays, const SE3d& world_
     const auto* ray = rays.ptr<cv::Vec2f>(r);
     const auto* g = grey.ptr<std::uint8_t>(r);
     const auto* bgr = colour_bgr.empty() ? nullptr : colour_bgr.ptr<cv::Vec3b>(r);
+    const std::uint8_t* n_views = views.empty() ? nullptr : views.ptr<std::uint8_t>(r);
     for (int c = 0; c < depth_m.cols; c += pixel_step) {
       if (z[c] <= 0 || std::isnan(ray[c][0])) continue;
       const Eigen::Vector3f p_camera(ray[c][0] * z[c], ray[c][1] * z[c], z[c]);
       points->push_back(rotation * p_camera + translation);
       colours->push_back(bgr != nullptr ? Rgb{bgr[c][2], bgr[c][1], bgr[c][0]}
                                         : Rgb{g[c], g[c], g[c]});
+      if (support != nullptr) support->push_back(n_views != nullptr ? n_views[c] : 1);
     }
   }
 }
@@ -182,7 +210,7 @@ PointCloud BuildDenseCloud(const Trajectory& keyframes, const KeyframeImageSourc
     tbb::parallel_for(computed, need_end, [&](std::size_t j) {
       KeyframeImages images = source.Load(jobs[j].frame);
       DepthImage& d = held[j].emplace();
-      d.depth = KeyframeDepth(images, source, options);
+      d.depth = KeyframeDepth(images, source, options, options.NeighbourMaxDepth());
       d.grey = std::move(images.grey);
       d.colour = std::move(images.colour);
     });
@@ -199,18 +227,27 @@ PointCloud BuildDenseCloud(const Trajectory& keyframes, const KeyframeImageSourc
           FilterByConsistency(d.depth, jobs[i].world_from_camera, neighbours, rays, source.camera(),
                               options.pixel_step, consistency);
       ViewPoints& v = views[i - begin];
-      v.valid_share =
-          static_cast<double>(cv::countNonZero(d.depth)) / static_cast<double>(d.depth.total());
+      // Pixels of the pixel_step grid with a depth in [min, max] depth.
+      const int step = options.pixel_step;
+      const double grid = static_cast<double>((d.depth.rows + step - 1) / step) *
+                          static_cast<double>((d.depth.cols + step - 1) / step);
+      v.valid_share = static_cast<double>(filtered.candidates) / grid;
       v.candidates = static_cast<std::size_t>(filtered.candidates);
+      v.unconfirmed = static_cast<std::size_t>(filtered.unconfirmed);
+      v.contradicted = static_cast<std::size_t>(filtered.contradicted);
+      v.deferred = static_cast<std::size_t>(filtered.deferred);
       BackProject(filtered.depth, rays, jobs[i].world_from_camera, d.grey, d.colour,
-                  options.pixel_step, &v.points, &v.colours);
+                  options.pixel_step, &v.points, &v.colours, filtered.views, &v.support);
     });
     for (std::size_t i = begin; i < end; ++i) {
       ViewPoints& v = views[i - begin];
       stats->depth_points += v.candidates;
       stats->consistent_points += v.points.size();
+      stats->unconfirmed_points += v.unconfirmed;
+      stats->contradicted_points += v.contradicted;
+      stats->deferred_points += v.deferred;
       valid_share_sum += v.valid_share;
-      grid.AddView(static_cast<int>(i), v.points, v.colours);
+      grid.AddView(static_cast<int>(i), v.points, v.colours, v.support);
       v = ViewPoints{};
       progress.Add();
     }

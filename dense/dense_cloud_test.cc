@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/util/error.h"
@@ -63,6 +65,7 @@ TEST_F(DenseCloudTest, RgbdKeyframesFuseOntoTheWall) {
   DenseOptions o;
   o.voxel_m = 0.02;
   o.quiet = true;
+  o.keep_unconfirmed = false;  // the strict filter: >= 2 keyframes for every point
   DenseStats stats;
   const PointCloud fused = BuildDenseCloud(Keyframes({0, 2}), source, o, &stats);
   EXPECT_EQ(stats.keyframes_used, 2);
@@ -83,6 +86,17 @@ TEST_F(DenseCloudTest, RgbdKeyframesFuseOntoTheWall) {
   const PointCloud all = BuildDenseCloud(Keyframes({0, 2}), source, o, &stats);
   EXPECT_GT(all.size(), fused.size());
   EXPECT_EQ(stats.voxels, all.size());
+  // The default keeps them as well: nothing contradicts a margin only one keyframe sees.
+  // Their points carry views 1, the overlap's views 2.
+  o.min_views = 2;
+  o.keep_unconfirmed = true;
+  const PointCloud kept = BuildDenseCloud(Keyframes({0, 2}), source, o, &stats);
+  EXPECT_EQ(kept.size(), all.size());
+  EXPECT_GT(stats.unconfirmed_points, 0u);
+  std::size_t single = 0;
+  for (std::size_t i = 0; i < kept.size(); ++i) single += kept.views[i] == 1;
+  EXPECT_GT(single, 0u);
+  EXPECT_EQ(kept.size() - single, fused.size());
 }
 
 TEST_F(DenseCloudTest, WindowAndBatchSizes) {
@@ -91,6 +105,7 @@ TEST_F(DenseCloudTest, WindowAndBatchSizes) {
   o.voxel_m = 0.02;
   o.quiet = true;
   o.window = 1;
+  o.keep_unconfirmed = false;
   o.batch = 1;  // depth maps released as soon as the window has passed them
   DenseStats stats;
   const Trajectory kfs = Keyframes({0, 1, 2, 3, 4, 5});
@@ -160,6 +175,53 @@ TEST(DenseStereoSourceTest, SameRectifiedCameraAsTheRun) {
   const cv::Mat depth = KeyframeDepth(images, source, o);
   const double valid = static_cast<double>(cv::countNonZero(depth)) / depth.total();
   EXPECT_GT(valid, 0.3);
+}
+
+TEST(DenseStereoSourceTest, FullViewKeepsTheRunsGeometryOnAWiderCanvas) {
+  PKSLAM_REQUIRE_SHARED_DATA(shared);
+  const fs::path dataset = shared / "euroc" / "V1_01_easy_static";
+  const auto run_view = KeyframeImageSource::Open(dataset, std::nullopt);
+  const auto full = KeyframeImageSource::Open(dataset, std::nullopt, true);
+  const CameraModel& a = run_view.camera();
+  const CameraModel& b = full.camera();
+  // Same focal length and baseline (the run's poses and disparities stay valid), larger image.
+  EXPECT_EQ(b.fx(), a.fx());
+  EXPECT_EQ(b.fy(), a.fy());
+  EXPECT_DOUBLE_EQ(full.bf(), run_view.bf());
+  EXPECT_TRUE(run_view.valid_mask().empty());
+  const int dx = static_cast<int>(std::lround(b.cx() - a.cx()));
+  const int dy = static_cast<int>(std::lround(b.cy() - a.cy()));
+  EXPECT_DOUBLE_EQ(b.cx() - a.cx(), dx);
+  EXPECT_DOUBLE_EQ(b.cy() - a.cy(), dy);
+  EXPECT_GT(dx, 20);  // EuRoC's barrel distortion: the raw images reach well beyond
+  EXPECT_GT(b.width(), a.width() + 2 * 20);
+  EXPECT_GE(b.height(), a.height());
+  ASSERT_EQ(full.valid_mask().size(), cv::Size(b.width(), b.height()));
+  EXPECT_EQ(full.valid_mask().at<std::uint8_t>(b.height() / 2, b.width() / 2), 255);
+  EXPECT_EQ(full.valid_mask().at<std::uint8_t>(0, 0), 0);  // the canvas corner is no raw pixel
+  // The run's rectified image is the full view's centre (the same rectifying rotation).
+  const std::size_t frame = *full.FindFrame(full.timestamps()[10]);
+  const KeyframeImages small = run_view.Load(frame);
+  const KeyframeImages wide = full.Load(frame);
+  ASSERT_EQ(wide.grey.size(), cv::Size(b.width(), b.height()));
+  ASSERT_EQ(wide.right.size(), wide.grey.size());
+  const cv::Rect inner(dx + 10, dy + 10, a.width() - 20, a.height() - 20);
+  cv::Mat diff;
+  cv::absdiff(small.grey(cv::Rect(10, 10, a.width() - 20, a.height() - 20)), wide.grey(inner),
+              diff);
+  EXPECT_LT(cv::mean(diff)[0], 1.0);
+  cv::absdiff(small.right(cv::Rect(10, 10, a.width() - 20, a.height() - 20)), wide.right(inner),
+              diff);
+  EXPECT_LT(cv::mean(diff)[0], 1.0);
+  // More depth pixels, none outside the raw footprint.
+  DenseOptions o;
+  o.max_depth_m = 10;
+  const cv::Mat d_small = KeyframeDepth(small, run_view, o);
+  const cv::Mat d_wide = KeyframeDepth(wide, full, o);
+  EXPECT_GT(cv::countNonZero(d_wide), cv::countNonZero(d_small) * 11 / 10);
+  cv::Mat outside;
+  cv::bitwise_and(d_wide > 0, full.valid_mask() == 0, outside);
+  EXPECT_EQ(cv::countNonZero(outside), 0);
 }
 
 }  // namespace

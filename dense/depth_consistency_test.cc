@@ -38,8 +38,16 @@ TEST(DepthConsistencyTest, AgreeingViewsConfirmAndAverage) {
   // by the other: with min_views 2 every pixel survives.
   EXPECT_EQ(r.kept, kW * kH);
   EXPECT_NEAR(r.depth.at<float>(30, 0), 0.5f * (2.01f + 2.0f), 1e-4);  // only b sees column 0
-  // Three views needed: the columns only one neighbour sees go.
+  // Three views needed: the columns only one neighbour sees go (strict filter), or stay
+  // unaveraged as unconfirmed (nothing contradicts them).
   o.min_views = 3;
+  const ConsistencyResult loose =
+      FilterByConsistency(mine, CameraAt(0), neighbours, rays, camera, 1, o);
+  EXPECT_EQ(loose.kept, kW * kH);
+  EXPECT_GT(loose.unconfirmed, 0);
+  EXPECT_EQ(loose.depth.at<float>(30, 0), 2.01f);
+  EXPECT_EQ(loose.views.at<std::uint8_t>(30, 0), 1);
+  o.keep_unconfirmed = false;
   const ConsistencyResult r3 =
       FilterByConsistency(mine, CameraAt(0), neighbours, rays, camera, 1, o);
   EXPECT_LT(r3.kept, kW * kH);
@@ -48,6 +56,7 @@ TEST(DepthConsistencyTest, AgreeingViewsConfirmAndAverage) {
   EXPECT_GT(r3.depth.at<float>(30, 40), 0.0f);
   // Averaging off: the own depth stays.
   o.min_views = 2;
+  o.keep_unconfirmed = true;
   o.average = false;
   EXPECT_EQ(FilterByConsistency(mine, CameraAt(0), neighbours, rays, camera, 1, o)
                 .depth.at<float>(30, 40),
@@ -64,6 +73,7 @@ TEST(DepthConsistencyTest, DisagreeingOrMissingDepthsDoNotConfirm) {
   const std::vector<DepthView> far_off = {{&other, CameraAt(0.05).Inverse()}};
   ConsistencyOptions o;
   o.tolerance_rel = 0.01;
+  o.keep_unconfirmed = false;  // confirmations only (see the test below for the rest)
   EXPECT_EQ(FilterByConsistency(mine, CameraAt(0), far_off, rays, camera, 1, o).kept, 0);
   const cv::Mat good = WallDepth(2.0f);
   cv::Mat holes = WallDepth(0.0f);  // sees nothing: neither confirms nor rejects
@@ -83,6 +93,76 @@ TEST(DepthConsistencyTest, DisagreeingOrMissingDepthsDoNotConfirm) {
   const ConsistencyResult all = FilterByConsistency(mine, CameraAt(0), {}, rays, camera, 2, o);
   EXPECT_EQ(all.kept, (kW / 2) * (kH / 2) - 1);  // (20, 20) is on the grid and has no depth
   EXPECT_EQ(all.depth.at<float>(11, 11), 0.0f);
+}
+
+TEST(DepthConsistencyTest, UncontradictedSingleViewDepthsAreKeptUnconfirmed) {
+  const CameraModel camera = Camera();
+  const cv::Mat rays = RayTable(camera);
+  cv::Mat mine = WallDepth(2.0f);
+  mine.at<float>(10, 60) = 1.6f;  // in front of the wall: the neighbour sees through it
+  mine.at<float>(12, 70) = 2.5f;  // behind the wall that the neighbour sees on i's ray
+  // The neighbour sees the wall except in its left half (a hole: no evidence either way).
+  cv::Mat other = WallDepth(2.0f);
+  other(cv::Rect(0, 0, kW / 2, kH)).setTo(0.0f);
+  const std::vector<DepthView> views = {{&other, CameraAt(0.05).Inverse()}};
+  ConsistencyOptions o;
+  o.tolerance_rel = 0.02;
+  const ConsistencyResult r = FilterByConsistency(mine, CameraAt(0), views, rays, camera, 1, o);
+  // Where the neighbour has no depth, the wall is kept, unconfirmed (views 1, not averaged).
+  EXPECT_EQ(r.depth.at<float>(30, 5), 2.0f);
+  EXPECT_EQ(r.views.at<std::uint8_t>(30, 5), 1);
+  // Confirmed pixels carry their view count.
+  EXPECT_EQ(r.views.at<std::uint8_t>(30, 60), 2);
+  // The two outliers project where the neighbour sees the wall: contradicted, dropped.
+  EXPECT_EQ(r.depth.at<float>(10, 60), 0.0f);
+  EXPECT_EQ(r.depth.at<float>(12, 70), 0.0f);
+  EXPECT_EQ(r.contradicted, 2);
+  EXPECT_EQ(r.kept, r.candidates - 2);
+  // The strict filter drops every unconfirmed pixel.
+  o.keep_unconfirmed = false;
+  const ConsistencyResult strict =
+      FilterByConsistency(mine, CameraAt(0), views, rays, camera, 1, o);
+  EXPECT_EQ(strict.depth.at<float>(30, 5), 0.0f);
+  EXPECT_EQ(strict.unconfirmed, 0);
+  EXPECT_EQ(strict.kept, r.kept - r.unconfirmed);
+}
+
+TEST(DepthConsistencyTest, GenuineOcclusionDoesNotContradict) {
+  const CameraModel camera = Camera();
+  const cv::Mat rays = RayTable(camera);
+  // View i sees the wall at 2 m everywhere; view j (1 m to the side) has a post at 1 m in
+  // front of part of the wall, which i does not see (it is off i's lines of sight there).
+  const cv::Mat mine = WallDepth(2.0f);
+  cv::Mat other = WallDepth(2.0f);
+  other(cv::Rect(30, 0, 10, kH)).setTo(1.0f);
+  const std::vector<DepthView> views = {{&other, CameraAt(1.0).Inverse()}};
+  ConsistencyOptions o;
+  o.tolerance_rel = 0.02;
+  const ConsistencyResult r = FilterByConsistency(mine, CameraAt(0), views, rays, camera, 1, o);
+  EXPECT_EQ(r.contradicted, 0);
+  EXPECT_EQ(r.kept, r.candidates);
+}
+
+TEST(DepthConsistencyTest, DeferRatioLeavesASurfaceToTheCloserView) {
+  const CameraModel camera = Camera();
+  const cv::Mat rays = RayTable(camera);
+  const cv::Mat mine = WallDepth(3.0f);
+  const cv::Mat closer = WallDepth(1.5f);  // 1.5 m nearer the wall
+  const SE3d closer_pose(SO3d(), Eigen::Vector3d(0, 0, 1.5));
+  const std::vector<DepthView> views = {{&closer, closer_pose.Inverse()}};
+  ConsistencyOptions o;
+  o.tolerance_rel = 0.02;
+  const ConsistencyResult kept = FilterByConsistency(mine, CameraAt(0), views, rays, camera, 1, o);
+  EXPECT_GT(kept.kept, kW * kH / 5);  // the centre, which the closer view also sees
+  EXPECT_EQ(kept.deferred, 0);
+  o.defer_ratio = 1.5;
+  const ConsistencyResult deferred =
+      FilterByConsistency(mine, CameraAt(0), views, rays, camera, 1, o);
+  EXPECT_EQ(deferred.deferred, kept.kept - kept.unconfirmed);  // every confirmed pixel
+  EXPECT_EQ(deferred.depth.at<float>(30, 40), 0.0f);
+  EXPECT_GT(deferred.depth.at<float>(2, 2), 0.0f);  // outside the closer view: kept
+  o.defer_ratio = 2.5;                              // 3 m / 1.5 m = 2 < 2.5: keep
+  EXPECT_EQ(FilterByConsistency(mine, CameraAt(0), views, rays, camera, 1, o).deferred, 0);
 }
 
 TEST(DepthConsistencyTest, AveragingShrinksIndependentNoise) {

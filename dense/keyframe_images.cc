@@ -1,6 +1,8 @@
 #include "dense/keyframe_images.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -11,8 +13,70 @@ namespace pkslam::dense {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// Rectified pixel -> raw pixel maps of one camera for an ideal pinhole `canvas` whose frame is
+// rect_from_raw * raw frame; pixels whose ray does not reach the raw image get -1 (remap's
+// constant border) and 0 in `valid`.
+void FullViewMaps(const CameraModel& raw, const SO3d& rect_from_raw, const CameraModel& canvas,
+                  cv::Mat* map_x, cv::Mat* map_y, cv::Mat* valid) {
+  const Eigen::Matrix3d raw_from_rect = rect_from_raw.Inverse().Matrix();
+  map_x->create(canvas.height(), canvas.width(), CV_32FC1);
+  map_y->create(canvas.height(), canvas.width(), CV_32FC1);
+  valid->create(canvas.height(), canvas.width(), CV_8UC1);
+  for (int r = 0; r < canvas.height(); ++r) {
+    auto* mx = map_x->ptr<float>(r);
+    auto* my = map_y->ptr<float>(r);
+    auto* ok = valid->ptr<std::uint8_t>(r);
+    for (int c = 0; c < canvas.width(); ++c) {
+      const Eigen::Vector3d ray((c - canvas.cx()) / canvas.fx(), (r - canvas.cy()) / canvas.fy(),
+                                1.0);
+      const auto uv = raw.Project(raw_from_rect * ray);
+      const bool inside = uv && uv->x() >= 0 && uv->y() >= 0 && uv->x() <= raw.width() - 1 &&
+                          uv->y() <= raw.height() - 1;
+      mx[c] = inside ? static_cast<float>(uv->x()) : -1.0f;
+      my[c] = inside ? static_cast<float>(uv->y()) : -1.0f;
+      ok[c] = inside ? 255 : 0;
+    }
+  }
+}
+
+// The run's rectified pinhole grown (same fx, fy) to the bounding box of both raw images'
+// borders, at most `max_growth` times the raw size per axis.
+CameraModel FullViewCanvas(const StereoRectification& rect, double max_growth) {
+  const CameraModel& k = rect.rectified_camera();
+  double u0 = 0, v0 = 0, u1 = k.width() - 1, v1 = k.height() - 1;
+  auto extend = [&](const CameraModel& raw, const SO3d& rect_from_raw) {
+    const int w = raw.width(), h = raw.height();
+    std::vector<Eigen::Vector2d> border;
+    for (int x = 0; x < w; ++x) border.insert(border.end(), {{x, 0.0}, {x, h - 1.0}});
+    for (int y = 0; y < h; ++y) border.insert(border.end(), {{0.0, y}, {w - 1.0, y}});
+    for (const Eigen::Vector2d& uv : border) {
+      const Eigen::Vector3d q = rect_from_raw * raw.Unproject(uv);
+      if (q.z() <= 1e-3) continue;
+      u0 = std::min(u0, k.fx() * q.x() / q.z() + k.cx());
+      u1 = std::max(u1, k.fx() * q.x() / q.z() + k.cx());
+      v0 = std::min(v0, k.fy() * q.y() / q.z() + k.cy());
+      v1 = std::max(v1, k.fy() * q.y() / q.z() + k.cy());
+    }
+  };
+  extend(rect.left_camera(), rect.rect_left_from_left());
+  extend(rect.right_camera(), rect.rect_right_from_right());
+  const double grow_u = 0.5 * (max_growth - 1.0) * k.width();
+  const double grow_v = 0.5 * (max_growth - 1.0) * k.height();
+  const int left = static_cast<int>(std::ceil(std::min(-u0, grow_u)));
+  const int top = static_cast<int>(std::ceil(std::min(-v0, grow_v)));
+  const int right = static_cast<int>(std::ceil(std::min(u1 - (k.width() - 1), grow_u)));
+  const int bottom = static_cast<int>(std::ceil(std::min(v1 - (k.height() - 1), grow_v)));
+  return CameraModel::Pinhole(k.width() + left + right, k.height() + top + bottom, k.fx(), k.fy(),
+                              k.cx() + left, k.cy() + top);
+}
+
+}  // namespace
+
 KeyframeImageSource KeyframeImageSource::Open(const fs::path& dataset,
-                                              const std::optional<fs::path>& settings) {
+                                              const std::optional<fs::path>& settings,
+                                              bool full_view) {
   if (!fs::is_directory(dataset)) throw InputError(dataset, "dataset directory does not exist");
   KeyframeImageSource s;
   if (EurocDataset::LooksLikeEuroc(dataset)) {
@@ -37,6 +101,21 @@ KeyframeImageSource KeyframeImageSource::Open(const fs::path& dataset,
                                *s.settings_.right_from_left);
       s.camera_ = s.rectification_->rectified_camera();
       s.bf_ = s.rectification_->bf();
+      if (full_view) {
+        s.camera_ = FullViewCanvas(*s.rectification_, 1.5);
+        cv::Mat left_valid, right_valid;
+        FullViewMaps(s.rectification_->left_camera(), s.rectification_->rect_left_from_left(),
+                     s.camera_, &s.left_map_x_, &s.left_map_y_, &left_valid);
+        FullViewMaps(s.rectification_->right_camera(), s.rectification_->rect_right_from_right(),
+                     s.camera_, &s.right_map_x_, &s.right_map_y_, &right_valid);
+        // A left pixel needs its right match inside the raw right image: at zero disparity or
+        // to its left on the same row, so rows the right image does not reach are dropped;
+        // the stereo matcher and its left-right check handle the columns.
+        s.valid_mask_ = left_valid.clone();
+        for (int r = 0; r < right_valid.rows; ++r) {
+          if (cv::countNonZero(right_valid.row(r)) == 0) s.valid_mask_.row(r).setTo(0);
+        }
+      }
     }
     for (const StereoPair& p : s.euroc_->stereo_pairs()) {
       s.timestamps_.push_back(p.t_ns);
@@ -87,7 +166,11 @@ KeyframeImages KeyframeImageSource::Load(std::size_t index) const {
   if (euroc_) {
     const cv::Mat left = euroc_->LoadCam0(a);
     const cv::Mat right = euroc_->LoadCam1(b);
-    if (rectification_) {
+    if (!left_map_x_.empty()) {
+      cv::remap(left, out.grey, left_map_x_, left_map_y_, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+      cv::remap(right, out.right, right_map_x_, right_map_y_, cv::INTER_LINEAR,
+                cv::BORDER_CONSTANT);
+    } else if (rectification_) {
       std::tie(out.grey, out.right) = rectification_->Rectify(left, right);
     } else {
       out.grey = left;

@@ -40,8 +40,13 @@ class KeyframeImageSource {
   // `settings`: the settings file the run used (nullopt: as `pkslam run` defaults: EuRoC
   // sensor.yaml files, TUM RGB-D DATASET/settings.yaml). EuRoC datasets give stereo (cam1
   // required), TUM RGB-D datasets depth images. Throws InputError / OptionError.
+  // full_view (stereo with rectification): rectify onto a canvas grown to hold every raw pixel
+  // of both cameras, with the run's rectifying rotations and focal length (so the run's
+  // keyframe poses and bf stay valid): the run's rectified images (alpha 0, the raw size) crop
+  // the distorted periphery the cameras saw.
   static KeyframeImageSource Open(const std::filesystem::path& dataset,
-                                  const std::optional<std::filesystem::path>& settings);
+                                  const std::optional<std::filesystem::path>& settings,
+                                  bool full_view = false);
 
   DepthSource source() const { return source_; }
   const Settings& settings() const { return settings_; }
@@ -53,6 +58,10 @@ class KeyframeImageSource {
   CameraModel PinholeCamera() const;
   // Stereo: rectified fx * baseline (px m); RGB-D: 0.
   double bf() const { return bf_; }
+  // full_view: CV_8UC1 over camera()'s image, 255 where the left pixel comes from inside the
+  // raw left image and its right counterpart row from inside the raw right image; empty when
+  // every pixel is valid.
+  const cv::Mat& valid_mask() const { return valid_mask_; }
   const std::optional<StereoRectification>& rectification() const { return rectification_; }
 
   // Frame timestamps (t_ns) in dataset order.
@@ -70,6 +79,9 @@ class KeyframeImageSource {
   CameraModel camera_;
   double bf_ = 0;
   std::optional<StereoRectification> rectification_;
+  // full_view remap tables (rectified pixel -> raw pixel, CV_32FC1); empty otherwise.
+  cv::Mat left_map_x_, left_map_y_, right_map_x_, right_map_y_;
+  cv::Mat valid_mask_;
   std::optional<EurocDataset> euroc_;
   std::optional<TumRgbdDataset> tum_;
   std::vector<std::int64_t> timestamps_;

@@ -61,8 +61,25 @@ cv::Mat ComputeRawDisparity(const cv::Mat& rect_left, const cv::Mat& rect_right,
   options.Check();
   CheckPair(rect_left, rect_right);
   cv::Mat fixed;
-  MakeMatcher(options)->compute(rect_left, rect_right, fixed);
-  return ToFloatDisparity(fixed, options.min_disparity);
+  if (!options.pad_borders) {
+    MakeMatcher(options)->compute(rect_left, rect_right, fixed);
+    return ToFloatDisparity(fixed, options.min_disparity);
+  }
+  const int pad = options.min_disparity + options.num_disparities;
+  cv::Mat left, right;
+  cv::copyMakeBorder(rect_left, left, 0, 0, pad, 0, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::copyMakeBorder(rect_right, right, 0, 0, pad, 0, cv::BORDER_CONSTANT, cv::Scalar(0));
+  MakeMatcher(options)->compute(left, right, fixed);
+  cv::Mat disparity = ToFloatDisparity(fixed(cv::Rect(pad, 0, rect_left.cols, rect_left.rows)),
+                                       options.min_disparity);
+  // A match inside the padding is no match.
+  for (int r = 0; r < disparity.rows; ++r) {
+    float* d = disparity.ptr<float>(r);
+    for (int c = 0; c < disparity.cols; ++c) {
+      if (d[c] > static_cast<float>(c)) d[c] = 0;
+    }
+  }
+  return disparity;
 }
 
 int LeftRightCheck(const cv::Mat& right_disparity, double max_difference, cv::Mat* left_disparity) {

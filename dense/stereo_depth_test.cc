@@ -157,6 +157,42 @@ TEST(StereoDepthTest, LeftRightCheckRemovesOccludedBackground) {
   EXPECT_NEAR(checked.at<float>(240, 600), db, 0.5);
 }
 
+TEST(StereoDepthTest, PaddingRecoversBothImageSides) {
+  const cv::Mat tex = Texture(4, kWidth + 200);
+  // A fronto-parallel plane at disparity 16: every left pixel at x >= 16 has its match.
+  const double disparity = 16;
+  const Pair p =
+      MakePair([&](int, double) { return disparity; }, [&](int, double) { return disparity; },
+               [&](int, double) { return &tex; });
+  StereoDepthOptions o;
+  o.num_disparities = 64;
+  // Valid share of the rows [20, 460) over left columns [c0, c1).
+  auto valid_share = [&](const cv::Mat& disp, int c0, int c1) {
+    int valid = 0, n = 0;
+    for (int r = 20; r < kHeight - 20; ++r) {
+      for (int c = c0; c < c1; ++c) {
+        ++n;
+        valid += std::abs(disp.at<float>(r, c) - disparity) < 0.5;
+      }
+    }
+    return static_cast<double>(valid) / n;
+  };
+  const cv::Mat padded = ComputeDisparity(p.left, p.right, o);
+  o.pad_borders = false;
+  const cv::Mat unpadded = ComputeDisparity(p.left, p.right, o);
+  // Left side: SGBM alone leaves the first num_disparities columns empty.
+  EXPECT_LT(valid_share(unpadded, 24, 60), 0.05);
+  EXPECT_GT(valid_share(padded, 24, 60), 0.9);
+  // Right side: the mirrored right-view matching loses the right image's last
+  // num_disparities columns, so the left-right check rejected the left pixels matching there.
+  EXPECT_LT(valid_share(unpadded, kWidth - 40, kWidth - 10), 0.05);
+  EXPECT_GT(valid_share(padded, kWidth - 40, kWidth - 10), 0.9);
+  // No disparity points outside the right image.
+  for (int r = 0; r < kHeight; ++r) {
+    for (int c = 0; c < 16; ++c) EXPECT_LE(padded.at<float>(r, c), static_cast<float>(c));
+  }
+}
+
 TEST(StereoDepthTest, LeftRightCheckByHand) {
   cv::Mat left = cv::Mat::zeros(1, 40, CV_32F), right = cv::Mat::zeros(1, 40, CV_32F);
   left.at<float>(0, 20) = 10.0f;  // right x = 10 agrees

@@ -30,10 +30,12 @@ VoxelGrid::VoxelGrid(double voxel_m) : voxel_m_(voxel_m) {
 }
 
 void VoxelGrid::AddView(int view, const std::vector<Eigen::Vector3f>& points,
-                        const std::vector<Rgb>& colours) {
+                        const std::vector<Rgb>& colours, const std::vector<std::uint8_t>& support) {
   PKSLAM_CHECK(view >= 0, "view id {} < 0", view);
   PKSLAM_CHECK(colours.empty() || colours.size() == points.size(), "{} colours for {} points",
                colours.size(), points.size());
+  PKSLAM_CHECK(support.empty() || support.size() == points.size(), "{} supports for {} points",
+               support.size(), points.size());
   if (!colours.empty()) has_colour_ = true;
   const double inv = 1.0 / voxel_m_;
   for (std::size_t n = 0; n < points.size(); ++n) {
@@ -44,13 +46,16 @@ void VoxelGrid::AddView(int view, const std::vector<Eigen::Vector3f>& points,
     PKSLAM_CHECK(std::abs(i) < kHalfRange && std::abs(j) < kHalfRange && std::abs(k) < kHalfRange,
                  "point ({}, {}, {}) is outside the voxel grid's range", p.x(), p.y(), p.z());
     Voxel& v = voxels_[PackKey(i, j, k)];
-    v.offset_sum[0] += static_cast<float>(p.x() - static_cast<double>(i) * voxel_m_);
-    v.offset_sum[1] += static_cast<float>(p.y() - static_cast<double>(j) * voxel_m_);
-    v.offset_sum[2] += static_cast<float>(p.z() - static_cast<double>(k) * voxel_m_);
+    const std::uint8_t s = support.empty() ? 1 : std::max<std::uint8_t>(support[n], 1);
+    const float w = s;
+    v.offset_sum[0] += w * static_cast<float>(p.x() - static_cast<double>(i) * voxel_m_);
+    v.offset_sum[1] += w * static_cast<float>(p.y() - static_cast<double>(j) * voxel_m_);
+    v.offset_sum[2] += w * static_cast<float>(p.z() - static_cast<double>(k) * voxel_m_);
     if (!colours.empty()) {
-      for (int c = 0; c < 3; ++c) v.colour_sum[c] += colours[n][c];
+      for (int c = 0; c < 3; ++c) v.colour_sum[c] += w * colours[n][c];
     }
-    ++v.count;
+    v.weight += w;
+    v.support = std::max(v.support, s);
     if (v.last_view != view) {
       v.last_view = view;
       if (v.views < UINT16_MAX) ++v.views;
@@ -72,13 +77,14 @@ PointCloud VoxelGrid::Extract(int min_views) const {
   for (std::uint64_t key : keys) {
     const Voxel& v = voxels_.at(key);
     const Eigen::Vector3i ijk = UnpackKey(key);
-    const double n = v.count;
+    const double n = v.weight;
     Eigen::Vector3f p;
     for (int a = 0; a < 3; ++a) {
       p[a] = static_cast<float>(ijk[a] * voxel_m_ + v.offset_sum[a] / n);
     }
     cloud.points.push_back(p);
-    cloud.views.push_back(static_cast<std::uint8_t>(std::min<int>(v.views, 255)));
+    cloud.views.push_back(
+        static_cast<std::uint8_t>(std::min<int>(std::max<int>(v.views, v.support), 255)));
     if (has_colour_) {
       Rgb c;
       for (int a = 0; a < 3; ++a) {

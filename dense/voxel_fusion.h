@@ -22,18 +22,22 @@ class VoxelGrid {
   // Voxel side in metres (> 0; throws OptionError otherwise).
   explicit VoxelGrid(double voxel_m);
 
-  // Adds the points (world frame) of one view. `colours` is empty or one per point. A view's
-  // points must arrive in one call or in consecutive calls with the same `view` id; a view
-  // id that comes back later counts as a new view. Points beyond +-2^20 voxels from the
-  // origin throw Error.
+  // Adds the points (world frame) of one view. `colours` is empty or one per point. `support`
+  // is empty (1 each) or one per point: the keyframes that agreed on that depth (itself
+  // included, dense/depth_consistency.h); a voxel averages its points weighted by support, so
+  // confirmed, averaged depths outweigh single-view ones. A view's points must arrive in one
+  // call or in consecutive calls with the same `view` id; a view id that comes back later
+  // counts as a new view. Points beyond +-2^20 voxels from the origin throw Error.
   void AddView(int view, const std::vector<Eigen::Vector3f>& points,
-               const std::vector<Rgb>& colours);
+               const std::vector<Rgb>& colours, const std::vector<std::uint8_t>& support = {});
 
   std::size_t NumVoxels() const { return voxels_.size(); }
   double voxel_m() const { return voxel_m_; }
 
-  // One point per voxel seen by >= min_views views: mean position, mean colour (when colours
-  // were given), views (capped at 255); ordered by voxel index (deterministic).
+  // One point per voxel seen by >= min_views views: support-weighted mean position and colour
+  // (when colours were given), views = the larger of the distinct views that put a point
+  // there and the largest support of its points (capped at 255; 1 = one keyframe's
+  // unconfirmed depth); ordered by voxel index (deterministic).
   PointCloud Extract(int min_views) const;
 
   // Voxel count per number of views (index v: voxels seen by exactly v views; last bin
@@ -42,11 +46,12 @@ class VoxelGrid {
 
  private:
   struct Voxel {
-    float offset_sum[3] = {0, 0, 0};  // sum of (point - voxel corner), metres
-    std::uint32_t colour_sum[3] = {0, 0, 0};
-    std::uint32_t count = 0;
+    float offset_sum[3] = {0, 0, 0};  // weighted sum of (point - voxel corner), metres
+    float colour_sum[3] = {0, 0, 0};  // weighted
+    float weight = 0;
     std::int32_t last_view = -1;
     std::uint16_t views = 0;
+    std::uint8_t support = 0;  // largest point support
   };
 
   double voxel_m_;

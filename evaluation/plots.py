@@ -39,6 +39,8 @@ def read_results(path):
         r["ok"] = r["status"] == "ok"
         for k in ("ate_m", "keyframes", "median_tracking_ms", "wall_s", "sweep_value"):
             r[k] = number(r[k])
+        # Absent in results.csv files written before dense clouds were part of a bench.
+        r["dense_points"] = number(r.get("dense_points"))
         r["index"] = int(r["index"])
     rows.sort(key=lambda r: r["index"])
     return rows
@@ -198,7 +200,11 @@ def trajectories(index, rows, roots):
 def sweeps(index, rows):
     for param in unique(r["sweep_param"] for r in rows if r["sweep_param"]):
         sub = [r for r in rows if r["sweep_param"] == param]
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
+        dense = any(math.isfinite(r["dense_points"]) for r in sub if r["ok"])
+        if dense:
+            fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(16, 4))
+        else:
+            fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
         for dataset in unique(r["dataset"] for r in sub):
             for sensor in unique(r["sensor"] for r in sub if r["dataset"] == dataset):
                 for base in unique(r["config"].split("@")[0] for r in sub):
@@ -214,15 +220,47 @@ def sweeps(index, rows):
                                 marker="o", capsize=3, label=label)
                     a2.errorbar(values, [m for m, _ in kfs], yerr=[s for _, s in kfs],
                                 marker="s", capsize=3, label=label)
+                    if dense:
+                        equation13(a3, values, [m for m, _ in ate],
+                                   [mean_std([r["dense_points"] for r in pts
+                                              if r["sweep_value"] == v and r["ok"]])[0]
+                                    for v in values], label)
         a1.set_xlabel(param)
         a1.set_ylabel("ATE RMSE [m] (mean ± std)")
         a2.set_xlabel(param)
         a2.set_ylabel("keyframes (mean ± std)")
-        for a in (a1, a2):
+        axes = (a1, a2)
+        if dense:
+            a3.set_xlabel(param)
+            a3.set_ylabel("normalised dense points − normalised ATE")
+            a3.set_title("PKS paper Eq. 13 (star: best value)", fontsize=9)
+            axes = (a1, a2, a3)
+        for a in axes:
             a.grid(alpha=0.3)
             a.legend(fontsize=8)
         index.save(fig, f"sweep_{safe(param)}.png", "sweeps",
-                   f"Sweep of {param}: accuracy and keyframe count per value")
+                   f"Sweep of {param}: accuracy and keyframe count per value"
+                   + (", and the Eq. 13 score from the dense clouds" if dense else ""))
+
+
+def equation13(axis, values, ate, dense, label):
+    """Plots min-max normalised density minus normalised ATE; marks the argmax."""
+    pts = [(v, a, d) for v, a, d in zip(values, ate, dense)
+           if math.isfinite(a) and math.isfinite(d)]
+    if len(pts) < 2:
+        return
+
+    def norm(x, xs):
+        lo, hi = min(xs), max(xs)
+        return (x - lo) / (hi - lo) if hi > lo else 0.0
+
+    a_all = [a for _, a, _ in pts]
+    d_all = [d for _, _, d in pts]
+    score = [norm(d, d_all) - norm(a, a_all) for _, a, d in pts]
+    xs = [v for v, _, _ in pts]
+    line, = axis.plot(xs, score, marker="o", label=label)
+    best = int(np.argmax(score))
+    axis.plot([xs[best]], [score[best]], marker="*", markersize=14, color=line.get_color())
 
 
 def main():

@@ -43,6 +43,7 @@ LoopClosing::LoopClosing(Atlas* atlas, Sensor sensor, MappingControl mapping,
   PKSLAM_CHECK(atlas_ != nullptr, "loop closing needs an atlas");
   options_.verifier.fix_scale = !IsMonocular(sensor_);
   options_.Check();
+  seed_ = options_.seed;
 }
 
 LoopClosing::~LoopClosing() { Finish(); }

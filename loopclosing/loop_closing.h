@@ -61,6 +61,8 @@ struct LoopClosingOptions {
   double fuse_radius = 4.0;
   // Process in the caller's thread, run the global BA inline (deterministic mode).
   bool synchronous = false;
+  // First RANSAC seed of place verification (each verification draws the next one).
+  std::uint64_t seed = 0;
   // Ceres threads of the essential graph (1 in deterministic mode).
   int num_threads = 1;
 

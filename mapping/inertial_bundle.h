@@ -9,8 +9,9 @@
 //
 // Local window: the newest `window` keyframes of the chain ending at the new keyframe are free
 // (pose, velocity, biases with random walks); the keyframe just before the window is fixed and
-// joined by its inertial edge: it anchors the window like a marginalisation prior with the
-// previous state held at its estimate (ORB-SLAM3's choice). Other keyframes observing the
+// joined by its inertial edge: it anchors the window in place of a marginalisation prior, the
+// previous state held at its estimate (ORB-SLAM3's choice; no Schur-complement prior is kept, so
+// information of states that left the window is dropped). Other keyframes observing the
 // window's points are fixed, visual only. Full: every chain keyframe, the first pose fixed;
 // optionally one bias pair shared by all with zero-mean priors (the BA right after the
 // inertial-only initialisation).
@@ -31,9 +32,11 @@ struct InertialBundleOptions {
   int window = 10;
   // Local window: at most this many fixed visual-only keyframes (most shared points first).
   int max_fixed_keyframes = 15;
-  // Solver passes as BundleAdjustmentOptions (robust pass, outliers removed, refinement).
-  int iterations_first = 4;
-  int iterations_second = 4;
+  // Solver passes as BundleAdjustmentOptions: a robust (Huber) pass, then, if
+  // iterations_second > 0, a refinement without the outliers. 0 is ORB-SLAM3's local inertial
+  // BA: one robust pass whose outliers are only classified (half the Ceres set-up cost).
+  int iterations_first = 8;
+  int iterations_second = 0;
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
   int num_threads = 1;

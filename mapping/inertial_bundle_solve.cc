@@ -138,7 +138,9 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.enable_fast_removal = true;
+  // Removing outlier blocks between the passes needs Ceres' removal index; a single pass
+  // (ORB-SLAM3's local inertial BA) only classifies them and skips its upkeep.
+  problem_options.enable_fast_removal = options.iterations_second > 0;
   ceres::Problem ceres_problem(problem_options);
 
   std::vector<std::uint8_t> pose_added(static_cast<std::size_t>(num_kf), 0);
@@ -261,7 +263,7 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
                            (o.u_right >= 0 ? options.chi2_stereo : options.chi2_mono));
     if (!outlier) continue;
     result.visual.outlier_observations.push_back(i);
-    if (blocks[i] != nullptr) {
+    if (blocks[i] != nullptr && options.iterations_second > 0) {
       ceres_problem.RemoveResidualBlock(blocks[i]);
       blocks[i] = nullptr;
     }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "imu/imu_test_utils.h"
@@ -133,6 +134,34 @@ TEST(InertialBundle, FixedAnchorStateIsUntouched) {
   EXPECT_TRUE(r.visual.camera_from_world[0].translation() ==
               s.problem.visual.keyframes[0].camera_from_world.translation());
   ExpectRecovered(s, r);
+}
+
+TEST(InertialBundle, SinglePassClassifiesOutliersAndStillRecovers) {
+  Scene s = MakeScene(false);
+  // Two gross outliers on a middle keyframe.
+  int corrupted = 0;
+  std::vector<int> bad;
+  for (int i = 0; i < static_cast<int>(s.problem.visual.observations.size()) && corrupted < 2;
+       ++i) {
+    auto& o = s.problem.visual.observations[i];
+    if (o.keyframe_index != 6) continue;
+    o.uv += Eigen::Vector2d(40, -30);
+    o.u_right += 40;
+    bad.push_back(i);
+    ++corrupted;
+  }
+  ASSERT_EQ(corrupted, 2);
+  InertialBundleOptions options;  // the local BA defaults: one robust pass
+  ASSERT_EQ(options.iterations_second, 0);
+  options.iterations_first = 30;
+  const InertialBundleResult r = SolveInertialBundle(s.problem, options);
+  ExpectRecovered(s, r);
+  for (int i : bad) {
+    EXPECT_NE(
+        std::find(r.visual.outlier_observations.begin(), r.visual.outlier_observations.end(), i),
+        r.visual.outlier_observations.end())
+        << "observation " << i;
+  }
 }
 
 }  // namespace

@@ -15,9 +15,11 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "core/frame/camera_rig.h"
+#include "core/imu/imu_types.h"
 #include "core/map/atlas.h"
 #include "core/map/mapping_backend.h"
 #include "core/optim/bundle_adjustment.h"
@@ -43,13 +45,28 @@ struct LocalMappingOptions {
   void Check() const;
 };
 
+// The map's keyframe chain right after one IMU initialisation stage (its full visual-inertial
+// BA included), for evaluation against ground truth (scale, gravity, biases per stage).
+struct ImuStageSnapshot {
+  std::int64_t t_ns = 0;  // the keyframe that triggered the stage
+  int stage = 0;          // 0 initialisation, 1 VIBA1, 2 VIBA2
+  double scale = 1.0;     // the scale the inertial-only step applied
+  ImuBias bias;
+  std::vector<std::pair<std::int64_t, SE3d>> world_from_body;  // chain keyframes, oldest first
+};
+
 struct LocalMappingStats {
   std::vector<double> keyframe_ms;  // processing time per keyframe
   std::vector<double> ba_ms;        // local BA time per keyframe (0 when skipped)
+  // CPU time of the mapping thread per keyframe, all of it and local BA alone (the wall-clock
+  // times above also count lock waits and preemption on a busy machine).
+  std::vector<double> keyframe_cpu_ms;
+  std::vector<double> ba_cpu_ms;
   int ba_aborted = 0;
   int keyframes_culled = 0;
   int points_created = 0;
   int points_culled = 0;
+  std::vector<ImuStageSnapshot> imu_stages;
 };
 
 class LocalMapper : public MappingBackend {
@@ -98,7 +115,7 @@ class LocalMapper : public MappingBackend {
   // --- inertial sensors (mapping/local_mapper_inertial.cc) ---
   // IMU initialisation stages (first, VIBA1, VIBA2) when due.
   void InertialStep(const KeyFramePtr& kf);
-  bool InitializeImu(const KeyFramePtr& kf, double gyro_prior, double accel_prior, bool refinement);
+  bool InitializeImu(const KeyFramePtr& kf, double gyro_prior, double accel_prior, int stage);
   void FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyro_prior, double accel_prior);
   // Local inertial BA once the map's IMU is initialised; false if it did not apply (then the
   // visual local BA runs).
@@ -126,6 +143,10 @@ class LocalMapper : public MappingBackend {
 
   // Owned by the mapping thread: points created recently, checked by CullRecentPoints.
   std::vector<MapPointPtr> recent_points_;
+  // Owned by the mapping thread: seconds of motion since the IMU initialisation of moving_map_
+  // (the clock of the VIBA refinements, mapping/inertial_mapping.h).
+  const Map* moving_map_ = nullptr;
+  double moving_s_ = 0;
 
   std::thread thread_;
 };

@@ -1,4 +1,5 @@
 // LocalMapper: IMU initialisation stages and local inertial BA (see mapping/inertial_mapping.h).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -45,20 +46,26 @@ void InertialMappingOptions::Check() const {
   PKSLAM_CHECK_OPTION(mono_min_travel >= 0, "inertial.mono_min_travel", "{}", mono_min_travel);
   PKSLAM_CHECK_OPTION(init_gyro_prior >= 0 && init_accel_prior_mono >= 0 &&
                           init_accel_prior_stereo >= 0 && viba1_gyro_prior >= 0 &&
-                          viba1_accel_prior >= 0,
+                          viba1_accel_prior >= 0 && viba2_gyro_prior >= 0 && viba2_accel_prior >= 0,
                       "inertial.priors", "{}", "negative");
   PKSLAM_CHECK_OPTION(viba1_s > 0 && viba2_s > viba1_s, "inertial.viba", "{} / {}", viba1_s,
                       viba2_s);
+  PKSLAM_CHECK_OPTION(moving_distance >= 0 && moving_angle_rad >= 0 && moving_max_interval_s > 0,
+                      "inertial.moving", "{} / {} / {}", moving_distance, moving_angle_rad,
+                      moving_max_interval_s);
   PKSLAM_CHECK_OPTION(full_ba_iterations >= 1, "inertial.full_ba_iterations", "{}",
                       full_ba_iterations);
   local_ba.Check();
+  culling.Check();
 }
 
 void LocalMapper::InertialStep(const KeyFramePtr& kf) {
   bool initialized = false;
   bool ba1 = false;
   bool ba2 = false;
+  double step_s = 0;  // the interval from the previous keyframe, if the body moved over it
   std::int64_t init_t_ns = 0;
+  const InertialMappingOptions& o = options_.inertial;
   {
     std::shared_lock lock(atlas_->mutex());
     if (kf->IsBad() || kf->map() == nullptr) return;
@@ -67,17 +74,34 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
     ba1 = map->inertial_ba1_done;
     ba2 = map->inertial_ba2_done;
     init_t_ns = map->imu_init_t_ns;
+    if (map != moving_map_) {
+      moving_map_ = map;
+      moving_s_ = 0;
+    }
+    if (const KeyFrame* previous = kf->imu.previous; previous != nullptr && !previous->IsBad()) {
+      const SE3d previous_from_kf = WorldFromBody(*previous).Inverse() * WorldFromBody(*kf);
+      if (previous_from_kf.translation().norm() > o.moving_distance ||
+          previous_from_kf.so3().Log().norm() > o.moving_angle_rad) {
+        step_s = std::min(o.moving_max_interval_s,
+                          static_cast<double>(kf->t_ns() - previous->t_ns()) * 1e-9);
+      }
+    }
   }
-  const InertialMappingOptions& o = options_.inertial;
   const bool mono = IsMonocular(rig_->sensor);
   if (!initialized) {
     initializing_imu_.store(true);
-    InitializeImu(kf, o.init_gyro_prior, mono ? o.init_accel_prior_mono : o.init_accel_prior_stereo,
-                  false);
+    if (InitializeImu(kf, o.init_gyro_prior,
+                      mono ? o.init_accel_prior_mono : o.init_accel_prior_stereo, 0)) {
+      moving_s_ = 0;
+    }
     initializing_imu_.store(false);
     return;
   }
-  const double since = static_cast<double>(kf->t_ns() - init_t_ns) * 1e-9;
+  // The refinements wait for motion time since the initialisation, not clock time: a platform
+  // standing still adds nothing that separates the accelerometer bias from gravity.
+  moving_s_ += step_s;
+  const double since =
+      o.viba_motion_time ? moving_s_ : static_cast<double>(kf->t_ns() - init_t_ns) * 1e-9;
   auto mark = [&](bool second) {
     std::unique_lock lock(atlas_->mutex());
     if (kf->map() == nullptr) return;
@@ -85,17 +109,18 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
   };
   if (!ba1 && since > o.viba1_s) {
     initializing_imu_.store(true);
-    if (InitializeImu(kf, o.viba1_gyro_prior, o.viba1_accel_prior, true)) mark(false);
+    if (InitializeImu(kf, o.viba1_gyro_prior, o.viba1_accel_prior, 1)) mark(false);
     initializing_imu_.store(false);
   } else if (ba1 && !ba2 && since > o.viba2_s) {
     initializing_imu_.store(true);
-    if (InitializeImu(kf, 0.0, 0.0, true)) mark(true);
+    if (InitializeImu(kf, o.viba2_gyro_prior, o.viba2_accel_prior, 2)) mark(true);
     initializing_imu_.store(false);
   }
 }
 
 bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double accel_prior,
-                                bool refinement) {
+                                int stage) {
+  const bool refinement = stage > 0;
   const InertialMappingOptions& o = options_.inertial;
   const bool mono = IsMonocular(rig_->sensor);
   std::vector<InertialInitKeyFrame> keyframes;
@@ -175,6 +200,19 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
       r.bias.gyro.x(), r.bias.gyro.y(), r.bias.gyro.z(), r.bias.accel.x(), r.bias.accel.y(),
       r.bias.accel.z(), ms);
   FullInertialBundleAdjustment(kf, gyro_prior, accel_prior);
+  ImuStageSnapshot snapshot;
+  snapshot.t_ns = kf->t_ns();
+  snapshot.stage = stage;
+  snapshot.scale = r.scale;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    snapshot.bias = kf->imu.state.bias;
+    for (KeyFrame* k : InertialChain(kf.get(), 0)) {
+      snapshot.world_from_body.emplace_back(k->t_ns(), WorldFromBody(*k));
+    }
+  }
+  std::lock_guard stats_lock(mutex_);
+  stats_.imu_stages.push_back(std::move(snapshot));
   return true;
 }
 

@@ -10,7 +10,9 @@
 #include "core/map/keyframe_database.h"
 #include "core/map/map_point.h"
 #include "core/matching/orb_matcher.h"
+#include "core/util/cpu_time.h"
 #include "core/util/log.h"
+#include "mapping/inertial_culling.h"
 #include "mapping/local_mapper.h"
 #include "mapping/triangulation.h"
 
@@ -32,11 +34,13 @@ void LocalMapper::ProcessNext() {
     queue_.pop_front();
   }
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = ThreadCpuSeconds();
   abort_ba_.store(false);
   ProcessNewKeyFrame(kf);
   CullRecentPoints(kf);
   CreateNewMapPoints(kf);
   double ba_ms = 0;
+  double ba_cpu_ms = 0;
   if (!HasQueued()) {
     SearchInNeighbours(kf);
   }
@@ -48,19 +52,22 @@ void LocalMapper::ProcessNext() {
     }
     if (keyframes > 2) {
       const auto ba_start = std::chrono::steady_clock::now();
+      const double ba_cpu_start = ThreadCpuSeconds();
       if (!IsInertial(rig_->sensor) || !LocalInertialBundleAdjustment(kf)) {
         LocalBundleAdjustment(kf);
       }
       ba_ms = MsSince(ba_start);
+      ba_cpu_ms = 1e3 * (ThreadCpuSeconds() - ba_cpu_start);
     }
-    // Inertial maps keep every keyframe: the preintegration chain needs them (not culled).
-    if (options_.cull_keyframes && !IsInertial(rig_->sensor)) CullKeyFrames(kf);
+    if (options_.cull_keyframes) CullKeyFrames(kf);
   }
   if (IsInertial(rig_->sensor) && !IsStoppedOrStopRequested()) InertialStep(kf);
   {
     std::lock_guard lock(mutex_);
     stats_.keyframe_ms.push_back(MsSince(start));
     stats_.ba_ms.push_back(ba_ms);
+    stats_.keyframe_cpu_ms.push_back(1e3 * (ThreadCpuSeconds() - cpu_start));
+    stats_.ba_cpu_ms.push_back(ba_cpu_ms);
   }
   if (consumer_) consumer_(kf);
 }
@@ -225,11 +232,24 @@ void LocalMapper::CullKeyFrames(const KeyFramePtr& kf) {
   const bool mono = IsMonocular(rig_->sensor);
   const int observers = options_.culling_observers;
   const KeyFrame* origin = kf->map()->origin();
+  // Inertial maps: the temporal chain's spacing rules (mapping/inertial_culling.h).
+  const bool inertial = IsInertial(rig_->sensor);
+  const InertialCullingOptions& inertial_culling = options_.inertial.culling;
+  if (inertial && !inertial_culling.enabled) return;
+  const double redundancy = !inertial ? options_.culling_redundancy
+                            : mono    ? inertial_culling.redundancy_mono
+                                      : inertial_culling.redundancy_stereo;
+  InertialCullingContext context;
+  if (inertial) {
+    RepairInertialChain(kf.get(), 2 * inertial_culling.window);
+    context = MakeInertialCullingContext(*kf, inertial_culling);
+  }
   int culled = 0;
   int examined = 0;
   for (KeyFrame* candidate : std::vector<KeyFrame*>(kf->CovisiblesByWeight())) {
     if (candidate == origin || candidate->IsBad()) continue;
-    if (++examined > 100) break;
+    if (++examined > 100 || (inertial && examined > 20 && abort_ba_.load())) break;
+    if (inertial && !InertialCullingAllowed(*candidate, context, inertial_culling)) continue;
     const auto& kps = candidate->keypoints_undistorted();
     int points = 0;
     int redundant = 0;
@@ -254,8 +274,10 @@ void LocalMapper::CullKeyFrames(const KeyFramePtr& kf) {
       }
       if (seen_by >= observers) ++redundant;
     }
-    if (points > 0 && redundant > options_.culling_redundancy * points) {
+    if (points > 0 && redundant > redundancy * points) {
       candidate->SetBad();
+      if (!candidate->IsBad()) continue;  // protected by loop closing for now
+      if (inertial) SpliceOutOfInertialChain(candidate);
       ++culled;
     }
   }

@@ -33,7 +33,8 @@ float Albedo(const Scene& scene, const Shape& shape, int face, const Eigen::Vect
 }  // namespace
 
 std::size_t WriteReferenceCloud(const Scene& scene, const SurfaceVisibility* visibility,
-                                double spacing_m, const std::filesystem::path& file) {
+                                double spacing_m, const std::filesystem::path& file,
+                                const std::string& description) {
   PKSLAM_CHECK(spacing_m > 0.0, "cloud spacing must be > 0");
   const float step = static_cast<float>(spacing_m);
   std::vector<PlyVertex> points;
@@ -74,9 +75,14 @@ std::size_t WriteReferenceCloud(const Scene& scene, const SurfaceVisibility* vis
   }
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(fmt::format("cannot write {}", file.string()));
-  out << "ply\nformat binary_little_endian 1.0\ncomment pkslam simulate reference surface\n"
-      << fmt::format("comment spacing_m {}\n", spacing_m)
-      << fmt::format("element vertex {}\n", points.size())
+  out << "ply\nformat binary_little_endian 1.0\n"
+      << fmt::format("comment pkslam simulate {}\n", description)
+      << fmt::format("comment spacing_m {}\n", spacing_m);
+  if (visibility != nullptr && visibility->max_depth_m() > 0) {
+    out << fmt::format("comment visibility_cell_m {}\ncomment max_depth_m {}\n",
+                       visibility->cell_m(), visibility->max_depth_m());
+  }
+  out << fmt::format("element vertex {}\n", points.size())
       << "property float x\nproperty float y\nproperty float z\n"
          "property float nx\nproperty float ny\nproperty float nz\n"
          "property uchar intensity\nend_header\n";

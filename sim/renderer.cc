@@ -87,8 +87,10 @@ CameraRays::CameraRays(const CameraModel& camera, int supersample)
   }
 }
 
-SurfaceVisibility::SurfaceVisibility(const Scene& scene, float cell_m) : cell_m_(cell_m) {
+SurfaceVisibility::SurfaceVisibility(const Scene& scene, float cell_m, float max_depth_m)
+    : cell_m_(cell_m), max_depth_m_(max_depth_m) {
   PKSLAM_CHECK(cell_m > 0.0f, "visibility cell must be > 0");
+  PKSLAM_CHECK(max_depth_m >= 0.0f, "visibility max depth {} < 0", max_depth_m);
   std::size_t words = 0;
   faces_.resize(scene.shapes.size());
   for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
@@ -118,7 +120,8 @@ bool SurfaceVisibility::Index(int shape, int face, const Eigen::Vector2f& uv, st
   return true;
 }
 
-void SurfaceVisibility::Mark(int shape, int face, const Eigen::Vector2f& uv) {
+void SurfaceVisibility::Mark(int shape, int face, const Eigen::Vector2f& uv, float depth_m) {
+  if (max_depth_m_ > 0.0f && depth_m > max_depth_m_) return;
   std::size_t word = 0;
   std::uint64_t bit = 0;
   if (!Index(shape, face, uv, &word, &bit)) return;
@@ -174,7 +177,7 @@ struct FrameShape {
 }  // namespace
 
 void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, RenderBuffers* out,
-                      SurfaceVisibility* visibility) const {
+                      std::span<SurfaceVisibility* const> visibility) const {
   const int w = rays.width();
   const int h = rays.height();
   const int channels = options_.colour ? 3 : 1;
@@ -301,8 +304,11 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
                   const Eigen::Vector3f c = tex.SampleColour(st.x(), st.y(), lod);
                   for (int ch = 0; ch < 3; ++ch) acc[ch] += shade * c[ch];
                 }
-                depth_acc += t * rc.z();
-                if (visibility != nullptr) visibility->Mark(best->index, face, uv);
+                const float hit_depth = t * rc.z();
+                depth_acc += hit_depth;
+                for (SurfaceVisibility* v : visibility) {
+                  if (v != nullptr) v->Mark(best->index, face, uv, hit_depth);
+                }
               }
               for (int ch = 0; ch < channels; ++ch) rad[x * channels + ch] = acc[ch] * inv_samples;
               if (dep) dep[x] = depth_acc * inv_samples;

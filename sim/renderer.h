@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <span>
 #include <vector>
 
 #include "core/camera/camera_model.h"
@@ -54,14 +55,19 @@ class CameraRays {
   std::vector<Tile> tiles_;
 };
 
-// Marks which parts of which faces were seen (for the reference point cloud): per face a
-// grid of cells; set bits are seen. Thread-safe marking (atomic OR); see reference_cloud.h.
+// Marks which parts of which faces were seen (for the reference point clouds): per face a
+// grid of cells; set bits are seen. With max_depth_m > 0 only hits at a depth (along the
+// optical axis) of at most max_depth_m mark a cell: the surfaces a camera observed within a
+// survey range. Thread-safe marking (atomic OR, so the result does not depend on the order);
+// see reference_cloud.h.
 class SurfaceVisibility {
  public:
-  SurfaceVisibility(const Scene& scene, float cell_m);
-  void Mark(int shape, int face, const Eigen::Vector2f& uv);
+  SurfaceVisibility(const Scene& scene, float cell_m, float max_depth_m = 0.0f);
+  // depth_m: of the hit along the camera's optical axis.
+  void Mark(int shape, int face, const Eigen::Vector2f& uv, float depth_m);
   bool Seen(int shape, int face, const Eigen::Vector2f& uv) const;
   float cell_m() const { return cell_m_; }
+  float max_depth_m() const { return max_depth_m_; }
 
  private:
   struct FaceGrid {
@@ -73,6 +79,7 @@ class SurfaceVisibility {
              std::uint64_t* bit) const;
 
   float cell_m_ = 0.05f;
+  float max_depth_m_ = 0.0f;                  // 0: any depth
   std::vector<std::vector<FaceGrid>> faces_;  // [shape][face]
   std::vector<std::atomic<std::uint64_t>> bits_;
 };
@@ -96,8 +103,9 @@ class Renderer {
   Renderer(const Scene& scene, const RenderOptions& options);
 
   // Renders the view of a camera at world_from_camera (optical frame: z forward, y down).
+  // Every ray's hit marks each of `visibility` (null entries are skipped).
   void Render(const CameraRays& rays, const SE3d& world_from_camera, RenderBuffers* out,
-              SurfaceVisibility* visibility = nullptr) const;
+              std::span<SurfaceVisibility* const> visibility = {}) const;
 
   const RenderOptions& options() const { return options_; }
 

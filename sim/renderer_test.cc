@@ -197,6 +197,44 @@ TEST(Renderer, DepthIsDistanceAlongTheOpticalAxis) {
   }
 }
 
+TEST(Renderer, RangeLimitedVisibilityMarksOnlyHitsWithinItsDepth) {
+  const Scene scene = MarkerScene();
+  const CameraModel cam = CameraModel::Pinhole(64, 48, 50, 50, 31.5, 23.5);
+  const CameraRays rays(cam);
+  const Renderer renderer(scene, RenderOptions{});
+  // The room is shape 0; find the -y wall face and the cell straight ahead of the camera.
+  SurfaceVisibility any(scene, 0.1f);
+  SurfaceVisibility near(scene, 0.1f, 2.5f);
+  SurfaceVisibility nearer(scene, 0.1f, 1.5f);
+  SurfaceVisibility* marks[] = {&any, &near, &nearer, nullptr};
+  RenderBuffers b;
+  // The wall is 2 m ahead along the optical axis.
+  const SE3d pose = LookAt(Eigen::Vector3d(1.0, -2.0, 2.0), Eigen::Vector3d(1.0, -4.0, 2.0), 0);
+  renderer.Render(rays, pose, &b, marks);
+  int seen_any = 0, seen_near = 0, seen_nearer = 0;
+  for (int s = 0; s < static_cast<int>(scene.shapes.size()); ++s) {
+    for (int f = 0; f < scene.shapes[s].num_faces(); ++f) {
+      const Scene::FaceFrame frame = Scene::Face(scene.shapes[s], f);
+      for (float u = 0.05f; u < frame.size.x(); u += 0.1f) {
+        for (float v = 0.05f; v < frame.size.y(); v += 0.1f) {
+          const Eigen::Vector2f uv(u, v);
+          seen_any += any.Seen(s, f, uv);
+          seen_near += near.Seen(s, f, uv);
+          seen_nearer += nearer.Seen(s, f, uv);
+          if (near.Seen(s, f, uv)) {
+            EXPECT_TRUE(any.Seen(s, f, uv));
+          }
+        }
+      }
+    }
+  }
+  // Every hit is at depth 2 m: the 2.5 m layer sees what the unlimited one sees, the 1.5 m
+  // layer nothing (a 64 x 48 view of a wall 2 m away: about 2.6 x 1.9 m, ~500 cells).
+  EXPECT_GT(seen_any, 300);
+  EXPECT_EQ(seen_near, seen_any);
+  EXPECT_EQ(seen_nearer, 0);
+}
+
 TEST(Renderer, DistantSurfacesAreFilteredNotAliased) {
   // A fine texture 7 m away: a pixel covers ~0.14 m = hundreds of texels. Moving the camera by
   // 1/30 of a pixel footprint must barely change a mip-mapped image; point sampling (a large

@@ -55,6 +55,12 @@ void SimulationOptions::Check() const {
                       cloud_spacing_m);
   PKSLAM_CHECK_OPTION(visibility_cell_m >= cloud_spacing_m && visibility_cell_m <= 2.0,
                       "visibility_cell_m", "{} (>= cloud spacing)", visibility_cell_m);
+  PKSLAM_CHECK_OPTION(observed_range_m >= 0.0 && observed_range_m <= 100.0, "--observed-range",
+                      "{}", observed_range_m);
+  PKSLAM_CHECK_OPTION(observed_cell_m >= 0.001 && observed_cell_m <= 2.0, "--observed-cell", "{}",
+                      observed_cell_m);
+  PKSLAM_CHECK_OPTION(!reference_only || (write_cloud && write_images && !bench),
+                      "--reference-only", "{}", "needs images and the cloud (no --bench)");
   PKSLAM_CHECK_OPTION(bench_frames >= 0, "bench_frames", "{}", bench_frames);
   if (trajectory.empty()) motion.Check();
   replay.Check();
@@ -157,6 +163,9 @@ void WriteSimYaml(const std::filesystem::path& file, const SimulationOptions& o,
   e << YAML::Key << "spacing_m" << YAML::Value << o.cloud_spacing_m;
   e << YAML::Key << "visibility_cell_m" << YAML::Value << o.visibility_cell_m;
   e << YAML::Key << "points" << YAML::Value << s.cloud_points;
+  e << YAML::Key << "observed_range_m" << YAML::Value << o.observed_range_m;
+  e << YAML::Key << "observed_cell_m" << YAML::Value << o.observed_cell_m;
+  e << YAML::Key << "observed_points" << YAML::Value << s.observed_points;
   e << YAML::EndMap;
   e << YAML::EndMap;
 

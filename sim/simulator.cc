@@ -3,6 +3,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -57,7 +58,7 @@ CameraRig RgbdCamera(double rate_hz) {
 // Renders the radiance seen by a camera at time t, averaged over the exposure (motion blur).
 void RenderFrame(const Renderer& renderer, const CameraRays& rays, const SplineTrajectory& traj,
                  const SE3d& body_from_camera, std::int64_t t_ns, double exposure_s, int samples,
-                 RenderBuffers* out, SurfaceVisibility* visibility) {
+                 RenderBuffers* out, std::span<SurfaceVisibility* const> visibility) {
   if (exposure_s <= 0.0 || samples <= 1) {
     renderer.Render(rays, traj.WorldFromBody(t_ns) * body_from_camera, out, visibility);
     return;
@@ -69,7 +70,7 @@ void RenderFrame(const Renderer& renderer, const CameraRays& rays, const SplineT
                                        traj.begin_ns(), traj.end_ns());
     const bool centre = i == samples / 2;
     renderer.Render(rays, traj.WorldFromBody(ti) * body_from_camera, &sub,
-                    centre ? visibility : nullptr);
+                    centre ? visibility : std::span<SurfaceVisibility* const>{});
     if (i == 0) {
       sum = sub.radiance.clone();
     } else {
@@ -134,6 +135,18 @@ void MotionStatistics(const SplineTrajectory& traj, std::int64_t begin, std::int
   const double duration = 1e-9 * static_cast<double>(end - begin);
   s->mean_speed_mps = duration > 0.0 ? s->path_length_m / duration : 0.0;
   s->mean_angular_rate_dps = n > 0 ? rate_sum / n : 0.0;
+}
+
+void WriteReferenceClouds(const Scene& scene, const SurfaceVisibility* visibility,
+                          const SurfaceVisibility* observed, const SimulationOptions& o,
+                          SimulationSummary* summary) {
+  summary->cloud_points = WriteReferenceCloud(scene, visibility, o.cloud_spacing_m,
+                                              o.output_dir / "reference_cloud.ply");
+  if (observed != nullptr) {
+    summary->observed_points = WriteReferenceCloud(
+        scene, observed, o.cloud_spacing_m, o.output_dir / "reference_observed.ply",
+        fmt::format("observed reference: surfaces cam0 saw within {} m", o.observed_range_m));
+  }
 }
 
 }  // namespace
@@ -206,7 +219,11 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   // IMU and ground truth (EuRoC layout only).
   std::unique_ptr<EurocWriter> euroc;
   std::unique_ptr<TumRgbdWriter> tum;
-  if (!o.bench) {
+  if (o.reference_only) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.output_dir, ec);
+    if (ec) throw Error(fmt::format("cannot create {}: {}", o.output_dir.string(), ec.message()));
+  } else if (!o.bench) {
     std::error_code ec;
     std::filesystem::create_directories(o.output_dir, ec);
     if (ec) throw Error(fmt::format("cannot create {}: {}", o.output_dir.string(), ec.message()));
@@ -218,7 +235,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
           o.output_dir, o.write_images ? cameras : std::vector<CameraRig>{}, o.imu, o.write_imu);
     }
   }
-  if (!o.rgbd) {
+  if (!o.rgbd && !o.reference_only) {
     const std::vector<ImuSample> imu = SimulateImu(traj, begin_ns, end_ns, o.imu, o.seed);
     summary.imu_samples = static_cast<int>(imu.size());
     if (euroc) {
@@ -254,10 +271,17 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     sensors.emplace_back(o.sensor, rays[c], DeriveSeed(o.seed, 0x43414D00 + c));
   }
   std::unique_ptr<SurfaceVisibility> visibility;
+  std::unique_ptr<SurfaceVisibility> observed;
   if (o.write_cloud && !o.bench && frames > 0) {
     visibility =
         std::make_unique<SurfaceVisibility>(scene, static_cast<float>(o.visibility_cell_m));
+    if (o.observed_range_m > 0.0) {
+      observed = std::make_unique<SurfaceVisibility>(scene, static_cast<float>(o.observed_cell_m),
+                                                     static_cast<float>(o.observed_range_m));
+    }
   }
+  // cam0's rays mark both (the dense tool reconstructs the left camera's view).
+  const std::array<SurfaceVisibility*, 2> cam0_marks = {visibility.get(), observed.get()};
   const PixelNoise depth_noise;
   const double exposure = o.motion_blur_exposure_s;
   Progress progress(o.bench ? "bench" : "simulate", static_cast<std::size_t>(frames), o.quiet);
@@ -282,10 +306,15 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     std::vector<cv::Mat> images(cameras.size());
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t cpu0 = std::clock();
-    if (!black) {
+    if (!black && o.reference_only) {  // cam0 alone, no image formation
+      RenderFrame(renderer, rays[0], traj, cameras[0].body_from_camera, t, exposure,
+                  o.motion_blur_samples, &buffers[0], cam0_marks);
+    } else if (!black) {
       for (std::size_t c = 0; c < cameras.size(); ++c) {
         RenderFrame(renderer, rays[c], traj, cameras[c].body_from_camera, t, exposure,
-                    o.motion_blur_samples, &buffers[c], c == 0 ? visibility.get() : nullptr);
+                    o.motion_blur_samples, &buffers[c],
+                    c == 0 ? std::span<SurfaceVisibility* const>(cam0_marks)
+                           : std::span<SurfaceVisibility* const>{});
       }
       // One exposure for the rig (the VI-Sensor shares it between cameras).
       const double gain = sensors[0].NextGain(buffers[0].radiance, 1.0 / rate);
@@ -335,6 +364,11 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     summary.layout = "bench";
     return summary;
   }
+  if (o.reference_only) {
+    summary.layout = "reference";
+    WriteReferenceClouds(scene, visibility.get(), observed.get(), o, &summary);
+    return summary;
+  }
   if (tum) {
     // Ground truth of the colour camera at 100 Hz (TUM's motion-capture rate).
     for (std::int64_t t = first; t <= end_ns; t += 10'000'000) {
@@ -348,10 +382,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     WriteSettings(o.output_dir / "settings.yaml", cameras, o);
     summary.layout = "euroc";
   }
-  if (o.write_cloud) {
-    summary.cloud_points = WriteReferenceCloud(scene, visibility.get(), o.cloud_spacing_m,
-                                               o.output_dir / "reference_cloud.ply");
-  }
+  if (o.write_cloud) WriteReferenceClouds(scene, visibility.get(), observed.get(), o, &summary);
   WriteSimYaml(o.output_dir / "sim.yaml", o, summary);
   return summary;
 }

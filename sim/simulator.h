@@ -3,7 +3,10 @@
 //     DIR/settings.yaml (ORB-SLAM3 format), DIR/timestamps.txt.
 //   RGB-D mode: TUM RGB-D layout (rgb/, depth/, rgb.txt, depth.txt, associations.txt,
 //     groundtruth.txt of the colour camera), DIR/settings.yaml.
-//   Both: DIR/reference_cloud.ply (seen surfaces), DIR/sim.yaml (every option + seed).
+//   Both: DIR/reference_cloud.ply (every surface cam0 saw), DIR/reference_observed.ply (the
+//     surfaces cam0 saw within observed_range_m: the surveyed area), DIR/sim.yaml (every
+//     option + seed). reference_only renders cam0 for the two clouds and writes nothing else
+//     (to add them to a sequence rendered earlier with the same options).
 // Same options and seed -> identical bytes.
 //
 // Threads: RunSimulation drives frames sequentially on the calling thread; rendering and
@@ -52,18 +55,25 @@ struct SimulationOptions {
   double depth_noise = 1.0;        // x the Kinect depth noise model (0: exact depth)
   double blackout_begin_s = -1.0;  // images in [begin, end] (s from start) are black
   double blackout_end_s = -1.0;
-  bool write_cloud = true;          // reference_cloud.ply
+  bool write_cloud = true;          // reference_cloud.ply (+ reference_observed.ply)
   double cloud_spacing_m = 0.01;    // point spacing on the surfaces
   double visibility_cell_m = 0.05;  // granularity of "seen" surface cells
-  bool bench = false;               // render and develop only; write nothing
-  int bench_frames = 200;           // frames rendered by bench (0: the whole sequence)
-  bool quiet = false;               // no progress bar
+  // reference_observed.ply: surfaces cam0 saw at a depth (optical axis) <= this, in any
+  // frame (0: not written): the surveyed area. Below the dense tool's 4 m depth limit, as
+  // keyframes see what the frames between them saw from a little farther away.
+  double observed_range_m = 3.0;
+  double observed_cell_m = 0.02;  // granularity of its "seen" cells
+  // Render cam0 only for the reference clouds; write no images, IMU or sim.yaml.
+  bool reference_only = false;
+  bool bench = false;      // render and develop only; write nothing
+  int bench_frames = 200;  // frames rendered by bench (0: the whole sequence)
+  bool quiet = false;      // no progress bar
 
   void Check() const;
 };
 
 struct SimulationSummary {
-  std::string layout;  // "euroc" | "tum_rgbd" | "bench"
+  std::string layout;  // "euroc" | "tum_rgbd" | "bench" | "reference"
   std::int64_t begin_ns = 0;
   std::int64_t end_ns = 0;
   int frames = 0;  // camera frames (stereo pairs or RGB-D frames)
@@ -78,6 +88,7 @@ struct SimulationSummary {
                                     // file-writing runs it includes overlapping PNG encoding
   double total_seconds = 0.0;       // wall time of the frame loop including image files
   std::size_t cloud_points = 0;
+  std::size_t observed_points = 0;  // reference_observed.ply
   SceneBuildReport scene;
 };
 

@@ -9,11 +9,30 @@
 #include "core/map/keyframe.h"
 #include "core/map/map.h"
 #include "core/util/error.h"
+#include "io/trajectory.h"
 
 namespace pkslam {
 
 void WriteInertialOutputs(const SlamSystem& system, const std::filesystem::path& out_dir) {
   if (!IsInertial(system.rig().sensor)) return;
+  Trajectory online;
+  const SE3d camera_from_body = system.rig().body_from_camera.Inverse();
+  for (const FrameRecord& r : system.tracker().records()) {
+    if (r.camera_from_world_online) {
+      online.poses.push_back({r.t_ns, r.camera_from_world_online->Inverse() * camera_from_body});
+    }
+  }
+  WriteTrajectory(online, out_dir / "trajectory_online_body.txt", TrajectoryFormat::kTum);
+  // The keyframe chain right after each IMU initialisation stage.
+  const LocalMappingStats mapping = system.mapping_stats();
+  for (std::size_t i = 0; i < mapping.imu_stages.size(); ++i) {
+    const ImuStageSnapshot& stage = mapping.imu_stages[i];
+    Trajectory chain;
+    for (const auto& [t_ns, pose] : stage.world_from_body) chain.poses.push_back({t_ns, pose});
+    WriteTrajectory(chain,
+                    out_dir / fmt::format("imu_stage{}_{}_keyframes_body.txt", i, stage.stage),
+                    TrajectoryFormat::kTum);
+  }
   const std::filesystem::path file = out_dir / "keyframes_imu.csv";
   std::ofstream out(file);
   if (!out) throw Error(fmt::format("cannot write {}", file.string()));

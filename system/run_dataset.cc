@@ -11,6 +11,7 @@
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
+#include "core/util/prefetch.h"
 #include "core/util/progress.h"
 #include "io/euroc_dataset.h"
 #include "io/settings_euroc.h"
@@ -81,7 +82,8 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
       const auto& images = euroc->cam0().images;
       for (std::size_t i = 0; i < images.size(); ++i) sources.push_back({images[i].t_ns, i, 0});
     }
-    settings = options.settings ? ReadOrbSlam3Settings(*options.settings) : SettingsFromEuroc(*euroc);
+    settings =
+        options.settings ? ReadOrbSlam3Settings(*options.settings) : SettingsFromEuroc(*euroc);
   } else if (TumRgbdDataset::LooksLikeTumRgbd(options.dataset)) {
     tum = TumRgbdDataset::Open(options.dataset);
     if (IsStereo(sensor)) throw OptionError("a TUM RGB-D dataset has no stereo pair");
@@ -116,7 +118,14 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   PKSLAM_LOG_INFO("loading vocabulary {}", vocabulary_path.string());
   auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary_path));
 
-  SlamSystem system(settings, vocabulary, options.system);
+  SystemOptions system_options = options.system;
+  // Offline visual-only monocular runs keep tracking in lock-step with local mapping (each
+  // keyframe is mapped before the next frame is tracked). A monocular map gets its points only
+  // from local mapping, and ORB-SLAM's rule refuses monocular keyframes while local mapping is
+  // busy; fed frames faster than it maps (no --realtime, or a loaded machine) the map starves
+  // of keyframes and tracking is lost in fast turns. Offline there is no deadline to meet.
+  if (!options.realtime && sensor == Sensor::kMonocular) system_options.tracking.lockstep = true;
+  SlamSystem system(settings, vocabulary, system_options);
 
   // --- the frame loop ---
   RunSummary summary;
@@ -131,6 +140,23 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     throw InputError(options.dataset,
                      fmt::format("sensor {} needs IMU data (mav0/imu0)", SensorName(sensor)));
   }
+  // Images are decoded in a thread of their own, a couple of frames ahead of tracking.
+  struct LoadedImages {
+    cv::Mat a;  // left / rgb
+    cv::Mat b;  // right / depth (empty for monocular)
+  };
+  Prefetcher<LoadedImages> images(
+      sources.size(),
+      [&](std::size_t k) {
+        const FrameSource& s = sources[k];
+        if (euroc) {
+          return LoadedImages{euroc->LoadCam0(s.a),
+                              IsStereo(sensor) ? euroc->LoadCam1(s.b) : cv::Mat()};
+        }
+        if (IsRgbd(sensor)) return LoadedImages{tum->LoadRgbGrey(s.a), tum->LoadDepthRaw(s.b)};
+        return LoadedImages{tum->LoadRgbGrey(s.a), cv::Mat()};
+      },
+      2);
   for (const FrameSource& s : sources) {
     if (interrupt != nullptr && interrupt->load()) {
       summary.interrupted = true;
@@ -146,17 +172,13 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
       system.AddImu(euroc->ImuBetween(imu_fed_ns, s.t_ns + kImuLookaheadNs));
       imu_fed_ns = s.t_ns + kImuLookaheadNs;
     }
-    if (euroc) {
-      const cv::Mat left = euroc->LoadCam0(s.a);
-      if (IsStereo(sensor)) {
-        r = system.TrackStereo(left, euroc->LoadCam1(s.b), s.t_ns);
-      } else {
-        r = system.TrackMonocular(left, s.t_ns);
-      }
+    const LoadedImages loaded = *images.Next();
+    if (IsStereo(sensor)) {
+      r = system.TrackStereo(loaded.a, loaded.b, s.t_ns);
     } else if (IsRgbd(sensor)) {
-      r = system.TrackRgbd(tum->LoadRgbGrey(s.a), tum->LoadDepthRaw(s.b), s.t_ns);
+      r = system.TrackRgbd(loaded.a, loaded.b, s.t_ns);
     } else {
-      r = system.TrackMonocular(tum->LoadRgbGrey(s.a), s.t_ns);
+      r = system.TrackMonocular(loaded.a, s.t_ns);
     }
     ++summary.frames;
     if (r.state == TrackingState::kOk) ++summary.tracked;
@@ -170,10 +192,11 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   summary.sequence_s =
       static_cast<double>(sources[std::max(0, summary.frames - 1)].t_ns - t0) * 1e-9;
   WriteRunOutputs(system, options, &summary);
-  PKSLAM_LOG_INFO("{} frames ({} tracked), {} keyframes, {} map points, {} map(s); "
-                  "{:.1f} s wall for {:.1f} s of data; outputs in {}",
-                  summary.frames, summary.tracked, summary.keyframes, summary.map_points,
-                  summary.maps, summary.wall_s, summary.sequence_s, options.out.string());
+  PKSLAM_LOG_INFO(
+      "{} frames ({} tracked), {} keyframes, {} map points, {} map(s); "
+      "{:.1f} s wall for {:.1f} s of data; outputs in {}",
+      summary.frames, summary.tracked, summary.keyframes, summary.map_points, summary.maps,
+      summary.wall_s, summary.sequence_s, options.out.string());
   return summary;
 }
 

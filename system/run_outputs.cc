@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <fstream>
+#include <numeric>
 #include <set>
 
+#include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
-#include "system/sparse_model_builder.h"
+#include "io/rigid_transform_file.h"
 #include "system/inertial_outputs.h"
+#include "system/sparse_model_builder.h"
 
 namespace pkslam {
 namespace {
@@ -40,8 +43,8 @@ void WriteTrace(const Tracker& tracker, const std::filesystem::path& file) {
   out << '\n';
   const std::string selector(tracker.selector().name());
   for (const auto& row : tracker.trace()) {
-    out << fmt::format("{:.9f},{},{},{},{},{}", static_cast<double>(row.t_ns) * 1e-9,
-                       row.frame_id, selector, row.decision.insert ? 1 : 0, row.decision.reason,
+    out << fmt::format("{:.9f},{},{},{},{},{}", static_cast<double>(row.t_ns) * 1e-9, row.frame_id,
+                       selector, row.decision.insert ? 1 : 0, row.decision.reason,
                        row.frames_since_keyframe);
     for (const auto& k : keys) {
       out << ',';
@@ -123,11 +126,20 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   const auto& out = options.out;
   const Trajectory frames = system.FrameTrajectory();
   WriteTrajectory(frames, out / "trajectory.txt", TrajectoryFormat::kTum);
-  // The same poses for the body (IMU) frame, comparable with EuRoC ground truth.
-  Trajectory body = frames;
-  const SE3d camera_from_body = system.rig().body_from_camera.Inverse();
-  for (auto& p : body.poses) p.pose = p.pose * camera_from_body;
-  WriteTrajectory(body, out / "trajectory_body.txt", TrajectoryFormat::kTum);
+  // The same poses for the body (IMU) frame, comparable with EuRoC ground truth. That applies
+  // the metric camera-body lever arm to map units: right for metric maps, wrong for
+  // visual-only monocular ones (after a Sim(3) alignment of scale s the lever arm counts s
+  // times), so those get no body trajectory. They are evaluated on camera poses against the
+  // ground truth moved into the camera (pkslam eval --body-from-camera, the bench,
+  // cloud-compare), which needs the extrinsic.
+  if (options.system.sensor != Sensor::kMonocular) {
+    Trajectory body = frames;
+    const SE3d camera_from_body = system.rig().body_from_camera.Inverse();
+    for (auto& p : body.poses) p.pose = p.pose * camera_from_body;
+    WriteTrajectory(body, out / "trajectory_body.txt", TrajectoryFormat::kTum);
+  }
+  WriteRigidTransform(system.rig().body_from_camera, out / "body_from_camera.txt",
+                      "body_from_camera (row-major 4x4, metres)");
   WriteTrajectory(system.KeyFrameTrajectory(), out / "keyframes.txt", TrajectoryFormat::kTum);
   system.WriteMapPly(out / "map_points.ply");
   WriteSparseModel(BuildSparseModel(system), out / "sparse_model.txt");
@@ -136,11 +148,15 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
 
   const auto& records = system.tracker().records();
   std::vector<double> tracking_ms;
+  std::vector<double> tracking_cpu_ms;
+  std::vector<double> build_cpu_ms;
   std::map<std::string, int> states;
   bool initialised = false;
   int lost = 0;
   for (const FrameRecord& r : records) {
     tracking_ms.push_back(r.tracking_ms);
+    tracking_cpu_ms.push_back(r.tracking_cpu_ms);
+    build_cpu_ms.push_back(r.build_cpu_ms);
     ++states[TrackingStateName(r.state)];
     if (r.state != TrackingState::kNotInitialized) initialised = true;
     if (initialised && r.state != TrackingState::kOk) ++lost;
@@ -178,11 +194,26 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   json.Member("median_tracking_ms", summary->median_tracking_ms);
   json.Member("median_local_mapping_ms", Median(mapping.keyframe_ms));
   json.Member("local_ba_aborted", mapping.ba_aborted);
+  // CPU time (independent of the machine's load): per-thread sums and medians.
+  const auto sum = [](const std::vector<double>& v) {
+    return std::accumulate(v.begin(), v.end(), 0.0);
+  };
+  json.Member("process_cpu_s", ProcessCpuSeconds());
+  json.Member("tracking_cpu_s", 1e-3 * (sum(tracking_cpu_ms) + sum(build_cpu_ms)));
+  json.Member("median_tracking_cpu_ms", Median(tracking_cpu_ms));
+  json.Member("median_build_cpu_ms", Median(build_cpu_ms));
+  json.Member("local_mapping_cpu_s", 1e-3 * sum(mapping.keyframe_cpu_ms));
+  json.Member("median_local_mapping_cpu_ms", Median(mapping.keyframe_cpu_ms));
+  json.Member("median_local_ba_cpu_ms", Median(mapping.ba_cpu_ms));
   json.Member("peak_memory_mib", PeakMemoryMiB());
   WriteLoopClosing(system, options, &json);
   WriteArray(&json, "tracking_ms", tracking_ms);
   WriteArray(&json, "local_mapping_ms", mapping.keyframe_ms);
   WriteArray(&json, "local_ba_ms", mapping.ba_ms);
+  WriteArray(&json, "tracking_cpu_ms", tracking_cpu_ms);
+  WriteArray(&json, "build_cpu_ms", build_cpu_ms);
+  WriteArray(&json, "local_mapping_cpu_ms", mapping.keyframe_cpu_ms);
+  WriteArray(&json, "local_ba_cpu_ms", mapping.ba_cpu_ms);
   json.EndObject();
   std::ofstream file(out / "stats.json");
   if (!file) throw Error(fmt::format("cannot write {}", (out / "stats.json").string()));

@@ -34,6 +34,8 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
     options_.loop.num_threads = 1;
     options_.loop.global_ba_options.num_threads = 1;
   }
+  options_.tracking.seed = options_.seed;
+  options_.loop.seed = options_.seed;
   options_.Check();
   std::map<std::string, double> selector_parameters = settings.keyframe;
   for (const auto& [k, v] : options_.selector_parameters) selector_parameters[k] = v;

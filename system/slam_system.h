@@ -6,10 +6,9 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
-
-#include <opencv2/core.hpp>
 
 #include "core/bow/vocabulary.h"
 #include "core/map/atlas.h"
@@ -29,6 +28,9 @@ struct SystemOptions {
   std::map<std::string, double> selector_parameters;
   // Fixed seeds, local mapping in lock-step with tracking, single-threaded solvers.
   bool deterministic = false;
+  // Run seed (--seed): passed to tracking and loop closing, so repeated research runs draw
+  // different RANSAC samples; combined with `deterministic` each seed is reproducible.
+  std::uint64_t seed = 0;
   // Record per-frame keyframe decisions (keyframe_trace.csv).
   bool trace = false;
   TrackingOptions tracking;
@@ -82,7 +84,6 @@ class SlamSystem {
   const Map* LargestMap() const;  // requires the Atlas lock
 
  private:
-
   SystemOptions options_;
   RigSetup setup_;
   std::shared_ptr<const Vocabulary> vocabulary_;

@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -33,17 +34,28 @@ std::vector<std::string> Lines(const fs::path& file) {
   return out;
 }
 
+std::vector<std::string> Fields(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream ss(line);
+  std::string f;
+  while (std::getline(ss, f, ',')) fields.push_back(f);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
 // summary.csv without the timing columns (wall time and tracking time differ run to run).
 std::vector<std::string> SummaryWithoutTimes(const fs::path& file) {
+  const auto lines = Lines(file);
+  if (lines.empty()) return {};
+  const auto header = Fields(lines[0]);
   std::vector<std::string> out;
-  for (const auto& line : Lines(file)) {
-    std::vector<std::string> fields;
-    std::stringstream ss(line);
-    std::string f;
-    while (std::getline(ss, f, ',')) fields.push_back(f);
-    if (fields.size() > 2) fields.resize(fields.size() - 2);
+  for (const auto& line : lines) {
+    const auto fields = Fields(line);
     std::string joined;
-    for (const auto& x : fields) joined += x + ",";
+    for (std::size_t i = 0; i < fields.size() && i < header.size(); ++i) {
+      if (header[i] == "wall_mean_s" || header[i] == "median_tracking_mean_ms") continue;
+      joined += fields[i] + ",";
+    }
     out.push_back(joined);
   }
   return out;
@@ -72,17 +84,60 @@ TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
     EXPECT_TRUE(fs::exists(out / "plots/sweep_delta.png")) << r.output;
   }
 
-  // Resume: everything is finished, nothing runs again.
-  r = RunPkslam(
-      fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --quiet --no-plots",
-                  kSmoke.string(), out.string(), cache.string()));
+  // Resume: everything is finished, nothing runs again; --reevaluate measures the finished
+  // runs again (same numbers: the same files and ground truth).
+  const auto before = Lines(out / "results.csv");
+  r = RunPkslam(fmt::format(
+      "--log-level warn bench '{}' --out '{}' --cache '{}' --quiet --no-plots --reevaluate",
+      kSmoke.string(), out.string(), cache.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("6 runs: 0 executed, 6 already finished"));
+  EXPECT_EQ(Lines(out / "results.csv"), before);
+
+  // The same suite asking for dense clouds of its sweep: only the two sweep runs get one
+  // (pkslam dense on the finished runs), and the sweep table gains the Eq. 13 columns.
+  {
+    std::ifstream in(kSmoke);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string yaml = text.str();
+    const std::string sweep = "values: [40]}";
+    ASSERT_NE(yaml.find(sweep), std::string::npos);
+    yaml.replace(yaml.find(sweep), sweep.size(), "values: [40], dense: true}");
+    std::ofstream(dir / "smoke_dense.yaml") << yaml;
+  }
+  r = RunPkslam(
+      fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --quiet --no-plots",
+                  (dir / "smoke_dense.yaml").string(), out.string(), cache.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("6 runs: 2 executed, 4 already finished, 0 failed"));
+  const fs::path sweep_run = out / "runs/sim_medium_5s/stereo/pks@delta=40/seed1";
+  EXPECT_TRUE(fs::exists(sweep_run / "dense.ply"));
+  EXPECT_FALSE(fs::exists(out / "runs/sim_medium_5s/stereo/pks/seed1/dense.ply"));
+  const auto dense_rows = Lines(out / "results.csv");
+  const auto columns = Fields(dense_rows.at(0));
+  const auto dense_column = static_cast<std::size_t>(
+      std::find(columns.begin(), columns.end(), "dense_points") - columns.begin());
+  ASSERT_LT(dense_column, columns.size());
+  int with_dense = 0;
+  for (std::size_t i = 1; i < dense_rows.size(); ++i) {
+    const auto f = Fields(dense_rows[i]);
+    ASSERT_EQ(f.size(), columns.size()) << dense_rows[i];
+    if (!f[dense_column].empty()) {
+      ++with_dense;
+      EXPECT_GT(std::stod(f[dense_column]), 1000.0) << dense_rows[i];
+    }
+  }
+  EXPECT_EQ(with_dense, 2);
+  std::ifstream report(out / "report.md");
+  std::stringstream report_text;
+  report_text << report.rdbuf();
+  EXPECT_THAT(report_text.str(), HasSubstr("Eq. 13 score"));
 
   // Scale-out: emitted jobs run by GNU parallel (or sh without it), then --collect.
   const fs::path jobs = dir / "jobs";
-  r = RunPkslam(fmt::format("bench '{}' --emit-jobs '{}' --cache '{}'", kSmoke.string(),
-                            jobs.string(), cache.string()));
+  r = RunPkslam(fmt::format("bench '{}' --emit-jobs '{}' --cache '{}'",
+                            (dir / "smoke_dense.yaml").string(), jobs.string(), cache.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("emitted 6 jobs"));
   ASSERT_EQ(Lines(jobs / "jobs.txt").size(), 6u);
@@ -94,7 +149,7 @@ TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
   r = RunPkslam(fmt::format("--log-level warn bench --collect '{}' --no-plots", jobs.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("collected 6 runs"));
-  // Deterministic runs: the same numbers as the local bench.
+  // Deterministic runs: the same numbers (dense clouds included) as the local bench.
   EXPECT_EQ(SummaryWithoutTimes(jobs / "summary.csv"), SummaryWithoutTimes(out / "summary.csv"));
 }
 

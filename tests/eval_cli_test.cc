@@ -104,6 +104,38 @@ TEST_F(EvalCliTest, SyntheticRunWithEveryAlignmentAndRpeUnit) {
   }
 }
 
+// --body-from-camera moves body-frame ground truth into the camera: a camera trajectory
+// 0.5 m ahead of the body along its x axis matches it exactly, and does not without the option.
+TEST_F(EvalCliTest, BodyFromCameraComparesCameraPoses) {
+  const std::string gt = Write("gt.txt", kGood);
+  // Body yaw 90 deg (qz = qw = sqrt(1/2)): the camera, 0.5 m along body x, sits at +0.5 m y.
+  const std::string est = Write("est.txt",
+                                "1.00 0 0.5 0 0 0 0.7071067811865476 0.7071067811865476\n"
+                                "1.05 1 0.5 0 0 0 0.7071067811865476 0.7071067811865476\n"
+                                "1.10 2 0.5 0 0 0 0.7071067811865476 0.7071067811865476\n"
+                                "1.15 3 1.5 0 0 0 0.7071067811865476 0.7071067811865476\n");
+  const std::string rotated_gt = Write("rotated_gt.txt",
+                                       "1.00 0 0 0 0 0 0.7071067811865476 0.7071067811865476\n"
+                                       "1.05 1 0 0 0 0 0.7071067811865476 0.7071067811865476\n"
+                                       "1.10 2 0 0 0 0 0.7071067811865476 0.7071067811865476\n"
+                                       "1.15 3 1 0 0 0 0.7071067811865476 0.7071067811865476\n");
+  const std::string extrinsic =
+      Write("body_from_camera.txt", "# body_from_camera\n1 0 0 0.5\n0 1 0 0\n0 0 1 0\n0 0 0 1\n");
+  testing::CommandResult r =
+      Eval(fmt::format("--gt {} --est {} --align none --body-from-camera {} --json {}/r.json",
+                       rotated_gt, est, extrinsic, dir_.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_LT(JsonNumber(ReadFile(dir_ / "r.json"), "\"ate\"", "rmse"), 1e-9) << r.output;
+  r = Eval(fmt::format("--gt {} --est {} --align none --json {}/r.json", rotated_gt, est,
+                       dir_.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NEAR(JsonNumber(ReadFile(dir_ / "r.json"), "\"ate\"", "rmse"), 0.5, 1e-9);
+  const std::string bad = Write("bad.txt", "1 0 0\n");
+  const std::string out =
+      ExpectOneLineError(fmt::format("--gt {} --est {} --body-from-camera {}", gt, gt, bad));
+  EXPECT_NE(out.find("bad.txt:1: expected 4 numbers"), std::string::npos) << out;
+}
+
 TEST_F(EvalCliTest, BadInputsGiveOneLineErrors) {
   const std::string good = Write("good.txt", kGood);
   const std::string empty = Write("empty.txt", "");

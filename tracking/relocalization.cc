@@ -63,7 +63,7 @@ bool Tracker::Relocalize() {
     Candidate c{place.keyframe, {}, nullptr};
     if (bow_matcher.SearchByBoW(*place.keyframe, current_, &c.matches) < 15) continue;
     PnpRansacOptions pnp;
-    pnp.seed = static_cast<std::uint64_t>(current_.id());
+    pnp.seed = MixSeed(options_.seed, static_cast<std::uint64_t>(current_.id()));
     c.pnp = std::make_unique<PnpRansac>(MakePnpCorrespondences(current_, c.matches), camera, pnp);
     candidates.push_back(std::move(c));
   }

@@ -8,6 +8,7 @@
 #include "core/map/keyframe.h"
 #include "core/map/map_point.h"
 #include "core/matching/orb_matcher.h"
+#include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "tracking/pose_optimizer.h"
@@ -65,23 +66,33 @@ Tracker::~Tracker() = default;
 
 TrackResult Tracker::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
   PKSLAM_CHECK(IsStereo(rig_->sensor), "TrackStereo with a {} rig", SensorName(rig_->sensor));
-  return Track(builder_.BuildStereo(atlas_->NextFrameId(), t_ns, left, right));
+  const double cpu = ThreadCpuSeconds();
+  Frame frame = builder_.BuildStereo(atlas_->NextFrameId(), t_ns, left, right);
+  build_cpu_ms_ = 1e3 * (ThreadCpuSeconds() - cpu);
+  return Track(std::move(frame));
 }
 
 TrackResult Tracker::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns) {
   PKSLAM_CHECK(IsRgbd(rig_->sensor), "TrackRgbd with a {} rig", SensorName(rig_->sensor));
-  return Track(builder_.BuildRgbd(atlas_->NextFrameId(), t_ns, image, depth));
+  const double cpu = ThreadCpuSeconds();
+  Frame frame = builder_.BuildRgbd(atlas_->NextFrameId(), t_ns, image, depth);
+  build_cpu_ms_ = 1e3 * (ThreadCpuSeconds() - cpu);
+  return Track(std::move(frame));
 }
 
 TrackResult Tracker::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
   PKSLAM_CHECK(IsMonocular(rig_->sensor), "TrackMonocular with a {} rig",
                SensorName(rig_->sensor));
   const bool initialising = state_ == TrackingState::kNotInitialized;
-  return Track(builder_.BuildMonocular(atlas_->NextFrameId(), t_ns, image, initialising));
+  const double cpu = ThreadCpuSeconds();
+  Frame frame = builder_.BuildMonocular(atlas_->NextFrameId(), t_ns, image, initialising);
+  build_cpu_ms_ = 1e3 * (ThreadCpuSeconds() - cpu);
+  return Track(std::move(frame));
 }
 
 TrackResult Tracker::Track(Frame frame) {
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = ThreadCpuSeconds();
   current_ = std::move(frame);
   if (imu_) PreintegrateImu();
   TrackResult result;
@@ -171,7 +182,7 @@ TrackResult Tracker::Track(Frame frame) {
 
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  RecordFrame(new_keyframe, ms);
+  RecordFrame(new_keyframe, ms, 1e3 * (ThreadCpuSeconds() - cpu_start));
   result.state = state_;
   result.new_keyframe = new_keyframe;
   result.inliers = inliers_;
@@ -185,13 +196,15 @@ TrackResult Tracker::Track(Frame frame) {
   return result;
 }
 
-void Tracker::RecordFrame(bool keyframe, double ms) {
+void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
   FrameRecord r;
   r.t_ns = current_.t_ns();
   r.frame_id = current_.id();
   r.state = state_;
   r.keyframe = keyframe;
   r.tracking_ms = ms;
+  r.tracking_cpu_ms = cpu_ms;
+  r.build_cpu_ms = build_cpu_ms_;
   r.inliers = inliers_;
   const KeyFramePtr& ref = current_.reference_kf ? current_.reference_kf : reference_kf_;
   // Inertial: RECENTLY_LOST frames carry the IMU prediction and are recorded too.
@@ -202,6 +215,7 @@ void Tracker::RecordFrame(bool keyframe, double ms) {
     if (imu_) SyncWithInertialMapLocked(/*correct_current=*/true);
     r.reference = ref;
     r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
+    r.camera_from_world_online = current_.camera_from_world();
   }
   records_.push_back(std::move(r));
 }

@@ -35,8 +35,15 @@ struct FrameRecord {
   TrackingState state = TrackingState::kNotInitialized;
   KeyFramePtr reference;  // null when the frame has no pose
   SE3d camera_from_reference;
+  // The pose as tracking estimated it then, in the world of that moment (later map
+  // optimisation does not move it): what a live user saw; inertial runs write it out.
+  std::optional<SE3d> camera_from_world_online;
   bool keyframe = false;
   double tracking_ms = 0;
+  // CPU time of the tracking thread: building the frame (ORB, stereo matching) and tracking it
+  // (the wall-clock tracking_ms also counts waits for the Atlas lock and preemption).
+  double build_cpu_ms = 0;
+  double tracking_cpu_ms = 0;
   int inliers = 0;
 };
 
@@ -102,7 +109,7 @@ class Tracker {
   void HandleLost();
   // Back to NOT_INITIALIZED on the current (new or cleared) map.
   void StartOver();
-  void RecordFrame(bool keyframe, double ms);
+  void RecordFrame(bool keyframe, double ms, double cpu_ms);
 
   // --- inertial sensors (tracking/tracker_inertial.cc) ---
   bool ImuReady() const;  // the current map's IMU is initialised (Atlas lock held)
@@ -138,6 +145,7 @@ class Tracker {
   KeyFramePtr reference_kf_;
   KeyFramePtr last_kf_;
   FrameId last_reloc_frame_id_ = -1000000;
+  double build_cpu_ms_ = 0;  // CPU ms building the frame being tracked (for its FrameRecord)
   int inliers_ = 0;
   std::int64_t lost_since_t_ns_ = 0;
   int relocalisations_ = 0;

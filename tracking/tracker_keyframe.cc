@@ -142,7 +142,7 @@ void Tracker::MonocularInitialization() {
     return;
   }
   TwoViewOptions two_view;
-  two_view.seed = static_cast<std::uint64_t>(current_.id());
+  two_view.seed = MixSeed(options_.seed, static_cast<std::uint64_t>(current_.id()));
   const auto reconstruction = ReconstructTwoView(*init_frame_, current_, init_matches_, two_view);
   if (!reconstruction) return;
   for (std::size_t i = 0; i < init_matches_.size(); ++i) {

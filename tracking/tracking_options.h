@@ -1,6 +1,8 @@
 // Options of the tracking thread (ORB-SLAM3 defaults; see ORBSLAM3_FACTS.md "Tracking").
 #pragma once
 
+#include <cstdint>
+
 #include "tracking/pose_optimizer.h"
 
 namespace pkslam {
@@ -40,9 +42,18 @@ struct TrackingOptions {
   int min_keyframes_to_keep_map = 10;
   // Deterministic mode: wait for local mapping to finish each keyframe before going on.
   bool lockstep = false;
+  // Mixed into every RANSAC seed (two-view initialisation, relocalisation PnP): runs with
+  // different seeds differ, runs with the same seed in deterministic mode are identical.
+  std::uint64_t seed = 0;
   PoseOptimizerOptions pose;
 
   void Check() const;
 };
+
+// A RANSAC seed from the run seed and a per-call value (a frame id). Run seed 0 gives the
+// per-call value itself.
+inline std::uint64_t MixSeed(std::uint64_t run_seed, std::uint64_t value) {
+  return value + run_seed * 0x9E3779B97F4A7C15ULL;
+}
 
 }  // namespace pkslam

@@ -100,8 +100,15 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
   BenchCounts c;
   c.total = static_cast<int>(runs.size());
   std::vector<const RunSpec*> pending;
+  std::vector<const RunSpec*> finished;
   for (const auto& r : runs) {
-    if (NeedsExecution(options, r)) pending.push_back(&r);
+    (NeedsExecution(options, r) ? pending : finished).push_back(&r);
+  }
+  if (options.reevaluate && !finished.empty()) {
+    Progress progress("evaluate", finished.size(), options.quiet);
+    ParallelFor(
+        static_cast<int>(finished.size()), options.jobs, cancel,
+        [&](int i) { ReevaluateRun(suite, *finished[i], options); }, [&](int) { progress.Add(); });
   }
   c.skipped = c.total - static_cast<int>(pending.size());
   if (c.skipped > 0) PKSLAM_LOG_INFO("{} of {} runs already finished: skipped", c.skipped, c.total);

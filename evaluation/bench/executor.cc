@@ -1,5 +1,8 @@
 #include "evaluation/bench/executor.h"
 
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -35,6 +38,48 @@ std::string LastLine(const fs::path& log) {
 
 void WriteResult(const fs::path& run_dir, const RunResult& r) {
   WriteResultsCsv(run_dir / "result.csv", {r});
+}
+
+// The "points" field of `pkslam dense --json` (plain JSON, read as YAML flow style).
+double ReadDensePoints(const fs::path& file) {
+  if (!fs::exists(file)) throw InputError(file, "missing (pkslam dense wrote no statistics)");
+  try {
+    const YAML::Node root = YAML::LoadFile(file.string());
+    if (!root["points"]) throw InputError(file, "no 'points' field");
+    return root["points"].as<double>();
+  } catch (const YAML::Exception& e) {
+    throw InputError(file, e.mark.line + 1, "not valid JSON: " + e.msg);
+  }
+}
+
+bool LacksDenseCloud(const RunSpec& run, const RunResult& r) {
+  return run.dense && r.ok && !std::isfinite(r.dense_points);
+}
+
+// Builds the dense cloud of a finished run (RUN/dense.ply, dense.json, dense.log) and records
+// its point count; a failure marks the run failed. Returns false when cancelled.
+bool AddDenseCloud(const Suite& suite, const RunSpec& run, const HarnessOptions& options,
+                   const fs::path& dataset, const fs::path& run_dir, RunResult* result,
+                   const std::atomic<bool>* cancel) {
+  std::vector<std::string> argv = {options.pkslam.string()};
+  const auto args = DenseArguments(suite, run, dataset, run_dir);
+  argv.insert(argv.end(), args.begin(), args.end());
+  const fs::path log = run_dir / "dense.log";
+  { std::ofstream(log) << "# " << ShellCommand(argv) << '\n'; }
+  const ProcessResult p = RunProcess(argv, log, suite.timeout_s, cancel);
+  if (cancel != nullptr && cancel->load()) return false;
+  if (!p.ok()) {
+    result->ok = false;
+    result->error = fmt::format("pkslam dense {}: {}", p.Describe(), LastLine(log));
+    return true;
+  }
+  try {
+    result->dense_points = ReadDensePoints(run_dir / "dense.json");
+  } catch (const Error& e) {
+    result->ok = false;
+    result->error = std::string("dense: ") + e.what();
+  }
+  return true;
 }
 
 }  // namespace
@@ -114,12 +159,29 @@ std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
                                       const fs::path& dataset, const fs::path& run_dir) {
   const DatasetSpec& d = DatasetOf(suite, run);
   std::vector<std::string> a = {
-      "run",      "--dataset", dataset.string(), "--out",      run_dir.string(),
-      "--sensor", run.sensor,  "--selector",     run.selector, "--quiet"};
+      "run",      "--dataset",  dataset.string(), "--out",  run_dir.string(),         "--sensor",
+      run.sensor, "--selector", run.selector,     "--seed", std::to_string(run.seed), "--quiet"};
   for (const auto& [k, v] : run.params) a.insert(a.end(), {"--param", k + "=" + FormatNumber(v)});
   if (d.settings) a.insert(a.end(), {"--settings", d.settings->string()});
   if (d.max_frames > 0) a.insert(a.end(), {"--max-frames", std::to_string(d.max_frames)});
   if (suite.deterministic) a.push_back("--deterministic");
+  return a;
+}
+
+std::vector<std::string> DenseArguments(const Suite& suite, const RunSpec& run,
+                                        const fs::path& dataset, const fs::path& run_dir) {
+  const DatasetSpec& d = DatasetOf(suite, run);
+  std::vector<std::string> a = {"dense",
+                                "--run",
+                                run_dir.string(),
+                                "--dataset",
+                                dataset.string(),
+                                "--out",
+                                (run_dir / "dense.ply").string(),
+                                "--json",
+                                (run_dir / "dense.json").string(),
+                                "--quiet"};
+  if (d.settings) a.insert(a.end(), {"--settings", d.settings->string()});
   return a;
 }
 
@@ -134,16 +196,51 @@ std::optional<RunResult> ReadFinished(const fs::path& run_dir) {
   return std::nullopt;  // unreadable: run again
 }
 
+std::optional<RunResult> ReevaluateRun(const Suite& suite, const RunSpec& run,
+                                       const HarnessOptions& options) {
+  const fs::path run_dir = RunDir(options.out, run);
+  const auto done = ReadFinished(run_dir);
+  if (!done || !done->ok) return std::nullopt;
+  RunResult result = ResultSkeleton(run, suite);
+  result.dense_points = done->dense_points;
+  try {
+    const fs::path dataset = PrepareDataset(suite, run, options);
+    const DatasetSpec& d = DatasetOf(suite, run);
+    EvaluateRun({run_dir, dataset, d.ground_truth, suite.rpe_delta_m}, &result);
+  } catch (const Error& e) {
+    result.ok = false;
+    result.error = std::string("evaluation: ") + e.what();
+  }
+  WriteResult(run_dir, result);
+  return result;
+}
+
 bool NeedsExecution(const HarnessOptions& options, const RunSpec& run) {
   const auto r = ReadFinished(RunDir(options.out, run));
-  return !r || (!r->ok && options.retry_failed);
+  return !r || (!r->ok && options.retry_failed) || LacksDenseCloud(run, *r);
 }
 
 std::optional<RunResult> ExecuteRun(const Suite& suite, const RunSpec& run,
                                     const HarnessOptions& options,
                                     const std::atomic<bool>* cancel) {
-  RunResult result = ResultSkeleton(run, suite);
   const fs::path run_dir = RunDir(options.out, run);
+  // A finished run of a suite that asks for dense clouds now: only the cloud is missing.
+  if (const auto done = ReadFinished(run_dir); done && LacksDenseCloud(run, *done)) {
+    RunResult result = *done;
+    try {
+      const fs::path dataset = PrepareDataset(suite, run, options, cancel);
+      if (!AddDenseCloud(suite, run, options, dataset, run_dir, &result, cancel)) {
+        return std::nullopt;
+      }
+    } catch (const Error& e) {
+      if (cancel != nullptr && cancel->load()) return std::nullopt;
+      result.ok = false;
+      result.error = std::string("dense: ") + e.what();
+    }
+    WriteResult(run_dir, result);
+    return result;
+  }
+  RunResult result = ResultSkeleton(run, suite);
   fs::remove_all(run_dir);
   fs::create_directories(run_dir);
   fs::path dataset;
@@ -174,6 +271,10 @@ std::optional<RunResult> ExecuteRun(const Suite& suite, const RunSpec& run,
   } catch (const Error& e) {
     result.ok = false;
     result.error = std::string("evaluation: ") + e.what();
+  }
+  if (result.ok && run.dense &&
+      !AddDenseCloud(suite, run, options, dataset, run_dir, &result, cancel)) {
+    return std::nullopt;
   }
   WriteResult(run_dir, result);
   return result;

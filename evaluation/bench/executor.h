@@ -24,6 +24,7 @@ struct HarnessOptions {
   int jobs = 1;                  // runs executed at once
   bool quiet = false;            // no progress bars
   bool retry_failed = false;     // re-execute runs whose result.csv says failed
+  bool reevaluate = false;       // measure finished runs again (new evaluation code or truth)
 
   void Check() const;
 };
@@ -53,9 +54,21 @@ std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
                                       const std::filesystem::path& dataset,
                                       const std::filesystem::path& run_dir);
 
+// The `pkslam dense` command line of a run with `dense` (without the executable).
+std::vector<std::string> DenseArguments(const Suite& suite, const RunSpec& run,
+                                        const std::filesystem::path& dataset,
+                                        const std::filesystem::path& run_dir);
+
+// Measures a finished, successful run again from its folder (ATE, RPE, biases, plot files)
+// without running SLAM; keeps its dense cloud count. Returns the new result (written to
+// result.csv), or std::nullopt when the run is not finished or failed.
+std::optional<RunResult> ReevaluateRun(const Suite& suite, const RunSpec& run,
+                                       const HarnessOptions& options);
+
 // The recorded result of a finished run, if its folder has a readable result.csv.
 std::optional<RunResult> ReadFinished(const std::filesystem::path& run_dir);
-// Whether a run still has to be executed (no result, or failed and retry_failed).
+// Whether a run still has to be executed (no result, failed and retry_failed, or finished
+// without the dense cloud its suite now asks for - then only the cloud is built).
 bool NeedsExecution(const HarnessOptions& options, const RunSpec& run);
 
 // Renders (if needed), runs and evaluates one run; writes its result.csv. Failures of the run

@@ -14,13 +14,14 @@ struct Config {
   std::map<std::string, double> params;
   std::string sweep_param;
   double sweep_value = 0.0;
+  bool dense = false;
 };
 
 // The configurations run on `dataset`: the suite's selectors, then the sweep points.
 std::vector<Config> Configurations(const Suite& suite, const std::string& dataset) {
   std::vector<Config> out;
   for (const auto& sel : suite.selectors) {
-    Config c{sel.label, sel.name, suite.params, "", 0.0};
+    Config c{sel.label, sel.name, suite.params, "", 0.0, suite.dense};
     for (const auto& [k, v] : sel.params) c.params[k] = v;
     out.push_back(c);
   }
@@ -35,8 +36,12 @@ std::vector<Config> Configurations(const Suite& suite, const std::string& datase
     }
     PKSLAM_CHECK(base != nullptr, "sweep selector {} not in the suite", sw.selector);
     for (double v : sw.values) {
-      Config c{base->label + "@" + sw.param + "=" + FormatNumber(v), base->name, suite.params,
-               sw.param, v};
+      Config c{base->label + "@" + sw.param + "=" + FormatNumber(v),
+               base->name,
+               suite.params,
+               sw.param,
+               v,
+               suite.dense || sw.dense};
       for (const auto& [k, x] : base->params) c.params[k] = x;
       c.params[sw.param] = v;
       out.push_back(c);
@@ -79,6 +84,7 @@ std::vector<RunSpec> ExpandSuite(const Suite& suite) {
           r.params = c.params;
           r.sweep_param = c.sweep_param;
           r.sweep_value = c.sweep_value;
+          r.dense = c.dense;
           r.run = k;
           r.seed = suite.seed + static_cast<std::uint64_t>(k);
           if (d.sim) {

@@ -24,7 +24,8 @@ struct RunSpec {
   std::map<std::string, double> params;  // suite params, then selector params, then sweep
   std::string sweep_param;               // empty unless a sweep point
   double sweep_value = 0.0;
-  int run = 0;  // 0 .. runs-1
+  bool dense = false;  // build the run's dense cloud after it
+  int run = 0;         // 0 .. runs-1
   std::uint64_t seed = 0;
   std::optional<SimRecipe> sim;  // with the seed of this run's rendering
 };

@@ -213,6 +213,11 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
   doc.Heading(2, "Keyframes, maps and run time");
   doc.AddTable(DetailTable(groups));
   doc.Images(plots, "keyframes");
+  const Table biases = BiasTable(groups);
+  if (!biases.rows.empty()) {
+    doc.Heading(2, "IMU biases");
+    doc.AddTable(biases);
+  }
   const auto sweeps = SweepTables(groups);
   if (!sweeps.empty()) {
     doc.Heading(2, "Parameter sweeps");

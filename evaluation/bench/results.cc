@@ -1,5 +1,6 @@
 #include "evaluation/bench/results.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -87,7 +88,10 @@ std::vector<std::string> ResultColumns() {
           "map_points",
           "lost_frames",
           "wall_s",
-          "median_tracking_ms"};
+          "median_tracking_ms",
+          "dense_points",
+          "gyro_bias_err_pct",
+          "accel_bias_err_pct"};
 }
 
 std::string CsvField(const std::string& text) {
@@ -161,7 +165,10 @@ std::string ResultCsvRow(const RunResult& r) {
                                       std::to_string(r.map_points),
                                       std::to_string(r.lost_frames),
                                       Num(r.wall_s),
-                                      Num(r.median_tracking_ms)};
+                                      Num(r.median_tracking_ms),
+                                      Num(r.dense_points),
+                                      Num(r.gyro_bias_err_pct),
+                                      Num(r.accel_bias_err_pct)};
   std::string out;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (i > 0) out.push_back(',');
@@ -188,7 +195,15 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
   std::string line;
   if (!std::getline(in, line)) throw InputError(file, "empty file (expected a results.csv header)");
   const auto header = SplitCsvLine(line);
-  if (header != ResultColumns()) {
+  const auto columns = ResultColumns();
+  // Files from before the optional trailing columns: a prefix of the columns that holds at
+  // least every required one (through median_tracking_ms).
+  const std::size_t required =
+      static_cast<std::size_t>(std::find(columns.begin(), columns.end(), "median_tracking_ms") -
+                               columns.begin()) +
+      1;
+  if (header.size() < required || header.size() > columns.size() ||
+      !std::equal(header.begin(), header.end(), columns.begin())) {
     throw InputError(file, 1,
                      "header does not match results.csv columns (" + ResultCsvHeader() + ")");
   }
@@ -235,6 +250,11 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
     r.lost_frames = static_cast<int>(ParseInt(next(), file, n, "lost_frames"));
     r.wall_s = ParseDouble(next(), file, n, "wall_s");
     r.median_tracking_ms = ParseDouble(next(), file, n, "median_tracking_ms");
+    double* optional[] = {&r.dense_points, &r.gyro_bias_err_pct, &r.accel_bias_err_pct};
+    PKSLAM_CHECK(required + std::size(optional) == columns.size(), "optional columns");
+    for (std::size_t k = 0; required + k < header.size(); ++k) {
+      *optional[k] = ParseDouble(next(), file, n, header[required + k]);
+    }
     out.push_back(std::move(r));
   }
   return out;

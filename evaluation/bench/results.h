@@ -42,6 +42,13 @@ struct RunResult {
   int lost_frames = 0;
   double wall_s = kNaN;
   double median_tracking_ms = kNaN;
+  // Optional trailing columns (results.csv files written before they existed still read).
+  // Points of the run's dense cloud (runs with `dense`; empty otherwise).
+  double dense_points = kNaN;
+  // Inertial runs on ground truth with biases: mean relative bias error (%) of the keyframes
+  // from 15 s after the first one (bias_evaluation.h); empty otherwise.
+  double gyro_bias_err_pct = kNaN;
+  double accel_bias_err_pct = kNaN;
 };
 
 // The headline alignment of a run: `suite_choice` when "se3"/"sim3"; for "auto" "sim3" for

@@ -48,6 +48,8 @@ TEST(ResultsCsv, RoundTripsEveryField) {
   ok.frames = 200;
   ok.wall_s = 12.5;
   ok.median_tracking_ms = 20.25;
+  ok.dense_points = 123456;
+  ok.accel_bias_err_pct = 12.5;
   RunResult failed = ok;
   failed.index = 5;
   failed.run_id = "d/mono/pks/seed4";
@@ -67,10 +69,36 @@ TEST(ResultsCsv, RoundTripsEveryField) {
   EXPECT_EQ(back[0].keyframes, 42);
   EXPECT_EQ(back[0].map_points, 1234);
   EXPECT_DOUBLE_EQ(back[0].median_tracking_ms, 20.25);
+  EXPECT_DOUBLE_EQ(back[0].dense_points, 123456);
+  EXPECT_DOUBLE_EQ(back[0].accel_bias_err_pct, 12.5);
+  EXPECT_TRUE(std::isnan(back[0].gyro_bias_err_pct));
   EXPECT_TRUE(std::isnan(back[0].rpe_trans_m));
   EXPECT_FALSE(back[1].ok);
   EXPECT_EQ(back[1].error, failed.error);
   EXPECT_TRUE(std::isnan(back[1].ate_m));
+}
+
+// result.csv files of runs finished before the optional trailing columns still read (a resumed or
+// collected bench must not run them again).
+TEST(ResultsCsv, ReadsFilesWithoutTheDenseColumn) {
+  RunResult r;
+  r.run_id = "d/stereo/pks/seed1";
+  r.ok = true;
+  r.ate_m = 0.01;
+  r.dense_points = 5;
+  std::string header = ResultCsvHeader();
+  std::string row = ResultCsvRow(r);
+  for (int k = 0; k < 3; ++k) {  // dense_points and the bias errors came later
+    header = header.substr(0, header.rfind(','));
+    row = row.substr(0, row.rfind(','));
+  }
+  const auto dir = testing::MakeTempDir("bench_results_legacy");
+  std::ofstream(dir / "result.csv") << header << '\n' << row << '\n';
+  const auto back = ReadResultsCsv(dir / "result.csv");
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_TRUE(back[0].ok);
+  EXPECT_DOUBLE_EQ(back[0].ate_m, 0.01);
+  EXPECT_TRUE(std::isnan(back[0].dense_points));
 }
 
 TEST(ResultsCsv, MalformedFilesNameTheLine) {

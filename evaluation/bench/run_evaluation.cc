@@ -6,7 +6,9 @@
 #include <map>
 
 #include "core/util/error.h"
+#include "evaluation/bench/bias_evaluation.h"
 #include "evaluation/evaluate.h"
+#include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
 
 namespace pkslam::bench {
@@ -105,8 +107,15 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   // EuRoC ground truth is the body (IMU) frame: compare body poses; TUM's is the camera's.
   const bool body = gt_file.filename() == "data.csv" ||
                     DetectTrajectoryFormat(gt_file) == TrajectoryFormat::kEuroc;
-  const fs::path est_file = files.run_dir / (body ? "trajectory_body.txt" : "trajectory.txt");
-  const Trajectory gt = ReadTrajectory(gt_file);
+  // Visual-only monocular maps have no metric scale, so the metric lever arm of
+  // trajectory_body.txt does not fit them: compare camera poses with the ground truth moved
+  // into the camera instead (the run wrote the extrinsic).
+  const fs::path extrinsic = files.run_dir / "body_from_camera.txt";
+  const bool camera_gt = body && result->sensor == "mono" && fs::exists(extrinsic);
+  const fs::path est_file =
+      files.run_dir / (body && !camera_gt ? "trajectory_body.txt" : "trajectory.txt");
+  Trajectory gt = ReadTrajectory(gt_file);
+  if (camera_gt) gt = ChangeSensorFrame(gt, ReadRigidTransform(extrinsic));
   const Trajectory est = ReadTrajectory(est_file, TrajectoryFormat::kTum);
   const Trajectory keyframes =
       ReadTrajectory(files.run_dir / "keyframes.txt", TrajectoryFormat::kTum);
@@ -136,6 +145,10 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   } catch (const OptionError&) {
   }
   result->coverage = stats.frames > 0 ? static_cast<double>(se3.pairs.size()) / stats.frames : 0.0;
+  if (const auto bias = EvaluateBiases(files.run_dir / "keyframes_imu.csv", gt, 15.0)) {
+    result->gyro_bias_err_pct = bias->gyro_pct;
+    result->accel_bias_err_pct = bias->accel_pct;
+  }
   WritePlotFiles(files.run_dir, gt, est, keyframes, use_sim3 ? sim3 : se3);
   result->ok = true;
   result->error.clear();

@@ -7,6 +7,7 @@
 
 #include "core/geometry/se3.h"
 #include "core/util/error.h"
+#include "io/trajectory.h"
 #include "tests/support/test_data.h"
 
 namespace pkslam::bench {
@@ -92,6 +93,60 @@ TEST(EvaluateRun, MonocularUsesSim3AndRecoversScale) {
   EXPECT_LT(r.ate_sim3_m, 1e-6);
   EXPECT_GT(r.ate_se3_m, 0.1);  // a rigid alignment cannot fix the scale
   EXPECT_DOUBLE_EQ(r.ate_m, r.ate_sim3_m);
+}
+
+// A monocular map has no metric scale: its camera poses are compared with the ground truth
+// moved into the camera (body_from_camera.txt); trajectory_body.txt, whose metric lever arm
+// does not fit the map's unit, is not used.
+TEST(EvaluateRun, MonocularComparesCameraPosesWhenTheRunHasTheExtrinsic) {
+  const Fixture f = MakeRun("bench_eval_mono_camera", 0.5, 0.0);
+  const SE3d body_from_camera(SO3d::Exp(Eigen::Vector3d(0.2, 0.1, 1.5)),
+                              Eigen::Vector3d(-0.02, -0.3, 0.01));
+  const Trajectory gt = ReadTrajectory(FindGroundTruth(f.dataset));
+  {
+    std::ofstream extrinsic(f.run / "body_from_camera.txt");
+    const Eigen::Matrix4d m = body_from_camera.Matrix();
+    for (int row = 0; row < 4; ++row) {
+      extrinsic << fmt::format("{:.15f} {:.15f} {:.15f} {:.15f}\n", m(row, 0), m(row, 1), m(row, 2),
+                               m(row, 3));
+    }
+    std::ofstream est(f.run / "trajectory.txt");
+    std::ofstream est_body(f.run / "trajectory_body.txt");
+    for (const StampedPose& p : gt.poses) {
+      // The camera in a map of half the metric unit (any world frame would do), and the body
+      // as pkslam run writes it: the metric lever arm applied in map units.
+      const SE3d world_from_camera = p.pose * body_from_camera;
+      const SE3d map_from_camera(world_from_camera.so3(), 0.5 * world_from_camera.translation());
+      const SE3d map_from_body = map_from_camera * body_from_camera.Inverse();
+      for (const auto& [out, pose] : {std::pair<std::ofstream*, SE3d>{&est, map_from_camera},
+                                      std::pair<std::ofstream*, SE3d>{&est_body, map_from_body}}) {
+        const Eigen::Vector3d pe = pose.translation();
+        const Eigen::Quaterniond q = pose.so3().quaternion();
+        *out << fmt::format("{:.9f} {:.9f} {:.9f} {:.9f} {} {} {} {}\n", 1e-9 * p.t_ns, pe.x(),
+                            pe.y(), pe.z(), q.x(), q.y(), q.z(), q.w());
+      }
+    }
+  }
+  RunResult r;
+  r.sensor = "mono";
+  r.alignment = "sim3";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_NEAR(r.scale, 2.0, 1e-6);
+  EXPECT_LT(r.ate_sim3_m, 1e-6);
+  // trajectory_body.txt carries the lever arm (0.3 m here) scale times: centimetres off.
+  r.sensor = "stereo";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_GT(r.ate_sim3_m, 0.02);
+  r.sensor = "mono";
+  // Stereo runs keep comparing body poses (trajectory_body.txt is right for metric maps), and
+  // so do monocular runs of older versions without the extrinsic file.
+  fs::remove(f.run / "trajectory_body.txt");
+  EXPECT_NO_THROW(EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r));
+  r.sensor = "stereo";
+  EXPECT_THROW(EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r), InputError);
+  r.sensor = "mono";
+  fs::remove(f.run / "body_from_camera.txt");
+  EXPECT_THROW(EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r), InputError);
 }
 
 TEST(EvaluateRun, MissingOrBrokenFilesAreInputErrors) {

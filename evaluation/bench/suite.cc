@@ -185,7 +185,7 @@ SelectorSpec ParseSelector(const Context& c, const YAML::Node& node) {
 }
 
 SweepSpec ParseSweep(const Context& c, const YAML::Node& node) {
-  CheckKeys(c, node, "a sweep", {"selector", "param", "values", "datasets"});
+  CheckKeys(c, node, "a sweep", {"selector", "param", "values", "datasets", "dense"});
   SweepSpec s;
   if (!node["selector"] || !node["param"] || !node["values"]) {
     c.Fail(node, "a sweep needs 'selector', 'param' and 'values'");
@@ -197,6 +197,7 @@ SweepSpec ParseSweep(const Context& c, const YAML::Node& node) {
   if (!v.IsSequence() || v.size() == 0) c.Fail(v, "sweep 'values' must be a non-empty list");
   for (const auto& x : v) s.values.push_back(Number(c, x, "values"));
   if (node["datasets"]) s.datasets = StringList(c, node["datasets"], "datasets");
+  if (node["dense"]) s.dense = Bool(c, node["dense"], "dense");
   return s;
 }
 
@@ -272,7 +273,7 @@ Suite ParseSuite(const std::string& text, const fs::path& file) {
   }
   if (!root || root.IsNull()) throw InputError(file, "empty suite");
   CheckKeys(c, root, "the suite",
-            {"name", "runs", "seed", "deterministic", "baseline", "alignment", "timeout_s",
+            {"name", "runs", "seed", "deterministic", "dense", "baseline", "alignment", "timeout_s",
              "rpe_delta_m", "sensors", "selectors", "params", "sweeps", "datasets"});
   Suite s;
   s.file = file;
@@ -280,6 +281,7 @@ Suite ParseSuite(const std::string& text, const fs::path& file) {
   if (root["runs"]) s.runs = static_cast<int>(Integer(c, root["runs"], "runs", 1));
   if (root["seed"]) s.seed = static_cast<std::uint64_t>(Integer(c, root["seed"], "seed", 0));
   if (root["deterministic"]) s.deterministic = Bool(c, root["deterministic"], "deterministic");
+  if (root["dense"]) s.dense = Bool(c, root["dense"], "dense");
   if (root["baseline"]) s.baseline = String(c, root["baseline"], "baseline");
   if (root["alignment"]) {
     s.alignment = String(c, root["alignment"], "alignment");

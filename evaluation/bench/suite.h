@@ -11,7 +11,9 @@
 //   sensors: [stereo, mono]     # passed through to `pkslam run --sensor`
 //   selectors: [orbslam3, pks, {name: pks, label: pks-strict, params: {tau: 0.3}}]
 //   params: {name: value}       # overrides for every run (pkslam run --param)
-//   sweeps: [{selector: pks, param: delta, values: [10, 20, 30, 40], datasets: [V101]}]
+//   dense: false                # build a dense cloud of every run (pkslam dense)
+//   sweeps: [{selector: pks, param: delta, values: [10, 20, 30, 40], datasets: [V101],
+//             dense: true}]     # dense clouds for the sweep's runs (the paper's Eq. 13)
 //   datasets:
 //     - {name: MH_01_easy, path: ${EUROC_ROOT}/MH_01_easy}         # real data on disk
 //     - {name: sim_V102, sim: {trajectory: ..., start: 20, duration: 10, args: [...]}}
@@ -69,6 +71,9 @@ struct SweepSpec {
   std::string param;
   std::vector<double> values;
   std::vector<std::string> datasets;  // only on these datasets (empty: all)
+  // Build each sweep run's dense cloud: its point count is the density of the PKS paper's
+  // Eq. 13 (delta = argmax of normalised density - normalised ATE).
+  bool dense = false;
 };
 
 struct Suite {
@@ -77,6 +82,7 @@ struct Suite {
   int runs = 10;
   std::uint64_t seed = 1;
   bool deterministic = false;
+  bool dense = false;  // a dense cloud for every run (`pkslam dense` after `pkslam run`)
   std::string baseline = "orbslam3";
   double timeout_s = 3600.0;  // per run; a run that takes longer is killed and marked failed
   double rpe_delta_m = 1.0;   // RPE pose-pair distance in metres

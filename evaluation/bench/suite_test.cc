@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <algorithm>
+
 #include "core/util/error.h"
+#include "evaluation/bench/executor.h"
 #include "evaluation/bench/matrix.h"
 
 namespace pkslam::bench {
@@ -50,6 +53,35 @@ TEST(Suite, ParsesAllFields) {
   ASSERT_EQ(s.datasets.size(), 2u);
   EXPECT_EQ(*s.datasets[0].path, std::filesystem::absolute("dir/data/real"));
   EXPECT_EQ(*s.datasets[1].path, std::filesystem::path("/abs/path"));
+}
+
+// Repeated runs must differ by more than thread timing: each passes its own --seed to run.
+TEST(Suite, RunArgumentsCarryTheRunSeed) {
+  const Suite s = ParseSuite(kSuite, "dir/suite.yaml");
+  const auto runs = ExpandSuite(s);
+  for (int k = 0; k < 3; ++k) {
+    const auto a = RunArguments(s, runs[static_cast<std::size_t>(k)], "data", "out");
+    const auto it = std::find(a.begin(), a.end(), "--seed");
+    ASSERT_NE(it, a.end());
+    ASSERT_NE(it + 1, a.end());
+    EXPECT_EQ(*(it + 1), std::to_string(10 + k));
+  }
+}
+
+TEST(Suite, DenseCloudsForTheSweepOrTheWholeSuite) {
+  std::string text = kSuite;
+  text.replace(text.find("values: [10, 20]}"), 17, "values: [10, 20], dense: true}");
+  const Suite s = ParseSuite(text, "dir/suite.yaml");
+  ASSERT_TRUE(s.sweeps[0].dense);
+  const auto runs = ExpandSuite(s);
+  EXPECT_FALSE(runs[0].dense);               // real/stereo/orbslam3
+  EXPECT_TRUE(runs[6].dense) << runs[6].id;  // real/stereo/pks@delta_deg=10
+  const auto a = DenseArguments(s, runs[6], "data", "out/run");
+  EXPECT_EQ(a[0], "dense");
+  EXPECT_NE(std::find(a.begin(), a.end(), "out/run/dense.json"), a.end());
+  const Suite all = ParseSuite("dense: true\n" + std::string(kSuite), "dir/suite.yaml");
+  EXPECT_TRUE(ExpandSuite(all)[0].dense);
+  ExpectError("dense: maybe\n" + std::string(kSuite), 1, "dense");
 }
 
 TEST(Suite, ExpandsTheMatrixInOrderWithDistinctSeeds) {

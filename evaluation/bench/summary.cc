@@ -50,6 +50,41 @@ MeanStd ComputeMeanStd(const std::vector<double>& values) {
   return m;
 }
 
+namespace {
+
+// Eq. 13 of the PKS paper over each sweep (dataset, sensor, selector, parameter) whose points
+// have dense clouds. A sweep where every value gives the same density (or ATE) contributes 0
+// for that term rather than dividing by zero.
+void ScoreSweeps(std::vector<GroupSummary>* groups) {
+  auto scored = [](const GroupSummary& g) {
+    return !g.sweep_param.empty() && g.dense_points.n > 0 && std::isfinite(g.ate_m.mean);
+  };
+  for (auto& g : *groups) {
+    if (!scored(g)) continue;
+    double d_lo = g.dense_points.mean, d_hi = d_lo, a_lo = g.ate_m.mean, a_hi = a_lo;
+    int points = 0;
+    for (const auto& o : *groups) {
+      if (!scored(o) || o.dataset != g.dataset || o.sensor != g.sensor ||
+          o.selector != g.selector || o.sweep_param != g.sweep_param) {
+        continue;
+      }
+      ++points;
+      d_lo = std::min(d_lo, o.dense_points.mean);
+      d_hi = std::max(d_hi, o.dense_points.mean);
+      a_lo = std::min(a_lo, o.ate_m.mean);
+      a_hi = std::max(a_hi, o.ate_m.mean);
+    }
+    if (points < 2) continue;
+    auto normalised = [](double x, double lo, double hi) {
+      return hi > lo ? (x - lo) / (hi - lo) : 0.0;
+    };
+    g.sweep_score =
+        normalised(g.dense_points.mean, d_lo, d_hi) - normalised(g.ate_m.mean, a_lo, a_hi);
+  }
+}
+
+}  // namespace
+
 std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
   using Key = std::tuple<std::string, std::string, std::string>;
   std::map<Key, std::vector<const RunResult*>> by_group;
@@ -68,7 +103,8 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
     g.baseline = first.baseline;
     g.alignment = first.alignment;
     g.runs = static_cast<int>(runs.size());
-    std::vector<double> ate, se3, sim3, scale, rpe, kf, mp, lost, wall, track, coverage;
+    std::vector<double> ate, se3, sim3, scale, rpe, kf, mp, lost, wall, track, coverage, dense, bg,
+        ba;
     for (const RunResult* r : runs) {
       g.order = std::min(g.order, r->index);
       if (!r->ok) continue;
@@ -84,6 +120,9 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
       wall.push_back(r->wall_s);
       track.push_back(r->median_tracking_ms);
       coverage.push_back(r->coverage);
+      dense.push_back(r->dense_points);
+      bg.push_back(r->gyro_bias_err_pct);
+      ba.push_back(r->accel_bias_err_pct);
     }
     g.ate_m = ComputeMeanStd(ate);
     g.ate_se3_m = ComputeMeanStd(se3);
@@ -96,6 +135,9 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
     g.wall_s = ComputeMeanStd(wall);
     g.median_tracking_ms = ComputeMeanStd(track);
     g.coverage = ComputeMeanStd(coverage);
+    g.dense_points = ComputeMeanStd(dense);
+    g.gyro_bias_err_pct = ComputeMeanStd(bg);
+    g.accel_bias_err_pct = ComputeMeanStd(ba);
     g.ate_median_m = Median(ate);
     groups.push_back(std::move(g));
   }
@@ -109,6 +151,7 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
       }
     }
   }
+  ScoreSweeps(&groups);
   return groups;
 }
 
@@ -117,16 +160,18 @@ void WriteSummaryCsv(const fs::path& file, const std::vector<GroupSummary>& grou
   out << "dataset,sensor,config,selector,sweep_param,sweep_value,runs,ok,alignment,"
          "ate_mean_m,ate_std_m,ate_median_m,ate_se3_mean_m,ate_sim3_mean_m,scale_mean,"
          "rpe_trans_mean_m,improvement_pct,keyframes_mean,keyframes_std,map_points_mean,"
-         "lost_frames_mean,coverage_mean,wall_mean_s,median_tracking_mean_ms\n";
+         "lost_frames_mean,coverage_mean,wall_mean_s,median_tracking_mean_ms,dense_points_mean,"
+         "sweep_score,gyro_bias_err_mean_pct,accel_bias_err_mean_pct\n";
   for (const auto& g : groups) {
-    out << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-                       CsvField(g.dataset), CsvField(g.sensor), CsvField(g.config),
-                       CsvField(g.selector), CsvField(g.sweep_param), Num(g.sweep_value), g.runs,
-                       g.ok, g.alignment, Num(g.ate_m.mean), Num(g.ate_m.std), Num(g.ate_median_m),
-                       Num(g.ate_se3_m.mean), Num(g.ate_sim3_m.mean), Num(g.scale.mean),
-                       Num(g.rpe_trans_m.mean), Num(g.improvement_pct), Num(g.keyframes.mean),
-                       Num(g.keyframes.std), Num(g.map_points.mean), Num(g.lost_frames.mean),
-                       Num(g.coverage.mean), Num(g.wall_s.mean), Num(g.median_tracking_ms.mean));
+    out << fmt::format(
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+        CsvField(g.dataset), CsvField(g.sensor), CsvField(g.config), CsvField(g.selector),
+        CsvField(g.sweep_param), Num(g.sweep_value), g.runs, g.ok, g.alignment, Num(g.ate_m.mean),
+        Num(g.ate_m.std), Num(g.ate_median_m), Num(g.ate_se3_m.mean), Num(g.ate_sim3_m.mean),
+        Num(g.scale.mean), Num(g.rpe_trans_m.mean), Num(g.improvement_pct), Num(g.keyframes.mean),
+        Num(g.keyframes.std), Num(g.map_points.mean), Num(g.lost_frames.mean), Num(g.coverage.mean),
+        Num(g.wall_s.mean), Num(g.median_tracking_ms.mean), Num(g.dense_points.mean),
+        Num(g.sweep_score), Num(g.gyro_bias_err_pct.mean), Num(g.accel_bias_err_pct.mean));
   }
   if (!out) throw Error("cannot write " + file.string());
 }
@@ -253,15 +298,54 @@ std::vector<Table> SweepTables(const std::vector<GroupSummary>& groups) {
     Table t;
     t.title = "Sweep of " + p;
     t.header = {"dataset", "sensor", "config", p, "ATE [m]", "keyframes", "ok/runs"};
+    const bool dense = std::any_of(groups.begin(), groups.end(), [&](const GroupSummary& g) {
+      return g.sweep_param == p && g.dense_points.n > 0;
+    });
+    if (dense) {
+      t.title += " (Eq. 13: normalised dense points - normalised ATE, largest is best)";
+      t.header.insert(t.header.end(), {"dense points", "Eq. 13 score"});
+    }
     for (const auto& g : groups) {
       if (g.sweep_param != p) continue;
-      t.rows.push_back({g.dataset, g.sensor, g.config, FormatNumber(g.sweep_value),
-                        FormatMeanStd(g.ate_m, 4), FormatMeanStd(g.keyframes, 1),
-                        fmt::format("{}/{}", g.ok, g.runs)});
+      std::vector<std::string> row = {g.dataset,
+                                      g.sensor,
+                                      g.config,
+                                      FormatNumber(g.sweep_value),
+                                      FormatMeanStd(g.ate_m, 4),
+                                      FormatMeanStd(g.keyframes, 1),
+                                      fmt::format("{}/{}", g.ok, g.runs)};
+      if (dense) {
+        bool best = std::isfinite(g.sweep_score);
+        for (const auto& o : groups) {
+          if (o.dataset == g.dataset && o.sensor == g.sensor && o.selector == g.selector &&
+              o.sweep_param == p && std::isfinite(o.sweep_score) && o.sweep_score > g.sweep_score) {
+            best = false;
+          }
+        }
+        row.push_back(FormatMeanStd(g.dense_points, 0));
+        row.push_back(std::isfinite(g.sweep_score)
+                          ? fmt::format("{:+.2f}{}", g.sweep_score, best ? " (best)" : "")
+                          : "—");
+      }
+      t.rows.push_back(std::move(row));
     }
     tables.push_back(t);
   }
   return tables;
+}
+
+Table BiasTable(const std::vector<GroupSummary>& groups) {
+  Table t;
+  t.title =
+      "IMU bias estimates: relative error [%] of the keyframes' gyro and accelerometer biases "
+      "from 15 s after the first keyframe, mean ± std over runs";
+  t.header = {"dataset", "sensor", "config", "gyro bias error [%]", "accel bias error [%]"};
+  for (const auto& g : groups) {
+    if (g.gyro_bias_err_pct.n == 0) continue;
+    t.rows.push_back({g.dataset, g.sensor, g.config, FormatMeanStd(g.gyro_bias_err_pct, 1),
+                      FormatMeanStd(g.accel_bias_err_pct, 1)});
+  }
+  return t;
 }
 
 Table FailureTable(const std::vector<RunResult>& results) {

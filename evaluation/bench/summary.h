@@ -42,8 +42,15 @@ struct GroupSummary {
   MeanStd coverage;  // fraction of frames with a pose in the evaluated trajectory
   MeanStd wall_s;
   MeanStd median_tracking_ms;
+  MeanStd dense_points;       // runs with dense clouds
+  MeanStd gyro_bias_err_pct;  // inertial runs (bias_evaluation.h)
+  MeanStd accel_bias_err_pct;
   double ate_median_m = kNaN;
   double improvement_pct = kNaN;  // vs the baseline group of the same dataset and sensor
+  // Sweep points with dense clouds: the PKS paper's Eq. 13 criterion, mean density and mean
+  // ATE each min-max normalised over the sweep's values, density_n - ATE_n (the paper picks
+  // the value with the largest score).
+  double sweep_score = kNaN;
 };
 
 // Groups in matrix order (by their first run's index).
@@ -72,6 +79,8 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups);
 Table DetailTable(const std::vector<GroupSummary>& groups);
 // One table per swept parameter: value -> ATE and keyframes per dataset and sensor.
 std::vector<Table> SweepTables(const std::vector<GroupSummary>& groups);
+// Inertial runs: gyro and accelerometer bias errors (%) per group (no rows when none).
+Table BiasTable(const std::vector<GroupSummary>& groups);
 // Failed runs with their error (empty table when none).
 Table FailureTable(const std::vector<RunResult>& results);
 

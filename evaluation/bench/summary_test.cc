@@ -74,5 +74,37 @@ TEST(Summary, GroupsInMatrixOrderWithImprovementOverBaseline) {
   EXPECT_NE(md.find("| dataset | orbslam3 | pks |"), std::string::npos) << md;
 }
 
+// Eq. 13: density and ATE normalised over the sweep, the largest density - ATE wins.
+TEST(Summary, SweepScoreFollowsEquation13) {
+  std::vector<RunResult> results;
+  const double deltas[] = {10, 20, 30};
+  const double ates[] = {0.010, 0.020, 0.012};
+  const double dense[] = {1000, 3000, 2500};
+  for (int i = 0; i < 3; ++i) {
+    RunResult r =
+        Result(i, "V1", "pks@delta=" + std::to_string(static_cast<int>(deltas[i])), ates[i], 20);
+    r.selector = "pks";
+    r.sweep_param = "delta";
+    r.sweep_value = deltas[i];
+    r.dense_points = dense[i];
+    results.push_back(r);
+  }
+  const auto groups = Summarize(results);
+  ASSERT_EQ(groups.size(), 3u);
+  EXPECT_NEAR(groups[0].sweep_score, 0.0 - 0.0, 1e-12);   // fewest points, best ATE
+  EXPECT_NEAR(groups[1].sweep_score, 1.0 - 1.0, 1e-12);   // most points, worst ATE
+  EXPECT_NEAR(groups[2].sweep_score, 0.75 - 0.2, 1e-12);  // the paper's choice here
+  const auto tables = SweepTables(groups);
+  ASSERT_EQ(tables.size(), 1u);
+  ASSERT_EQ(tables[0].header.back(), "Eq. 13 score");
+  EXPECT_EQ(tables[0].rows[2].back(), "+0.55 (best)");
+  EXPECT_EQ(tables[0].rows[0].back(), "+0.00");
+  // Without dense clouds there is no score and no extra columns.
+  for (auto& r : results) r.dense_points = kNaN;
+  const auto plain = Summarize(results);
+  EXPECT_TRUE(std::isnan(plain[2].sweep_score));
+  EXPECT_EQ(SweepTables(plain)[0].header.back(), "ok/runs");
+}
+
 }  // namespace
 }  // namespace pkslam::bench

@@ -1,0 +1,29 @@
+// A rigid transform in a small text file (the camera-body extrinsic a run writes beside its
+// trajectories), and moving a trajectory to another rigidly attached sensor.
+//
+// Format: '#' comment lines, then four rows of four numbers (the row-major 4x4 matrix, metres).
+// Used to compare monocular runs with body-frame ground truth: their maps have no metric scale,
+// so the metric lever arm cannot be applied to the estimate; the ground truth is moved into the
+// camera instead (pkslam eval --body-from-camera, the bench).
+#pragma once
+
+#include <filesystem>
+#include <string_view>
+
+#include "core/geometry/se3.h"
+#include "io/trajectory.h"
+
+namespace pkslam {
+
+// Throws pkslam::Error when the file cannot be written.
+void WriteRigidTransform(const SE3d& transform, const std::filesystem::path& file,
+                         std::string_view comment);
+// Throws InputError (file and line) for a missing file, a row without four numbers, a wrong
+// row count, a last row other than 0 0 0 1 or a rotation block that is not a rotation (1e-6).
+SE3d ReadRigidTransform(const std::filesystem::path& file);
+
+// world_from_b = world_from_a * a_from_b for every pose; per-pose extras are dropped (the
+// velocity of another point of the body differs).
+Trajectory ChangeSensorFrame(const Trajectory& world_from_a, const SE3d& a_from_b);
+
+}  // namespace pkslam
