@@ -1,8 +1,7 @@
 #include "mapping/triangulation.h"
 
-#include <cmath>
-
 #include <Eigen/SVD>
+#include <cmath>
 
 #include "core/map/keyframe.h"
 

@@ -17,16 +17,17 @@ RigSetup MakeRig(const Settings& settings, Sensor sensor) {
 
   if (IsInertial(sensor)) {
     if (!settings.imu || !settings.body_from_cam0) {
-      throw OptionError(fmt::format("sensor {} needs IMU calibration (IMU.* keys)",
-                                    SensorName(sensor)));
+      throw OptionError(
+          fmt::format("sensor {} needs IMU calibration (IMU.* keys)", SensorName(sensor)));
     }
     rig->imu = settings.imu;
   }
 
   if (IsStereo(sensor)) {
     if (!settings.IsStereo()) {
-      throw OptionError("stereo sensor needs a stereo calibration (Camera2.* and Stereo.T_c1_c2, "
-                        "or Camera.type Rectified with Stereo.b)");
+      throw OptionError(
+          "stereo sensor needs a stereo calibration (Camera2.* and Stereo.T_c1_c2, "
+          "or Camera.type Rectified with Stereo.b)");
     }
     if (settings.rectified_stereo) {
       rig->camera = settings.camera1;
@@ -55,8 +56,9 @@ RigSetup MakeRig(const Settings& settings, Sensor sensor) {
   if (rig->camera.type() != CameraType::kPinhole) {
     // Tracking, matching and BA work on undistorted keypoints of an ideal pinhole; a fisheye
     // image cannot be undistorted to one beyond 90 degrees.
-    throw OptionError("the SLAM pipeline supports pinhole (radial-tangential) cameras; "
-                      "Kannala-Brandt fisheye is supported by the camera model only");
+    throw OptionError(
+        "the SLAM pipeline supports pinhole (radial-tangential) cameras; "
+        "Kannala-Brandt fisheye is supported by the camera model only");
   }
   rig->UpdateDerived();
   rig->bf = rig->fx * rig->baseline;

@@ -49,8 +49,8 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   orb.n_levels = settings.orb.n_levels;
   orb.ini_th_fast = settings.orb.ini_th_fast;
   orb.min_th_fast = settings.orb.min_th_fast;
-  tracker_ = std::make_unique<Tracker>(&atlas_, vocabulary_.get(), setup_.rig,
-                                       std::move(selector), mapper_.get(), options_.tracking, orb);
+  tracker_ = std::make_unique<Tracker>(&atlas_, vocabulary_.get(), setup_.rig, std::move(selector),
+                                       mapper_.get(), options_.tracking, orb);
   tracker_->EnableTrace(options_.trace);
   if (!options_.no_loop) {
     LocalMapper* mapper = mapper_.get();
@@ -66,9 +66,8 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   }
   mapper_->Start();
   PKSLAM_LOG_INFO("sensor {}, camera {}, baseline {:.4f} m, selector {}{}",
-                  SensorName(options_.sensor), setup_.rig->camera.ToString(),
-                  setup_.rig->baseline, options_.selector,
-                  options_.deterministic ? ", deterministic" : "");
+                  SensorName(options_.sensor), setup_.rig->camera.ToString(), setup_.rig->baseline,
+                  options_.selector, options_.deterministic ? ", deterministic" : "");
 }
 
 SlamSystem::~SlamSystem() { Shutdown(); }
@@ -81,8 +80,7 @@ void SlamSystem::Shutdown() {
   if (loop_) loop_->Finish();
 }
 
-TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right,
-                                    std::int64_t t_ns) {
+TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
   if (setup_.rectification) {
     const auto [l, r] = setup_.rectification->Rectify(left, right);
     return tracker_->TrackStereo(l, r, t_ns);
@@ -90,8 +88,7 @@ TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right,
   return tracker_->TrackStereo(left, right, t_ns);
 }
 
-TrackResult SlamSystem::TrackRgbd(const cv::Mat& image, const cv::Mat& depth,
-                                  std::int64_t t_ns) {
+TrackResult SlamSystem::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns) {
   return tracker_->TrackRgbd(image, depth, t_ns);
 }
 
@@ -153,8 +150,7 @@ void SlamSystem::WriteMapPly(const std::filesystem::path& file) const {
   if (!out) throw Error(fmt::format("cannot write {}", file.string()));
   const std::size_t n = map != nullptr ? map->map_points().size() : 0;
   out << "ply\nformat binary_little_endian 1.0\ncomment pkslam map points (world frame)\n"
-      << "element vertex " << n
-      << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << "element vertex " << n << "\nproperty float x\nproperty float y\nproperty float z\n"
       << "property uchar observations\nend_header\n";
   if (map == nullptr) return;
   for (const auto& [id, mp] : map->map_points()) {
@@ -162,7 +158,8 @@ void SlamSystem::WriteMapPly(const std::filesystem::path& file) const {
                           static_cast<float>(mp->position().y()),
                           static_cast<float>(mp->position().z())};
     out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
-    const auto obs = static_cast<unsigned char>(std::min<std::size_t>(255, mp->observations().size()));
+    const auto obs =
+        static_cast<unsigned char>(std::min<std::size_t>(255, mp->observations().size()));
     out.put(static_cast<char>(obs));
   }
 }

@@ -25,10 +25,7 @@ FrameFeatures ToFrameFeatures(OrbFeatures&& f) {
 
 FrameBuilder::FrameBuilder(std::shared_ptr<const CameraRig> rig, const OrbOptions& orb,
                            StereoMatcherOptions stereo)
-    : rig_(std::move(rig)),
-      extractor_(orb),
-      init_extractor_(Doubled(orb)),
-      stereo_(stereo) {
+    : rig_(std::move(rig)), extractor_(orb), init_extractor_(Doubled(orb)), stereo_(stereo) {
   stereo_.Check();
 }
 

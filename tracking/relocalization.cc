@@ -84,7 +84,8 @@ bool Tracker::Relocalize() {
       std::fill(current_.map_points.begin(), current_.map_points.end(), nullptr);
       const auto& correspondences = c.pnp->correspondences();
       for (std::size_t k = 0; k < correspondences.size(); ++k) {
-        if (pnp.inliers[k]) current_.map_points[correspondences[k].index] = c.matches[correspondences[k].index];
+        if (pnp.inliers[k])
+          current_.map_points[correspondences[k].index] = c.matches[correspondences[k].index];
       }
       current_.outliers.assign(current_.size(), 0);
       int good = OptimizePose(&current_, options_.pose);
@@ -99,8 +100,8 @@ bool Tracker::Relocalize() {
           current_.outliers.assign(current_.size(), 0);
           good = OptimizePose(&current_, options_.pose);
           if (good > 30 && good < 50) {
-            const int again = projection_matcher.SearchByProjection(
-                &current_, *c.keyframe, FoundPoints(current_), 3, 64);
+            const int again = projection_matcher.SearchByProjection(&current_, *c.keyframe,
+                                                                    FoundPoints(current_), 3, 64);
             if (good + again >= 50) {
               current_.outliers.assign(current_.size(), 0);
               good = OptimizePose(&current_, options_.pose);

@@ -53,9 +53,9 @@ Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<con
       options_(options),
       builder_(rig_, orb_options) {
   options_.Check();
-  PKSLAM_CHECK(atlas_ != nullptr && vocabulary_ != nullptr && selector_ != nullptr &&
-                   mapping_ != nullptr,
-               "tracker needs an atlas, a vocabulary, a selector and local mapping");
+  PKSLAM_CHECK(
+      atlas_ != nullptr && vocabulary_ != nullptr && selector_ != nullptr && mapping_ != nullptr,
+      "tracker needs an atlas, a vocabulary, a selector and local mapping");
   if (IsInertial(rig_->sensor)) {
     PKSLAM_CHECK(rig_->imu.has_value(), "inertial sensor without IMU noise model");
     imu_ = std::make_unique<InertialTrackingState>();
@@ -81,8 +81,7 @@ TrackResult Tracker::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::
 }
 
 TrackResult Tracker::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
-  PKSLAM_CHECK(IsMonocular(rig_->sensor), "TrackMonocular with a {} rig",
-               SensorName(rig_->sensor));
+  PKSLAM_CHECK(IsMonocular(rig_->sensor), "TrackMonocular with a {} rig", SensorName(rig_->sensor));
   const bool initialising = state_ == TrackingState::kNotInitialized;
   const double cpu = ThreadCpuSeconds();
   Frame frame = builder_.BuildMonocular(atlas_->NextFrameId(), t_ns, image, initialising);
@@ -135,7 +134,8 @@ TrackResult Tracker::Track(Frame frame) {
       if (ok) {
         state_ = TrackingState::kOk;
       } else if (state_ == TrackingState::kOk) {
-        const bool keep = atlas_->current_map()->NumKeyFrames() > options_.min_keyframes_to_keep_map;
+        const bool keep =
+            atlas_->current_map()->NumKeyFrames() > options_.min_keyframes_to_keep_map;
         state_ = keep ? TrackingState::kRecentlyLost : TrackingState::kLost;
         lost_since_t_ns_ = current_.t_ns();
       } else if (state_ == TrackingState::kRecentlyLost &&

@@ -6,10 +6,9 @@
 
 #include <cstdint>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/frame/frame.h"
 #include "core/map/atlas.h"

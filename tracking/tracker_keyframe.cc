@@ -134,9 +134,8 @@ void Tracker::MonocularInitialization() {
     return;
   }
   const OrbMatcher matcher(0.9, true);
-  const int n =
-      matcher.SearchForInitialization(*init_frame_, current_, &init_prev_matched_, &init_matches_,
-                                      100);
+  const int n = matcher.SearchForInitialization(*init_frame_, current_, &init_prev_matched_,
+                                                &init_matches_, 100);
   if (n < kMinFeatures) {
     init_frame_.reset();
     return;

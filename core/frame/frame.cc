@@ -45,8 +45,7 @@ Frame::Frame(FrameId id, std::int64_t t_ns, std::shared_ptr<const CameraRig> rig
                  n);
   }
   if (!right_u_.empty()) {
-    PKSLAM_CHECK(right_u_.size() == n, "{} right coordinates for {} keypoints", right_u_.size(),
-                 n);
+    PKSLAM_CHECK(right_u_.size() == n, "{} right coordinates for {} keypoints", right_u_.size(), n);
   }
   grid_ = FeatureGrid(keypoints_un_, rig_->bounds);
   map_points.assign(n, nullptr);

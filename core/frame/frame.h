@@ -4,13 +4,12 @@
 // is being tracked (keyframes copy what they need).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <opencv2/core/types.hpp>
 #include <optional>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core/types.hpp>
 
 #include "core/bow/bow_vector.h"
 #include "core/features/descriptor.h"

@@ -177,8 +177,8 @@ int KeyFrame::Weight(const KeyFrame* kf) const {
 }
 
 std::vector<KeyFrame*> KeyFrame::BestCovisibles(int n) const {
-  const auto count = std::min<std::size_t>(static_cast<std::size_t>(std::max(n, 0)),
-                                           ordered_connected_.size());
+  const auto count =
+      std::min<std::size_t>(static_cast<std::size_t>(std::max(n, 0)), ordered_connected_.size());
   return {ordered_connected_.begin(), ordered_connected_.begin() + static_cast<long>(count)};
 }
 

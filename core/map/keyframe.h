@@ -6,15 +6,14 @@
 // until the keyframe is retired.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <opencv2/core/types.hpp>
 #include <optional>
 #include <set>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core/types.hpp>
 
 #include "core/bow/bow_vector.h"
 #include "core/features/descriptor.h"

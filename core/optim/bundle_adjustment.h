@@ -4,10 +4,9 @@
 //   Collect (shared lock) -> Solve (no lock, abortable) -> Apply (exclusive lock).
 #pragma once
 
+#include <Eigen/Core>
 #include <atomic>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/geometry/se3.h"
 #include "core/map/ids.h"
