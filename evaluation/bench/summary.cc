@@ -270,9 +270,19 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
 Table DetailTable(const std::vector<GroupSummary>& groups) {
   Table t;
   t.title = "Per configuration: keyframes, map, losses and run time (mean ± std over runs)";
-  t.header = {"dataset",    "sensor",      "config",   "ok/runs",
-              "ATE [m]",    "RPE [m]",     "scale",    "keyframes",
-              "map points", "lost frames", "wall [s]", "median tracking [ms]"};
+  t.header = {"dataset",
+              "sensor",
+              "config",
+              "ok/runs",
+              "ATE [m]",
+              "RPE [m]",
+              "scale",
+              "coverage",
+              "keyframes",
+              "map points",
+              "lost frames",
+              "wall [s]",
+              "median tracking [ms]"};
   for (const auto& g : groups) {
     t.rows.push_back({g.dataset, g.sensor, g.config, fmt::format("{}/{}", g.ok, g.runs),
                       FormatMeanStd(g.ate_m, 4), FormatMeanStd(g.rpe_trans_m, 4),

@@ -63,6 +63,11 @@ TEST(Summary, GroupsInMatrixOrderWithImprovementOverBaseline) {
   EXPECT_EQ(tables[0].rows[3][2], "-12.5%");
   EXPECT_EQ(tables[0].rows[4][2], "1/2");
   EXPECT_EQ(FailureTable(results).rows.size(), 1u);
+  // Every table's rows are as wide as its header (a missing header cell shifts the columns).
+  const Table detail = DetailTable(groups);
+  for (const auto& row : detail.rows) EXPECT_EQ(row.size(), detail.header.size());
+  EXPECT_EQ(detail.header[7], "coverage");
+  EXPECT_EQ(detail.rows[0][7], "100%");
 
   // A configuration tracking only part of the sequence is flagged.
   auto partial = results;
