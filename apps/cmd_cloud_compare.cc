@@ -55,18 +55,12 @@ Alignment AlignRun(const CompareArgs& args) {
   const fs::path run = args.align_run;
   if (!fs::is_directory(run)) throw InputError(run, "run directory does not exist");
   if (args.gt.empty()) throw OptionError("--align-run needs --gt (the ground-truth trajectory)");
-  // Body poses compare with EuRoC ground truth (IMU frame); for RGB-D runs body = camera.
-  fs::path estimate = run / "trajectory_body.txt";
-  if (!fs::exists(estimate)) estimate = run / "trajectory.txt";
-  const Trajectory est = ReadTrajectory(estimate, TrajectoryFormat::kTum);
-  Trajectory gt = ReadTrajectory(args.gt);
-  // Monocular runs have camera poses only (no metric lever arm): compare them with the
-  // EuRoC body ground truth moved into the camera.
-  const fs::path extrinsic = run / "body_from_camera.txt";
-  if (estimate.filename() == "trajectory.txt" && fs::exists(extrinsic) &&
-      DetectTrajectoryFormat(args.gt) == TrajectoryFormat::kEuroc) {
-    gt = ChangeSensorFrame(gt, ReadRigidTransform(extrinsic));
-  }
+  // Body poses against EuRoC ground truth; monocular runs (no trajectory_body.txt) on camera
+  // poses against the ground truth moved into the camera.
+  const RunAndGroundTruth pair = ReadRunAndGroundTruth(run, args.gt, std::nullopt);
+  const Trajectory& gt = pair.ground_truth;
+  const Trajectory& est = pair.estimate;
+  const fs::path estimate = pair.estimate_file;
   EvaluationOptions options;
   options.alignment = ParseAlignmentMethod(args.align);
   if (options.alignment != AlignmentMethod::kSE3 && options.alignment != AlignmentMethod::kSim3) {

@@ -62,4 +62,24 @@ Trajectory ChangeSensorFrame(const Trajectory& world_from_a, const SE3d& a_from_
   return out;
 }
 
+RunAndGroundTruth ReadRunAndGroundTruth(const std::filesystem::path& run_dir,
+                                        const std::filesystem::path& gt_file,
+                                        std::optional<bool> monocular) {
+  namespace fs = std::filesystem;
+  RunAndGroundTruth r;
+  r.ground_truth = ReadTrajectory(gt_file);
+  const bool body_gt = gt_file.filename() == "data.csv" ||
+                       DetectTrajectoryFormat(gt_file) == TrajectoryFormat::kEuroc;
+  const fs::path body = run_dir / "trajectory_body.txt";
+  const fs::path extrinsic = run_dir / "body_from_camera.txt";
+  const bool camera_poses =
+      !body_gt || (monocular ? *monocular && fs::exists(extrinsic) : !fs::exists(body));
+  r.estimate_file = camera_poses ? run_dir / "trajectory.txt" : body;
+  if (body_gt && camera_poses && fs::exists(extrinsic)) {
+    r.ground_truth = ChangeSensorFrame(r.ground_truth, ReadRigidTransform(extrinsic));
+  }
+  r.estimate = ReadTrajectory(r.estimate_file, TrajectoryFormat::kTum);
+  return r;
+}
+
 }  // namespace pkslam

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string_view>
 
 #include "core/geometry/se3.h"
@@ -25,5 +26,22 @@ SE3d ReadRigidTransform(const std::filesystem::path& file);
 // world_from_b = world_from_a * a_from_b for every pose; per-pose extras are dropped (the
 // velocity of another point of the body differs).
 Trajectory ChangeSensorFrame(const Trajectory& world_from_a, const SE3d& a_from_b);
+
+// A run's trajectory and the ground truth it is compared with, in the same sensor frame.
+struct RunAndGroundTruth {
+  Trajectory ground_truth;
+  Trajectory estimate;
+  std::filesystem::path estimate_file;
+};
+// Body (EuRoC) ground truth is compared with RUN/trajectory_body.txt, except for visual-only
+// monocular runs: their camera trajectory.txt is compared with the ground truth moved into
+// the camera through RUN/body_from_camera.txt. `monocular`: the run's sensor when the caller
+// knows it (a monocular run of an older version without the extrinsic file keeps its body
+// trajectory); std::nullopt: a run without trajectory_body.txt is taken as monocular. Camera
+// (TUM) ground truth is compared with RUN/trajectory.txt. Throws InputError for missing or
+// malformed files.
+RunAndGroundTruth ReadRunAndGroundTruth(const std::filesystem::path& run_dir,
+                                        const std::filesystem::path& gt_file,
+                                        std::optional<bool> monocular);
 
 }  // namespace pkslam

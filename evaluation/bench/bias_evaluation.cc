@@ -2,12 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <sstream>
-#include <string>
 #include <vector>
 
-#include "core/util/error.h"
+#include "io/text_rows.h"
 
 namespace pkslam::bench {
 namespace {
@@ -20,42 +17,23 @@ struct KeyFrameBias {
 };
 
 // keyframes_imu.csv: time,vx,vy,vz,bgx,bgy,bgz,bax,bay,baz,valid,map_imu_initialized (time in
-// seconds with nanosecond digits).
+// decimal seconds, read exactly to nanoseconds).
 std::vector<KeyFrameBias> ReadKeyFrameBiases(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file, "cannot read");
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("time,", 0) != 0) {
-    throw InputError(file, 1, "expected the header 'time,vx,vy,vz,bgx,...'");
-  }
   std::vector<KeyFrameBias> out;
-  std::size_t n = 1;
-  while (std::getline(in, line)) {
-    ++n;
-    if (line.empty()) continue;
-    std::vector<std::string> f;
-    std::stringstream ss(line);
-    std::string field;
-    while (std::getline(ss, field, ',')) f.push_back(field);
-    if (f.size() != 12) throw InputError(file, n, fmt::format("{} fields, expected 12", f.size()));
+  ForEachDataRow(file, FieldSeparator::kComma, [&](const TextRow& row) {
+    if (row.line == 1 && !row.fields.empty() && row.fields[0] == "time") return;  // header
+    RequireFieldCount(row, 12, file, "keyframes_imu.csv (time,vx,...,map_imu_initialized)");
     KeyFrameBias k;
-    try {
-      // Seconds.nanoseconds: split to keep the nanosecond timestamp exact.
-      const std::size_t dot = f[0].find('.');
-      const std::string sec = f[0].substr(0, dot);
-      std::string frac = dot == std::string::npos ? "" : f[0].substr(dot + 1);
-      frac.resize(9, '0');
-      k.t_ns = std::stoll(sec) * 1000000000LL + std::stoll(frac);
-      for (int i = 0; i < 3; ++i) {
-        k.gyro[i] = std::stod(f[4 + static_cast<std::size_t>(i)]);
-        k.accel[i] = std::stod(f[7 + static_cast<std::size_t>(i)]);
-      }
-      k.initialised = f[10] == "1" && f[11] == "1";
-    } catch (const std::exception&) {
-      throw InputError(file, n, "not a number in '" + line + "'");
+    k.t_ns = SecondsFieldToNs(row.fields[0], file, row.line, "time");
+    for (int i = 0; i < 3; ++i) {
+      const auto g = static_cast<std::size_t>(4 + i);
+      const auto a = static_cast<std::size_t>(7 + i);
+      k.gyro[i] = DoubleField(row.fields[g], file, row.line, "gyro bias");
+      k.accel[i] = DoubleField(row.fields[a], file, row.line, "accel bias");
     }
+    k.initialised = row.fields[10] == "1" && row.fields[11] == "1";
     out.push_back(k);
-  }
+  });
   return out;
 }
 

@@ -104,19 +104,12 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   result->median_tracking_ms = stats.median_tracking_ms;
 
   const fs::path gt_file = files.ground_truth.value_or(FindGroundTruth(files.dataset));
-  // EuRoC ground truth is the body (IMU) frame: compare body poses; TUM's is the camera's.
-  const bool body = gt_file.filename() == "data.csv" ||
-                    DetectTrajectoryFormat(gt_file) == TrajectoryFormat::kEuroc;
-  // Visual-only monocular maps have no metric scale, so the metric lever arm of
-  // trajectory_body.txt does not fit them: compare camera poses with the ground truth moved
-  // into the camera instead (the run wrote the extrinsic).
-  const fs::path extrinsic = files.run_dir / "body_from_camera.txt";
-  const bool camera_gt = body && result->sensor == "mono" && fs::exists(extrinsic);
-  const fs::path est_file =
-      files.run_dir / (body && !camera_gt ? "trajectory_body.txt" : "trajectory.txt");
-  Trajectory gt = ReadTrajectory(gt_file);
-  if (camera_gt) gt = ChangeSensorFrame(gt, ReadRigidTransform(extrinsic));
-  const Trajectory est = ReadTrajectory(est_file, TrajectoryFormat::kTum);
+  // Visual-only monocular maps have no metric scale: their camera poses are compared with the
+  // ground truth moved into the camera (io/rigid_transform_file.h).
+  const RunAndGroundTruth pair =
+      ReadRunAndGroundTruth(files.run_dir, gt_file, result->sensor == "mono");
+  const Trajectory& gt = pair.ground_truth;
+  const Trajectory& est = pair.estimate;
   const Trajectory keyframes =
       ReadTrajectory(files.run_dir / "keyframes.txt", TrajectoryFormat::kTum);
 
