@@ -1,5 +1,7 @@
 #include "loopclosing/global_bundle.h"
 
+#include <algorithm>
+#include <cmath>
 #include <deque>
 #include <map>
 #include <set>
@@ -43,6 +45,14 @@ void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResul
     }
   }
 
+  // Velocities (inertial maps) turn with their keyframe's orientation.
+  for (const auto& [id, kf] : map->keyframes()) {
+    const auto it = before.find(id);
+    if (kf->IsBad() || !kf->imu.state.valid || it == before.end()) continue;
+    kf->imu.state.velocity_world =
+        kf->world_from_camera().so3() * (it->second.so3() * kf->imu.state.velocity_world);
+  }
+
   // Points created meanwhile move rigidly with their reference keyframe.
   for (const auto& [id, mp] : map->map_points()) {
     if (mp->IsBad() || points_in_problem.count(id) > 0) continue;
@@ -54,6 +64,24 @@ void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResul
     mp->UpdateNormalAndDepth();
   }
   map->IncreaseChangeIndex();
+}
+
+std::map<KeyFrameId, Eigen::Vector3d> GravityInCameras(const Map& map) {
+  std::map<KeyFrameId, Eigen::Vector3d> out;
+  for (const auto& [id, kf] : map.keyframes()) {
+    if (!kf->IsBad()) out[id] = kf->camera_from_world().so3() * Eigen::Vector3d::UnitZ();
+  }
+  return out;
+}
+
+double MaxTiltChange(const Map& map, const std::map<KeyFrameId, Eigen::Vector3d>& before) {
+  double worst = 0;
+  for (const auto& [id, g] : GravityInCameras(map)) {
+    auto it = before.find(id);
+    if (it == before.end()) continue;
+    worst = std::max(worst, std::atan2(g.cross(it->second).norm(), g.dot(it->second)));
+  }
+  return worst;
 }
 
 }  // namespace pkslam

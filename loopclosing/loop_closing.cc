@@ -33,6 +33,9 @@ void LoopClosingOptions::Check() const {
       "LoopClosing.confirming_covisibles", "{} / {} / {}", confirming_covisibles, max_unconfirmed,
       keyframes_after_loop);
   PKSLAM_CHECK_OPTION(fuse_radius > 0, "LoopClosing.fuse_radius", "{}", fuse_radius);
+  PKSLAM_CHECK_OPTION(inertial_max_tilt_rad > 0 && inertial_max_yaw_rad > 0,
+                      "LoopClosing.inertial_max_tilt_rad / yaw", "{} / {}", inertial_max_tilt_rad,
+                      inertial_max_yaw_rad);
   PKSLAM_CHECK_OPTION(num_threads > 0, "LoopClosing.num_threads", "{}", num_threads);
   global_ba_options.Check();
 }
@@ -144,6 +147,11 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
     event.map = region->query->map()->id();
     event.matched_map = region->matched->map()->id();
     merge = region->query->map() != region->matched->map();
+    if (!merge && !AcceptsInertialLoop(*region)) {
+      std::lock_guard stats_lock(mutex_);
+      ++stats_.rejected_inertial;
+      return;
+    }
   }
   const auto correct_start = std::chrono::steady_clock::now();
   Map* corrected = merge ? MergeMaps(*region, &event) : CorrectLoop(*region, &event);
@@ -292,8 +300,14 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
       std::unique_lock lock(atlas_->mutex());
       // A newer loop or merge may have aborted us in the meantime (then it owns the map).
       if (!gba_abort_.load()) {
+        const auto gravity_before = GravityInCameras(*map);
         MergeGlobalBundle(map, problem, result);
         applied = true;
+        if (IsInertial(sensor_) && map->imu_initialized) {
+          ++map->imu_change_index;
+          PKSLAM_LOG_INFO("global BA of map {}: largest keyframe tilt change {:.2e} rad", map->id(),
+                          MaxTiltChange(*map, gravity_before));
+        }
       }
     }
     ReleaseMapping();
