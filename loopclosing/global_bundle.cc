@@ -13,6 +13,12 @@
 namespace pkslam {
 
 void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResult& result) {
+  MergeGlobalBundle(
+      map, problem, [&] { ApplyBundle(problem, result); }, false);
+}
+
+void MergeGlobalBundle(Map* map, const BundleProblem& problem, const std::function<void()>& apply,
+                       bool apply_sets_velocities) {
   if (map == nullptr || map->origin() == nullptr) return;
   // Poses before the write-back: what everything outside the problem is relative to.
   std::map<KeyFrameId, SE3d> before;
@@ -24,7 +30,7 @@ void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResul
   std::set<MapPointId> points_in_problem;
   for (const auto& p : problem.points) points_in_problem.insert(p.point->id());
 
-  ApplyBundle(problem, result);
+  apply();
 
   // Keyframes created while the BA ran: breadth-first down the spanning tree, each keeps its
   // pose relative to its (already updated) parent.
@@ -49,6 +55,7 @@ void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResul
   for (const auto& [id, kf] : map->keyframes()) {
     const auto it = before.find(id);
     if (kf->IsBad() || !kf->imu.state.valid || it == before.end()) continue;
+    if (apply_sets_velocities && in_problem.count(id) > 0) continue;
     kf->imu.state.velocity_world =
         kf->world_from_camera().so3() * (it->second.so3() * kf->imu.state.velocity_world);
   }

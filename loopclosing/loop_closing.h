@@ -62,6 +62,11 @@ struct LoopClosingOptions {
   // Global bundle adjustment after a loop / merge.
   bool global_ba = true;
   BundleAdjustmentOptions global_ba_options;
+  // Inertial maps with the IMU initialised and at most this many keyframes: the global BA is
+  // the full visual-inertial BA (ORB-SLAM3 v1.0: FullInertialBA, 7 iterations, < 200
+  // keyframes); larger inertial maps get the visual global BA.
+  int inertial_global_ba_max_keyframes = 200;
+  int inertial_global_ba_iterations = 7;
   // Inertial maps (IMU initialised): a loop is accepted only if its world correction turns
   // about the horizontal axes by less than inertial_max_tilt_rad (each rotation-vector
   // component) and about gravity by less than inertial_max_yaw_rad (ORB-SLAM3: 0.008, 0.349).
