@@ -27,31 +27,40 @@ class InertialLoopTest : public testing::RevisitTest {
  protected:
   // The second visit drifted by yaw `yaw` and roll `roll` (rad) and a translation; both visits
   // form one inertial map with a temporal chain and valid velocities.
-  void Build(double yaw, double roll) {
+  // With `merge`, the second visit is a second inertial map of the Atlas.
+  void Build(double yaw, double roll, bool merge = false) {
     drift_ = SE3d(SO3d::Exp(Eigen::Vector3d(roll, 0, yaw)), Eigen::Vector3d(0.12, -0.03, 0.05));
-    second_ = Revisit(atlas_.current_map(), scene_);
+    Map* second_map = atlas_.current_map();
+    if (merge) {
+      std::unique_lock lock(atlas_.mutex());
+      second_map = atlas_.CreateNewMap();
+    }
+    second_ = Revisit(second_map, scene_);
     Finish(second_);
     std::unique_lock lock(atlas_.mutex());
-    Map* map = atlas_.current_map();
-    map->imu_initialized = true;
-    map->inertial_ba1_done = true;
-    map->inertial_ba2_done = true;
-    KeyFrame* previous = nullptr;
-    for (const auto& kf : map->keyframes()) {
-      kf.second->imu.previous = previous;
-      if (previous != nullptr) previous->imu.next = kf.second.get();
-      kf.second->imu.state.valid = true;
-      kf.second->imu.state.velocity_world = Eigen::Vector3d(0.4, 0.1, -0.05);
-      previous = kf.second.get();
+    for (Map* map : atlas_.maps()) {
+      map->imu_initialized = true;
+      map->inertial_ba1_done = true;
+      map->inertial_ba2_done = true;
+      KeyFrame* previous = nullptr;
+      for (const auto& kf : map->keyframes()) {
+        kf.second->imu.previous = previous;
+        if (previous != nullptr) previous->imu.next = kf.second.get();
+        kf.second->imu.state.valid = true;
+        kf.second->imu.state.velocity_world = Eigen::Vector3d(0.4, 0.1, -0.05);
+        previous = kf.second.get();
+      }
     }
   }
 
   Snapshot Take() {
     std::shared_lock lock(atlas_.mutex());
     Snapshot s;
-    for (const auto& [id, kf] : atlas_.current_map()->keyframes()) {
-      s.camera_from_world[id] = kf->camera_from_world();
-      s.velocity[id] = kf->imu.state.velocity_world;
+    for (const Map* map : atlas_.maps()) {
+      for (const auto& [id, kf] : map->keyframes()) {
+        s.camera_from_world[id] = kf->camera_from_world();
+        s.velocity[id] = kf->imu.state.velocity_world;
+      }
     }
     return s;
   }
@@ -100,6 +109,22 @@ TEST_F(InertialLoopTest, CorrectsYawAndTranslationKeepingGravity) {
     EXPECT_LT((kf.imu.state.velocity_world - turn * before.velocity.at(kf.id())).norm(), 1e-9);
   }
   EXPECT_GT(atlas_.current_map()->imu_change_index, 0);  // tracking re-anchors on its keyframe
+}
+
+TEST_F(InertialLoopTest, TwoInertialMapsMergeByYawAndTranslation) {
+  Build(0.03, 0.004, /*merge=*/true);
+  const Snapshot before = Take();
+  const LoopClosingStats stats = Close(Sensor::kStereoInertial);
+  ASSERT_EQ(stats.merges.size(), 1u);
+  std::shared_lock lock(atlas_.mutex());
+  EXPECT_EQ(atlas_.NumMaps(), 1);
+  EXPECT_LT(MaxTiltChange(before), 1e-9);
+  for (int k = 0; k < kKeyFrames; ++k) {
+    const KeyFrame& kf = *second_[static_cast<std::size_t>(k)];
+    EXPECT_LT(CentreError(kf, poses_[static_cast<std::size_t>(k)]), 0.02) << "keyframe " << k;
+    const SO3d turn = kf.world_from_camera().so3() * before.camera_from_world.at(kf.id()).so3();
+    EXPECT_LT((kf.imu.state.velocity_world - turn * before.velocity.at(kf.id())).norm(), 1e-9);
+  }
 }
 
 TEST_F(InertialLoopTest, AVisualMapTakesTheTiltToo) {
