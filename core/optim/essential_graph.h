@@ -22,6 +22,7 @@
 //
 // Cost (loop_closing_benchmark, Release, 1 thread): 40 keyframes / 188 edges ~10 ms; 184
 // keyframes / 4465 edges ~0.3 s CPU, about 2/3 autodiff Jacobians and 1/3 sparse Cholesky.
+// kYawTranslation (BM_EssentialGraphYawTranslation, loaded machine): ~7 ms / ~0.21 s CPU.
 #pragma once
 
 #include <Eigen/Core>
