@@ -1,5 +1,7 @@
 #include "loopclosing/global_bundle.h"
 
+#include <algorithm>
+#include <cmath>
 #include <deque>
 #include <map>
 #include <set>
@@ -11,6 +13,12 @@
 namespace pkslam {
 
 void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResult& result) {
+  MergeGlobalBundle(
+      map, problem, [&] { ApplyBundle(problem, result); }, false);
+}
+
+void MergeGlobalBundle(Map* map, const BundleProblem& problem, const std::function<void()>& apply,
+                       bool apply_sets_velocities) {
   if (map == nullptr || map->origin() == nullptr) return;
   // Poses before the write-back: what everything outside the problem is relative to.
   std::map<KeyFrameId, SE3d> before;
@@ -22,7 +30,7 @@ void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResul
   std::set<MapPointId> points_in_problem;
   for (const auto& p : problem.points) points_in_problem.insert(p.point->id());
 
-  ApplyBundle(problem, result);
+  apply();
 
   // Keyframes created while the BA ran: breadth-first down the spanning tree, each keeps its
   // pose relative to its (already updated) parent.
@@ -43,6 +51,15 @@ void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResul
     }
   }
 
+  // Velocities (inertial maps) turn with their keyframe's orientation.
+  for (const auto& [id, kf] : map->keyframes()) {
+    const auto it = before.find(id);
+    if (kf->IsBad() || !kf->imu.state.valid || it == before.end()) continue;
+    if (apply_sets_velocities && in_problem.count(id) > 0) continue;
+    kf->imu.state.velocity_world =
+        kf->world_from_camera().so3() * (it->second.so3() * kf->imu.state.velocity_world);
+  }
+
   // Points created meanwhile move rigidly with their reference keyframe.
   for (const auto& [id, mp] : map->map_points()) {
     if (mp->IsBad() || points_in_problem.count(id) > 0) continue;
@@ -54,6 +71,24 @@ void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResul
     mp->UpdateNormalAndDepth();
   }
   map->IncreaseChangeIndex();
+}
+
+std::map<KeyFrameId, Eigen::Vector3d> GravityInCameras(const Map& map) {
+  std::map<KeyFrameId, Eigen::Vector3d> out;
+  for (const auto& [id, kf] : map.keyframes()) {
+    if (!kf->IsBad()) out[id] = kf->camera_from_world().so3() * Eigen::Vector3d::UnitZ();
+  }
+  return out;
+}
+
+double MaxTiltChange(const Map& map, const std::map<KeyFrameId, Eigen::Vector3d>& before) {
+  double worst = 0;
+  for (const auto& [id, g] : GravityInCameras(map)) {
+    auto it = before.find(id);
+    if (it == before.end()) continue;
+    worst = std::max(worst, std::atan2(g.cross(it->second).norm(), g.dot(it->second)));
+  }
+  return worst;
 }
 
 }  // namespace pkslam

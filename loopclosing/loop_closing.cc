@@ -11,6 +11,7 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "loopclosing/global_bundle.h"
+#include "mapping/inertial_bundle.h"
 
 namespace pkslam {
 namespace {
@@ -33,8 +34,14 @@ void LoopClosingOptions::Check() const {
       "LoopClosing.confirming_covisibles", "{} / {} / {}", confirming_covisibles, max_unconfirmed,
       keyframes_after_loop);
   PKSLAM_CHECK_OPTION(fuse_radius > 0, "LoopClosing.fuse_radius", "{}", fuse_radius);
+  PKSLAM_CHECK_OPTION(inertial_max_tilt_rad > 0 && inertial_max_yaw_rad > 0,
+                      "LoopClosing.inertial_max_tilt_rad / yaw", "{} / {}", inertial_max_tilt_rad,
+                      inertial_max_yaw_rad);
   PKSLAM_CHECK_OPTION(num_threads > 0, "LoopClosing.num_threads", "{}", num_threads);
   global_ba_options.Check();
+  PKSLAM_CHECK_OPTION(inertial_global_ba_max_keyframes >= 0 && inertial_global_ba_iterations >= 1,
+                      "LoopClosing.inertial_global_ba", "{} / {}", inertial_global_ba_max_keyframes,
+                      inertial_global_ba_iterations);
 }
 
 LoopClosing::LoopClosing(Atlas* atlas, Sensor sensor, MappingControl mapping,
@@ -144,6 +151,11 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
     event.map = region->query->map()->id();
     event.matched_map = region->matched->map()->id();
     merge = region->query->map() != region->matched->map();
+    if (!merge && !AcceptsInertialLoop(*region)) {
+      std::lock_guard stats_lock(mutex_);
+      ++stats_.rejected_inertial;
+      return;
+    }
   }
   const auto correct_start = std::chrono::steady_clock::now();
   Map* corrected = merge ? MergeMaps(*region, &event) : CorrectLoop(*region, &event);
@@ -276,24 +288,60 @@ void LoopClosing::StopGlobalBundle() {
 
 void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
   const auto start = std::chrono::steady_clock::now();
+  const std::atomic<bool>* abort = options_.synchronous ? nullptr : &gba_abort_;
+  // Inertial maps: the full visual-inertial BA over the temporal chain (ORB-SLAM3).
+  InertialBundleOptions inertial_options;
+  inertial_options.iterations_first = options_.inertial_global_ba_iterations;
+  inertial_options.iterations_second = 0;
+  inertial_options.num_threads = options_.global_ba_options.num_threads;
+  InertialBundleProblem inertial;
   BundleProblem problem;
   {
     std::shared_lock lock(atlas_->mutex());
-    problem = CollectGlobalBundle(*map);
+    if (IsInertial(sensor_) && map->imu_initialized &&
+        map->NumKeyFrames() <= options_.inertial_global_ba_max_keyframes) {
+      KeyFrame* newest = nullptr;
+      for (auto it = map->keyframes().rbegin(); it != map->keyframes().rend() && !newest; ++it) {
+        if (!it->second->IsBad()) newest = it->second.get();
+      }
+      if (newest != nullptr) inertial = CollectFullInertialBundle(newest, inertial_options);
+      if (inertial.edges.empty()) inertial = InertialBundleProblem{};
+    }
+    if (inertial.empty()) problem = CollectGlobalBundle(*map);
   }
-  PKSLAM_LOG_INFO("global BA of map {} started: {} keyframes, {} points", map->id(),
-                  problem.keyframes.size(), problem.points.size());
-  const BundleResult result = SolveBundle(problem, options_.global_ba_options,
-                                          options_.synchronous ? nullptr : &gba_abort_);
+  const bool use_inertial = !inertial.empty();
+  const BundleProblem& visual = use_inertial ? inertial.visual : problem;
+  PKSLAM_LOG_INFO("{}global BA of map {} started: {} keyframes, {} points",
+                  use_inertial ? "inertial " : "", map->id(), visual.keyframes.size(),
+                  visual.points.size());
+  InertialBundleResult inertial_result;
+  BundleResult result;
+  if (use_inertial) {
+    inertial_result = SolveInertialBundle(inertial, inertial_options, abort);
+  } else {
+    result = SolveBundle(problem, options_.global_ba_options, abort);
+  }
+  const bool aborted = use_inertial ? inertial_result.visual.aborted : result.aborted;
   bool applied = false;
-  if (!result.aborted && !gba_abort_.load()) {
+  if (!aborted && !gba_abort_.load()) {
     PauseMapping();
     {
       std::unique_lock lock(atlas_->mutex());
       // A newer loop or merge may have aborted us in the meantime (then it owns the map).
       if (!gba_abort_.load()) {
-        MergeGlobalBundle(map, problem, result);
+        const auto gravity_before = GravityInCameras(*map);
+        if (use_inertial) {
+          MergeGlobalBundle(
+              map, inertial.visual, [&] { ApplyInertialBundle(inertial, inertial_result); }, true);
+        } else {
+          MergeGlobalBundle(map, problem, result);
+        }
         applied = true;
+        if (IsInertial(sensor_) && map->imu_initialized) {
+          ++map->imu_change_index;
+          PKSLAM_LOG_INFO("global BA of map {}: largest keyframe tilt change {:.2e} rad", map->id(),
+                          MaxTiltChange(*map, gravity_before));
+        }
       }
     }
     ReleaseMapping();

@@ -5,10 +5,15 @@
 //  - a loop is corrected: the query's covisibility window is moved by the loop Sim3, its
 //    points fused with the other side's, the essential graph spreads the correction over the
 //    map, and a global bundle adjustment runs in its own thread and is merged back into the
-//    live map (new keyframes and points follow the spanning tree);
-//  - a merge moves the current map into the recognised map (rigidly / by the Sim3), welds the
-//    two sides by fusing points, re-roots the spanning tree and optimises the essential graph
-//    of the merged map, which becomes the Atlas' current map.
+//    live map (new keyframes and points follow the spanning tree). Inertial maps with the IMU
+//    initialised: a loop whose transform tilts gravity by more than inertial_max_tilt_rad (or
+//    turns more than inertial_max_yaw_rad) is refused; otherwise it is reduced to yaw +
+//    translation and the 4-DoF essential graph keeps every keyframe's roll and pitch, and
+//    the global BA is the full visual-inertial BA (mapping/inertial_bundle.h);
+//  - a merge moves the current map into the recognised map (rigidly / by the Sim3; by yaw +
+//    translation when both maps are gravity-aligned), welds the two sides by fusing points,
+//    re-roots the spanning tree and optimises the essential graph of the merged map (4-DoF
+//    when both are inertial), which becomes the Atlas' current map.
 //
 // Threads (docs/architecture.md): the queue, flags and statistics are guarded by `mutex_`;
 // the map model by the Atlas mutex (shared while detecting, exclusive while correcting or
@@ -32,6 +37,7 @@
 #include "core/frame/camera_rig.h"
 #include "core/map/atlas.h"
 #include "core/optim/bundle_adjustment.h"
+#include "core/optim/essential_graph.h"
 #include "loopclosing/place_verifier.h"
 
 namespace pkslam {
@@ -57,6 +63,16 @@ struct LoopClosingOptions {
   // Global bundle adjustment after a loop / merge.
   bool global_ba = true;
   BundleAdjustmentOptions global_ba_options;
+  // Inertial maps with the IMU initialised and at most this many keyframes: the global BA is
+  // the full visual-inertial BA (ORB-SLAM3 v1.0: FullInertialBA, 7 iterations, < 200
+  // keyframes); larger inertial maps get the visual global BA.
+  int inertial_global_ba_max_keyframes = 200;
+  int inertial_global_ba_iterations = 7;
+  // Inertial maps (IMU initialised): a loop is accepted only if its world correction turns
+  // about the horizontal axes by less than inertial_max_tilt_rad (each rotation-vector
+  // component) and about gravity by less than inertial_max_yaw_rad (ORB-SLAM3: 0.008, 0.349).
+  double inertial_max_tilt_rad = 0.008;
+  double inertial_max_yaw_rad = 0.349;
   // Loop fusion: projection radius (px) of the other side's points into the corrected window.
   double fuse_radius = 4.0;
   // Process in the caller's thread, run the global BA inline (deterministic mode).
@@ -91,6 +107,7 @@ struct LoopClosingStats {
   int tested_candidates = 0;         // database candidates put through verification
   int verified_regions = 0;          // candidates that passed verification (before confirmation)
   int rejected_regions = 0;          // pending regions dropped unconfirmed
+  int rejected_inertial = 0;         // confirmed loops refused by the inertial tilt/yaw check
   int global_ba_started = 0;
   int global_ba_finished = 0;
   int global_ba_aborted = 0;
@@ -144,6 +161,12 @@ class LoopClosing {
   void StopGlobalBundle();
   void PauseMapping();
   void ReleaseMapping();
+  // Whether `map` is corrected in 4 DoF (inertial sensor, IMU initialised: gravity along -z),
+  // and the essential graph's Dof for it. Atlas mutex held.
+  bool UsesFourDof(const Map& map) const;
+  PoseGraphDof GraphDof(const Map& map) const;
+  // The inertial loop check (options inertial_max_*); true for non-inertial maps. Shared lock.
+  bool AcceptsInertialLoop(const CommonRegion& region) const;
 
   Atlas* atlas_;
   Sensor sensor_;

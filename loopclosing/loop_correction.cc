@@ -1,5 +1,13 @@
 // LoopClosing: loop correction (ORB-SLAM3's CorrectLoop) and map merging (a simplified
 // MergeLocal: the whole current map is moved into the recognised map, then welded).
+// Inertial maps with the IMU initialised (gravity along the world's -z) are corrected in 4 DoF:
+// the loop / merge transform is reduced to yaw + translation (ProjectToYawTranslation, about
+// the query's camera centre, scale 1) and the essential graph runs in kYawTranslation, so
+// roll and pitch of every keyframe stay as the IMU estimated them; velocities turn with their
+// keyframes (the essential graph's Apply), biases are kept.
+#include <algorithm>
+#include <cmath>
+#include <map>
 #include <mutex>
 #include <set>
 #include <shared_mutex>
@@ -9,7 +17,9 @@
 #include "core/map/map_point.h"
 #include "core/matching/orb_matcher.h"
 #include "core/optim/essential_graph.h"
+#include "core/optim/yaw_manifold.h"
 #include "core/util/log.h"
+#include "loopclosing/global_bundle.h"
 #include "loopclosing/loop_closing.h"
 
 namespace pkslam {
@@ -28,6 +38,33 @@ std::vector<KeyFrame*> Neighbourhood(KeyFrame* query) {
 }
 
 }  // namespace
+
+bool LoopClosing::UsesFourDof(const Map& map) const {
+  return IsInertial(sensor_) && map.imu_initialized;
+}
+
+PoseGraphDof LoopClosing::GraphDof(const Map& map) const {
+  if (UsesFourDof(map)) return PoseGraphDof::kYawTranslation;
+  return options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3;
+}
+
+bool LoopClosing::AcceptsInertialLoop(const CommonRegion& region) const {
+  const Map* map = region.query->map();
+  if (map == nullptr || !UsesFourDof(*map)) return true;
+  const Sim3d world_new_from_world_old =
+      region.query_camera_from_world.Inverse() * Sim3d(region.query->camera_from_world());
+  const Eigen::Vector3d phi = world_new_from_world_old.so3().Log();
+  const bool ok = std::abs(phi.x()) < options_.inertial_max_tilt_rad &&
+                  std::abs(phi.y()) < options_.inertial_max_tilt_rad &&
+                  std::abs(phi.z()) < options_.inertial_max_yaw_rad;
+  if (!ok) {
+    PKSLAM_LOG_INFO(
+        "inertial loop keyframe {} <-> {} refused: correction rotation ({:.4f} {:.4f} {:.4f}) "
+        "rad tilts gravity or turns too far",
+        region.query->id(), region.matched->id(), phi.x(), phi.y(), phi.z());
+  }
+  return ok;
+}
 
 std::map<KeyFrameId, std::vector<KeyFrameId>> LoopClosing::FuseRegion(
     const CommonRegion& region, const std::vector<KeyFrame*>& neighbourhood,
@@ -104,17 +141,21 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
     query->UpdateConnections();
     const std::vector<KeyFrame*> neighbourhood = Neighbourhood(query);
 
-    // Corrected poses: every neighbour keeps its pose relative to the query.
+    // Corrected poses: every neighbour keeps its pose relative to the query, i.e. the whole
+    // neighbourhood moves by the loop's world correction (world_new_from_world_old).
     LoopCorrection correction;
     correction.current_keyframe = query->id();
     correction.loop_keyframe = region.matched->id();
-    const Sim3d world_from_query(query->world_from_camera());
     const Eigen::Vector3d query_centre_before = query->CameraCenter();
+    const bool four_dof = UsesFourDof(*map);
+    const auto gravity_before = GravityInCameras(*map);
+    Sim3d world_correction =
+        region.query_camera_from_world.Inverse() * Sim3d(query->camera_from_world());
+    if (four_dof) world_correction = ProjectToYawTranslation(world_correction, query_centre_before);
     for (KeyFrame* kf : neighbourhood) {
       const Sim3d non_corrected(kf->camera_from_world());
       correction.non_corrected_camera_from_world[kf->id()] = non_corrected;
-      correction.corrected_camera_from_world[kf->id()] =
-          non_corrected * world_from_query * region.query_camera_from_world;
+      correction.corrected_camera_from_world[kf->id()] = non_corrected * world_correction.Inverse();
     }
     // Points move with the first neighbour that sees them; then the poses.
     std::vector<MapPoint*> moved;
@@ -139,12 +180,19 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
         FuseRegion(region, neighbourhood, correction.corrected_camera_from_world);
 
     EssentialGraphOptions graph;
-    graph.dof = options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3;
+    graph.dof = GraphDof(*map);
     graph.num_threads = options_.num_threads;
     const EssentialGraphProblem problem = CollectEssentialGraph(map, correction, graph);
     ApplyEssentialGraph(problem, SolveEssentialGraph(problem, graph));
     query->AddLoopEdge(region.matched.get());
     region.matched->AddLoopEdge(query);
+    // Tracking predicts from its last keyframe (corrected pose and velocity) next time.
+    if (four_dof) ++map->imu_change_index;
+    PKSLAM_LOG_INFO(
+        "loop correction of map {} ({}): yaw {:.4f} rad, largest keyframe tilt change "
+        "{:.2e} rad",
+        map->id(), four_dof ? "4-DoF" : "6/7-DoF", ClosestYawAngle(world_correction.so3()),
+        MaxTiltChange(*map, gravity_before));
   }
   ReleaseMapping();
   return map;
@@ -165,13 +213,20 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
       ReleaseMapping();
       return nullptr;
     }
-    // The current map's world in the recognised map's world.
-    const Sim3d merged_from_current =
-        region.query_camera_from_world.Inverse() * Sim3d(query->camera_from_world());
-    const Sim3d current_from_merged = merged_from_current.Inverse();
+    // The current map's world in the recognised map's world. Two gravity-aligned worlds
+    // differ by yaw + translation only: the alignment keeps both maps' gravity.
+    const bool four_dof = UsesFourDof(*current) && UsesFourDof(*merged);
     const Eigen::Vector3d query_centre_before = query->CameraCenter();
+    Sim3d merged_from_current =
+        region.query_camera_from_world.Inverse() * Sim3d(query->camera_from_world());
+    if (four_dof) {
+      merged_from_current = ProjectToYawTranslation(merged_from_current, query_centre_before);
+    }
+    const Sim3d current_from_merged = merged_from_current.Inverse();
     for (const auto& [id, kf] : current->keyframes()) {
       kf->SetPose((Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
+      kf->imu.state.velocity_world =
+          merged_from_current.scale() * (merged_from_current.so3() * kf->imu.state.velocity_world);
     }
     for (const auto& [id, kf] : current->retired_keyframes()) {
       kf->SetPose((Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
@@ -229,7 +284,8 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     correction.loop_connections =
         FuseRegion(region, neighbourhood, correction.corrected_camera_from_world);
     EssentialGraphOptions graph;
-    graph.dof = options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3;
+    graph.dof = four_dof ? PoseGraphDof::kYawTranslation
+                         : (options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3);
     graph.num_threads = options_.num_threads;
     const EssentialGraphProblem problem = CollectEssentialGraph(merged, correction, graph);
     ApplyEssentialGraph(problem, SolveEssentialGraph(problem, graph));
@@ -237,6 +293,7 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     region.matched->AddLoopEdge(query);
 
     merged->imu_initialized = merged->imu_initialized && current->imu_initialized;
+    ++merged->imu_change_index;
     atlas_->SetCurrentMap(merged);
     atlas_->RemoveMap(current);
     merged->IncreaseChangeIndex();

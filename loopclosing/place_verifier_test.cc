@@ -15,71 +15,14 @@
 #include "core/map/keyframe_database.h"
 #include "core/map/keyframe_database_test_utils.h"
 #include "loopclosing/loop_closing.h"
+#include "loopclosing/revisit_fixture.h"
 
 namespace pkslam {
 namespace {
 
-using testing::AddKeyFrames;
-using testing::MakeScene;
-using testing::MakeStereoRig;
-using testing::Strip;
-
-constexpr int kKeyFrames = 6;
-
-// The same strip of keyframes visited twice: the first visit is "true", the second one's map
-// has drifted by `drift` (world_drifted_from_world), and shares no points with the first.
-class RevisitTest : public ::testing::Test {
- protected:
-  RevisitTest()
-      : vocabulary_(testing::MakeRandomVocabulary(10, 4, 5)),
-        rig_(MakeStereoRig()),
-        scene_(MakeScene(2500, 11, 4.0, 2.5, 3.0, 8.0)),
-        poses_(Strip(-0.3, 0.12, kKeyFrames)),
-        drift_(SO3d::Exp(Eigen::Vector3d(0.0, 0.03, 0.01)), Eigen::Vector3d(0.12, -0.03, 0.05)) {}
-
-  // Builds the second visit in `map` (drifted) from `scene`.
-  std::vector<KeyFramePtr> Revisit(Map* map, const testing::SyntheticScene& scene) {
-    auto kfs = AddKeyFrames(&atlas_, map, scene, rig_, poses_, vocabulary_, 100);
-    std::unique_lock lock(atlas_.mutex());
-    for (const auto& kf : kfs) {
-      for (const auto& mp : kf->map_points()) {
-        if (mp && mp->first_keyframe_id() == kf->id()) mp->SetPosition(drift_ * mp->position());
-      }
-    }
-    for (const auto& kf : kfs) kf->SetPose(kf->camera_from_world() * drift_.Inverse());
-    return kfs;
-  }
-
-  void Finish(const std::vector<KeyFramePtr>& kfs) {
-    std::unique_lock lock(atlas_.mutex());
-    for (const auto& kf : kfs) {
-      atlas_.database()->Add(kf.get());
-      for (const auto& mp : kf->map_points()) {
-        if (!mp) continue;
-        mp->ComputeDistinctiveDescriptor();
-        mp->UpdateNormalAndDepth();
-      }
-    }
-  }
-
-  void SetUp() override {
-    atlas_.SetDatabase(std::make_unique<KeyFrameDatabase>(vocabulary_));
-    first_ = AddKeyFrames(&atlas_, atlas_.current_map(), scene_, rig_, poses_, vocabulary_, 1);
-    Finish(first_);
-  }
-
-  Vocabulary vocabulary_;
-  std::shared_ptr<CameraRig> rig_;
-  testing::SyntheticScene scene_;
-  std::vector<SE3d> poses_;
-  SE3d drift_;
-  Atlas atlas_;
-  std::vector<KeyFramePtr> first_;
-};
-
-double CentreError(const KeyFrame& kf, const SE3d& true_camera_from_world) {
-  return (kf.CameraCenter() - true_camera_from_world.Inverse().translation()).norm();
-}
+using testing::CentreError;
+using testing::kKeyFrames;
+using testing::RevisitTest;
 
 TEST_F(RevisitTest, VerifiesTheRevisitAndRecoversTheTruePose) {
   const auto second = Revisit(atlas_.current_map(), scene_);

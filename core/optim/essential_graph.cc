@@ -11,6 +11,7 @@
 #include "core/map/keyframe.h"
 #include "core/map/map.h"
 #include "core/map/map_point.h"
+#include "core/optim/yaw_manifold.h"
 #include "core/util/error.h"
 
 namespace pkslam {
@@ -105,7 +106,19 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
     v.camera_from_world = it != correction.corrected_camera_from_world.end()
                               ? it->second
                               : Sim3d(kf->camera_from_world());
-    if (options.dof == PoseGraphDof::kSE3) v.camera_from_world.set_scale(1.0);
+    if (options.dof != PoseGraphDof::kSim3) v.camera_from_world.set_scale(1.0);
+    auto non = correction.non_corrected_camera_from_world.find(id);
+    v.camera_from_world_before =
+        non != correction.non_corrected_camera_from_world.end() ? non->second : v.camera_from_world;
+    if (options.dof == PoseGraphDof::kYawTranslation &&
+        it != correction.corrected_camera_from_world.end() &&
+        non != correction.non_corrected_camera_from_world.end()) {
+      // Only yaw and translation of the given correction: the keyframe keeps its roll/pitch.
+      const Sim3d world_new_from_world_old = it->second.Inverse() * non->second;
+      const Eigen::Vector3d centre_old = non->second.Inverse().translation();
+      v.camera_from_world =
+          non->second * ProjectToYawTranslation(world_new_from_world_old, centre_old).Inverse();
+    }
     v.fixed = kf.get() == map->origin();
     problem.vertex_of[id] = static_cast<int>(problem.vertices.size());
     problem.vertices.push_back(std::move(v));
@@ -172,6 +185,17 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
       const int l = vertex(loop_id);
       if (l >= 0) add_edge(i, l, before(l) * world_from_i, EssentialGraphProblem::EdgeKind::kLoop);
     }
+    // Inertial maps: the previous keyframe of the temporal chain (ORB-SLAM3's 4-DoF graph).
+    const KeyFrame* previous = kf->imu.previous;
+    if (options.dof == PoseGraphDof::kYawTranslation && previous != nullptr && !previous->IsBad() &&
+        previous != parent && previous->parent() != kf &&
+        inserted.count(Ordered(id, previous->id())) == 0) {
+      const int p = vertex(previous->id());
+      if (p >= 0) {
+        add_edge(i, p, before(p) * world_from_i, EssentialGraphProblem::EdgeKind::kInertial);
+        inserted.insert(Ordered(id, previous->id()));
+      }
+    }
     // Strong covisibility, once per pair, not duplicating the edges above.
     for (const KeyFrame* n : kf->CovisiblesWithWeightAtLeast(options.min_covisibility_weight)) {
       if (n == parent || n->IsBad() || n->id() >= id) continue;
@@ -230,11 +254,15 @@ EssentialGraphResult SolveEssentialGraph(const EssentialGraphProblem& problem,
 
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::EigenQuaternionManifold quaternion_manifold;  // shared by all rotation blocks
+  // Shared by all rotation blocks.
+  ceres::EigenQuaternionManifold quaternion_manifold;
+  YawQuaternionManifold yaw_manifold;
+  const bool yaw_only = problem.dof == PoseGraphDof::kYawTranslation;
   ceres::Problem ceres_problem(problem_options);
   for (std::size_t v = 0; v < n; ++v) {
     double* p = &params[v * kVertexSize];
-    ceres_problem.AddParameterBlock(p + kQ, 4, &quaternion_manifold);
+    ceres_problem.AddParameterBlock(
+        p + kQ, 4, yaw_only ? static_cast<ceres::Manifold*>(&yaw_manifold) : &quaternion_manifold);
     ceres_problem.AddParameterBlock(p + kT, 3);
     ceres_problem.AddParameterBlock(p + kS, 1);
     const bool fixed = problem.vertices[v].fixed;
@@ -242,7 +270,8 @@ EssentialGraphResult SolveEssentialGraph(const EssentialGraphProblem& problem,
       ceres_problem.SetParameterBlockConstant(p + kQ);
       ceres_problem.SetParameterBlockConstant(p + kT);
     }
-    if (fixed || problem.dof == PoseGraphDof::kSE3) ceres_problem.SetParameterBlockConstant(p + kS);
+    if (fixed || problem.dof != PoseGraphDof::kSim3)
+      ceres_problem.SetParameterBlockConstant(p + kS);
   }
   for (const auto& e : problem.edges) {
     double* pi = &params[static_cast<std::size_t>(e.i) * kVertexSize];
@@ -285,6 +314,12 @@ void ApplyEssentialGraph(const EssentialGraphProblem& problem, const EssentialGr
   };
   // Keyframes created after Collect move with their nearest ancestor in the graph.
   const int max_steps = map->NumKeyFrames() + static_cast<int>(map->retired_keyframes().size());
+  // Velocities live in the world frame: they turn (and scale) with the keyframe's world.
+  auto move_velocity = [](KeyFrame* kf, const Sim3d& world_new_from_world_old) {
+    if (!kf->imu.state.valid) return;
+    kf->imu.state.velocity_world = world_new_from_world_old.scale() *
+                                   (world_new_from_world_old.so3() * kf->imu.state.velocity_world);
+  };
   auto ancestor_vertex = [&](const KeyFrame* kf) {
     for (int step = 0; kf != nullptr && step <= max_steps; ++step, kf = kf->parent()) {
       const int v = vertex_of(kf);
@@ -298,12 +333,15 @@ void ApplyEssentialGraph(const EssentialGraphProblem& problem, const EssentialGr
     const int v = vertex_of(kf.get());
     if (v >= 0) {
       kf->SetPose(result.camera_from_world[v].ToSE3ScaledTranslation());
+      move_velocity(kf.get(), result.camera_from_world[v].Inverse() *
+                                  problem.vertices[v].camera_from_world_before);
       continue;
     }
     const int a = ancestor_vertex(kf->parent());
     if (a < 0) continue;
     const Sim3d moved = Sim3d(kf->camera_from_world()) * correction[a].Inverse();
     kf->SetPose(moved.ToSE3ScaledTranslation());
+    move_velocity(kf.get(), correction[a]);
   }
 
   std::map<MapPointId, int> point_vertex;

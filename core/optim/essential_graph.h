@@ -1,23 +1,28 @@
 // ORB-SLAM's OptimizeEssentialGraph: after a loop is detected and the current keyframe's
 // neighbourhood has been corrected, a pose graph over all live keyframes of the map spreads
-// the correction: Sim3 (7-DoF, monocular) or SE3 (6-DoF, stereo/RGB-D) vertices; edges of the
-// spanning tree, the existing loop edges, strong covisibility (weight >= 100) and the new loop
-// connections, each holding the relative pose before the correction (for the corrected
-// neighbourhood: its non-corrected pose). The map's first keyframe is fixed. Map points follow
-// the correction of their reference keyframe.
+// the correction: Sim3 (7-DoF, monocular), SE3 (6-DoF, stereo/RGB-D) or yaw + translation
+// (4-DoF, inertial maps with the IMU initialised: ORB-SLAM3's OptimizeEssentialGraph4DoF)
+// vertices; edges of the spanning tree, the existing loop edges, strong covisibility
+// (weight >= 100), the new loop connections and, for inertial maps, each keyframe's link to
+// the previous keyframe of the temporal chain (KeyFrame::imu.previous), each holding the
+// relative pose before the correction (for the corrected neighbourhood: its non-corrected
+// pose). The map's first keyframe is fixed. Map points follow the correction of their
+// reference keyframe; keyframe velocities (inertial state) turn with their keyframe.
 //
 // Three phases, as core/optim/bundle_adjustment.h, so the solver runs without the Atlas lock:
 //   Collect (shared lock) -> Solve (no lock) -> Apply (exclusive lock).
 //
 // Parameterisation: per keyframe a rotation block (quaternion), a translation block and a
 // log-scale block of its camera_from_world Sim3; the Dof switch decides which blocks move
-// (SE3 keeps every log-scale at 0). The 4-DoF inertial variant (issue 7) adds a value here:
-// its rotation block gets a manifold that only turns about the world's gravity axis (yaw)
-// and its scale stays fixed; edges and Apply are shared (ORB-SLAM3 also adds an edge to the
-// previous keyframe for inertial maps: one more EdgeKind).
+// (SE3 keeps every log-scale at 0). kYawTranslation keeps the scale at 1 and puts the
+// rotation block on core/optim/yaw_manifold.h's manifold, which only turns the world about its
+// gravity axis z: roll and pitch of every keyframe stay exactly as they were. Its Collect also
+// reduces each given correction (corrected vs non-corrected pose) to yaw + translation about
+// the keyframe's centre, so a loop measurement with a roll/pitch error cannot tilt the map.
 //
 // Cost (loop_closing_benchmark, Release, 1 thread): 40 keyframes / 188 edges ~10 ms; 184
 // keyframes / 4465 edges ~0.3 s CPU, about 2/3 autodiff Jacobians and 1/3 sparse Cholesky.
+// kYawTranslation (BM_EssentialGraphYawTranslation, loaded machine): ~7 ms / ~0.21 s CPU.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,6 +37,9 @@ namespace pkslam {
 enum class PoseGraphDof {
   kSim3,  // 7 DoF: rotation, translation, scale (monocular)
   kSE3,   // 6 DoF: scale fixed (stereo, RGB-D)
+  // 4 DoF: yaw about the world z (gravity) axis and translation; scale fixed (inertial maps
+  // with the IMU initialised; their world has gravity along -z).
+  kYawTranslation,
 };
 
 struct EssentialGraphOptions {
@@ -67,10 +75,15 @@ struct LoopCorrection {
 };
 
 struct EssentialGraphProblem {
-  enum class EdgeKind { kSpanningTree, kLoop, kNewLoop, kCovisibility };
+  // kInertial: keyframe -> previous keyframe of the temporal chain (kYawTranslation only;
+  // pairs already joined by a spanning-tree edge are not repeated).
+  enum class EdgeKind { kSpanningTree, kLoop, kNewLoop, kCovisibility, kInertial };
   struct Vertex {
     KeyFramePtr keyframe;
     Sim3d camera_from_world;  // initial estimate (corrected where known)
+    // The pose before the loop correction (non-corrected where given, else the initial one):
+    // the world its keyframe's velocity is expressed in.
+    Sim3d camera_from_world_before;
     bool fixed = false;
   };
   struct Edge {
@@ -108,9 +121,11 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
 EssentialGraphResult SolveEssentialGraph(const EssentialGraphProblem& problem,
                                          const EssentialGraphOptions& options);
 // Requires the Atlas mutex (exclusive). Sets each live vertex keyframe's pose to its optimised
-// Sim3 with the translation divided by the scale, moves every live map point of the map with
-// the correction S_wc(optimised) * S_cw(initial) of the keyframe it follows (or, for points and
-// keyframes created after Collect, of the nearest spanning-tree ancestor in the graph),
+// Sim3 with the translation divided by the scale, turns (and scales) valid keyframe
+// velocities from the world of camera_from_world_before to the optimised one (callers leave
+// the velocities of the corrected neighbourhood as they were), moves every live map point of the
+// map with the correction S_wc(optimised) * S_cw(initial) of the keyframe it follows (or, for
+// points and keyframes created after Collect, of the nearest spanning-tree ancestor in the graph),
 // updates normals and depth ranges, and bumps the map's change index.
 void ApplyEssentialGraph(const EssentialGraphProblem& problem, const EssentialGraphResult& result);
 

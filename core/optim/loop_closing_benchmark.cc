@@ -184,5 +184,46 @@ BENCHMARK(BM_EssentialGraph)
     ->Args({180, 0})
     ->Unit(benchmark::kMillisecond);
 
+// The 4-DoF (yaw + translation) graph of inertial maps on the same loop in a gravity-aligned
+// world (the circle's axis is z), scale drift 0, with the temporal chain's edges.
+void BM_EssentialGraphYawTranslation(benchmark::State& state) {
+  testing::LoopScenarioOptions o;
+  o.keyframes_per_lap = static_cast<int>(state.range(0));
+  o.drift_yaw_per_keyframe = 0.144 / o.keyframes_per_lap;
+  o.drift_scale_per_keyframe = 1.0;
+  o.drift_step_per_keyframe = 0.072 / o.keyframes_per_lap;
+  o.world_from_scenario = SO3d::Exp(Eigen::Vector3d(M_PI / 2, 0, 0));
+  auto scene = testing::MakeCylinderScene(3000, 3);
+  testing::RotateScene(o.world_from_scenario, &scene);
+  testing::LoopScenario s;
+  testing::BuildLoopScenario(o, scene, &s);
+  {
+    std::unique_lock lock(s.atlas.mutex());
+    for (std::size_t k = 1; k < s.synthetic.keyframes.size(); ++k) {
+      s.synthetic.keyframes[k]->imu.previous = s.synthetic.keyframes[k - 1].get();
+    }
+  }
+  EssentialGraphOptions options;
+  options.dof = PoseGraphDof::kYawTranslation;
+  EssentialGraphProblem problem;
+  EssentialGraphResult result;
+  for (auto _ : state) {
+    {
+      std::shared_lock lock(s.atlas.mutex());
+      problem = CollectEssentialGraph(s.map, s.correction, options);
+    }
+    result = SolveEssentialGraph(problem, options);
+  }
+  state.counters["kf_rmse_before"] = testing::KeyFramePositionRmse(s);
+  {
+    std::unique_lock lock(s.atlas.mutex());
+    ApplyEssentialGraph(problem, result);
+  }
+  state.counters["kf_rmse_after"] = testing::KeyFramePositionRmse(s);
+  state.counters["edges"] = static_cast<double>(problem.edges.size());
+  state.counters["lm_iterations"] = result.iterations;
+}
+BENCHMARK(BM_EssentialGraphYawTranslation)->Arg(36)->Arg(180)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 }  // namespace pkslam

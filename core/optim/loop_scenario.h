@@ -31,6 +31,10 @@ struct LoopScenarioOptions {
   // cannot observe it (it bends the circle): keep it small to test what a loop can fix.
   double drift_step_per_keyframe = 0.002;
   std::uint64_t seed = 3;
+  // The scenario's world in the map's world (identity: the circle's axis, the drift's rotation
+  // axis, is y; a rotation taking y to z makes it a gravity-aligned inertial world). Rotate
+  // the scene with RotateScene to match.
+  SO3d world_from_scenario;
 };
 
 struct LoopScenario {
@@ -83,6 +87,10 @@ inline SyntheticScene MakeCylinderScene(int n, std::uint64_t seed) {
   return scene;
 }
 
+inline void RotateScene(const SO3d& world_from_scenario, SyntheticScene* scene) {
+  for (auto& p : scene->points_world) p = world_from_scenario * p;
+}
+
 inline void BuildLoopScenario(const LoopScenarioOptions& o, const SyntheticScene& scene,
                               LoopScenario* s) {
   const auto rig = MakeStereoRig();
@@ -94,7 +102,9 @@ inline void BuildLoopScenario(const LoopScenarioOptions& o, const SyntheticScene
     world_r_camera.col(1) = Eigen::Vector3d(0, 1, 0);
     world_r_camera.col(2) = Eigen::Vector3d(std::cos(a), 0, std::sin(a));
     const Eigen::Vector3d centre(2.0 * std::cos(a), 0.0, 2.0 * std::sin(a));
-    s->true_camera_from_world.push_back(SE3d(world_r_camera, centre).Inverse());
+    s->true_camera_from_world.push_back(
+        SE3d(world_r_camera, centre).Inverse() *
+        SE3d(o.world_from_scenario.Inverse(), Eigen::Vector3d::Zero()));
   }
   s->map = s->atlas.current_map();
   s->synthetic = MakeMap(&s->atlas, scene, rig, s->true_camera_from_world, {});
