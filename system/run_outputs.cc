@@ -107,6 +107,7 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
   json->Member("tested_candidates", stats.tested_candidates);
   json->Member("verified_candidates", stats.verified_regions);
   json->Member("unconfirmed_candidates", stats.rejected_regions);
+  json->Member("rejected_inertial_loops", stats.rejected_inertial);
   json->Member("global_ba_started", stats.global_ba_started);
   json->Member("global_ba_finished", stats.global_ba_finished);
   json->Member("global_ba_aborted", stats.global_ba_aborted);
