@@ -148,5 +148,45 @@ TEST_F(InertialLoopTest, RefusesALoopThatTiltsGravity) {
   }
 }
 
+// A second visit "drifted" by 1.5 m over a path of about a metre: what a repeating place a
+// texture period away looks like to verification. Stereo and stereo-inertial maps are metric,
+// so such a jump is refused (bound 0.3 m + 5% of the path); the map stays as it was.
+class DriftBoundTest : public InertialLoopTest {
+ protected:
+  void ExpectRefused(Sensor sensor) {
+    drift_ = SE3d(SO3d::Exp(Eigen::Vector3d(0, 0, 0.01)), Eigen::Vector3d(1.5, 0.0, 0.0));
+    second_ = Revisit(atlas_.current_map(), scene_);
+    Finish(second_);
+    if (IsInertial(sensor)) {
+      std::unique_lock lock(atlas_.mutex());
+      atlas_.current_map()->imu_initialized = true;
+      atlas_.current_map()->inertial_ba2_done = true;
+    }
+    const Snapshot before = Take();
+    const LoopClosingStats stats = Close(sensor);
+    EXPECT_TRUE(stats.loops.empty());
+    EXPECT_GE(stats.rejected_implausible, 1);
+    std::shared_lock lock(atlas_.mutex());
+    for (const auto& [id, kf] : atlas_.current_map()->keyframes()) {
+      EXPECT_EQ(kf->camera_from_world().Matrix(), before.camera_from_world.at(id).Matrix());
+    }
+  }
+};
+
+TEST_F(DriftBoundTest, StereoRefusesAJumpFarBeyondTheDriftBound) { ExpectRefused(Sensor::kStereo); }
+
+TEST_F(DriftBoundTest, StereoInertialRefusesAJumpFarBeyondTheDriftBound) {
+  ExpectRefused(Sensor::kStereoInertial);
+}
+
+TEST_F(DriftBoundTest, MonocularMapsHaveNoMetricBound) {
+  // The same jump in a visual monocular map is a plausible scale/translation drift: corrected.
+  drift_ = SE3d(SO3d::Exp(Eigen::Vector3d(0, 0, 0.01)), Eigen::Vector3d(1.5, 0.0, 0.0));
+  second_ = Revisit(atlas_.current_map(), scene_);
+  Finish(second_);
+  const LoopClosingStats stats = Close(Sensor::kMonocular);
+  EXPECT_EQ(stats.rejected_implausible, 0);
+}
+
 }  // namespace
 }  // namespace pkslam

@@ -37,6 +37,8 @@ void LoopClosingOptions::Check() const {
   PKSLAM_CHECK_OPTION(inertial_max_tilt_rad > 0 && inertial_max_yaw_rad > 0,
                       "LoopClosing.inertial_max_tilt_rad / yaw", "{} / {}", inertial_max_tilt_rad,
                       inertial_max_yaw_rad);
+  PKSLAM_CHECK_OPTION(max_loop_correction_m >= 0, "LoopClosing.max_loop_correction_m", "{}",
+                      max_loop_correction_m);
   PKSLAM_CHECK_OPTION(num_threads > 0, "LoopClosing.num_threads", "{}", num_threads);
   global_ba_options.Check();
   PKSLAM_CHECK_OPTION(inertial_global_ba_max_keyframes >= 0 && inertial_global_ba_iterations >= 1,
@@ -154,6 +156,11 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
     if (!merge && !AcceptsInertialLoop(*region)) {
       std::lock_guard stats_lock(mutex_);
       ++stats_.rejected_inertial;
+      return;
+    }
+    if (!merge && !AcceptsLoopCorrection(*region)) {
+      std::lock_guard stats_lock(mutex_);
+      ++stats_.rejected_implausible;
       return;
     }
   }

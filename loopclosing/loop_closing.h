@@ -73,6 +73,16 @@ struct LoopClosingOptions {
   // component) and about gravity by less than inertial_max_yaw_rad (ORB-SLAM3: 0.008, 0.349).
   double inertial_max_tilt_rad = 0.008;
   double inertial_max_yaw_rad = 0.349;
+  // Metric maps (stereo, RGB-D, inertial with the IMU initialised; not visual monocular, whose
+  // scale drifts): a loop is accepted only if it moves the query keyframe by at most
+  // max_loop_correction_m + max_loop_correction_ratio * the path travelled (keyframe centres in
+  // creation order) from the matched keyframe to the query. Not in ORB-SLAM3: a place that
+  // repeats (same texture or structure a few metres apart) passes appearance, geometric and
+  // temporal verification and then drags the map by the repeat's period (simulated V1_02
+  // replay: a 2.15 m correction after 17 m of stereo-inertial flight whose drift was < 1 cm).
+  // A ratio <= 0 disables the check.
+  double max_loop_correction_m = 0.3;
+  double max_loop_correction_ratio = 0.05;
   // Loop fusion: projection radius (px) of the other side's points into the corrected window.
   double fuse_radius = 4.0;
   // Process in the caller's thread, run the global BA inline (deterministic mode).
@@ -108,6 +118,7 @@ struct LoopClosingStats {
   int verified_regions = 0;          // candidates that passed verification (before confirmation)
   int rejected_regions = 0;          // pending regions dropped unconfirmed
   int rejected_inertial = 0;         // confirmed loops refused by the inertial tilt/yaw check
+  int rejected_implausible = 0;      // confirmed loops refused: correction beyond the drift bound
   int global_ba_started = 0;
   int global_ba_finished = 0;
   int global_ba_aborted = 0;
@@ -167,6 +178,8 @@ class LoopClosing {
   PoseGraphDof GraphDof(const Map& map) const;
   // The inertial loop check (options inertial_max_*); true for non-inertial maps. Shared lock.
   bool AcceptsInertialLoop(const CommonRegion& region) const;
+  // The drift bound of max_loop_correction_m / _ratio. Requires the Atlas mutex (shared).
+  bool AcceptsLoopCorrection(const CommonRegion& region) const;
 
   Atlas* atlas_;
   Sensor sensor_;

@@ -66,6 +66,34 @@ bool LoopClosing::AcceptsInertialLoop(const CommonRegion& region) const {
   return ok;
 }
 
+bool LoopClosing::AcceptsLoopCorrection(const CommonRegion& region) const {
+  const Map* map = region.query->map();
+  if (map == nullptr || options_.max_loop_correction_ratio <= 0) return true;
+  if (IsMonocular(sensor_) && !UsesFourDof(*map)) return true;  // scale drifts: no metric bound
+  const KeyFrameId first = std::min(region.matched->id(), region.query->id());
+  const KeyFrameId last = std::max(region.matched->id(), region.query->id());
+  double path_m = 0;
+  const KeyFrame* previous = nullptr;
+  for (auto it = map->keyframes().lower_bound(first);
+       it != map->keyframes().end() && it->first <= last; ++it) {
+    if (it->second->IsBad()) continue;
+    if (previous != nullptr)
+      path_m += (it->second->CameraCenter() - previous->CameraCenter()).norm();
+    previous = it->second.get();
+  }
+  const Eigen::Vector3d corrected_centre =
+      region.query_camera_from_world.Inverse() * Eigen::Vector3d::Zero();
+  const double moved_m = (corrected_centre - region.query->CameraCenter()).norm();
+  const double bound_m =
+      options_.max_loop_correction_m + options_.max_loop_correction_ratio * path_m;
+  if (moved_m <= bound_m) return true;
+  PKSLAM_LOG_INFO(
+      "loop keyframe {} <-> {} refused: it would move the keyframe {:.3f} m after {:.2f} m of "
+      "travel (bound {:.3f} m)",
+      region.query->id(), region.matched->id(), moved_m, path_m, bound_m);
+  return false;
+}
+
 std::map<KeyFrameId, std::vector<KeyFrameId>> LoopClosing::FuseRegion(
     const CommonRegion& region, const std::vector<KeyFrame*>& neighbourhood,
     const std::map<KeyFrameId, Sim3d>& camera_from_world) {

@@ -108,6 +108,7 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
   json->Member("verified_candidates", stats.verified_regions);
   json->Member("unconfirmed_candidates", stats.rejected_regions);
   json->Member("rejected_inertial_loops", stats.rejected_inertial);
+  json->Member("rejected_implausible_loops", stats.rejected_implausible);
   json->Member("global_ba_started", stats.global_ba_started);
   json->Member("global_ba_finished", stats.global_ba_finished);
   json->Member("global_ba_aborted", stats.global_ba_aborted);
