@@ -243,6 +243,8 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
     }
   }
   ++kf->map()->imu_change_index;
+  // Every state moved: marginalisation priors of the local inertial BA are stale.
+  kf->map()->IncreaseChangeIndex();
 }
 
 bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
@@ -275,11 +277,10 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
   if (kf->map() == nullptr) return true;
   ApplyInertialBundle(problem, result);
   ++kf->map()->imu_change_index;
-  if (result.visual.aborted) {
-    lock.unlock();
-    std::lock_guard stats_lock(mutex_);
-    ++stats_.ba_aborted;
-  }
+  lock.unlock();
+  std::lock_guard stats_lock(mutex_);
+  if (result.visual.aborted) ++stats_.ba_aborted;
+  ++(problem.anchor_prior ? stats_.inertial_ba_with_prior : stats_.inertial_ba_fixed_anchor);
   return true;
 }
 
