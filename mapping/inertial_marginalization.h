@@ -13,6 +13,11 @@
 // (core/imu/inertial_state.h InertialStatePrior), stored as a mean x_lin [+] (-H'^+ b') and the
 // information H' for InertialStatePriorError (imu/imu_factors.h).
 //
+// Approximations: the prior is linearised once (at the solve that made it) and never
+// re-linearised; the marginalised keyframe's observations may still enter later windows as a
+// fixed visual-only keyframe constraining the points, so that information is counted twice
+// (once through the prior, with the points taken as exact).
+//
 // The prior of keyframe k summarises only factors of keyframes older than k, so a later window
 // whose anchor is k may use it whatever happened to the keyframes after k. It is dropped when its
 // keyframe is culled (mapping/inertial_culling.h) and ignored once anything moved the map as a
