@@ -106,6 +106,9 @@ void InertialBundleOptions::Check() const {
                       gravity_magnitude);
   PKSLAM_CHECK_OPTION(marginalization_threshold >= 0 && marginalization_threshold < 1,
                       "inertial_ba.marginalization_threshold", "{}", marginalization_threshold);
+  PKSLAM_CHECK_OPTION(marginalization_visual_weight > 0 && marginalization_visual_weight <= 1,
+                      "inertial_ba.marginalization_visual_weight", "{}",
+                      marginalization_visual_weight);
 }
 
 std::vector<KeyFrame*> InertialChain(KeyFrame* newest, int max_length) {

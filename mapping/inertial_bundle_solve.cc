@@ -65,9 +65,12 @@ double ObservationChi2(const BodyCamera& camera, const BundleProblem::Observatio
 
 // The marginal of the anchor's factors (`residuals`, at the current values) on the next
 // keyframe's state: `blocks` are the anchor's then the next keyframe's {pose, v, b_g, b_a}.
+// Residual blocks from `first_visual` on are reprojections, weighted by
+// options.marginalization_visual_weight.
 std::optional<InertialStatePrior> MarginalPrior(
     ceres::Problem& problem, const std::vector<double*>& blocks,
-    const std::vector<ceres::ResidualBlockId>& residuals, const InertialBundleOptions& options) {
+    const std::vector<ceres::ResidualBlockId>& residuals, std::size_t first_visual,
+    const InertialBundleOptions& options) {
   constexpr int kState = 15;
   // A fixed anchor (no prior of its own) is marginalised as a free state.
   for (int k = 0; k < 4; ++k) problem.SetParameterBlockVariable(blocks[k]);
@@ -86,7 +89,17 @@ std::optional<InertialStatePrior> MarginalPrior(
   for (int row = 0; row < crs.num_rows; ++row) {
     for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) j(row, crs.cols[k]) = crs.values[k];
   }
-  const Eigen::Map<const Eigen::VectorXd> residual(r.data(), static_cast<Eigen::Index>(r.size()));
+  Eigen::VectorXd residual =
+      Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
+  int visual_row = 0;
+  for (std::size_t i = 0; i < first_visual && i < residuals.size(); ++i) {
+    visual_row += problem.GetCostFunctionForResidualBlock(residuals[i])->num_residuals();
+  }
+  if (options.marginalization_visual_weight != 1.0 && visual_row < crs.num_rows) {
+    const double w = std::sqrt(options.marginalization_visual_weight);
+    j.bottomRows(crs.num_rows - visual_row) *= w;
+    residual.tail(crs.num_rows - visual_row) *= w;
+  }
   const Eigen::MatrixXd h = j.transpose() * j;
   const Eigen::VectorXd b = j.transpose() * residual;
   Eigen::MatrixXd h_next;
@@ -336,6 +349,7 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
   if (marginalize && marg_edge && !result.visual.aborted) {
     std::vector<std::uint8_t> outlier(static_cast<std::size_t>(num_obs), 0);
     for (int i : result.visual.outlier_observations) outlier[i] = 1;
+    const std::size_t first_visual = marginalized.size();
     for (int i = 0; i < num_obs; ++i) {
       if (blocks[i] != nullptr && outlier[i] == 0 &&
           visual.observations[i].keyframe_index == marg_from) {
@@ -346,7 +360,7 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
         MarginalPrior(ceres_problem,
                       {s.pose(marg_from), s.v(marg_from), bg(marg_from), ba(marg_from),
                        s.pose(marg_to), s.v(marg_to), bg(marg_to), ba(marg_to)},
-                      marginalized, options);
+                      marginalized, first_visual, options);
   }
   write_result();
   return result;
