@@ -11,6 +11,7 @@
 #include "core/map/map_point.h"
 #include "core/util/error.h"
 #include "imu/preintegration.h"
+#include "mapping/inertial_marginalization.h"
 
 namespace pkslam {
 namespace {
@@ -103,6 +104,11 @@ void InertialBundleOptions::Check() const {
   PKSLAM_CHECK_OPTION(num_threads >= 1, "inertial_ba.num_threads", "{}", num_threads);
   PKSLAM_CHECK_OPTION(gravity_magnitude > 0, "inertial_ba.gravity_magnitude", "{}",
                       gravity_magnitude);
+  PKSLAM_CHECK_OPTION(marginalization_threshold >= 0 && marginalization_threshold < 1,
+                      "inertial_ba.marginalization_threshold", "{}", marginalization_threshold);
+  PKSLAM_CHECK_OPTION(marginalization_visual_weight > 0 && marginalization_visual_weight <= 1,
+                      "inertial_ba.marginalization_visual_weight", "{}",
+                      marginalization_visual_weight);
 }
 
 std::vector<KeyFrame*> InertialChain(KeyFrame* newest, int max_length) {
@@ -139,11 +145,22 @@ InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
   const Map* map = keyframe->map();
   SetCommon(*keyframe, options, &problem);
   KeyFrameIndex index;
-  // The oldest is the anchor (fixed state, joined by its inertial edge).
+  // The oldest is the anchor, joined by its inertial edge: free with its marginalisation prior
+  // when it has a valid one, otherwise fixed.
+  const KeyFrame* anchor = chain.front();
+  const bool with_prior =
+      options.marginalization_prior && anchor->imu.prior && PriorIsValid(*anchor->imu.prior, *map);
   for (std::size_t i = 0; i < chain.size(); ++i) {
-    AddKeyFrame(chain[i], i == 0, i == 0 ? kFixedInertial : kFreeInertial, &problem, &index);
+    const bool fixed = i == 0 && !with_prior;
+    AddKeyFrame(chain[i], fixed, fixed ? kFixedInertial : kFreeInertial, &problem, &index);
   }
   AddEdges(chain, index, &problem);
+  if (options.marginalization_prior) {
+    if (with_prior) problem.anchor_prior = *anchor->imu.prior;
+    problem.marginalize_from = 0;
+    problem.marginalize_to = 1;
+    StampPrior(*map, &problem.stamps);
+  }
   const std::vector<KeyFrame*> free(chain.begin() + 1, chain.end());
   const std::vector<MapPointPtr> points = PointsOf(free, map);
   // Fixed visual keyframes: other observers of the points, those sharing most first.
@@ -203,6 +220,13 @@ void ApplyInertialBundle(const InertialBundleProblem& problem, const InertialBun
     kf->imu.state.velocity_world = result.velocities[i];
     kf->imu.state.bias = result.biases[i];
     kf->imu.state.valid = true;
+  }
+  if (result.next_prior && problem.marginalize_to >= 0) {
+    KeyFrame* next = problem.visual.keyframes[problem.marginalize_to].keyframe.get();
+    if (!next->IsBad() && next->map() != nullptr && PriorIsValid(problem.stamps, *next->map())) {
+      next->imu.prior = *result.next_prior;
+      StampPrior(*next->map(), &*next->imu.prior);
+    }
   }
   // Preintegrations follow their start keyframe's bias (re-integrated when it moved far).
   const PreintegrationOptions reintegration;

@@ -8,10 +8,13 @@
 // consecutive keyframes of the map's temporal chain (KeyFrame::imu.previous).
 //
 // Local window: the newest `window` keyframes of the chain ending at the new keyframe are free
-// (pose, velocity, biases with random walks); the keyframe just before the window is fixed and
-// joined by its inertial edge: it anchors the window in place of a marginalisation prior, the
-// previous state held at its estimate (ORB-SLAM3's choice; no Schur-complement prior is kept, so
-// information of states that left the window is dropped). Other keyframes observing the
+// (pose, velocity, biases with random walks); the keyframe just before the window, the anchor,
+// is joined by its inertial edge. With `marginalization_prior` and a valid prior on the anchor
+// (mapping/inertial_marginalization.h) the anchor is free and carries that 15-D Gaussian prior:
+// the information of the states that left the window (accumulated bias information in
+// particular) is kept. Without a prior it is fixed at its estimate (ORB-SLAM3's choice). Either
+// way the solve marginalises the anchor onto the next chain keyframe and Apply stores the result
+// as that keyframe's prior, used when it becomes the anchor. Other keyframes observing the
 // window's points are fixed, visual only. Full: every chain keyframe, the first pose fixed;
 // optionally one bias pair shared by all with zero-mean priors (the BA right after the
 // inertial-only initialisation).
@@ -20,9 +23,11 @@
 #include <Eigen/Core>
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/imu/imu_types.h"
+#include "core/imu/inertial_state.h"
 #include "core/optim/bundle_adjustment.h"
 
 namespace pkslam {
@@ -41,6 +46,16 @@ struct InertialBundleOptions {
   double chi2_stereo = 7.815;
   int num_threads = 1;
   double gravity_magnitude = 9.81;
+  // Local window: keep a marginalisation prior on the anchor instead of fixing it (see above).
+  bool marginalization_prior = true;
+  // Eigenvalues of the marginalised anchor block below this share of its largest are treated as
+  // unobservable (pseudo-inverse) when the prior is computed.
+  double marginalization_threshold = 1e-12;
+  // Weight (0, 1] of the anchor's reprojection factors in the marginalisation. They are
+  // evaluated with the points held fixed, and the marginalised keyframe's observations keep
+  // constraining the points of later windows as a fixed keyframe: < 1 discounts that
+  // over-confidence (0.1 measured no better than 1 on the simulated EuRoC replays).
+  double marginalization_visual_weight = 1.0;
 
   void Check() const;
 };
@@ -65,6 +80,13 @@ struct InertialBundleProblem {
   bool shared_bias = false;
   double gyro_prior_information = 0;
   double accel_prior_information = 0;
+  // Local window with marginalisation: the prior of the anchor (keyframe 0), which is then free;
+  // and the anchor -> next keyframe pair whose marginal Solve computes (-1: none), with the map
+  // stamps at collection (Apply stores the prior only if they still hold).
+  std::optional<InertialStatePrior> anchor_prior;
+  int marginalize_from = -1;
+  int marginalize_to = -1;
+  InertialStatePrior stamps;
 
   bool empty() const { return visual.keyframes.empty(); }
 };
@@ -73,6 +95,9 @@ struct InertialBundleResult {
   BundleResult visual;
   std::vector<Eigen::Vector3d> velocities;  // per visual.keyframes entry
   std::vector<ImuBias> biases;
+  // The prior of keyframe problem.marginalize_to (Solve computes it when requested; stamps as
+  // problem.stamps).
+  std::optional<InertialStatePrior> next_prior;
 };
 
 // Requires the Atlas mutex (shared). Keyframes without a valid inertial state end the chain.
@@ -85,7 +110,8 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
                                          const InertialBundleOptions& options,
                                          const std::atomic<bool>* abort = nullptr);
 // Requires the Atlas mutex (exclusive): ApplyBundle for the visual part, then velocities and
-// biases of free inertial keyframes, and re-linearises the preintegrations whose bias moved.
+// biases of free inertial keyframes, and re-linearises the preintegrations whose bias moved;
+// stores result.next_prior on its keyframe if the map did not move map-wide since Collect.
 void ApplyInertialBundle(const InertialBundleProblem& problem, const InertialBundleResult& result);
 
 // The temporal chain ending at `newest` (oldest first), at most `max_length` keyframes (0: all),

@@ -1,4 +1,5 @@
 // Solve phase of visual-inertial bundle adjustment: Ceres on a copy of the collected state.
+#include <ceres/crs_matrix.h>
 #include <ceres/iteration_callback.h>
 #include <ceres/loss_function.h>
 #include <ceres/ordered_groups.h>
@@ -15,6 +16,7 @@
 #include "imu/imu_factors.h"
 #include "imu/imu_manifolds.h"
 #include "mapping/inertial_bundle.h"
+#include "mapping/inertial_marginalization.h"
 
 namespace pkslam {
 namespace {
@@ -59,6 +61,57 @@ double ObservationChi2(const BodyCamera& camera, const BundleProblem::Observatio
                           Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right), o.inv_sigma2);
   }
   return BodyMonoChi2(camera, world_from_body, p, o.uv, o.inv_sigma2);
+}
+
+// The marginal of the anchor's factors (`residuals`, at the current values) on the next
+// keyframe's state: `blocks` are the anchor's then the next keyframe's {pose, v, b_g, b_a}.
+// Residual blocks from `first_visual` on are reprojections, weighted by
+// options.marginalization_visual_weight.
+std::optional<InertialStatePrior> MarginalPrior(
+    ceres::Problem& problem, const std::vector<double*>& blocks,
+    const std::vector<ceres::ResidualBlockId>& residuals, std::size_t first_visual,
+    const InertialBundleOptions& options) {
+  constexpr int kState = 15;
+  // A fixed anchor (no prior of its own) is marginalised as a free state.
+  for (int k = 0; k < 4; ++k) problem.SetParameterBlockVariable(blocks[k]);
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  evaluate.residual_blocks = residuals;
+  evaluate.apply_loss_function = true;
+  evaluate.num_threads = options.num_threads;
+  double cost = 0;
+  std::vector<double> r;
+  ceres::CRSMatrix crs;
+  if (!problem.Evaluate(evaluate, &cost, &r, nullptr, &crs) || crs.num_cols != 2 * kState) {
+    return std::nullopt;
+  }
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) j(row, crs.cols[k]) = crs.values[k];
+  }
+  Eigen::VectorXd residual =
+      Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
+  int visual_row = 0;
+  for (std::size_t i = 0; i < first_visual && i < residuals.size(); ++i) {
+    visual_row += problem.GetCostFunctionForResidualBlock(residuals[i])->num_residuals();
+  }
+  if (options.marginalization_visual_weight != 1.0 && visual_row < crs.num_rows) {
+    const double w = std::sqrt(options.marginalization_visual_weight);
+    j.bottomRows(crs.num_rows - visual_row) *= w;
+    residual.tail(crs.num_rows - visual_row) *= w;
+  }
+  const Eigen::MatrixXd h = j.transpose() * j;
+  const Eigen::VectorXd b = j.transpose() * residual;
+  Eigen::MatrixXd h_next;
+  Eigen::VectorXd b_next;
+  MarginalizeLeading(h, b, kState, &h_next, &b_next, options.marginalization_threshold);
+  if (!h_next.allFinite() || !b_next.allFinite()) return std::nullopt;
+  NavState next;
+  next.world_from_body = BodyPoseFromBlock(blocks[4]);
+  next.velocity_world = Eigen::Map<const Eigen::Vector3d>(blocks[5]);
+  const ImuBias bias{Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(blocks[6])),
+                     Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(blocks[7]))};
+  return MakeInertialStatePrior(next, bias, h_next, b_next);
 }
 
 }  // namespace
@@ -168,17 +221,37 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
     }
   };
 
+  // The residual blocks of the anchor that the marginalisation folds into the next prior.
+  const int marg_from = problem.marginalize_from;
+  const int marg_to = problem.marginalize_to;
+  const bool marginalize = marg_from >= 0 && marg_to >= 0 && shared_index < 0;
+  std::vector<ceres::ResidualBlockId> marginalized;
+  bool marg_edge = false;
+  if (problem.anchor_prior && marg_from >= 0 && shared_index < 0) {
+    add_inertial(marg_from);
+    const InertialStatePrior& prior = *problem.anchor_prior;
+    marginalized.push_back(ceres_problem.AddResidualBlock(
+        new InertialStatePriorError(prior.mean, prior.bias_mean, prior.information), nullptr,
+        {s.pose(marg_from), s.v(marg_from), bg(marg_from), ba(marg_from)}));
+  }
   for (const auto& e : problem.edges) {
     add_inertial(e.from);
     add_inertial(e.to);
-    ceres_problem.AddResidualBlock(
+    const bool marg = marginalize && e.from == marg_from && e.to == marg_to;
+    marg_edge = marg_edge || marg;
+    const ceres::ResidualBlockId inertial = ceres_problem.AddResidualBlock(
         new InertialError(e.preintegration, problem.gravity_world), nullptr,
         {s.pose(e.from), s.v(e.from), bg(e.from), ba(e.from), s.pose(e.to), s.v(e.to)});
+    if (marg) marginalized.push_back(inertial);
     if (shared_index < 0) {
-      ceres_problem.AddResidualBlock(BiasRandomWalkError::Gyro(e.preintegration).release(), nullptr,
-                                     bg(e.from), bg(e.to));
-      ceres_problem.AddResidualBlock(BiasRandomWalkError::Accel(e.preintegration).release(),
-                                     nullptr, ba(e.from), ba(e.to));
+      const ceres::ResidualBlockId gyro = ceres_problem.AddResidualBlock(
+          BiasRandomWalkError::Gyro(e.preintegration).release(), nullptr, bg(e.from), bg(e.to));
+      const ceres::ResidualBlockId accel = ceres_problem.AddResidualBlock(
+          BiasRandomWalkError::Accel(e.preintegration).release(), nullptr, ba(e.from), ba(e.to));
+      if (marg) {
+        marginalized.push_back(gyro);
+        marginalized.push_back(accel);
+      }
     }
   }
   if (shared_index >= 0) {
@@ -272,6 +345,22 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
     loss_mono.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
     loss_stereo.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
     solve(options.iterations_second);
+  }
+  if (marginalize && marg_edge && !result.visual.aborted) {
+    std::vector<std::uint8_t> outlier(static_cast<std::size_t>(num_obs), 0);
+    for (int i : result.visual.outlier_observations) outlier[i] = 1;
+    const std::size_t first_visual = marginalized.size();
+    for (int i = 0; i < num_obs; ++i) {
+      if (blocks[i] != nullptr && outlier[i] == 0 &&
+          visual.observations[i].keyframe_index == marg_from) {
+        marginalized.push_back(blocks[i]);
+      }
+    }
+    result.next_prior =
+        MarginalPrior(ceres_problem,
+                      {s.pose(marg_from), s.v(marg_from), bg(marg_from), ba(marg_from),
+                       s.pose(marg_to), s.v(marg_to), bg(marg_to), ba(marg_to)},
+                      marginalized, first_visual, options);
   }
   write_result();
   return result;

@@ -164,5 +164,45 @@ TEST(InertialBundle, SinglePassClassifiesOutliersAndStillRecovers) {
   }
 }
 
+// How far keyframe 0 moved (translation plus rotation angle) from its start.
+double AnchorMotion(const Scene& s, const InertialBundleResult& r) {
+  const SE3d start = s.problem.visual.keyframes[0].camera_from_world.Inverse();
+  const SE3d end = r.visual.camera_from_world[0].Inverse();
+  return (end.translation() - start.translation()).norm() +
+         (start.so3().Inverse() * end.so3()).Log().norm() +
+         (r.velocities[0] - s.problem.velocities[0]).norm() +
+         (r.biases[0].accel - s.problem.biases[0].accel).norm();
+}
+
+TEST(InertialBundle, AnchorPriorHoldsTheFreeAnchor) {
+  // The local window's anchor, free, starting at the true state, the rest perturbed.
+  Scene s = MakeScene(false);
+  s.problem.velocities[0] = s.truth[0].velocity_world;
+  s.problem.biases[0] = s.bias;
+  s.problem.visual.keyframes[0].fixed = false;
+  s.problem.marginalize_from = 0;
+  s.problem.marginalize_to = 1;
+  InertialBundleOptions options;
+  options.iterations_first = 30;
+  auto solve_with = [&](double information) {
+    Scene with = s;
+    if (information > 0) {
+      InertialStatePrior prior;
+      prior.mean = s.truth[0];
+      prior.bias_mean = s.bias;
+      prior.information = information * Eigen::Matrix<double, 15, 15>::Identity();
+      with.problem.anchor_prior = prior;
+    }
+    return AnchorMotion(with, SolveInertialBundle(with.problem, options));
+  };
+  const double free_motion = solve_with(0);
+  const double weak_motion = solve_with(1e2);
+  const double strong_motion = solve_with(1e14);
+  EXPECT_GT(free_motion, 1e-4);
+  EXPECT_LT(weak_motion, free_motion);
+  EXPECT_LT(strong_motion, 1e-6);
+  EXPECT_LT(strong_motion, weak_motion);
+}
+
 }  // namespace
 }  // namespace pkslam

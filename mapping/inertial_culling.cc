@@ -84,6 +84,7 @@ void SpliceOutOfInertialChain(KeyFrame* keyframe) {
   keyframe->imu.previous = nullptr;
   keyframe->imu.next = nullptr;
   keyframe->imu.from_previous.reset();
+  keyframe->imu.prior.reset();  // its marginalisation prior goes with it
 }
 
 int RepairInertialChain(KeyFrame* newest, int length) {

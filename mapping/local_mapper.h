@@ -63,6 +63,9 @@ struct LocalMappingStats {
   std::vector<double> keyframe_cpu_ms;
   std::vector<double> ba_cpu_ms;
   int ba_aborted = 0;
+  // Local inertial BAs whose anchor carried a marginalisation prior / was fixed.
+  int inertial_ba_with_prior = 0;
+  int inertial_ba_fixed_anchor = 0;
   int keyframes_culled = 0;
   int points_created = 0;
   int points_culled = 0;

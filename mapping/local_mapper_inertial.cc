@@ -243,6 +243,8 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
     }
   }
   ++kf->map()->imu_change_index;
+  // Every state moved: marginalisation priors of the local inertial BA are stale.
+  kf->map()->IncreaseChangeIndex();
 }
 
 bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
@@ -275,11 +277,19 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
   if (kf->map() == nullptr) return true;
   ApplyInertialBundle(problem, result);
   ++kf->map()->imu_change_index;
-  if (result.visual.aborted) {
-    lock.unlock();
-    std::lock_guard stats_lock(mutex_);
-    ++stats_.ba_aborted;
-  }
+  lock.unlock();
+  PKSLAM_LOG_DEBUG(
+      "local inertial BA at kf {}: {} iterations, cost {:.1f} -> {:.1f}, anchor {}, next prior "
+      "information trace pose {:.3g} velocity {:.3g} gyro {:.3g} accel {:.3g}",
+      kf->id(), result.visual.iterations, result.visual.initial_cost, result.visual.final_cost,
+      problem.anchor_prior ? "with prior" : "fixed",
+      result.next_prior ? result.next_prior->information.topLeftCorner<6, 6>().trace() : 0.0,
+      result.next_prior ? result.next_prior->information.block<3, 3>(6, 6).trace() : 0.0,
+      result.next_prior ? result.next_prior->information.block<3, 3>(9, 9).trace() : 0.0,
+      result.next_prior ? result.next_prior->information.block<3, 3>(12, 12).trace() : 0.0);
+  std::lock_guard stats_lock(mutex_);
+  if (result.visual.aborted) ++stats_.ba_aborted;
+  ++(problem.anchor_prior ? stats_.inertial_ba_with_prior : stats_.inertial_ba_fixed_anchor);
   return true;
 }
 

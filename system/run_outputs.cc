@@ -196,6 +196,8 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   json.Member("median_tracking_ms", summary->median_tracking_ms);
   json.Member("median_local_mapping_ms", Median(mapping.keyframe_ms));
   json.Member("local_ba_aborted", mapping.ba_aborted);
+  json.Member("inertial_ba_with_prior", mapping.inertial_ba_with_prior);
+  json.Member("inertial_ba_fixed_anchor", mapping.inertial_ba_fixed_anchor);
   // CPU time (independent of the machine's load): per-thread sums and medians.
   const auto sum = [](const std::vector<double>& v) {
     return std::accumulate(v.begin(), v.end(), 0.0);

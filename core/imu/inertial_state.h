@@ -30,6 +30,21 @@ struct FrameImu {
   InertialState state;
 };
 
+// Gaussian prior on a keyframe's 15-D state that summarises the states marginalised before it
+// (the local inertial BA's marginalisation prior, mapping/inertial_marginalization.h). Written
+// and read by local mapping under the Atlas mutex. Valid only while the map it was computed in
+// has not moved map-wide: `map_id`, `map_change_index` (Map::change_index: loop corrections,
+// merges, global and full inertial BA) and `world_change_index` must still match.
+struct InertialStatePrior {
+  NavState mean;  // world_from_body and velocity at the prior's mean
+  ImuBias bias_mean;
+  // In the tangent order [rho, phi, v, b_g, b_a] of InertialStatePriorError (imu/imu_factors.h).
+  Eigen::Matrix<double, 15, 15> information = Eigen::Matrix<double, 15, 15>::Zero();
+  MapId map_id = -1;
+  int map_change_index = 0;
+  int world_change_index = 0;
+};
+
 // A keyframe's IMU data: the preintegration from the previous keyframe of the chain and the
 // estimated state.
 struct KeyFrameImu {
@@ -37,6 +52,7 @@ struct KeyFrameImu {
   KeyFrame* previous = nullptr;
   KeyFrame* next = nullptr;
   InertialState state;
+  std::optional<InertialStatePrior> prior;  // see InertialStatePrior
 };
 
 }  // namespace pkslam

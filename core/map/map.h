@@ -51,7 +51,8 @@ class Map {
   KeyFrame* origin() const { return origin_; }
   KeyFrameId max_keyframe_id() const { return max_kf_id_; }
 
-  // Bumped by loop closing / global BA so tracking knows poses moved under it.
+  // Bumped by loop closing / global BA so tracking knows poses moved under it, and by local
+  // mapping's full inertial BA (it invalidates the local inertial BA's marginalisation priors).
   int change_index() const { return change_index_; }
   void IncreaseChangeIndex() { ++change_index_; }
 

@@ -1,0 +1,276 @@
+// Marginalisation prior of the local inertial BA: the Schur complement against a dense solve,
+// the prior factor's quadratic, the validity stamps, and Collect / Apply on a synthetic
+// inertial map (the anchor is free with a valid prior, fixed with a stale one, and the solve's
+// marginal lands on the next keyframe).
+#include "mapping/inertial_marginalization.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <mutex>
+#include <random>
+
+#include "core/map/keyframe.h"
+#include "core/map/map.h"
+#include "core/testing/synthetic_map.h"
+#include "core/util/error.h"
+#include "imu/imu_factors.h"
+#include "imu/imu_manifolds.h"
+#include "imu/imu_test_utils.h"
+#include "imu/preintegration.h"
+#include "mapping/inertial_bundle.h"
+#include "mapping/inertial_culling.h"
+
+namespace pkslam {
+namespace {
+
+// A linear-Gaussian chain x0 - x1 - x2 (3 blocks of `dim`): a prior on x0, relative factors
+// between neighbours, a measurement of x2; J and r of the stacked whitened residuals.
+void MakeChain(int dim, std::mt19937* rng, Eigen::MatrixXd* j, Eigen::VectorXd* r) {
+  std::normal_distribution<double> n01(0.0, 1.0);
+  auto random = [&](int rows, int cols) {
+    Eigen::MatrixXd m(rows, cols);
+    for (int a = 0; a < rows; ++a) {
+      for (int b = 0; b < cols; ++b) m(a, b) = n01(*rng);
+    }
+    return m;
+  };
+  const int n = 3 * dim;
+  *j = Eigen::MatrixXd::Zero(4 * dim, n);
+  j->block(0, 0, dim, dim) = random(dim, dim) + 3 * Eigen::MatrixXd::Identity(dim, dim);
+  for (int e = 0; e < 2; ++e) {
+    j->block((1 + e) * dim, e * dim, dim, dim) = random(dim, dim);
+    j->block((1 + e) * dim, (e + 1) * dim, dim, dim) = random(dim, dim);
+  }
+  j->block(3 * dim, 2 * dim, dim, dim) = random(dim, dim);
+  *r = random(4 * dim, 1);
+}
+
+TEST(Marginalization, SchurComplementIsTheExactMarginal) {
+  std::mt19937 rng(11);
+  for (int dim : {1, 3, 15}) {
+    Eigen::MatrixXd j;
+    Eigen::VectorXd r;
+    MakeChain(dim, &rng, &j, &r);
+    const Eigen::MatrixXd h = j.transpose() * j;
+    const Eigen::VectorXd b = j.transpose() * r;
+    Eigen::MatrixXd h_kept;
+    Eigen::VectorXd b_kept;
+    MarginalizeLeading(h, b, dim, &h_kept, &b_kept);
+    // Dense: the joint covariance's kept block is the inverse of the marginal information, and
+    // the joint minimum -H^-1 b restricted to the kept variables is the marginal's minimum.
+    const Eigen::MatrixXd covariance = h.inverse();
+    const Eigen::MatrixXd marginal = covariance.bottomRightCorner(2 * dim, 2 * dim).inverse();
+    EXPECT_LT((h_kept - marginal).norm(), 1e-8 * marginal.norm()) << "dim " << dim;
+    const Eigen::VectorXd joint_min = -h.ldlt().solve(b);
+    const Eigen::VectorXd kept_min = -h_kept.ldlt().solve(b_kept);
+    EXPECT_LT((kept_min - joint_min.tail(2 * dim)).norm(), 1e-8 * (1 + joint_min.norm()));
+  }
+}
+
+TEST(Marginalization, UnobservableDirectionsCarryNothing) {
+  // x0 is seen only together with x1 (x0 - x1 measured); marginalising x0 leaves nothing on x1.
+  Eigen::MatrixXd j(1, 2);
+  j << 1, -1;
+  Eigen::VectorXd r(1);
+  r << 0.5;
+  Eigen::MatrixXd h_kept;
+  Eigen::VectorXd b_kept;
+  MarginalizeLeading(j.transpose() * j, j.transpose() * r, 1, &h_kept, &b_kept);
+  EXPECT_NEAR(h_kept(0, 0), 0.0, 1e-12);
+  EXPECT_NEAR(b_kept(0), 0.0, 1e-12);
+}
+
+TEST(Marginalization, ProjectToPsdClampsNegativeEigenvalues) {
+  Eigen::Matrix2d m;
+  m << 1, 2, 2.1, 1;  // eigenvalues ~3.05 and ~-1.05, slightly asymmetric
+  const Eigen::MatrixXd p = ProjectToPsd(m);
+  EXPECT_LT((p - p.transpose()).norm(), 1e-15);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(p);
+  EXPECT_GE(es.eigenvalues().minCoeff(), -1e-12);
+  EXPECT_NEAR(es.eigenvalues().maxCoeff(), 3.05, 1e-12);
+}
+
+TEST(Marginalization, PriorFactorReproducesTheQuadratic) {
+  // At the linearisation point the prior factor's J^T J and J^T r are H and b.
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  Eigen::Matrix<double, 15, 15> a;
+  Eigen::Matrix<double, 15, 1> b;
+  for (int i = 0; i < 15; ++i) {
+    b[i] = 1e-3 * n01(rng);
+    for (int k = 0; k < 15; ++k) a(i, k) = n01(rng);
+  }
+  const Eigen::Matrix<double, 15, 15> h =
+      a.transpose() * a + Eigen::Matrix<double, 15, 15>::Identity();
+  NavState lin;
+  lin.world_from_body = SE3d(SO3d::Exp(Eigen::Vector3d(0.3, -0.2, 1.0)), Eigen::Vector3d(1, 2, 3));
+  lin.velocity_world = Eigen::Vector3d(0.5, -0.1, 0.2);
+  const ImuBias bias(Eigen::Vector3d(0.01, 0, -0.02), Eigen::Vector3d(0.1, 0.2, -0.1));
+  const InertialStatePrior prior = MakeInertialStatePrior(lin, bias, h, b);
+  const InertialStatePriorError cost(prior.mean, prior.bias_mean, prior.information);
+  double pose[kBodyPoseBlockSize];
+  BodyPoseToBlock(lin.world_from_body, pose);
+  const double* params[] = {pose, lin.velocity_world.data(), bias.gyro.data(), bias.accel.data()};
+  Eigen::Matrix<double, 15, 1> r;
+  Eigen::Matrix<double, 15, 7, Eigen::RowMajor> j_pose;
+  Eigen::Matrix<double, 15, 3, Eigen::RowMajor> j_v, j_bg, j_ba;
+  double* jacobians[] = {j_pose.data(), j_v.data(), j_bg.data(), j_ba.data()};
+  ASSERT_TRUE(cost.Evaluate(params, r.data(), jacobians));
+  Eigen::Matrix<double, 15, 15> j;
+  j << j_pose.leftCols<6>(), j_v, j_bg, j_ba;
+  // First order in the mean shift (|H^-1 b| is small here).
+  EXPECT_LT((j.transpose() * j - h).norm(), 1e-2 * h.norm());
+  EXPECT_LT((j.transpose() * r - b).norm(), 1e-2 * b.norm());
+}
+
+TEST(Marginalization, OptionsAreChecked) {
+  InertialBundleOptions options;
+  EXPECT_NO_THROW(options.Check());
+  options.marginalization_visual_weight = 0;
+  EXPECT_THROW(options.Check(), OptionError);
+  options.marginalization_visual_weight = 1.5;
+  EXPECT_THROW(options.Check(), OptionError);
+  options.marginalization_visual_weight = 1;
+  options.marginalization_threshold = -1;
+  EXPECT_THROW(options.Check(), OptionError);
+}
+
+constexpr int kNumKeyFrames = 16;
+constexpr std::int64_t kKeyFramePeriodNs = 50'000'000;
+
+// A synthetic stereo-inertial map whose keyframes form a temporal chain with valid states.
+class MarginalizationMapTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    rig_ = testing::MakeStereoRig(Sensor::kStereoInertial);
+    map_ = testing::MakeMap(&atlas_, testing::MakeScene(400, 5), rig_,
+                            testing::MakeForwardPath(kNumKeyFrames, 0.15, 4), {});
+    const auto samples =
+        testing::SampleImu(testing::HelixMotion(), 0, kKeyFramePeriodNs * kNumKeyFrames, 5'000'000,
+                           bias_, noise_, nullptr);
+    std::unique_lock lock(atlas_.mutex());
+    for (int k = 0; k < kNumKeyFrames; ++k) {
+      KeyFrame* kf = map_.keyframes[k].get();
+      kf->imu.state.bias = bias_;
+      kf->imu.state.valid = true;
+      if (k == 0) continue;
+      KeyFrame* previous = map_.keyframes[k - 1].get();
+      kf->imu.previous = previous;
+      previous->imu.next = kf;
+      PreintegratedImu pim = StartPreintegration(bias_, noise_);
+      IntegrateSamples(samples, previous->t_ns(), kf->t_ns(), &pim);
+      kf->imu.from_previous = pim;
+    }
+    map()->imu_initialized = true;
+    options_.window = 5;
+  }
+  KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
+  Map* map() { return kf(0)->map(); }
+  KeyFrame* newest() { return kf(kNumKeyFrames - 1); }
+  KeyFrame* anchor() { return kf(kNumKeyFrames - 1 - options_.window); }
+  // A prior at the anchor's current state, stamped with the map.
+  void GiveAnchorPrior(double information) {
+    InertialStatePrior prior;
+    prior.mean.world_from_body =
+        anchor()->world_from_camera() * anchor()->rig().body_from_camera.Inverse();
+    prior.mean.velocity_world = anchor()->imu.state.velocity_world;
+    prior.bias_mean = anchor()->imu.state.bias;
+    prior.information = information * Eigen::Matrix<double, 15, 15>::Identity();
+    StampPrior(*map(), &prior);
+    anchor()->imu.prior = prior;
+  }
+
+  Atlas atlas_;
+  std::shared_ptr<CameraRig> rig_;
+  testing::SyntheticMap map_;
+  ImuBias bias_{Eigen::Vector3d(0.002, -0.001, 0.003), Eigen::Vector3d(0.05, 0.02, -0.04)};
+  ImuNoise noise_;
+  InertialBundleOptions options_;
+};
+
+TEST_F(MarginalizationMapTest, ValidPriorFreesTheAnchorStalePriorIsIgnored) {
+  std::unique_lock lock(atlas_.mutex());
+  {
+    const InertialBundleProblem p = CollectLocalInertialBundle(newest(), options_);
+    ASSERT_FALSE(p.empty());
+    EXPECT_EQ(p.visual.keyframes[0].keyframe.get(), anchor());
+    EXPECT_TRUE(p.visual.keyframes[0].fixed);  // no prior yet: fixed (ORB-SLAM3)
+    EXPECT_FALSE(p.anchor_prior.has_value());
+    EXPECT_EQ(p.marginalize_from, 0);
+    EXPECT_EQ(p.marginalize_to, 1);
+  }
+  GiveAnchorPrior(1e4);
+  {
+    const InertialBundleProblem p = CollectLocalInertialBundle(newest(), options_);
+    EXPECT_FALSE(p.visual.keyframes[0].fixed);
+    ASSERT_TRUE(p.anchor_prior.has_value());
+    EXPECT_EQ(p.inertial[0], 1);
+  }
+  InertialBundleOptions off = options_;
+  off.marginalization_prior = false;
+  {
+    const InertialBundleProblem p = CollectLocalInertialBundle(newest(), off);
+    EXPECT_TRUE(p.visual.keyframes[0].fixed);
+    EXPECT_FALSE(p.anchor_prior.has_value());
+    EXPECT_EQ(p.marginalize_from, -1);
+  }
+  // A loop correction / merge / global or full inertial BA moved the map: stale.
+  map()->IncreaseChangeIndex();
+  EXPECT_FALSE(PriorIsValid(*anchor()->imu.prior, *map()));
+  {
+    const InertialBundleProblem p = CollectLocalInertialBundle(newest(), options_);
+    EXPECT_TRUE(p.visual.keyframes[0].fixed);
+    EXPECT_FALSE(p.anchor_prior.has_value());
+  }
+  // An IMU initialisation / refinement rotated the map: stale too.
+  GiveAnchorPrior(1e4);
+  EXPECT_TRUE(PriorIsValid(*anchor()->imu.prior, *map()));
+  ++map()->world_change_index;
+  EXPECT_FALSE(PriorIsValid(*anchor()->imu.prior, *map()));
+  // Another map.
+  GiveAnchorPrior(1e4);
+  InertialStatePrior other = *anchor()->imu.prior;
+  other.map_id = map()->id() + 1;
+  EXPECT_FALSE(PriorIsValid(other, *map()));
+}
+
+TEST_F(MarginalizationMapTest, CulledKeyFrameDropsItsPrior) {
+  std::unique_lock lock(atlas_.mutex());
+  GiveAnchorPrior(1e4);
+  KeyFrame* k = anchor();
+  k->SetBad();
+  SpliceOutOfInertialChain(k);
+  EXPECT_FALSE(k->imu.prior.has_value());
+}
+
+TEST_F(MarginalizationMapTest, SolveMarginalisesTheAnchorOntoTheNextKeyFrame) {
+  InertialBundleProblem p;
+  {
+    std::shared_lock lock(atlas_.mutex());
+    p = CollectLocalInertialBundle(newest(), options_);
+  }
+  const InertialBundleResult r = SolveInertialBundle(p, options_);
+  ASSERT_TRUE(r.next_prior.has_value());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 15, 15>> es(r.next_prior->information);
+  EXPECT_GE(es.eigenvalues().minCoeff(), -1e-9 * es.eigenvalues().maxCoeff());
+  // The anchor's reprojections fix its pose, the edge carries that to the next pose.
+  EXPECT_GT((r.next_prior->information.topLeftCorner<6, 6>().trace()), 1.0);
+  KeyFrame* next = kf(kNumKeyFrames - options_.window);
+  {
+    std::unique_lock lock(atlas_.mutex());
+    ApplyInertialBundle(p, r);
+    ASSERT_TRUE(next->imu.prior.has_value());
+    EXPECT_TRUE(PriorIsValid(*next->imu.prior, *map()));
+    EXPECT_EQ(next->imu.prior->bias_mean.gyro, r.next_prior->bias_mean.gyro);
+    EXPECT_TRUE(next->imu.prior->mean.velocity_world.allFinite());
+    // Applying a result collected before a map-wide change stores nothing.
+    next->imu.prior.reset();
+    map()->IncreaseChangeIndex();
+    ApplyInertialBundle(p, r);
+    EXPECT_FALSE(next->imu.prior.has_value());
+  }
+}
+
+}  // namespace
+}  // namespace pkslam
