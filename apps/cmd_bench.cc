@@ -152,7 +152,9 @@ void RegisterBenchCommand(CLI::App& app) {
   cmd->add_option("--collect", args->collect,
                   "Merge the finished runs of these folders into one report (in --out, default "
                   "the first folder)");
-  cmd->add_option("--run-id", args->run_ids, "Execute only these runs (ids as --list prints)");
+  cmd->add_option("--run-id", args->run_ids,
+                  "Execute only these runs (ids as --list prints); no report is written: `pkslam "
+                  "bench --collect OUT` makes it");
   cmd->add_flag("--retry-failed", args->retry_failed, "Run failed runs again");
   cmd->add_flag("--reevaluate", args->reevaluate,
                 "Measure finished runs again against ground truth (no SLAM re-run)");
