@@ -213,9 +213,17 @@ void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
   if (posed && current_.HasPose() && ref) {
     std::shared_lock lock(atlas_->mutex());
     if (imu_) SyncWithInertialMapLocked(/*correct_current=*/true);
+    r.camera_from_world_online = current_.camera_from_world();
+    if (keyframe && ref->t_ns() == current_.t_ns() && !ref->IsBad()) {
+      // The frame became this keyframe: it is the keyframe's image, so it has the keyframe's
+      // pose. Local mapping may already have moved it (lock-step runs map before this point:
+      // the monocular-inertial initialisation rotates and rescales the world and then runs a
+      // full BA, more than SyncWithInertialMapLocked can carry the frame across; a frame 19 cm
+      // off at the initialisation of a MH_01 replay).
+      current_.SetPose(ref->camera_from_world());
+    }
     r.reference = ref;
     r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
-    r.camera_from_world_online = current_.camera_from_world();
   }
   records_.push_back(std::move(r));
 }
