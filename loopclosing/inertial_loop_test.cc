@@ -9,6 +9,7 @@
 #include <shared_mutex>
 
 #include "core/optim/yaw_manifold.h"
+#include "loopclosing/global_bundle.h"
 #include "loopclosing/loop_closing.h"
 #include "loopclosing/revisit_fixture.h"
 
@@ -21,6 +22,7 @@ using testing::kKeyFrames;
 struct Snapshot {
   std::map<KeyFrameId, SE3d> camera_from_world;
   std::map<KeyFrameId, Eigen::Vector3d> velocity;
+  std::map<KeyFrameId, Eigen::Vector3d> gravity_in_camera;  // GravityInCameras of every map
 };
 
 class InertialLoopTest : public testing::RevisitTest {
@@ -61,6 +63,7 @@ class InertialLoopTest : public testing::RevisitTest {
         s.camera_from_world[id] = kf->camera_from_world();
         s.velocity[id] = kf->imu.state.velocity_world;
       }
+      s.gravity_in_camera.merge(GravityInCameras(*map));
     }
     return s;
   }
@@ -80,13 +83,7 @@ class InertialLoopTest : public testing::RevisitTest {
   // Largest change (rad) of a keyframe's view of the world's z axis since `before`.
   double MaxTiltChange(const Snapshot& before) {
     std::shared_lock lock(atlas_.mutex());
-    double worst = 0;
-    for (const auto& [id, kf] : atlas_.current_map()->keyframes()) {
-      const Eigen::Vector3d a = before.camera_from_world.at(id).so3() * Eigen::Vector3d::UnitZ();
-      const Eigen::Vector3d b = kf->camera_from_world().so3() * Eigen::Vector3d::UnitZ();
-      worst = std::max(worst, std::atan2(a.cross(b).norm(), a.dot(b)));
-    }
-    return worst;
+    return pkslam::MaxTiltChange(*atlas_.current_map(), before.gravity_in_camera);
   }
 
   std::vector<KeyFramePtr> second_;

@@ -147,6 +147,29 @@ BENCHMARK(BM_Pnp<true>)
 
 // Essential graph on the loop scenario (+4 keyframes revisiting the start). Timed:
 // Collect + Solve; Apply once afterwards for the accuracy counters.
+// Times Collect + Solve of the scenario's essential graph, then applies it once and reports the
+// keyframe error before/after, the edge count and the iterations.
+void TimeEssentialGraph(benchmark::State& state, testing::LoopScenario* s,
+                        const EssentialGraphOptions& options) {
+  EssentialGraphProblem problem;
+  EssentialGraphResult result;
+  for (auto _ : state) {
+    {
+      std::shared_lock lock(s->atlas.mutex());
+      problem = CollectEssentialGraph(s->map, s->correction, options);
+    }
+    result = SolveEssentialGraph(problem, options);
+  }
+  state.counters["kf_rmse_before"] = testing::KeyFramePositionRmse(*s);
+  {
+    std::unique_lock lock(s->atlas.mutex());
+    ApplyEssentialGraph(problem, result);
+  }
+  state.counters["kf_rmse_after"] = testing::KeyFramePositionRmse(*s);
+  state.counters["edges"] = static_cast<double>(problem.edges.size());
+  state.counters["lm_iterations"] = result.iterations;
+}
+
 void BM_EssentialGraph(benchmark::State& state) {
   testing::LoopScenarioOptions o;
   o.keyframes_per_lap = static_cast<int>(state.range(0));
@@ -158,23 +181,7 @@ void BM_EssentialGraph(benchmark::State& state) {
   testing::BuildLoopScenario(o, scene, &s);
   EssentialGraphOptions options;
   options.exact_log = state.range(1) != 0;
-  EssentialGraphProblem problem;
-  EssentialGraphResult result;
-  for (auto _ : state) {
-    {
-      std::shared_lock lock(s.atlas.mutex());
-      problem = CollectEssentialGraph(s.map, s.correction, options);
-    }
-    result = SolveEssentialGraph(problem, options);
-  }
-  state.counters["kf_rmse_before"] = testing::KeyFramePositionRmse(s);
-  {
-    std::unique_lock lock(s.atlas.mutex());
-    ApplyEssentialGraph(problem, result);
-  }
-  state.counters["kf_rmse_after"] = testing::KeyFramePositionRmse(s);
-  state.counters["edges"] = static_cast<double>(problem.edges.size());
-  state.counters["lm_iterations"] = result.iterations;
+  TimeEssentialGraph(state, &s, options);
 }
 // args: keyframes per lap, exact Sim3 log (1) or decoupled error (0).
 BENCHMARK(BM_EssentialGraph)
@@ -205,23 +212,7 @@ void BM_EssentialGraphYawTranslation(benchmark::State& state) {
   }
   EssentialGraphOptions options;
   options.dof = PoseGraphDof::kYawTranslation;
-  EssentialGraphProblem problem;
-  EssentialGraphResult result;
-  for (auto _ : state) {
-    {
-      std::shared_lock lock(s.atlas.mutex());
-      problem = CollectEssentialGraph(s.map, s.correction, options);
-    }
-    result = SolveEssentialGraph(problem, options);
-  }
-  state.counters["kf_rmse_before"] = testing::KeyFramePositionRmse(s);
-  {
-    std::unique_lock lock(s.atlas.mutex());
-    ApplyEssentialGraph(problem, result);
-  }
-  state.counters["kf_rmse_after"] = testing::KeyFramePositionRmse(s);
-  state.counters["edges"] = static_cast<double>(problem.edges.size());
-  state.counters["lm_iterations"] = result.iterations;
+  TimeEssentialGraph(state, &s, options);
 }
 BENCHMARK(BM_EssentialGraphYawTranslation)->Arg(36)->Arg(180)->Unit(benchmark::kMillisecond);
 
