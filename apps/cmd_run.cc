@@ -79,6 +79,11 @@ void RegisterRunCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-loop", args->options.system.no_loop,
                 "Disable loop closing and map merging (for experiments)");
+  cmd->add_flag_function(
+      "--no-gravity-refinement",
+      [args](std::int64_t) { args->options.system.mapping.inertial.gravity_refinement = false; },
+      "Inertial sensors: keep gravity fixed after the 15 s visual-inertial BA, as ORB-SLAM3 "
+      "(for experiments)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_option("--max-frames", args->options.max_frames, "Stop after N frames (0: all)");
   cmd->add_flag("--trace", args->options.system.trace, "Write OUT/keyframe_trace.csv");

@@ -9,7 +9,7 @@
 #include <shared_mutex>
 
 #include "core/optim/yaw_manifold.h"
-#include "loopclosing/global_bundle.h"
+#include "mapping/global_bundle.h"
 #include "loopclosing/loop_closing.h"
 #include "loopclosing/revisit_fixture.h"
 

@@ -10,7 +10,7 @@
 #include "core/map/map.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
-#include "loopclosing/global_bundle.h"
+#include "mapping/global_bundle.h"
 #include "mapping/inertial_bundle.h"
 
 namespace pkslam {

@@ -19,7 +19,7 @@
 #include "core/optim/essential_graph.h"
 #include "core/optim/yaw_manifold.h"
 #include "core/util/log.h"
-#include "loopclosing/global_bundle.h"
+#include "mapping/global_bundle.h"
 #include "loopclosing/loop_closing.h"
 
 namespace pkslam {

@@ -11,6 +11,7 @@
 #include "core/map/map_point.h"
 #include "core/util/error.h"
 #include "imu/preintegration.h"
+#include "mapping/gravity_refinement.h"
 #include "mapping/inertial_marginalization.h"
 
 namespace pkslam {
@@ -187,7 +188,8 @@ InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
 }
 
 InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
-                                                const InertialBundleOptions& options) {
+                                                const InertialBundleOptions& options,
+                                                bool free_tilt, double gauge_information) {
   options.Check();
   InertialBundleProblem problem;
   const std::vector<KeyFrame*> chain = InertialChain(newest, 0);
@@ -195,16 +197,27 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
   const Map* map = newest->map();
   SetCommon(*newest, options, &problem);
   KeyFrameIndex index;
-  // The first pose anchors position and yaw; its velocity and biases stay free.
+  // The first pose anchors position and yaw (fixed, or with free_tilt by a prior on just those);
+  // its velocity and biases stay free.
   for (std::size_t i = 0; i < chain.size(); ++i) {
-    AddKeyFrame(chain[i], i == 0, kFreeInertial, &problem, &index);
+    AddKeyFrame(chain[i], i == 0 && !free_tilt, kFreeInertial, &problem, &index);
   }
   AddEdges(chain, index, &problem);
+  if (free_tilt) {
+    const KeyFrame& first = *chain.front();
+    problem.anchor_prior =
+        PositionYawPrior({first.world_from_camera() * first.rig().body_from_camera.Inverse(),
+                          first.imu.state.velocity_world},
+                         first.imu.state.bias, gauge_information);
+    problem.marginalize_from = 0;
+    problem.marginalize_to = -1;
+  }
   std::vector<KeyFrame*> others;
   for (const auto& [id, kf] : map->keyframes()) {
     if (!kf->IsBad() && index.count(kf.get()) == 0) others.push_back(kf.get());
   }
-  for (KeyFrame* kf : others) AddKeyFrame(kf, true, kNoInertial, &problem, &index);
+  // Fixed keyframes would hold the world's tilt.
+  for (KeyFrame* kf : others) AddKeyFrame(kf, !free_tilt, kNoInertial, &problem, &index);
   for (const MapPointPtr& point : PointsOf(chain, map)) AddPoint(point, index, &problem.visual);
   return problem;
 }

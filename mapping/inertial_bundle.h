@@ -17,7 +17,9 @@
 // as that keyframe's prior, used when it becomes the anchor. Other keyframes observing the
 // window's points are fixed, visual only. Full: every chain keyframe, the first pose fixed;
 // optionally one bias pair shared by all with zero-mean priors (the BA right after the
-// inertial-only initialisation).
+// inertial-only initialisation). Full with a free tilt (mapping/gravity_refinement.h): the
+// first pose carries a position + yaw gauge prior instead, so roll and pitch of the whole map
+// (the gravity direction) are estimated; keyframes off the chain are then free, visual only.
 #pragma once
 
 #include <Eigen/Core>
@@ -82,7 +84,8 @@ struct InertialBundleProblem {
   double accel_prior_information = 0;
   // Local window with marginalisation: the prior of the anchor (keyframe 0), which is then free;
   // and the anchor -> next keyframe pair whose marginal Solve computes (-1: none), with the map
-  // stamps at collection (Apply stores the prior only if they still hold).
+  // stamps at collection (Apply stores the prior only if they still hold). A full BA with a
+  // free tilt puts its gauge prior here (marginalize_from = 0, marginalize_to = -1).
   std::optional<InertialStatePrior> anchor_prior;
   int marginalize_from = -1;
   int marginalize_to = -1;
@@ -103,8 +106,12 @@ struct InertialBundleResult {
 // Requires the Atlas mutex (shared). Keyframes without a valid inertial state end the chain.
 InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
                                                  const InertialBundleOptions& options);
+// free_tilt: the first chain keyframe is held by PositionYawPrior(gauge_information) instead of
+// being fixed, and keyframes off the chain are free.
 InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
-                                                const InertialBundleOptions& options);
+                                                const InertialBundleOptions& options,
+                                                bool free_tilt = false,
+                                                double gauge_information = 1e8);
 // Pure computation; `abort` (may be null) is polled between iterations.
 InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
                                          const InertialBundleOptions& options,

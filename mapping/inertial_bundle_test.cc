@@ -10,6 +10,7 @@
 
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
+#include "mapping/gravity_refinement.h"
 
 namespace pkslam {
 namespace {
@@ -202,6 +203,48 @@ TEST(InertialBundle, AnchorPriorHoldsTheFreeAnchor) {
   EXPECT_LT(weak_motion, free_motion);
   EXPECT_LT(strong_motion, 1e-6);
   EXPECT_LT(strong_motion, weak_motion);
+}
+
+// Largest angle between the true and the estimated gravity direction seen from the body.
+double MaxGravityError(const Scene& s, const InertialBundleResult& r) {
+  double worst = 0;
+  for (std::size_t k = 0; k < s.truth.size(); ++k) {
+    const Eigen::Vector3d truth =
+        s.truth[k].world_from_body.so3().Inverse() * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d estimate = r.visual.camera_from_world[k].so3() * Eigen::Vector3d::UnitZ();
+    worst = std::max(worst, std::atan2(truth.cross(estimate).norm(), truth.dot(estimate)));
+  }
+  return worst;
+}
+
+TEST(InertialBundle, PositionYawGaugeLetsTheBundleCorrectATiltedWorld) {
+  // The whole start (poses and points) tilted by 5 mrad about the first keyframe, as an
+  // initialisation that got gravity wrong leaves a map.
+  Scene s = MakeScene(false);
+  const SE3d pivot(SO3d(), s.truth[0].world_from_body.translation());
+  const SE3d tilt = pivot *
+                    SE3d(SO3d::Exp(Eigen::Vector3d(0.004, -0.003, 0)), Eigen::Vector3d::Zero()) *
+                    pivot.Inverse();
+  for (auto& k : s.problem.visual.keyframes)
+    k.camera_from_world = k.camera_from_world * tilt.Inverse();
+  for (auto& p : s.problem.visual.points) p.position_world = tilt * p.position_world;
+  InertialBundleOptions options;
+  options.iterations_first = 40;
+  options.iterations_second = 10;
+  // First pose fixed: the world's tilt stays.
+  const InertialBundleResult fixed = SolveInertialBundle(s.problem, options);
+  EXPECT_GT(MaxGravityError(s, fixed), 4e-3);
+  // Position and yaw held by the gauge prior: gravity comes back.
+  Scene free = s;
+  free.problem.visual.keyframes[0].fixed = false;
+  const SE3d first = free.problem.visual.keyframes[0].camera_from_world.Inverse();
+  free.problem.anchor_prior = PositionYawPrior({first, Eigen::Vector3d::Zero()}, ImuBias(), 1e8);
+  free.problem.marginalize_from = 0;
+  const InertialBundleResult refined = SolveInertialBundle(free.problem, options);
+  EXPECT_LT(MaxGravityError(s, refined), 5e-4);
+  const SE3d first_after = refined.visual.camera_from_world[0].Inverse();
+  EXPECT_LT((first_after.translation() - first.translation()).norm(), 1e-3);
+  EXPECT_LT((refined.biases.back().accel - s.bias.accel).norm(), 2e-2);
 }
 
 }  // namespace

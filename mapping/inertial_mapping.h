@@ -58,6 +58,16 @@ struct InertialMappingOptions {
   double moving_max_interval_s = 1.0;
   // Iterations of the full visual-inertial BA after each stage.
   int full_ba_iterations = 15;
+  // Gravity refinement after VIBA2 (mapping/gravity_refinement.h; not in ORB-SLAM3): a full
+  // visual-inertial BA with free roll and pitch once the chain's TiltObservability reaches
+  // gravity_refinement_min, and again each time it grew by gravity_refinement_step since the
+  // last one; skipped for chains longer than gravity_refinement_max_keyframes (a full BA over
+  // the map: its cost grows with it).
+  bool gravity_refinement = true;
+  double gravity_refinement_min = 0.1;
+  double gravity_refinement_step = 0.1;
+  int gravity_refinement_max_keyframes = 300;
+  int gravity_refinement_iterations = 10;
   // Local inertial BA.
   InertialBundleOptions local_ba;
   // Keyframe culling with the time-spacing rules of the temporal chain.

@@ -55,6 +55,15 @@ struct ImuStageSnapshot {
   std::vector<std::pair<std::int64_t, SE3d>> world_from_body;  // chain keyframes, oldest first
 };
 
+// One gravity refinement (mapping/gravity_refinement.h).
+struct GravityRefinementStat {
+  std::int64_t t_ns = 0;       // the keyframe that triggered it
+  int keyframes = 0;           // chain keyframes in the BA
+  double observability = 0;    // TiltObservability of the chain
+  double tilt_change_rad = 0;  // how far gravity moved, seen from the first keyframe
+  double ms = 0;
+};
+
 struct LocalMappingStats {
   std::vector<double> keyframe_ms;  // processing time per keyframe
   std::vector<double> ba_ms;        // local BA time per keyframe (0 when skipped)
@@ -70,6 +79,8 @@ struct LocalMappingStats {
   int points_created = 0;
   int points_culled = 0;
   std::vector<ImuStageSnapshot> imu_stages;
+  std::vector<GravityRefinementStat> gravity_refinements;
+  int gravity_refinements_dropped = 0;  // results dropped: the map moved meanwhile
 };
 
 class LocalMapper : public MappingBackend {
@@ -123,6 +134,8 @@ class LocalMapper : public MappingBackend {
   // Local inertial BA once the map's IMU is initialised; false if it did not apply (then the
   // visual local BA runs).
   bool LocalInertialBundleAdjustment(const KeyFramePtr& kf);
+  // Gravity refinement when due (InertialMappingOptions::gravity_refinement).
+  void RefineGravity(const KeyFramePtr& kf);
 
   Atlas* atlas_;
   std::shared_ptr<const CameraRig> rig_;

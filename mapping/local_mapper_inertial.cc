@@ -12,6 +12,8 @@
 #include "core/util/log.h"
 #include "imu/inertial_initializer.h"
 #include "imu/preintegration.h"
+#include "mapping/global_bundle.h"
+#include "mapping/gravity_refinement.h"
 #include "mapping/local_mapper.h"
 
 namespace pkslam {
@@ -115,7 +117,81 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
     initializing_imu_.store(true);
     if (InitializeImu(kf, o.viba2_gyro_prior, o.viba2_accel_prior, 2)) mark(true);
     initializing_imu_.store(false);
+  } else if (ba2 && o.gravity_refinement) {
+    RefineGravity(kf);
   }
+}
+
+void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
+  const InertialMappingOptions& o = options_.inertial;
+  InertialBundleOptions ba = o.local_ba;
+  ba.iterations_first = o.gravity_refinement_iterations;
+  ba.iterations_second = 0;
+  ba.num_threads = options_.ba.num_threads;
+  InertialBundleProblem problem;
+  GravityRefinementStat stat;
+  int change_index = 0;
+  {
+    std::shared_lock lock(atlas_->mutex());
+    if (kf->IsBad() || kf->map() == nullptr) return;
+    const Map* map = kf->map();
+    const std::vector<KeyFrame*> chain = InertialChain(kf.get(), 0);
+    if (chain.size() < 2 || static_cast<int>(chain.size()) > o.gravity_refinement_max_keyframes) {
+      return;
+    }
+    std::vector<SO3d> orientations;
+    orientations.reserve(chain.size());
+    for (const KeyFrame* k : chain) orientations.push_back(WorldFromBody(*k).so3());
+    stat.observability = TiltObservability(orientations);
+    const double due = std::max(o.gravity_refinement_min,
+                                map->gravity_refinement_observability + o.gravity_refinement_step);
+    if (stat.observability < due) return;
+    problem = CollectFullInertialBundle(kf.get(), ba, /*free_tilt=*/true);
+    change_index = map->change_index();
+  }
+  if (problem.edges.empty()) return;
+  stat.t_ns = kf->t_ns();
+  stat.keyframes = static_cast<int>(problem.edges.size()) + 1;
+  const auto start = std::chrono::steady_clock::now();
+  const InertialBundleResult result = SolveInertialBundle(problem, ba);
+  Eigen::Vector3d accel_bias;
+  {
+    std::unique_lock lock(atlas_->mutex());
+    Map* map = kf->map();
+    if (map == nullptr || kf->IsBad() || map->change_index() != change_index) {
+      // A loop correction or merge moved the map meanwhile: the result is stale; the next
+      // keyframe tries again.
+      PKSLAM_LOG_INFO("gravity refinement at t = {:.2f} s dropped: the map moved meanwhile",
+                      kf->t_s());
+      std::lock_guard stats_lock(mutex_);
+      ++stats_.gravity_refinements_dropped;
+      return;
+    }
+    const KeyFrame& first = *problem.visual.keyframes.front().keyframe;
+    const Eigen::Vector3d up_before = first.camera_from_world().so3() * Eigen::Vector3d::UnitZ();
+    MergeGlobalBundle(
+        map, problem.visual, [&] { ApplyInertialBundle(problem, result); },
+        /*apply_sets_velocities=*/true);
+    const Eigen::Vector3d up_after = first.camera_from_world().so3() * Eigen::Vector3d::UnitZ();
+    stat.tilt_change_rad = std::atan2(up_after.cross(up_before).norm(), up_after.dot(up_before));
+    // Keyframes tracked while the BA ran continue from the newest estimate.
+    for (const auto& [id, other] : map->keyframes()) {
+      if (other->id() > kf->id() && !other->IsBad()) other->imu.state.bias = kf->imu.state.bias;
+    }
+    map->gravity_refinement_observability = stat.observability;
+    ++map->imu_change_index;
+    accel_bias = kf->imu.state.bias.accel;
+  }
+  stat.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  PKSLAM_LOG_INFO(
+      "gravity refinement at t = {:.2f} s over {} keyframes (tilt observability {:.2f}): gravity "
+      "moved {:.2f} mrad, cost {:.1f} -> {:.1f}, accel bias ({:.4f} {:.4f} {:.4f}), {:.0f} ms",
+      kf->t_s(), stat.keyframes, stat.observability, 1e3 * stat.tilt_change_rad,
+      result.visual.initial_cost, result.visual.final_cost, accel_bias.x(), accel_bias.y(),
+      accel_bias.z(), stat.ms);
+  std::lock_guard stats_lock(mutex_);
+  stats_.gravity_refinements.push_back(stat);
 }
 
 bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double accel_prior,

@@ -198,6 +198,19 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   json.Member("local_ba_aborted", mapping.ba_aborted);
   json.Member("inertial_ba_with_prior", mapping.inertial_ba_with_prior);
   json.Member("inertial_ba_fixed_anchor", mapping.inertial_ba_fixed_anchor);
+  json.Member("gravity_refinement_enabled", options.system.mapping.inertial.gravity_refinement);
+  json.Key("gravity_refinements").BeginArray();
+  for (const GravityRefinementStat& g : mapping.gravity_refinements) {
+    json.BeginObject();
+    json.Member("t_s", static_cast<double>(g.t_ns) * 1e-9);
+    json.Member("keyframes", g.keyframes);
+    json.Member("tilt_observability", g.observability);
+    json.Member("tilt_change_mrad", 1e3 * g.tilt_change_rad);
+    json.Member("ms", g.ms);
+    json.EndObject();
+  }
+  json.EndArray();
+  json.Member("gravity_refinements_dropped", mapping.gravity_refinements_dropped);
   // CPU time (independent of the machine's load): per-thread sums and medians.
   const auto sum = [](const std::vector<double>& v) {
     return std::accumulate(v.begin(), v.end(), 0.0);

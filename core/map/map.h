@@ -60,6 +60,9 @@ class Map {
   bool imu_initialized = false;
   bool inertial_ba1_done = false;
   bool inertial_ba2_done = false;
+  // Tilt observability (mapping/gravity_refinement.h) of the chain at the last gravity
+  // refinement (0: none yet).
+  double gravity_refinement_observability = 0;
   // Time of the first keyframe of the IMU initialisation and of the initialisation [ns].
   std::int64_t imu_init_t_ns = 0;
   // Bumped whenever local mapping rotates / rescales the map or re-estimates keyframe

@@ -2,7 +2,9 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <random>
+#include <vector>
 
 #include <sys/wait.h>
 
@@ -21,12 +23,46 @@ std::optional<std::filesystem::path> SharedDataDir() {
   return std::nullopt;
 }
 
+namespace {
+
+// The directories MakeTempDir made in this test process, removed when it exits (end-to-end
+// tests leave simulated sequences of ~150 MB; repeated ctest runs filled the disk) unless
+// PKSLAM_KEEP_TEST_DIRS is set, for debugging a failure.
+class TempDirRegistry {
+ public:
+  ~TempDirRegistry() {
+    if (const char* keep = std::getenv("PKSLAM_KEEP_TEST_DIRS"); keep != nullptr && *keep != '\0') {
+      return;
+    }
+    std::lock_guard lock(mutex_);
+    for (const auto& dir : dirs_) {
+      std::error_code ignored;
+      std::filesystem::remove_all(dir, ignored);
+    }
+  }
+  void Add(const std::filesystem::path& dir) {
+    std::lock_guard lock(mutex_);
+    dirs_.push_back(dir);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::filesystem::path> dirs_;
+};
+
+TempDirRegistry temp_dirs;
+
+}  // namespace
+
 std::filesystem::path MakeTempDir(const std::string& prefix) {
   namespace fs = std::filesystem;
   std::random_device rd;
   for (int attempt = 0; attempt < 100; ++attempt) {
     const fs::path dir = fs::temp_directory_path() / fmt::format("pkslam_{}_{:08x}", prefix, rd());
-    if (fs::create_directories(dir)) return dir;
+    if (fs::create_directories(dir)) {
+      temp_dirs.Add(dir);
+      return dir;
+    }
   }
   throw std::runtime_error("cannot create a temporary directory");
 }

@@ -11,7 +11,8 @@ namespace pkslam::testing {
 // The shared data root (contains euroc/, evo/) or nullopt.
 std::optional<std::filesystem::path> SharedDataDir();
 
-// A fresh empty directory under the system temp dir, unique per call.
+// A fresh empty directory under the system temp dir, unique per call; removed with its contents
+// when the test process exits (kept if PKSLAM_KEEP_TEST_DIRS is set).
 std::filesystem::path MakeTempDir(const std::string& prefix);
 
 // The built pkslam executable (build/bin/pkslam) for end-to-end CLI tests.

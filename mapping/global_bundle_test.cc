@@ -1,4 +1,4 @@
-#include "loopclosing/global_bundle.h"
+#include "mapping/global_bundle.h"
 
 #include <gtest/gtest.h>
 
