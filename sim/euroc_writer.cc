@@ -113,8 +113,8 @@ constexpr const char* kGroundTruthYaml =
 
 }  // namespace
 
-void WritePng(const std::filesystem::path& file, const cv::Mat& image) {
-  const std::vector<int> params{cv::IMWRITE_PNG_COMPRESSION, 1};
+void WritePng(const std::filesystem::path& file, const cv::Mat& image, int compression) {
+  const std::vector<int> params{cv::IMWRITE_PNG_COMPRESSION, compression};
   if (!cv::imwrite(file.string(), image, params)) {
     throw Error(fmt::format("cannot write image {}", file.string()));
   }
@@ -153,7 +153,7 @@ EurocWriter::EurocWriter(const std::filesystem::path& dir, const std::vector<Cam
 }
 
 void EurocWriter::WriteImage(int camera, std::int64_t t_ns, const cv::Mat& image) {
-  WritePng(AddImage(camera, t_ns), image);
+  WritePng(AddImage(camera, t_ns), image, kEurocPngCompression);
 }
 
 std::filesystem::path EurocWriter::AddImage(int camera, std::int64_t t_ns) {

@@ -336,7 +336,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     if (euroc) {
       for (std::size_t c = 0; c < cameras.size(); ++c) {
         const std::filesystem::path file = euroc->AddImage(static_cast<int>(c), t);
-        writers.run([file, image = images[c]] { WritePng(file, image); });
+        writers.run([file, image = images[c]] { WritePng(file, image, kEurocPngCompression); });
       }
     }
     if (tum) {

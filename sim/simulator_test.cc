@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -152,6 +153,9 @@ TEST(Simulator, ReplayWritesEurocFormatLikeTheRealDataset) {
       const cv::Mat image = cv::imread((mav / cam / "data" / f[1]).string(), cv::IMREAD_UNCHANGED);
       ASSERT_EQ(image.type(), real_image.type());
       ASSERT_EQ(image.size(), real_image.size());
+      // Stored like the real files (not deflated: as cheap to decode).
+      EXPECT_GE(std::filesystem::file_size(mav / cam / "data" / f[1]),
+                static_cast<std::uintmax_t>(image.total()));
       const double rel = 1e-9 * static_cast<double>(t - s.begin_ns);
       const bool black = rel >= 0.2 && rel <= 0.3;
       EXPECT_EQ(cv::countNonZero(image) == 0, black) << "t = " << rel << " s";
