@@ -1,14 +1,13 @@
 #include "tests/support/test_data.h"
 
+#include <fmt/format.h>
+#include <sys/wait.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
 #include <random>
 #include <vector>
-
-#include <sys/wait.h>
-
-#include <fmt/format.h>
 
 namespace pkslam::testing {
 

@@ -28,9 +28,9 @@ CommandResult RunCommand(const std::string& command);
 }  // namespace pkslam::testing
 
 // Inside a TEST body: binds `shared` (std::filesystem::path) or skips the test.
-#define PKSLAM_REQUIRE_SHARED_DATA(shared)                                              \
-  const auto shared##_opt = ::pkslam::testing::SharedDataDir();                        \
-  if (!shared##_opt) {                                                                 \
-    GTEST_SKIP() << "shared data not found (../shared/data or $PKSLAM_SHARED_DATA)";  \
-  }                                                                                    \
+#define PKSLAM_REQUIRE_SHARED_DATA(shared)                                           \
+  const auto shared##_opt = ::pkslam::testing::SharedDataDir();                      \
+  if (!shared##_opt) {                                                               \
+    GTEST_SKIP() << "shared data not found (../shared/data or $PKSLAM_SHARED_DATA)"; \
+  }                                                                                  \
   const std::filesystem::path shared = *shared##_opt
