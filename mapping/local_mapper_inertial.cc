@@ -133,7 +133,8 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
     std::shared_lock lock(atlas_->mutex());
     if (kf->IsBad() || kf->map() == nullptr) return false;
     chain = InertialChainThrough(kf.get());
-    newest = kf->map()->keyframes().at(chain.back()->id());
+    const auto newest_it = kf->map()->keyframes().find(chain.back()->id());
+    newest = newest_it != kf->map()->keyframes().end() ? newest_it->second : kf;
     PKSLAM_LOG_DEBUG("IMU initialisation check at kf {}: chain {}", kf->id(), chain.size());
     if (static_cast<int>(chain.size()) < o.min_keyframes) return false;
     const double span = static_cast<double>(chain.back()->t_ns() - chain.front()->t_ns()) * 1e-9;
