@@ -215,7 +215,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
   {
     std::shared_lock lock(atlas_->mutex());
     snapshot.bias = kf->imu.state.bias;
-    for (KeyFrame* k : InertialChain(kf.get(), 0)) {
+    for (KeyFrame* k : InertialChain(newest.get(), 0)) {
       snapshot.world_from_body.emplace_back(k->t_ns(), WorldFromBody(*k));
     }
   }
