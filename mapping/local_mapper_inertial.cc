@@ -14,6 +14,7 @@
 #include "imu/preintegration.h"
 #include "mapping/global_bundle.h"
 #include "mapping/gravity_refinement.h"
+#include "mapping/inertial_init_chain.h"
 #include "mapping/local_mapper.h"
 
 namespace pkslam {
@@ -202,11 +203,14 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
   std::vector<InertialInitKeyFrame> keyframes;
   std::vector<PreintegratedImu> preintegrations;
   std::vector<KeyFrame*> chain;
+  KeyFramePtr newest;  // the chain's newest keyframe (kf, or one tracking created after it)
   ImuBias initial_bias;
   {
     std::shared_lock lock(atlas_->mutex());
     if (kf->IsBad() || kf->map() == nullptr) return false;
-    chain = InertialChain(kf.get(), 0);
+    chain = InertialChainThrough(kf.get());
+    const auto newest_it = kf->map()->keyframes().find(chain.back()->id());
+    newest = newest_it != kf->map()->keyframes().end() ? newest_it->second : kf;
     PKSLAM_LOG_DEBUG("IMU initialisation check at kf {}: chain {}", kf->id(), chain.size());
     if (static_cast<int>(chain.size()) < o.min_keyframes) return false;
     const double span = static_cast<double>(chain.back()->t_ns() - chain.front()->t_ns()) * 1e-9;
@@ -243,8 +247,9 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
     Map* map = kf->map();
     if (map == nullptr || kf->IsBad()) return false;
     const SO3d new_from_old = r.world_from_gravity.Inverse();
-    // Chain keyframes get the estimated velocities; keyframes added since the collection get
-    // the newest one's. Everything is rotated (and scaled) below.
+    // Chain keyframes get the estimated velocities, keyframes tracking added after them since
+    // the collection predicted ones (inertial_init_chain.h); any other without a state (cut
+    // off by an IMU gap) the newest one's. Everything is rotated (and scaled) below.
     for (std::size_t i = 0; i < chain.size(); ++i) {
       if (chain[i]->IsBad()) continue;
       chain[i]->imu.state.velocity_world = r.velocities_world[i];
@@ -252,11 +257,14 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
     }
     for (const auto& [id, other] : map->keyframes()) {
       other->imu.state.bias = r.bias;
+      if (other->imu.from_previous) Reintegrate(r.bias, &*other->imu.from_previous);
+    }
+    PropagateVelocities(chain.back(), r.bias, r.gravity_world, r.scale);
+    for (const auto& [id, other] : map->keyframes()) {
       if (!other->imu.state.valid) {
         other->imu.state.velocity_world = r.velocities_world.back();
         other->imu.state.valid = true;
       }
-      if (other->imu.from_previous) Reintegrate(r.bias, &*other->imu.from_previous);
     }
     ApplyScaledRotation(map, new_from_old, r.scale);
     ++map->world_change_index;
@@ -275,7 +283,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
       refinement ? "refinement" : "initialisation", kf->t_s(), chain.size(), r.scale,
       r.bias.gyro.x(), r.bias.gyro.y(), r.bias.gyro.z(), r.bias.accel.x(), r.bias.accel.y(),
       r.bias.accel.z(), ms);
-  FullInertialBundleAdjustment(kf, gyro_prior, accel_prior);
+  FullInertialBundleAdjustment(newest, gyro_prior, accel_prior);
   ImuStageSnapshot snapshot;
   snapshot.t_ns = kf->t_ns();
   snapshot.stage = stage;
@@ -283,7 +291,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
   {
     std::shared_lock lock(atlas_->mutex());
     snapshot.bias = kf->imu.state.bias;
-    for (KeyFrame* k : InertialChain(kf.get(), 0)) {
+    for (KeyFrame* k : InertialChain(newest.get(), 0)) {
       snapshot.world_from_body.emplace_back(k->t_ns(), WorldFromBody(*k));
     }
   }
