@@ -289,6 +289,11 @@ InertialStatePriorError::InertialStatePriorError(const NavState& prior_state,
       prior_bias_(prior_bias),
       sqrt_info_(SqrtOfInformation<15>(information)) {}
 
+InertialStatePriorError::InertialStatePriorError(
+    const NavState& prior_state, const ImuBias& prior_bias,
+    const Eigen::Matrix<double, 15, 15>& sqrt_information, SqrtInformation)
+    : prior_state_(prior_state), prior_bias_(prior_bias), sqrt_info_(sqrt_information) {}
+
 bool InertialStatePriorError::Evaluate(double const* const* parameters, double* residuals,
                                        double** jacobians) const {
   const SE3d pose = BodyPoseFromBlock(parameters[0]);

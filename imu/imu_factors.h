@@ -106,6 +106,11 @@ class InertialStatePriorError final : public ceres::SizedCostFunction<15, 7, 3, 
  public:
   InertialStatePriorError(const NavState& prior_state, const ImuBias& prior_bias,
                           const Eigen::Matrix<double, 15, 15>& information);
+  // With a given square root W of the information (r = W [...]), e.g. for a rank-deficient
+  // prior whose root is known exactly.
+  struct SqrtInformation {};
+  InertialStatePriorError(const NavState& prior_state, const ImuBias& prior_bias,
+                          const Eigen::Matrix<double, 15, 15>& sqrt_information, SqrtInformation);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 

@@ -9,9 +9,9 @@
 #include <shared_mutex>
 
 #include "core/optim/yaw_manifold.h"
-#include "mapping/global_bundle.h"
 #include "loopclosing/loop_closing.h"
 #include "loopclosing/revisit_fixture.h"
+#include "mapping/global_bundle.h"
 
 namespace pkslam {
 namespace {

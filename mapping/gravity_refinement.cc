@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 
 namespace pkslam {
 
@@ -32,9 +33,14 @@ InertialStatePrior PositionYawPrior(const NavState& state, const ImuBias& bias,
   prior.bias_mean = bias;
   // The residual's position part is R_0^T (p - p_0): isotropic information is the same in any
   // frame. Its rotation part phi is in the body frame; the yaw is e_z . (R_0 phi) = u . phi.
-  prior.information.topLeftCorner<3, 3>() = information * Eigen::Matrix3d::Identity();
+  // The root is set exactly: rows 0-2 hold the position, row 3 the yaw, the rest are zero.
+  const double w = std::sqrt(information);
   const Eigen::Vector3d u = state.world_from_body.so3().Inverse() * Eigen::Vector3d::UnitZ();
-  prior.information.block<3, 3>(3, 3) = information * u * u.transpose();
+  Eigen::Matrix<double, 15, 15> root = Eigen::Matrix<double, 15, 15>::Zero();
+  root.block<3, 3>(0, 0) = w * Eigen::Matrix3d::Identity();
+  root.block<1, 3>(3, 3) = w * u.transpose();
+  prior.sqrt_information = root;
+  prior.information = root.transpose() * root;
   return prior;
 }
 

@@ -57,7 +57,12 @@ TEST(TiltObservability, RollAndPitchAloneSeparateLittle) {
 TEST(PositionYawPrior, HoldsPositionAndYawButNotTilt) {
   const NavState state{SE3d(Mounted(0.4), Eigen::Vector3d(1, 2, 3)), Eigen::Vector3d(0.1, 0, 0)};
   const InertialStatePrior prior = PositionYawPrior(state, ImuBias(), 1e4);
-  const InertialStatePriorError error(prior.mean, prior.bias_mean, prior.information);
+  ASSERT_TRUE(prior.sqrt_information.has_value());
+  EXPECT_LT(
+      (prior.sqrt_information->transpose() * *prior.sqrt_information - prior.information).norm(),
+      1e-9);
+  const InertialStatePriorError error(prior.mean, prior.bias_mean, *prior.sqrt_information,
+                                      InertialStatePriorError::SqrtInformation{});
   auto cost = [&](const SE3d& pose, const Eigen::Vector3d& v) {
     double block[kBodyPoseBlockSize];
     BodyPoseToBlock(pose, block);
@@ -71,14 +76,13 @@ TEST(PositionYawPrior, HoldsPositionAndYawButNotTilt) {
   const Eigen::Vector3d v(0.5, -0.2, 0.3);  // velocity and biases are free
   // A tilt of the world about the body position (roll / pitch): free.
   const SE3d about(SO3d(), state.world_from_body.translation());
-  const SE3d tilted =
-      about * SE3d(SO3d::Exp(Eigen::Vector3d(0.01, -0.02, 0)), Eigen::Vector3d::Zero()) *
-      about.Inverse() * state.world_from_body;
+  const SE3d tilted = about *
+                      SE3d(SO3d::Exp(Eigen::Vector3d(0.01, -0.02, 0)), Eigen::Vector3d::Zero()) *
+                      about.Inverse() * state.world_from_body;
   EXPECT_LT(cost(tilted, v), 1e-12);
   // Yaw and position are held.
-  const SE3d yawed =
-      about * SE3d(SO3d::Exp(Eigen::Vector3d(0, 0, 0.01)), Eigen::Vector3d::Zero()) *
-      about.Inverse() * state.world_from_body;
+  const SE3d yawed = about * SE3d(SO3d::Exp(Eigen::Vector3d(0, 0, 0.01)), Eigen::Vector3d::Zero()) *
+                     about.Inverse() * state.world_from_body;
   EXPECT_NEAR(cost(yawed, v), 1e4 * 1e-4, 1e-3);
   const SE3d moved(state.world_from_body.so3(),
                    state.world_from_body.translation() + Eigen::Vector3d(0, 0.01, 0));

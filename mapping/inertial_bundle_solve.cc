@@ -231,8 +231,11 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
     add_inertial(marg_from);
     const InertialStatePrior& prior = *problem.anchor_prior;
     marginalized.push_back(ceres_problem.AddResidualBlock(
-        new InertialStatePriorError(prior.mean, prior.bias_mean, prior.information), nullptr,
-        {s.pose(marg_from), s.v(marg_from), bg(marg_from), ba(marg_from)}));
+        prior.sqrt_information
+            ? new InertialStatePriorError(prior.mean, prior.bias_mean, *prior.sqrt_information,
+                                          InertialStatePriorError::SqrtInformation{})
+            : new InertialStatePriorError(prior.mean, prior.bias_mean, prior.information),
+        nullptr, {s.pose(marg_from), s.v(marg_from), bg(marg_from), ba(marg_from)}));
   }
   for (const auto& e : problem.edges) {
     add_inertial(e.from);
@@ -294,6 +297,7 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
   solver_options.linear_solver_type =
       free_poses <= kMaxFreePosesForDenseSchur ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
   solver_options.num_threads = options.num_threads;
+  if (options.reproducible) solver_options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
   solver_options.logging_type = ceres::SILENT;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (int i = 0; i < num_points; ++i) {

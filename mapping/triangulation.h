@@ -2,9 +2,8 @@
 // tests (parallax vs stereo, positive depth, reprojection chi2, scale consistency).
 #pragma once
 
-#include <optional>
-
 #include <Eigen/Core>
+#include <optional>
 
 #include "core/map/ids.h"
 
