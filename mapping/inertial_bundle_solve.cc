@@ -41,15 +41,21 @@ class AbortCallback final : public ceres::IterationCallback {
 
 constexpr int kMaxFreePosesForDenseSchur = 40;
 
+// Every block in one buffer (poses, velocities, gyro biases, accel biases, points): Ceres orders
+// the blocks of an elimination group by address, so separate vectors made the order of the
+// reduced system, and with it the last bits of the result, depend on where malloc put them
+// (--deterministic runs differed with the address layout).
 struct State {
-  std::vector<double> poses;                                  // 7 per keyframe (world_from_body)
-  std::vector<double> points;                                 // 3 per point
-  std::vector<double> velocities, gyro_biases, accel_biases;  // 3 per keyframe
-  double* pose(int i) { return poses.data() + kBodyPoseBlockSize * i; }
-  double* point(int i) { return points.data() + 3 * i; }
-  double* v(int i) { return velocities.data() + 3 * i; }
-  double* bg(int i) { return gyro_biases.data() + 3 * i; }
-  double* ba(int i) { return accel_biases.data() + 3 * i; }
+  State(int num_kf, int num_points)
+      : kf(num_kf),
+        data(static_cast<std::size_t>((kBodyPoseBlockSize + 9) * num_kf + 3 * num_points)) {}
+  int kf;
+  std::vector<double> data;
+  double* pose(int i) { return data.data() + kBodyPoseBlockSize * i; }
+  double* v(int i) { return data.data() + kBodyPoseBlockSize * kf + 3 * i; }
+  double* bg(int i) { return data.data() + (kBodyPoseBlockSize + 3) * kf + 3 * i; }
+  double* ba(int i) { return data.data() + (kBodyPoseBlockSize + 6) * kf + 3 * i; }
+  double* point(int i) { return data.data() + (kBodyPoseBlockSize + 9) * kf + 3 * i; }
 };
 
 double ObservationChi2(const BodyCamera& camera, const BundleProblem::ObservationState& o,
@@ -132,12 +138,7 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
   camera.camera_from_body = problem.camera_from_body;
   const SE3d body_from_camera = problem.camera_from_body.Inverse();
 
-  State s;
-  s.poses.resize(static_cast<std::size_t>(kBodyPoseBlockSize * num_kf));
-  s.points.resize(static_cast<std::size_t>(3 * num_points));
-  s.velocities.resize(static_cast<std::size_t>(3 * num_kf));
-  s.gyro_biases.resize(static_cast<std::size_t>(3 * num_kf));
-  s.accel_biases.resize(static_cast<std::size_t>(3 * num_kf));
+  State s(num_kf, num_points);
   for (int i = 0; i < num_kf; ++i) {
     BodyPoseToBlock(visual.keyframes[i].camera_from_world.Inverse() * problem.camera_from_body,
                     s.pose(i));
