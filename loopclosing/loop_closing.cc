@@ -301,7 +301,6 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
   inertial_options.iterations_first = options_.inertial_global_ba_iterations;
   inertial_options.iterations_second = 0;
   inertial_options.num_threads = options_.global_ba_options.num_threads;
-  inertial_options.reproducible = options_.global_ba_options.reproducible;
   InertialBundleProblem inertial;
   BundleProblem problem;
   {

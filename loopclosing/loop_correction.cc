@@ -210,7 +210,6 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
     EssentialGraphOptions graph;
     graph.dof = GraphDof(*map);
     graph.num_threads = options_.num_threads;
-    graph.reproducible = options_.global_ba_options.reproducible;
     const EssentialGraphProblem problem = CollectEssentialGraph(map, correction, graph);
     ApplyEssentialGraph(problem, SolveEssentialGraph(problem, graph));
     query->AddLoopEdge(region.matched.get());
@@ -316,7 +315,6 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     graph.dof = four_dof ? PoseGraphDof::kYawTranslation
                          : (options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3);
     graph.num_threads = options_.num_threads;
-    graph.reproducible = options_.global_ba_options.reproducible;
     const EssentialGraphProblem problem = CollectEssentialGraph(merged, correction, graph);
     ApplyEssentialGraph(problem, SolveEssentialGraph(problem, graph));
     query->AddLoopEdge(region.matched.get());

@@ -47,8 +47,6 @@ struct InertialBundleOptions {
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
   int num_threads = 1;
-  // As BundleAdjustmentOptions::reproducible (deterministic mode).
-  bool reproducible = false;
   double gravity_magnitude = 9.81;
   // Local window: keep a marginalisation prior on the anchor instead of fixing it (see above).
   bool marginalization_prior = true;

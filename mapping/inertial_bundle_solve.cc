@@ -298,7 +298,6 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
   solver_options.linear_solver_type =
       free_poses <= kMaxFreePosesForDenseSchur ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
   solver_options.num_threads = options.num_threads;
-  if (options.reproducible) solver_options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
   solver_options.logging_type = ceres::SILENT;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (int i = 0; i < num_points; ++i) {

@@ -129,7 +129,6 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
   ba.iterations_first = o.gravity_refinement_iterations;
   ba.iterations_second = 0;
   ba.num_threads = options_.ba.num_threads;
-  ba.reproducible = options_.ba.reproducible;
   InertialBundleProblem problem;
   GravityRefinementStat stat;
   int change_index = 0;
@@ -308,7 +307,6 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
   ba.iterations_first = options_.inertial.full_ba_iterations;
   ba.iterations_second = options_.inertial.full_ba_iterations;
   ba.num_threads = options_.ba.num_threads;
-  ba.reproducible = options_.ba.reproducible;
   {
     std::shared_lock lock(atlas_->mutex());
     if (kf->IsBad() || kf->map() == nullptr) return;
@@ -337,7 +335,6 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
   InertialBundleProblem problem;
   InertialBundleOptions ba = options_.inertial.local_ba;
   ba.num_threads = options_.ba.num_threads;
-  ba.reproducible = options_.ba.reproducible;
   {
     std::unique_lock lock(atlas_->mutex());
     if (kf->IsBad() || kf->map() == nullptr || !kf->map()->imu_initialized) return false;

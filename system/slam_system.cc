@@ -30,8 +30,6 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
     options_.tracking.lockstep = true;
     options_.tracking.pose.num_threads = 1;
     options_.mapping.ba.num_threads = 1;
-    options_.mapping.ba.reproducible = true;
-    options_.loop.global_ba_options.reproducible = true;
     options_.loop.synchronous = true;
     options_.loop.num_threads = 1;
     options_.loop.global_ba_options.num_threads = 1;

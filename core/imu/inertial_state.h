@@ -42,7 +42,7 @@ struct InertialStatePrior {
   Eigen::Matrix<double, 15, 15> information = Eigen::Matrix<double, 15, 15>::Zero();
   // A known square root W (W^T W = information) for priors built from one (the gauge of
   // mapping/gravity_refinement.h); otherwise the factor takes it from an eigen-decomposition,
-  // whose null-space directions are noise and differ run to run in the last bits.
+  // which for a rank-deficient prior adds rows of rounding-noise weight in arbitrary directions.
   std::optional<Eigen::Matrix<double, 15, 15>> sqrt_information;
   MapId map_id = -1;
   int map_change_index = 0;

@@ -23,10 +23,6 @@ struct BundleAdjustmentOptions {
   double chi2_stereo = 7.815;
   // Ceres threads (1 in deterministic mode).
   int num_threads = 1;
-  // Bit-for-bit repeatable sparse solves (deterministic mode): Eigen's simplicial Cholesky
-  // instead of CHOLMOD. With CHOLMOD the same stereo-inertial run gave two different outputs
-  // (last digits) depending on the address layout (ASLR): the order of its sums is not fixed.
-  bool reproducible = false;
   // Local BA: cap on local keyframes (covisibles by weight); 0 = no cap.
   int max_local_keyframes = 0;
 

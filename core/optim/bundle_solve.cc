@@ -161,7 +161,6 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
   solver_options.linear_solver_type = overrides.linear_solver.value_or(
       free_poses <= kMaxFreePosesForDenseSchur ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR);
   solver_options.num_threads = options.num_threads;
-  if (options.reproducible) solver_options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
   solver_options.logging_type = ceres::SILENT;
   // Schur complement: eliminate the points (group 0), then solve for the poses.
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();

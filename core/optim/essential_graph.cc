@@ -286,7 +286,6 @@ EssentialGraphResult SolveEssentialGraph(const EssentialGraphProblem& problem,
   solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver_options.max_num_iterations = options.iterations;
   solver_options.num_threads = options.num_threads;
-  if (options.reproducible) solver_options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &ceres_problem, &summary);

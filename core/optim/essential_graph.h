@@ -51,8 +51,6 @@ struct EssentialGraphOptions {
   int iterations = 20;
   // Ceres threads (1 in deterministic mode).
   int num_threads = 1;
-  // As BundleAdjustmentOptions::reproducible (deterministic mode).
-  bool reproducible = false;
   // Edge error: the Sim3 logarithm of S_ji * S_iw * S_jw^-1 (ORB-SLAM's EdgeSim3), or, when
   // false, its translation, rotation log and log-scale (equal to first order, cheaper).
   bool exact_log = true;
