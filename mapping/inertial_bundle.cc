@@ -206,8 +206,7 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
   if (free_tilt) {
     const KeyFrame& first = *chain.front();
     problem.anchor_prior =
-        PositionYawPrior({first.world_from_camera() * first.rig().body_from_camera.Inverse(),
-                          first.imu.state.velocity_world},
+        PositionYawPrior({first.world_from_body(), first.imu.state.velocity_world},
                          first.imu.state.bias, gauge_information);
     problem.marginalize_from = 0;
     problem.marginalize_to = -1;

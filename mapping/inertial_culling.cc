@@ -12,9 +12,7 @@ double SecondsBetween(const KeyFrame& a, const KeyFrame& b) {
   return static_cast<double>(b.t_ns() - a.t_ns()) * 1e-9;
 }
 
-Eigen::Vector3d BodyPosition(const KeyFrame& kf) {
-  return (kf.world_from_camera() * kf.rig().body_from_camera.Inverse()).translation();
-}
+Eigen::Vector3d BodyPosition(const KeyFrame& kf) { return kf.world_from_body().translation(); }
 
 }  // namespace
 

@@ -28,9 +28,7 @@ int PropagateVelocities(KeyFrame* last, const ImuBias& bias, const Eigen::Vector
   for (KeyFrame* previous = last; previous->imu.state.valid; previous = previous->imu.next) {
     KeyFrame* next = previous->imu.next;
     if (!LinkedAfter(previous, next) || next->imu.state.valid) break;
-    const SE3d world_from_body =
-        previous->world_from_camera() * previous->rig().body_from_camera.Inverse();
-    const NavState start{world_from_body, scale * previous->imu.state.velocity_world};
+    const NavState start{previous->world_from_body(), scale * previous->imu.state.velocity_world};
     const NavState predicted = PredictState(start, *next->imu.from_previous, bias, gravity_world);
     next->imu.state.velocity_world = predicted.velocity_world / scale;
     next->imu.state.valid = true;

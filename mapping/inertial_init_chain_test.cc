@@ -9,6 +9,7 @@
 #include "core/testing/synthetic_map.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
+#include "mapping/imu_chain_testing.h"
 
 namespace pkslam {
 namespace {
@@ -33,15 +34,7 @@ class InertialInitChainTest : public ::testing::Test {
     const auto samples =
         SampleImu(motion_, 0, (kNum - 1) * 50'000'000LL, 5'000'000, bias_, *rig_->imu, nullptr);
     std::unique_lock lock(atlas_.mutex());
-    for (int k = 1; k < kNum; ++k) {
-      KeyFrame* kf = map_.keyframes[k].get();
-      KeyFrame* previous = map_.keyframes[k - 1].get();
-      kf->imu.previous = previous;
-      previous->imu.next = kf;
-      PreintegratedImu pim = StartPreintegration(bias_, *rig_->imu);
-      IntegrateSamples(samples, previous->t_ns(), kf->t_ns(), &pim);
-      kf->imu.from_previous = pim;
-    }
+    testing::LinkWithImu(map_.keyframes, samples, bias_, *rig_->imu);
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
 

@@ -18,6 +18,7 @@
 #include "imu/imu_manifolds.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
+#include "mapping/imu_chain_testing.h"
 #include "mapping/inertial_bundle.h"
 #include "mapping/inertial_culling.h"
 
@@ -154,14 +155,8 @@ class MarginalizationMapTest : public ::testing::Test {
       KeyFrame* kf = map_.keyframes[k].get();
       kf->imu.state.bias = bias_;
       kf->imu.state.valid = true;
-      if (k == 0) continue;
-      KeyFrame* previous = map_.keyframes[k - 1].get();
-      kf->imu.previous = previous;
-      previous->imu.next = kf;
-      PreintegratedImu pim = StartPreintegration(bias_, noise_);
-      IntegrateSamples(samples, previous->t_ns(), kf->t_ns(), &pim);
-      kf->imu.from_previous = pim;
     }
+    testing::LinkWithImu(map_.keyframes, samples, bias_, noise_);
     map()->imu_initialized = true;
     options_.window = 5;
   }

@@ -20,10 +20,6 @@
 namespace pkslam {
 namespace {
 
-SE3d WorldFromBody(const KeyFrame& kf) {
-  return kf.world_from_camera() * kf.rig().body_from_camera.Inverse();
-}
-
 // Rotates (world' = R * world) and scales (x' = s x) every keyframe and point of the map, as
 // ORB-SLAM3's Map::ApplyScaledRotation. Requires the Atlas mutex (exclusive).
 void ApplyScaledRotation(Map* map, const SO3d& new_from_old, double scale) {
@@ -82,7 +78,7 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
       moving_s_ = 0;
     }
     if (const KeyFrame* previous = kf->imu.previous; previous != nullptr && !previous->IsBad()) {
-      const SE3d previous_from_kf = WorldFromBody(*previous).Inverse() * WorldFromBody(*kf);
+      const SE3d previous_from_kf = previous->world_from_body().Inverse() * kf->world_from_body();
       if (previous_from_kf.translation().norm() > o.moving_distance ||
           previous_from_kf.so3().Log().norm() > o.moving_angle_rad) {
         step_s = std::min(o.moving_max_interval_s,
@@ -142,7 +138,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
     }
     std::vector<SO3d> orientations;
     orientations.reserve(chain.size());
-    for (const KeyFrame* k : chain) orientations.push_back(WorldFromBody(*k).so3());
+    for (const KeyFrame* k : chain) orientations.push_back(k->world_from_body().so3());
     stat.observability = TiltObservability(orientations);
     const double due = std::max(o.gravity_refinement_min,
                                 map->gravity_refinement_observability + o.gravity_refinement_step);
@@ -209,8 +205,8 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
     std::shared_lock lock(atlas_->mutex());
     if (kf->IsBad() || kf->map() == nullptr) return false;
     chain = InertialChainThrough(kf.get());
-    const auto newest_it = kf->map()->keyframes().find(chain.back()->id());
-    newest = newest_it != kf->map()->keyframes().end() ? newest_it->second : kf;
+    newest = kf->map()->Share(chain.back());
+    if (newest == nullptr) newest = kf;
     PKSLAM_LOG_DEBUG("IMU initialisation check at kf {}: chain {}", kf->id(), chain.size());
     if (static_cast<int>(chain.size()) < o.min_keyframes) return false;
     const double span = static_cast<double>(chain.back()->t_ns() - chain.front()->t_ns()) * 1e-9;
@@ -225,7 +221,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
       if (travel < o.mono_min_travel) return false;
     }
     for (std::size_t i = 0; i < chain.size(); ++i) {
-      keyframes.push_back({chain[i]->t_ns(), WorldFromBody(*chain[i])});
+      keyframes.push_back({chain[i]->t_ns(), chain[i]->world_from_body()});
       if (i > 0) preintegrations.push_back(*chain[i]->imu.from_previous);
     }
     initial_bias = kf->imu.state.bias;
@@ -292,7 +288,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
     std::shared_lock lock(atlas_->mutex());
     snapshot.bias = kf->imu.state.bias;
     for (KeyFrame* k : InertialChain(newest.get(), 0)) {
-      snapshot.world_from_body.emplace_back(k->t_ns(), WorldFromBody(*k));
+      snapshot.world_from_body.emplace_back(k->t_ns(), k->world_from_body());
     }
   }
   std::lock_guard stats_lock(mutex_);

@@ -14,6 +14,7 @@
 #include "core/testing/synthetic_map.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
+#include "mapping/imu_chain_testing.h"
 #include "mapping/local_mapper.h"
 
 namespace pkslam {
@@ -62,15 +63,7 @@ InitialisedStates RunInitialisationWithQueuedKeyFrames(int num_keyframes,
       motion, 0, (num_keyframes - 1) * kKeyFramePeriodNs, kImuPeriodNs, bias, *rig->imu, nullptr);
   {
     std::unique_lock lock(atlas.mutex());
-    for (int k = 1; k < num_keyframes; ++k) {
-      KeyFrame* kf = map.keyframes[k].get();
-      KeyFrame* previous = map.keyframes[k - 1].get();
-      kf->imu.previous = previous;
-      previous->imu.next = kf;
-      PreintegratedImu pim = StartPreintegration(ImuBias(), *rig->imu);
-      IntegrateSamples(samples, previous->t_ns(), kf->t_ns(), &pim);
-      kf->imu.from_previous = pim;
-    }
+    testing::LinkWithImu(map.keyframes, samples, ImuBias(), *rig->imu);
   }
 
   LocalMappingOptions options;

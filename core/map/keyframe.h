@@ -68,6 +68,8 @@ class KeyFrame {
   const SE3d& camera_from_world() const { return camera_from_world_; }
   const SE3d& world_from_camera() const { return world_from_camera_; }
   Eigen::Vector3d CameraCenter() const { return world_from_camera_.translation(); }
+  // The IMU (body) pose: world_from_camera * camera_from_body.
+  SE3d world_from_body() const { return world_from_camera_ * rig_->body_from_camera.Inverse(); }
   void SetPose(const SE3d& camera_from_world);
   // Median depth of the observed map points (q = 0.5), or the q-quantile.
   double SceneDepthQuantile(double q = 0.5) const;
