@@ -28,6 +28,11 @@ struct SimulateArgs {
   bool no_images = false;
   bool no_auto_exposure = false;
   bool list_scenes = false;
+  std::string realism;                      // empty: euroc for replays, ideal otherwise
+  std::vector<std::string> realism_off;     // sources switched off
+  std::vector<std::string> realism_params;  // NAME=VALUE size overrides
+  std::uint64_t device_seed = 1;
+  bool realism_report = false;
 };
 
 Eigen::Vector3d ToVector(const std::vector<double>& v, const char* name) {
@@ -36,12 +41,60 @@ Eigen::Vector3d ToVector(const std::vector<double>& v, const char* name) {
   return Eigen::Vector3d(v[0], v[1], v[2]);
 }
 
-void Run(SimulateArgs& a) {
+// The realism options the flags ask for: the preset (euroc for EuRoC-layout replays unless
+// named), sources switched off, sizes overridden.
+sim::RealismOptions ResolveRealism(const SimulateArgs& a) {
+  const bool replay = !a.trajectory.empty() && !a.options.rgbd;
+  const sim::RealismPreset preset = a.realism.empty() ? (replay ? sim::RealismPreset::kEuroc
+                                                                : sim::RealismPreset::kIdeal)
+                                                      : sim::ParseRealismPreset(a.realism);
+  if (preset == sim::RealismPreset::kEuroc && a.options.rgbd) {
+    throw OptionError(
+        "--realism euroc models the EuRoC VI-Sensor (stereo + IMU); use --realism ideal with "
+        "--rgbd");
+  }
+  sim::RealismOptions r = sim::MakeRealism(preset);
+  r.device_seed = a.device_seed;
+  for (const std::string& name : a.realism_off) {
+    if (preset == sim::RealismPreset::kIdeal) {
+      throw OptionError("--realism-off needs --realism euroc (ideal has every source off)");
+    }
+    r.enabled[static_cast<std::size_t>(sim::ParseRealismSource(name))] = false;
+  }
+  for (const std::string& p : a.realism_params) sim::SetRealismParameter(&r, p);
+  return r;
+}
+
+// The realism preset's appearance, then the sensor flags the user gave on top of it.
+void ApplyAppearanceUnderFlags(const CLI::App& cmd, sim::SimulationOptions* o) {
+  const sim::SensorOptions given = o->sensor;
+  const double given_blur_exposure = o->motion_blur_exposure_s;
+  sim::ApplyAppearance(o->realism.appearance, o);
+  auto keep = [&](const char* flag, double sim::SensorOptions::*field) {
+    if (cmd.count(flag) > 0) o->sensor.*field = given.*field;
+  };
+  keep("--noise", &sim::SensorOptions::read_noise_dn);
+  keep("--blur", &sim::SensorOptions::blur_sigma_px);
+  keep("--vignetting", &sim::SensorOptions::vignetting);
+  keep("--gain-drift", &sim::SensorOptions::gain_drift);
+  if (cmd.count("--motion-blur") > 0) {  // a fixed exposure instead of the auto exposure's
+    o->sensor.max_exposure_s = 0.0;
+    o->motion_blur_exposure_s = given_blur_exposure;
+  }
+}
+
+void Run(SimulateArgs& a, const CLI::App& cmd) {
   if (a.list_scenes) {
     for (const auto& name : sim::BuiltinSceneNames()) std::cout << name << '\n';
     return;
   }
   sim::SimulationOptions& o = a.options;
+  o.realism = ResolveRealism(a);
+  if (a.realism_report) {
+    std::cout << sim::FormatRealismReport(o.realism);
+    return;
+  }
+  if (cmd.count("--scene") == 0) o.scene = sim::DefaultScene(o.realism, a.trajectory);
   o.output_dir = a.out;
   o.trajectory = a.trajectory;
   o.motion.level = sim::ParseMotionLevel(a.motion);
@@ -55,6 +108,7 @@ void Run(SimulateArgs& a) {
   o.imu.noise = !a.no_imu_noise;
   o.write_cloud = !a.no_cloud && !a.no_images;
   o.write_images = !a.no_images;
+  if (o.realism.On(sim::RealismSource::kAppearance)) ApplyAppearanceUnderFlags(cmd, &o);
   o.sensor.auto_exposure = !a.no_auto_exposure;
   const sim::SimulationSummary s = sim::RunSimulation(o);
   const double duration = 1e-9 * static_cast<double>(s.end_ns - s.begin_ns);
@@ -79,6 +133,13 @@ void Run(SimulateArgs& a) {
       s.mean_angular_rate_dps, s.max_angular_rate_dps,
       s.scene.objects_placed - s.scene.objects_removed, s.scene.objects_removed, s.cloud_points,
       s.observed_points);
+  std::cout << fmt::format("  realism {}: ", sim::RealismPresetName(o.realism.preset));
+  for (sim::RealismSource source : sim::kRealismSources) {
+    std::cout << fmt::format("{} {} ", sim::RealismSourceName(source),
+                             o.realism.On(source) ? "on" : "off");
+  }
+  std::cout << fmt::format("(scene {}; mean exposure {:.2f} ms, saturated {:.1f}%)\n", o.scene,
+                           s.mean_exposure_ms, 100.0 * s.saturated_share);
   if (s.frames > 0 && s.total_seconds > 0.0) {
     std::cout << fmt::format(
         "  {:.1f} frames/s end to end (rendering, image formation and PNG files)\n",
@@ -95,6 +156,8 @@ void RegisterSimulateCommand(CLI::App& app) {
       "simulate",
       "Render a EuRoC-format stereo+IMU (or TUM RGB-D) sequence with exact ground truth");
   cmd->add_option("--out", args->out, "Output directory (created)");
+  // The default scene is chosen from --realism (see Run): no default here.
+  o.scene.clear();
   auto* traj = cmd->add_option("--trajectory", args->trajectory,
                                "Replay this ground truth (TUM txt or EuRoC csv)")
                    ->check(CLI::ExistingFile);
@@ -106,8 +169,26 @@ void RegisterSimulateCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--start", o.start_s, "Replay: start this many seconds into the file")
       ->capture_default_str();
-  cmd->add_option("--scene", o.scene, "Built-in scene (see --list-scenes) or YAML file")
+  cmd->add_option("--scene", o.scene,
+                  "Built-in scene (see --list-scenes) or YAML file (default: by --realism: "
+                  "euroc_vicon_room / euroc_machine_hall for MH_* replays; vicon_room / "
+                  "machine_hall with --realism ideal)");
+  cmd->add_option("--realism", args->realism,
+                  "ideal|euroc: error sources of real EuRoC recordings (appearance, calibration, "
+                  "timing, imu, motion, ground-truth); default euroc for replays of ground truth "
+                  "(--trajectory), ideal otherwise (docs/realism.md)");
+  cmd->add_option("--realism-off", args->realism_off,
+                  "Switch these sources of the euroc preset off (ablation), e.g. "
+                  "calibration,timing")
+      ->delimiter(',');
+  cmd->add_option("--realism-param", args->realism_params,
+                  "Override a size: NAME=VALUE (names in --realism-report), repeatable");
+  cmd->add_option("--device-seed", args->device_seed,
+                  "Seed of the device errors (calibration, IMU axes): one rig for all sequences")
       ->capture_default_str();
+  cmd->add_flag("--realism-report", args->realism_report,
+                "Print every error source of the chosen --realism with its size and documented "
+                "source, then exit");
   cmd->add_option("--texture", o.texture_mode, "rich|weak|repetitive (default: the scene's)");
   cmd->add_option("--seed", o.seed, "Random seed (same seed -> identical bytes)")
       ->capture_default_str();
@@ -159,7 +240,7 @@ void RegisterSimulateCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--quiet", o.quiet, "No progress bar");
   cmd->add_flag("--list-scenes", args->list_scenes, "Print the built-in scene names");
-  cmd->callback([args] { Run(*args); });
+  cmd->callback([args, cmd] { Run(*args, *cmd); });
 }
 
 }  // namespace pkslam::apps

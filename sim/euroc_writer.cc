@@ -102,6 +102,24 @@ std::string ImuYaml(const ImuOptions& imu) {
       imu.gyro_noise_density, imu.gyro_random_walk, imu.accel_noise_density, imu.accel_random_walk);
 }
 
+constexpr const char* kGroundTruthHeader =
+    "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], "
+    "q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], "
+    "b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], "
+    "b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n";
+
+std::string GroundTruthLine(const GroundTruthRow& r) {
+  const Eigen::Vector3d& p = r.world_from_body.translation();
+  Eigen::Quaterniond q = r.world_from_body.quaternion();
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // EuRoC keeps w >= 0
+  return fmt::format(
+      "{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9e},{:.9e},"
+      "{:.9e},{:.9e},{:.9e},{:.9e}\n",
+      r.t_ns, p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), r.velocity_world.x(),
+      r.velocity_world.y(), r.velocity_world.z(), r.gyro_bias.x(), r.gyro_bias.y(), r.gyro_bias.z(),
+      r.accel_bias.x(), r.accel_bias.y(), r.accel_bias.z());
+}
+
 constexpr const char* kGroundTruthYaml =
     "%YAML:1.0\n# General sensor definitions.\nsensor_type: visual-inertial\n"
     "comment: pkslam simulator ground truth (the exact spline trajectory of the body/IMU "
@@ -137,10 +155,7 @@ EurocWriter::EurocWriter(const std::filesystem::path& dir, const std::vector<Cam
   WriteText(mav / "body.yaml", "%YAML:1.0\ncomment: pkslam simulated MAV (body = IMU frame)\n");
   WriteText(mav / "state_groundtruth_estimate0" / "sensor.yaml", kGroundTruthYaml);
   gt_csv_ = OpenOut(mav / "state_groundtruth_estimate0" / "data.csv");
-  gt_csv_ << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], "
-             "q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], "
-             "b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], "
-             "b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n";
+  gt_csv_ << kGroundTruthHeader;
   if (write_imu) {
     std::filesystem::create_directories(mav / "imu0", ec);
     if (ec) throw Error(fmt::format("cannot create {}: {}", mav.string(), ec.message()));
@@ -173,16 +188,31 @@ void EurocWriter::WriteImu(const ImuSample& s) {
   imu_csv_ << '\n';
 }
 
-void EurocWriter::WriteGroundTruth(const GroundTruthRow& r) {
-  const Eigen::Vector3d& p = r.world_from_body.translation();
-  Eigen::Quaterniond q = r.world_from_body.quaternion();
-  if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // EuRoC keeps w >= 0
-  gt_csv_ << fmt::format(
-      "{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9e},{:.9e},"
-      "{:.9e},{:.9e},{:.9e},{:.9e}\n",
-      r.t_ns, p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), r.velocity_world.x(),
-      r.velocity_world.y(), r.velocity_world.z(), r.gyro_bias.x(), r.gyro_bias.y(), r.gyro_bias.z(),
-      r.accel_bias.x(), r.accel_bias.y(), r.accel_bias.z());
+void EurocWriter::WriteGroundTruth(const GroundTruthRow& r) { gt_csv_ << GroundTruthLine(r); }
+
+void EurocWriter::OpenTruth(const std::vector<CameraRig>& true_cameras,
+                            const std::string& draw_yaml) {
+  const std::filesystem::path truth = dir_ / "truth";
+  std::error_code ec;
+  std::filesystem::create_directories(truth, ec);
+  if (ec) throw Error(fmt::format("cannot create {}: {}", truth.string(), ec.message()));
+  for (const CameraRig& c : true_cameras) {
+    WriteText(truth / (c.name + "_sensor.yaml"), CameraYaml(c));
+  }
+  WriteText(truth / "realism_draw.yaml", draw_yaml);
+  exact_gt_csv_ = OpenOut(truth / "state_groundtruth_exact.csv");
+  exact_gt_csv_ << kGroundTruthHeader;
+  frame_times_ = OpenOut(truth / "frame_times.csv");
+  frame_times_ << "#image timestamp [ns],mid-exposure time on the IMU clock [ns],exposure [s]\n";
+}
+
+void EurocWriter::WriteExactGroundTruth(const GroundTruthRow& r) {
+  exact_gt_csv_ << GroundTruthLine(r);
+}
+
+void EurocWriter::WriteFrameTime(std::int64_t stamp_ns, std::int64_t exposure_mid_ns,
+                                 double exposure_s) {
+  frame_times_ << stamp_ns << ',' << exposure_mid_ns << ',' << FormatDouble(exposure_s) << '\n';
 }
 
 void EurocWriter::Close() {
@@ -198,6 +228,12 @@ void EurocWriter::Close() {
   gt_csv_.close();
   timestamps_.close();
   ok = ok && !gt_csv_.fail() && !timestamps_.fail();
+  for (std::ofstream* f : {&exact_gt_csv_, &frame_times_}) {
+    if (f->is_open()) {
+      f->close();
+      ok = ok && !f->fail();
+    }
+  }
   if (!ok) throw Error(fmt::format("writing the EuRoC files under {} failed", dir_.string()));
 }
 

@@ -59,6 +59,14 @@ class EurocWriter {
   std::filesystem::path AddImage(int camera, std::int64_t t_ns);
   void WriteImu(const ImuSample& sample);
   void WriteGroundTruth(const GroundTruthRow& row);
+  // Diagnostics beside a sequence whose files carry realism errors (sim/realism.h): DIR/truth/
+  // with the exact calibration (camK_sensor.yaml, same layout as mav0/camK/sensor.yaml), the
+  // exact ground truth (state_groundtruth_exact.csv, same columns as the written one), the
+  // exposure times of the frames (frame_times.csv: image stamp, mid-exposure time on the IMU
+  // clock, exposure length) and the drawn errors (realism_draw.yaml).
+  void OpenTruth(const std::vector<CameraRig>& true_cameras, const std::string& draw_yaml);
+  void WriteExactGroundTruth(const GroundTruthRow& row);
+  void WriteFrameTime(std::int64_t stamp_ns, std::int64_t exposure_mid_ns, double exposure_s);
   // Flushes and closes all files; throws Error on a write failure. Called by the destructor
   // too (which swallows errors).
   void Close();
@@ -71,6 +79,8 @@ class EurocWriter {
   std::vector<std::ofstream> camera_csv_;
   std::ofstream imu_csv_;
   std::ofstream gt_csv_;
+  std::ofstream exact_gt_csv_;  // truth/ (OpenTruth)
+  std::ofstream frame_times_;   // truth/ (OpenTruth)
   std::ofstream timestamps_;
   std::int64_t last_timestamp_ = -1;
   bool closed_ = false;

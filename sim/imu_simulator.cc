@@ -12,6 +12,11 @@ std::int64_t ImuOptions::period_ns() const {
   return static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
 }
 
+bool ImuSensorErrors::IsIdeal() const {
+  return gyro_matrix.isIdentity(0.0) && accel_matrix.isIdentity(0.0) &&
+         gyro_g_sensitivity.isZero(0.0) && gyro_quantum == 0.0 && accel_quantum == 0.0;
+}
+
 void ImuOptions::Check() const {
   PKSLAM_CHECK_OPTION(rate_hz >= 10.0 && rate_hz <= 10000.0, "imu.rate_hz", "{}", rate_hz);
   PKSLAM_CHECK_OPTION(std::abs(1e9 / rate_hz - static_cast<double>(period_ns())) < 1e-6,
@@ -26,6 +31,13 @@ void ImuOptions::Check() const {
   PKSLAM_CHECK_OPTION(vibration_tones >= 1 && vibration_tones <= 64, "vibration_tones", "{}",
                       vibration_tones);
   PKSLAM_CHECK_OPTION(gravity > 0.0, "gravity", "{}", gravity);
+  PKSLAM_CHECK_OPTION(errors.gyro_matrix.allFinite() && errors.accel_matrix.allFinite() &&
+                          errors.gyro_g_sensitivity.allFinite(),
+                      "imu errors", "{}", "must be finite");
+  PKSLAM_CHECK_OPTION(
+      (errors.gyro_matrix - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 0.2 &&
+          (errors.accel_matrix - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 0.2,
+      "imu errors", "{}", "scale/misalignment entries must stay within 0.2 of identity");
 }
 
 void IdealImu(const BodyState& state, double gravity, Eigen::Vector3d* gyro,
@@ -70,15 +82,20 @@ Eigen::Vector3d EvaluateTones(const std::vector<Tone>& tones, double t_s) {
   return sum;
 }
 
+// The sensor's output resolution: round to whole LSBs.
+Eigen::Vector3d Quantise(const Eigen::Vector3d& v, double quantum) {
+  return (v / quantum).array().round().matrix() * quantum;
+}
+
 }  // namespace
 
-std::vector<ImuSample> SimulateImu(const SplineTrajectory& trajectory, std::int64_t begin_ns,
+std::vector<ImuSample> SimulateImu(const BodyMotion& motion, std::int64_t begin_ns,
                                    std::int64_t end_ns, const ImuOptions& options,
                                    std::uint64_t seed) {
   options.Check();
-  PKSLAM_CHECK(begin_ns >= trajectory.begin_ns() && end_ns <= trajectory.end_ns(),
+  PKSLAM_CHECK(begin_ns >= motion.begin_ns() && end_ns <= motion.end_ns(),
                "IMU window [{}, {}] outside the trajectory [{}, {}]", begin_ns, end_ns,
-               trajectory.begin_ns(), trajectory.end_ns());
+               motion.begin_ns(), motion.end_ns());
   const std::int64_t period = options.period_ns();
   const double dt = 1e-9 * static_cast<double>(period);
   const double gyro_sigma = options.gyro_noise_density / std::sqrt(dt);
@@ -95,6 +112,7 @@ std::vector<ImuSample> SimulateImu(const SplineTrajectory& trajectory, std::int6
     gyro_tones = MakeTones(&tone_rng, options.vibration_tones, options.vibration_gyro_rms);
   }
 
+  const bool ideal_sensor = options.errors.IsIdeal();
   std::vector<ImuSample> out;
   out.reserve(static_cast<std::size_t>((end_ns - begin_ns) / period + 1));
   Eigen::Vector3d bg = options.initial_gyro_bias;
@@ -108,7 +126,11 @@ std::vector<ImuSample> SimulateImu(const SplineTrajectory& trajectory, std::int6
   for (std::int64_t t = begin_ns; t <= end_ns; t += period) {
     ImuSample s;
     s.t_ns = t;
-    IdealImu(trajectory.State(t), options.gravity, &s.gyro, &s.accel);
+    IdealImu(motion.State(t), options.gravity, &s.gyro, &s.accel);
+    if (!ideal_sensor) {
+      s.gyro = options.errors.gyro_matrix * s.gyro + options.errors.gyro_g_sensitivity * s.accel;
+      s.accel = options.errors.accel_matrix * s.accel;
+    }
     s.gyro_bias = bg;
     s.accel_bias = ba;
     s.gyro += bg;
@@ -124,6 +146,10 @@ std::vector<ImuSample> SimulateImu(const SplineTrajectory& trajectory, std::int6
       s.accel += accel_sigma * normal3();
       bg += gyro_walk * normal3();
       ba += accel_walk * normal3();
+    }
+    if (options.errors.gyro_quantum > 0.0) s.gyro = Quantise(s.gyro, options.errors.gyro_quantum);
+    if (options.errors.accel_quantum > 0.0) {
+      s.accel = Quantise(s.accel, options.errors.accel_quantum);
     }
     out.push_back(s);
   }

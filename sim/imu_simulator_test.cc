@@ -105,7 +105,7 @@ void CheckIntegration(const SplineTrajectory& traj, std::int64_t t0, const char*
   const std::int64_t t1 = t0 + 10'000'000'000;
   ImuOptions o;
   o.noise = false;
-  const std::vector<ImuSample> imu = SimulateImu(traj, t0, t1, o, 1);
+  const std::vector<ImuSample> imu = SimulateImu(BodyMotion(traj), t0, t1, o, 1);
   ASSERT_EQ(imu.size(), 2001u);
   const IntegrationError analytic = IntegrateAnalytic(traj, t0, t1);
   const IntegrationError samples = IntegrateSamples(traj, imu, 1000);
@@ -173,7 +173,7 @@ TEST(ImuSimulator, NoiseDensitiesAndRandomWalksMatchTheConfiguration) {
   double g_std = 0, a_std = 0;
   std::size_t n_samples = 0;
   for (int run = 0; run < 10; ++run) {
-    const auto imu = SimulateImu(traj, 0, static_cast<std::int64_t>(seconds * 1e9), o, 100 + run);
+    const auto imu = SimulateImu(BodyMotion(traj), 0, static_cast<std::int64_t>(seconds * 1e9), o, 100 + run);
     std::vector<Eigen::Vector3d> eg, ea;
     eg.reserve(imu.size());
     ea.reserve(imu.size());
@@ -224,7 +224,7 @@ TEST(ImuSimulator, BiasesVibrationAndDeterminism) {
   o.initial_gyro_bias = Eigen::Vector3d(0.01, -0.02, 0.003);
   o.initial_accel_bias = Eigen::Vector3d(0.1, 0.0, -0.2);
   o.vibration = true;
-  const auto imu = SimulateImu(traj, 0, 20'000'000'000, o, 9);
+  const auto imu = SimulateImu(BodyMotion(traj), 0, 20'000'000'000, o, 9);
   Eigen::Vector3d g_ideal, a_ideal;
   IdealImu(traj.State(0), o.gravity, &g_ideal, &a_ideal);
   EXPECT_LT((a_ideal - Eigen::Vector3d(0, 0, 9.81)).norm(), 1e-12);  // at rest: +g up
@@ -243,15 +243,62 @@ TEST(ImuSimulator, BiasesVibrationAndDeterminism) {
   EXPECT_LT((accel_mean - a_ideal - o.initial_accel_bias).norm(), 0.01);  // tones average out
 
   ImuOptions noisy;
-  const auto a = SimulateImu(traj, 0, 1'000'000'000, noisy, 42);
-  const auto b = SimulateImu(traj, 0, 1'000'000'000, noisy, 42);
-  const auto c = SimulateImu(traj, 0, 1'000'000'000, noisy, 43);
+  const auto a = SimulateImu(BodyMotion(traj), 0, 1'000'000'000, noisy, 42);
+  const auto b = SimulateImu(BodyMotion(traj), 0, 1'000'000'000, noisy, 42);
+  const auto c = SimulateImu(BodyMotion(traj), 0, 1'000'000'000, noisy, 43);
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     ASSERT_EQ(a[i].gyro, b[i].gyro);
     ASSERT_EQ(a[i].accel, b[i].accel);
   }
   EXPECT_NE(a[5].gyro, c[5].gyro);
+}
+
+// Scale factors, misalignment and g-sensitivity act on the true rate and specific force as
+// documented (gyro = M_g w + G f + b, accel = M_a f + b), and quantisation rounds to LSBs.
+TEST(ImuSimulator, SensorErrorsFollowTheErrorModel) {
+  const SceneDescription description = LoadSceneDescription("vicon_room");
+  SceneBuildOptions build;
+  build.texture_size = 64;
+  const Scene scene = BuildScene(description, build, {});
+  MotionOptions mo;
+  mo.level = MotionLevel::kDifficult;
+  mo.duration_s = 4.0;
+  const SplineTrajectory traj = GenerateMotion(scene, mo, EurocCam0().body_from_camera, 5, 0);
+  ImuOptions o;
+  o.noise = false;
+  o.initial_gyro_bias = Eigen::Vector3d(0.01, -0.02, 0.003);
+  o.errors.gyro_matrix << 1.002, 0.0004, -0.0003, 0.0002, 0.998, 0.0005, -0.0001, 0.0003, 1.001;
+  o.errors.accel_matrix << 0.997, 0.0002, 0.0001, -0.0004, 1.003, 0.0002, 0.0003, 0.0001, 1.002;
+  o.errors.gyro_g_sensitivity = 1e-4 * Eigen::Matrix3d::Ones();
+  const auto imu = SimulateImu(BodyMotion(traj), 0, 3'000'000'000, o, 2);
+  double worst = 0.0;
+  for (const auto& s : imu) {
+    Eigen::Vector3d w, f;
+    IdealImu(traj.State(s.t_ns), o.gravity, &w, &f);
+    const Eigen::Vector3d gyro = o.errors.gyro_matrix * w + o.errors.gyro_g_sensitivity * f +
+                                 o.initial_gyro_bias;
+    const Eigen::Vector3d accel = o.errors.accel_matrix * f;
+    worst = std::max({worst, (gyro - s.gyro).norm(), (accel - s.accel).norm()});
+  }
+  EXPECT_LT(worst, 1e-12);
+  // With errors the measurements differ from the ideal ones by more than the noise would.
+  Eigen::Vector3d w, f;
+  IdealImu(traj.State(imu[100].t_ns), o.gravity, &w, &f);
+  EXPECT_GT((imu[100].accel - f).norm(), 0.01);
+
+  o.errors = ImuSensorErrors();
+  o.errors.gyro_quantum = 0.04 * M_PI / 180.0;
+  o.errors.accel_quantum = 9.81 / 1200.0;
+  o.noise = true;
+  for (const auto& s : SimulateImu(BodyMotion(traj), 0, 1'000'000'000, o, 3)) {
+    for (int k = 0; k < 3; ++k) {
+      const double g_lsb = s.gyro[k] / o.errors.gyro_quantum;
+      const double a_lsb = s.accel[k] / o.errors.accel_quantum;
+      ASSERT_NEAR(g_lsb, std::round(g_lsb), 1e-6);
+      ASSERT_NEAR(a_lsb, std::round(a_lsb), 1e-6);
+    }
+  }
 }
 
 }  // namespace

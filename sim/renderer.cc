@@ -297,7 +297,7 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
                   light +=
                       l.intensity * (cos_l / std::sqrt(d2)) / (1.0f + d2 / (l.range_m * l.range_m));
                 }
-                const float shade = albedo_scale * light;
+                const float shade = albedo_scale * light + mat.emission;
                 if (channels == 1) {
                   acc[0] += shade * tex.SampleGrey(st.x(), st.y(), lod);
                 } else {

@@ -27,6 +27,7 @@ struct Material {
   int macro_texture = -1;       // large-scale albedo variation (-1: none)
   float macro_tile_m = 8.0f;    // metres per macro texture repeat
   float macro_strength = 0.0f;  // albedo *= 1 + strength * (macro - 0.5) * 2
+  float emission = 0.0f;        // emitted radiance (windows, lamps), times the texture
   // Each tile shows the texture shifted by a random offset and turned/mirrored by one of
   // the 8 square symmetries (hash of the tile index), so a wall is not a visible grid of
   // identical copies. Off for repetitive textures (the repetition is the point).

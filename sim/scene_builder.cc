@@ -175,8 +175,14 @@ class Builder {
         }
         Eigen::Vector3f up =
             std::abs(normal.z()) > 0.9f ? Eigen::Vector3f::UnitY() : Eigen::Vector3f::UnitZ();
-        const Eigen::Vector3f x_axis = up.cross(normal).normalized();
+        Eigen::Vector3f x_axis = up.cross(normal).normalized();
         up = normal.cross(x_axis);
+        if (o.yaw_deg != 0.0) {  // turned about its normal (floor decals, tilted posters)
+          const float a = static_cast<float>(o.yaw_deg * M_PI / 180.0);
+          const Eigen::Vector3f x = std::cos(a) * x_axis + std::sin(a) * up;
+          up = normal.cross(x);
+          x_axis = x;
+        }
         s.world_from_local.col(0) = x_axis;
         s.world_from_local.col(1) = up;
         s.world_from_local.col(2) = normal;
@@ -198,6 +204,9 @@ class Builder {
 bool TooClose(const std::vector<Shape>& shapes, const std::vector<Eigen::Vector3d>& path,
               double clearance) {
   for (const Shape& s : shapes) {
+    // Flat decals (quads: tape on the floor, posters) cannot be flown into; removing them
+    // would only empty the floor under a take-off.
+    if (s.type == ShapeType::kQuad) continue;
     const float reach = s.bound_radius() + static_cast<float>(clearance);
     for (const auto& p : path) {
       const Eigen::Vector3f pf = p.cast<float>();
@@ -281,6 +290,7 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
     mat.stretch = m.stretch;
     mat.albedo = static_cast<float>(m.albedo);
     mat.macro_strength = static_cast<float>(m.macro_strength);
+    mat.emission = static_cast<float>(m.emission);
     // Procedural noise is seamless and has no recognisable motif: shuffling would only add seams.
     mat.shuffle_tiles = spec.kind == TextureKind::kPhoto;
     scene.materials.push_back(mat);
@@ -352,13 +362,18 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
         if (s.type == ObjectType::kCylinder) o.size.y() = o.size.x();
         // Scatter positions are absolute: convert back to room-relative for AddObject.
         const Eigen::Vector3d c = room.centre();
+        // Quads lie on the floor, a few millimetres above it and each at its own height, so
+        // neither the floor nor a crossing quad z-fights with them.
+        const bool decal = s.type == ObjectType::kQuad;
         o.position = Eigen::Vector3d((pos.x() - c.x()) / room.scale.x(),
-                                     (pos.y() - c.y()) / room.scale.y(), 0.0);
+                                     (pos.y() - c.y()) / room.scale.y(),
+                                     decal ? 0.003 + 0.0002 * (i % 16) : 0.0);
         std::vector<Shape> parts;
         builder.AddObject(o, room, group_id, &parts);
+        // Decals may cross anything (tape over tape); solids keep apart.
         bool ok = !TooClose(parts, path, options.clearance_m);
         for (const auto& g : groups) {
-          if (!ok) break;
+          if (!ok || decal) break;
           ok = !Overlaps(parts, g, 0.15f);
         }
         if (!ok) continue;

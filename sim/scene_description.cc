@@ -72,8 +72,13 @@ class Parser {
       t.kind = TextureKind::kRepetitive;
     } else if (kind == "checker") {
       t.kind = TextureKind::kChecker;
+    } else if (kind == "quilted") {
+      t.kind = TextureKind::kQuilted;
+    } else if (kind == "confetti") {
+      t.kind = TextureKind::kConfetti;
     } else {
-      Fail(node, "unknown texture kind '" + kind + "' (photo|noise|weak|repetitive|checker)");
+      Fail(node, "unknown texture kind '" + kind +
+                     "' (photo|noise|weak|repetitive|checker|quilted|confetti)");
     }
     t.photo = Get<std::string>(node, "photo", "");
     if ((t.kind == TextureKind::kPhoto) && t.photo.empty())
@@ -88,6 +93,10 @@ class Parser {
     t.checker_cols = Get<int>(node, "cols", t.checker_cols);
     t.checker_rows = Get<int>(node, "rows", t.checker_rows);
     t.checker_square_px = Get<int>(node, "square_px", t.checker_square_px);
+    t.stripes = Get<int>(node, "stripes", t.stripes);
+    t.seam_depth = Get<double>(node, "seam_depth", t.seam_depth);
+    t.flakes = Get<int>(node, "flakes", t.flakes);
+    t.flake_size = Get<double>(node, "flake_size", t.flake_size);
     return t;
   }
 
@@ -190,8 +199,11 @@ SceneDescription ParseSceneYaml(const std::string& text, const std::filesystem::
     m.stretch = p.Get<bool>(n, "stretch", m.stretch);
     m.albedo = p.Get<double>(n, "albedo", m.albedo);
     m.macro_strength = p.Get<double>(n, "macro", m.macro_strength);
-    if (!(m.tile_m > 0) || !(m.albedo > 0) || m.macro_strength < 0 || m.macro_strength > 0.5) {
-      p.Fail(n, "material '" + m.name + "': tile > 0, albedo > 0, macro in [0, 0.5]");
+    m.emission = p.Get<double>(n, "emission", m.emission);
+    if (!(m.tile_m > 0) || !(m.albedo > 0) || m.macro_strength < 0 || m.macro_strength > 0.5 ||
+        !(m.emission >= 0 && m.emission <= 1000)) {
+      p.Fail(n, "material '" + m.name +
+                    "': tile > 0, albedo > 0, macro in [0, 0.5], emission in [0, 1000]");
     }
     const int existing = d.MaterialIndex(m.name);
     if (existing >= 0) {

@@ -22,6 +22,9 @@ struct MaterialDesc {
   bool stretch = false;  // texture once over the face (markers, posters)
   double albedo = 0.7;
   double macro_strength = 0.2;  // large-scale albedo variation (0: none)
+  // Light the surface emits (windows, lamps), independent of the lights; in radiance units
+  // where a white wall under the ambient light is ~0.5, so a few units saturate the camera.
+  double emission = 0.0;
 };
 
 enum class ObjectType { kBox, kCylinder, kQuad, kShelf };

@@ -30,6 +30,10 @@ void SensorOptions::Check() const {
                       gain_min, gain_max);
   PKSLAM_CHECK_OPTION(gain_drift >= 0.0 && gain_drift <= 1.0, "sensor.gain_drift", "{}",
                       gain_drift);
+  PKSLAM_CHECK_OPTION(max_exposure_s >= 0.0 && max_exposure_s < 0.05, "sensor.max_exposure_s",
+                      "{}", max_exposure_s);
+  PKSLAM_CHECK_OPTION(exposure_at_unit_gain_s > 0.0 && exposure_at_unit_gain_s < 0.05,
+                      "sensor.exposure_at_unit_gain_s", "{}", exposure_at_unit_gain_s);
 }
 
 SensorModel::SensorModel(const SensorOptions& options, const CameraRays& rays, std::uint64_t seed)
@@ -59,8 +63,22 @@ double SensorModel::NextGain(const cv::Mat& radiance, double dt_s) {
   }
   cv::Mat grey = radiance;
   if (radiance.channels() == 3) cv::cvtColor(radiance, grey, cv::COLOR_RGB2GRAY);
-  const double mean = std::max(cv::mean(grey.mul(vignette_))[0], 1e-4);
-  const double ideal = options_.target_brightness / mean;
+  const cv::Mat exposed = grey.mul(vignette_);
+  // The gain that brings the metered mean to the target. Clipped metering: the mean of
+  // min(gain * radiance, 1) grows monotonically with the gain; a few fixed-point steps
+  // from the current gain find it (saturated pixels count as full scale, not as their radiance).
+  auto metered = [&](double gain) {
+    if (!options_.clip_metering) return gain * cv::mean(exposed)[0];
+    cv::Mat level = exposed * gain;
+    cv::min(level, 1.0, level);
+    return cv::mean(level)[0];
+  };
+  double ideal = options_.target_brightness / std::max(cv::mean(exposed)[0], 1e-4);
+  if (options_.clip_metering) {
+    for (int i = 0; i < 8; ++i) {
+      ideal *= options_.target_brightness / std::max(metered(ideal), 1e-4);
+    }
+  }
   if (gain_ <= 0.0) {
     gain_ = ideal;  // first frame: start converged
   } else {
@@ -68,6 +86,11 @@ double SensorModel::NextGain(const cv::Mat& radiance, double dt_s) {
   }
   gain_ = std::clamp(gain_, options_.gain_min, options_.gain_max);
   return gain_ * std::exp(drift_);
+}
+
+double SensorModel::exposure_s() const {
+  if (options_.max_exposure_s <= 0.0 || gain_ <= 0.0) return 0.0;
+  return std::min(gain_ * options_.exposure_at_unit_gain_s, options_.max_exposure_s);
 }
 
 cv::Mat SensorModel::Develop(const cv::Mat& radiance, double gain, std::uint64_t noise_key) const {

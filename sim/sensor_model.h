@@ -24,6 +24,13 @@ struct SensorOptions {
   double gain_min = 0.2;            // auto exposure limits
   double gain_max = 8.0;
   double gain_drift = 0.0;  // relative std of a slow random gain drift per second
+  // Auto exposure meters the clipped 8-bit image, as a camera's AEC does: a saturated window
+  // does not darken the rest of the frame more than its 255s weigh.
+  bool clip_metering = false;
+  // > 0: the exposure time follows the auto exposure (gain * exposure_at_unit_gain_s) up to
+  // this cap, beyond which analog gain takes over; the simulator blurs over it.
+  double max_exposure_s = 0.0;
+  double exposure_at_unit_gain_s = 0.002;  // exposure time of gain 1 (radiance 1 -> 255)
 
   void Check() const;
 };
@@ -39,6 +46,10 @@ class SensorModel {
   // the gain to develop all cameras of that frame with. dt_s: time since the previous frame.
   double NextGain(const cv::Mat& radiance, double dt_s);
   double gain() const { return gain_; }
+  bool initialised() const { return gain_ > 0.0; }
+  // Exposure time of the next frame (0 when the exposure model is off or before the first
+  // frame): the auto exposure sets it from the previous frames, as a real AEC lags by a frame.
+  double exposure_s() const;
 
   // Radiance (CV_32FC1 or CV_32FC3) -> 8-bit (CV_8UC1 or CV_8UC3, same channel order).
   // noise_key distinguishes frames and cameras (e.g. DeriveSeed(frame, camera)).

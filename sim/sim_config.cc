@@ -62,11 +62,36 @@ void SimulationOptions::Check() const {
   PKSLAM_CHECK_OPTION(!reference_only || (write_cloud && write_images && !bench),
                       "--reference-only", "{}", "needs images and the cloud (no --bench)");
   PKSLAM_CHECK_OPTION(bench_frames >= 0, "bench_frames", "{}", bench_frames);
+  PKSLAM_CHECK_OPTION(cam1_relative_gain > 0.1 && cam1_relative_gain < 10.0, "cam1_relative_gain",
+                      "{}", cam1_relative_gain);
   if (trajectory.empty()) motion.Check();
   replay.Check();
   scene_build.Check();
   imu.Check();
   sensor.Check();
+  realism.Check();
+}
+
+void ApplyAppearance(const AppearanceOptions& a, SimulationOptions* o) {
+  a.Check();
+  SensorOptions& s = o->sensor;
+  s.read_noise_dn = a.read_noise_dn;
+  s.shot_noise_gain = a.shot_noise_gain;
+  s.blur_sigma_px = a.blur_sigma_px;
+  s.vignetting = a.vignetting;
+  s.target_brightness = a.target_brightness;
+  s.exposure_adapt = a.exposure_adapt;
+  s.clip_metering = true;
+  s.max_exposure_s = 1e-3 * a.max_exposure_ms;
+  s.exposure_at_unit_gain_s = 1e-3 * a.exposure_at_unit_gain_ms;
+  o->cam1_relative_gain = a.cam1_relative_gain;
+}
+
+std::string DefaultScene(const RealismOptions& realism, const std::filesystem::path& trajectory) {
+  const std::string stem = trajectory.filename().string();
+  const bool machine_hall = stem.rfind("MH", 0) == 0;
+  if (!realism.On(RealismSource::kAppearance)) return machine_hall ? "machine_hall" : "vicon_room";
+  return machine_hall ? realism.appearance.machine_hall_scene : realism.appearance.vicon_scene;
 }
 
 namespace {
@@ -149,6 +174,10 @@ void WriteSimYaml(const std::filesystem::path& file, const SimulationOptions& o,
   e << YAML::Key << "auto_exposure" << YAML::Value << o.sensor.auto_exposure;
   e << YAML::Key << "target_brightness" << YAML::Value << o.sensor.target_brightness;
   e << YAML::Key << "gain_drift" << YAML::Value << o.sensor.gain_drift;
+  e << YAML::Key << "clip_metering" << YAML::Value << o.sensor.clip_metering;
+  e << YAML::Key << "cam1_relative_gain" << YAML::Value << o.cam1_relative_gain;
+  e << YAML::Key << "max_exposure_s" << YAML::Value << o.sensor.max_exposure_s;
+  e << YAML::Key << "exposure_at_unit_gain_s" << YAML::Value << o.sensor.exposure_at_unit_gain_s;
   e << YAML::Key << "motion_blur_exposure_s" << YAML::Value << o.motion_blur_exposure_s;
   e << YAML::Key << "motion_blur_samples" << YAML::Value << o.motion_blur_samples;
   e << YAML::Key << "depth_noise" << YAML::Value << o.depth_noise;
@@ -156,6 +185,28 @@ void WriteSimYaml(const std::filesystem::path& file, const SimulationOptions& o,
     << o.blackout_begin_s << o.blackout_end_s << YAML::EndSeq;
   e << YAML::Key << "images_written" << YAML::Value << o.write_images;
   e << YAML::Key << "frames" << YAML::Value << s.frames;
+  e << YAML::EndMap;
+
+  const RealismOptions& r = o.realism;
+  e << YAML::Key << "realism" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "preset" << YAML::Value << RealismPresetName(r.preset);
+  e << YAML::Key << "device_seed" << YAML::Value << r.device_seed;
+  e << YAML::Key << "sources" << YAML::Value << YAML::BeginMap;
+  for (RealismSource source : kRealismSources) {
+    e << YAML::Key << RealismSourceName(source) << YAML::Value << r.On(source);
+  }
+  e << YAML::EndMap;
+  e << YAML::Key << "vibration" << YAML::Value << r.motion.vibration;
+  e << YAML::Key << "parameters" << YAML::Value << YAML::BeginSeq;
+  for (const RealismEntry& entry : RealismReport(r)) {
+    e << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << entry.name
+      << YAML::Key << "value" << YAML::Value << entry.value << YAML::Key << "unit" << YAML::Value
+      << entry.unit << YAML::Key << "documented" << YAML::Value << entry.range << YAML::Key
+      << "source" << YAML::Value << entry.reference << YAML::EndMap;
+  }
+  e << YAML::EndSeq;
+  e << YAML::Key << "mean_exposure_ms" << YAML::Value << s.mean_exposure_ms;
+  e << YAML::Key << "saturated_share" << YAML::Value << s.saturated_share;
   e << YAML::EndMap;
 
   e << YAML::Key << "reference_cloud" << YAML::Value << YAML::BeginMap;

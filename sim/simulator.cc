@@ -17,6 +17,7 @@
 #include "sim/depth_sensor.h"
 #include "sim/euroc_writer.h"
 #include "sim/random.h"
+#include "sim/realism_draw.h"
 #include "sim/reference_cloud.h"
 #include "sim/tum_rgbd_writer.h"
 
@@ -56,20 +57,20 @@ CameraRig RgbdCamera(double rate_hz) {
 }
 
 // Renders the radiance seen by a camera at time t, averaged over the exposure (motion blur).
-void RenderFrame(const Renderer& renderer, const CameraRays& rays, const SplineTrajectory& traj,
+void RenderFrame(const Renderer& renderer, const CameraRays& rays, const BodyMotion& motion,
                  const SE3d& body_from_camera, std::int64_t t_ns, double exposure_s, int samples,
                  RenderBuffers* out, std::span<SurfaceVisibility* const> visibility) {
   if (exposure_s <= 0.0 || samples <= 1) {
-    renderer.Render(rays, traj.WorldFromBody(t_ns) * body_from_camera, out, visibility);
+    renderer.Render(rays, motion.WorldFromBody(t_ns) * body_from_camera, out, visibility);
     return;
   }
   RenderBuffers sub;
   cv::Mat sum;
   for (int i = 0; i < samples; ++i) {
     const std::int64_t ti = std::clamp(t_ns + Ns(exposure_s * ((i + 0.5) / samples - 0.5)),
-                                       traj.begin_ns(), traj.end_ns());
+                                       motion.begin_ns(), motion.end_ns());
     const bool centre = i == samples / 2;
-    renderer.Render(rays, traj.WorldFromBody(ti) * body_from_camera, &sub,
+    renderer.Render(rays, motion.WorldFromBody(ti) * body_from_camera, &sub,
                     centre ? visibility : std::span<SurfaceVisibility* const>{});
     if (i == 0) {
       sum = sub.radiance.clone();
@@ -137,6 +138,64 @@ void MotionStatistics(const SplineTrajectory& traj, std::int64_t begin, std::int
   s->mean_angular_rate_dps = n > 0 ? rate_sum / n : 0.0;
 }
 
+// IMU samples, and the ground truth as evaluation will see it (realism: the state at the stamp
+// plus the ground-truth time offset, with motion-capture noise) and exactly (truth/).
+void WriteImuAndGroundTruth(const BodyMotion& motion, const std::vector<ImuSample>& imu,
+                            const SimulationOptions& o, EurocWriter* euroc) {
+  const bool gt_errors = o.realism.On(RealismSource::kGroundTruth);
+  const GroundTruthErrorOptions& g = o.realism.ground_truth;
+  const std::int64_t offset = Ns(1e-3 * g.time_offset_ms);
+  Rng noise(DeriveSeed(o.seed, 0x47544E4F495345));  // "GTNOISE"
+  for (const ImuSample& s : imu) {
+    if (o.write_imu) euroc->WriteImu(s);
+    const BodyState exact = motion.State(s.t_ns);
+    const GroundTruthRow exact_row{s.t_ns, exact.world_from_body, exact.velocity_world,
+                                   s.gyro_bias, s.accel_bias};
+    if (!gt_errors) {
+      euroc->WriteGroundTruth(exact_row);
+      continue;
+    }
+    euroc->WriteExactGroundTruth(exact_row);
+    const std::int64_t t_true =
+        std::clamp(s.t_ns + offset, motion.begin_ns(), motion.end_ns());
+    const BodyState st = motion.State(t_true);
+    Eigen::Vector3d dp;
+    Eigen::Vector3d dr;
+    for (int i = 0; i < 3; ++i) dp[i] = 1e-3 * g.position_noise_mm * noise.Normal();
+    for (int i = 0; i < 3; ++i) dr[i] = g.rotation_noise_deg * M_PI / 180.0 * noise.Normal();
+    const SE3d noisy(st.world_from_body.so3() * SO3d::Exp(dr),
+                     st.world_from_body.translation() + dp);
+    euroc->WriteGroundTruth({s.t_ns, noisy, st.velocity_world, s.gyro_bias, s.accel_bias});
+  }
+}
+
+// When the frame stamped t was exposed (mid-exposure, IMU clock): the camera-IMU time offset
+// plus per-frame jitter (realism timing), inside the motion's range.
+std::int64_t ExposureTime(const SimulationOptions& o, const RealismDraw& draw,
+                          const BodyMotion& motion, std::int64_t t_ns, int frame) {
+  std::int64_t t = t_ns;
+  if (o.realism.On(RealismSource::kTiming)) {
+    t += Ns(1e-3 * draw.camera_imu_offset_ms);
+    if (o.realism.timing.jitter_ms > 0.0) {
+      Rng jitter(DeriveSeed(o.seed, 0x4A49545445520000ULL + static_cast<std::uint64_t>(frame)));
+      t += Ns(1e-3 * o.realism.timing.jitter_ms * jitter.Normal());
+    }
+  }
+  return std::clamp(t, motion.begin_ns(), motion.end_ns());
+}
+
+// Sub-renders a motion-blurred frame needs: one per 1.5 px of image motion over the exposure
+// (rotation at the focal length plus translation seen at 1.5 m), at most `max_samples`. Copies
+// 1.5 px apart merge under the optical blur (sigma ~0.7 px), and a smear shorter than that is
+// within it.
+int BlurSamples(const BodyState& state, double exposure_s, double focal_px, int max_samples) {
+  if (exposure_s <= 0.0 || max_samples <= 1) return 1;
+  const double motion_px =
+      exposure_s * focal_px * (state.omega_body.norm() + state.velocity_world.norm() / 1.5);
+  const int n = static_cast<int>(std::ceil(motion_px / 1.5));
+  return std::clamp(n, 1, max_samples);
+}
+
 void WriteReferenceClouds(const Scene& scene, const SurfaceVisibility* visibility,
                           const SurfaceVisibility* observed, const SimulationOptions& o,
                           SimulationSummary* summary) {
@@ -170,6 +229,20 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     cameras = {EurocCam0(), EurocCam1()};
     for (auto& c : cameras) c.rate_hz = o.camera_rate_hz;
   }
+  // Realism: the calibration SLAM will read, the IMU's axis errors and biases, the replay fit.
+  const RealismOptions& realism = o.realism;
+  const RealismDraw draw = DrawRealism(realism, cameras, o.seed);
+  if (realism.On(RealismSource::kImu)) {
+    o.imu.errors = draw.imu_errors;
+    o.imu.initial_gyro_bias += draw.gyro_bias;
+    o.imu.initial_accel_bias += draw.accel_bias;
+  }
+  if (realism.On(RealismSource::kMotion)) {
+    o.replay.position_knot_s = realism.motion.position_knot_s;
+    o.replay.rotation_knot_s = realism.motion.rotation_knot_s;
+    o.replay.position_cutoff_hz = realism.motion.position_cutoff_hz;
+    o.replay.rotation_cutoff_hz = realism.motion.rotation_cutoff_hz;
+  }
 
   // Motion.
   SimulationSummary summary;
@@ -199,6 +272,14 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   summary.begin_ns = begin_ns;
   summary.end_ns = end_ns;
   MotionStatistics(traj, begin_ns, end_ns, o.imu.period_ns(), &summary);
+  const bool vibrate = realism.On(RealismSource::kMotion) && realism.motion.vibration &&
+                       realism.motion.vibration_scale > 0.0;
+  VibrationOptions vibration_options;
+  vibration_options.scale = realism.motion.vibration_scale;
+  const BodyMotion motion =
+      vibrate ? BodyMotion(traj, Vibration(EurocVibrationSpectrum(), vibration_options,
+                                           DeriveSeed(o.seed, 0x56494254)))  // "VIBT"
+              : BodyMotion(traj);
 
   // Scene around the path of the body and the cameras.
   std::vector<Eigen::Vector3d> path;
@@ -231,21 +312,19 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
       tum = std::make_unique<TumRgbdWriter>(o.output_dir);
     } else {
       // Without images (IMU + ground truth only) there are no camera folders at all.
+      // sensor.yaml files carry the calibration SLAM reads (with realism: the erroneous one).
       euroc = std::make_unique<EurocWriter>(
-          o.output_dir, o.write_images ? cameras : std::vector<CameraRig>{}, o.imu, o.write_imu);
+          o.output_dir, o.write_images ? draw.written_cameras : std::vector<CameraRig>{}, o.imu,
+          o.write_imu);
+      if (realism.preset != RealismPreset::kIdeal) {
+        euroc->OpenTruth(cameras, RealismDrawYaml(draw));
+      }
     }
   }
   if (!o.rgbd && !o.reference_only) {
-    const std::vector<ImuSample> imu = SimulateImu(traj, begin_ns, end_ns, o.imu, o.seed);
+    const std::vector<ImuSample> imu = SimulateImu(motion, begin_ns, end_ns, o.imu, o.seed);
     summary.imu_samples = static_cast<int>(imu.size());
-    if (euroc) {
-      for (const ImuSample& s : imu) {
-        if (o.write_imu) euroc->WriteImu(s);
-        const BodyState st = traj.State(s.t_ns);
-        euroc->WriteGroundTruth(
-            {s.t_ns, st.world_from_body, st.velocity_world, s.gyro_bias, s.accel_bias});
-      }
-    }
+    if (euroc) WriteImuAndGroundTruth(motion, imu, o, euroc.get());
   }
 
   // Camera frames.
@@ -283,7 +362,10 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   // cam0's rays mark both (the dense tool reconstructs the left camera's view).
   const std::array<SurfaceVisibility*, 2> cam0_marks = {visibility.get(), observed.get()};
   const PixelNoise depth_noise;
-  const double exposure = o.motion_blur_exposure_s;
+  const bool exposure_model = o.sensor.max_exposure_s > 0.0;
+  const bool write_truth = euroc && realism.preset != RealismPreset::kIdeal;
+  double exposure_sum = 0.0;
+  double saturated_sum = 0.0;
   Progress progress(o.bench ? "bench" : "simulate", static_cast<std::size_t>(frames), o.quiet);
   double render_seconds = 0.0;
   double render_cpu = 0.0;
@@ -302,25 +384,47 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   const auto loop_start = std::chrono::steady_clock::now();
   for (int k = 0; k < frames; ++k) {
     const std::int64_t t = first + k * period;
+    const std::int64_t t_exposure = ExposureTime(o, draw, motion, t, k);
     const bool black = InBlackout(o, t, begin_ns);
     std::vector<cv::Mat> images(cameras.size());
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t cpu0 = std::clock();
+    double exposure = o.motion_blur_exposure_s;
     if (!black && o.reference_only) {  // cam0 alone, no image formation
-      RenderFrame(renderer, rays[0], traj, cameras[0].body_from_camera, t, exposure,
-                  o.motion_blur_samples, &buffers[0], cam0_marks);
+      const int samples = BlurSamples(motion.State(t_exposure), exposure, cameras[0].camera.fx(),
+                                      o.motion_blur_samples);
+      RenderFrame(renderer, rays[0], motion, cameras[0].body_from_camera, t_exposure, exposure,
+                  samples, &buffers[0], cam0_marks);
     } else if (!black) {
+      // One exposure for the rig (the VI-Sensor shares it between cameras), set by the auto
+      // exposure from the frames before; the first frame is metered on a sharp render.
+      SensorModel& meter = sensors[0];
+      if (exposure_model) {
+        if (!meter.initialised()) {
+          RenderFrame(renderer, rays[0], motion, cameras[0].body_from_camera, t_exposure, 0.0, 1,
+                      &buffers[0], {});
+          meter.NextGain(buffers[0].radiance, 1.0 / rate);
+        }
+        exposure = meter.exposure_s();
+      }
+      const int samples = BlurSamples(motion.State(t_exposure), exposure, cameras[0].camera.fx(),
+                                      o.motion_blur_samples);
       for (std::size_t c = 0; c < cameras.size(); ++c) {
-        RenderFrame(renderer, rays[c], traj, cameras[c].body_from_camera, t, exposure,
-                    o.motion_blur_samples, &buffers[c],
+        RenderFrame(renderer, rays[c], motion, cameras[c].body_from_camera, t_exposure, exposure,
+                    samples, &buffers[c],
                     c == 0 ? std::span<SurfaceVisibility* const>(cam0_marks)
                            : std::span<SurfaceVisibility* const>{});
       }
-      // One exposure for the rig (the VI-Sensor shares it between cameras).
-      const double gain = sensors[0].NextGain(buffers[0].radiance, 1.0 / rate);
+      const double gain = meter.NextGain(buffers[0].radiance, 1.0 / rate);
       for (std::size_t c = 0; c < cameras.size(); ++c) {
-        images[c] =
-            sensors[c].Develop(buffers[c].radiance, gain, static_cast<std::uint64_t>(k) * 8 + c);
+        const double camera_gain = c == 1 ? gain * o.cam1_relative_gain : gain;
+        images[c] = sensors[c].Develop(buffers[c].radiance, camera_gain,
+                                       static_cast<std::uint64_t>(k) * 8 + c);
+      }
+      exposure_sum += exposure;
+      if (images[0].channels() == 1) {
+        saturated_sum += static_cast<double>(cv::countNonZero(images[0] >= 255)) /
+                         static_cast<double>(images[0].total());
       }
     } else {
       for (std::size_t c = 0; c < cameras.size(); ++c) {
@@ -333,6 +437,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     // PNG encoding of this frame overlaps the rendering of the next one (a second core's
     // worth of work); list files are written here, in order.
     writers.wait();
+    if (write_truth) euroc->WriteFrameTime(t, t_exposure, black ? 0.0 : exposure);
     if (euroc) {
       for (std::size_t c = 0; c < cameras.size(); ++c) {
         const std::filesystem::path file = euroc->AddImage(static_cast<int>(c), t);
@@ -359,6 +464,10 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   summary.render_seconds = render_seconds;
   summary.render_cpu_seconds = render_cpu;
   summary.frames_per_second = render_seconds > 0.0 ? frames / render_seconds : 0.0;
+  if (frames > 0) {
+    summary.mean_exposure_ms = 1e3 * exposure_sum / frames;
+    summary.saturated_share = saturated_sum / frames;
+  }
 
   if (o.bench) {
     summary.layout = "bench";
@@ -372,14 +481,14 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   if (tum) {
     // Ground truth of the colour camera at 100 Hz (TUM's motion-capture rate).
     for (std::int64_t t = first; t <= end_ns; t += 10'000'000) {
-      tum->WriteGroundTruth(t, traj.WorldFromBody(t) * cameras[0].body_from_camera);
+      tum->WriteGroundTruth(t, motion.WorldFromBody(t) * cameras[0].body_from_camera);
     }
     tum->Close();
-    WriteSettings(o.output_dir / "settings.yaml", cameras, o);
+    WriteSettings(o.output_dir / "settings.yaml", draw.written_cameras, o);
     summary.layout = "tum_rgbd";
   } else {
     euroc->Close();
-    WriteSettings(o.output_dir / "settings.yaml", cameras, o);
+    WriteSettings(o.output_dir / "settings.yaml", draw.written_cameras, o);
     summary.layout = "euroc";
   }
   if (o.write_cloud) WriteReferenceClouds(scene, visibility.get(), observed.get(), o, &summary);

@@ -20,6 +20,7 @@
 
 #include "sim/imu_simulator.h"
 #include "sim/motion_generator.h"
+#include "sim/realism.h"
 #include "sim/renderer.h"
 #include "sim/scene_builder.h"
 #include "sim/sensor_model.h"
@@ -48,6 +49,7 @@ struct SimulationOptions {
   bool write_images = true;      // false: IMU + ground truth only (no rendering)
   double camera_rate_hz = 20.0;  // stereo cameras (EuRoC: 20)
   SensorOptions sensor;
+  double cam1_relative_gain = 1.0;  // cam1's response relative to cam0's (gain of its images)
   double motion_blur_exposure_s = 0.0;  // > 0: average sub-renders over this exposure
   int motion_blur_samples = 0;          // sub-renders (0: by quality: 3 / 5 / 9)
   bool rgbd = false;                    // TUM RGB-D output instead of EuRoC
@@ -68,9 +70,22 @@ struct SimulationOptions {
   bool bench = false;      // render and develop only; write nothing
   int bench_frames = 200;  // frames rendered by bench (0: the whole sequence)
   bool quiet = false;      // no progress bar
+  // Error sources of real recordings (calibration, timing, IMU axes, vibration, ground truth;
+  // appearance comes through `sensor` and `scene`, see ApplyAppearance). Default: ideal.
+  RealismOptions realism;
 
   void Check() const;
 };
+
+// Sets the sensor model (noise, blur, vignetting, auto exposure, exposure time and motion blur)
+// to the realism preset's appearance. The CLI applies it first and the user's explicit flags on
+// top.
+void ApplyAppearance(const AppearanceOptions& appearance, SimulationOptions* options);
+
+// The scene a sequence gets under `realism` when the user names none: the appearance's
+// machine-hall scene for trajectories whose file name starts with "MH", its Vicon-room scene
+// otherwise (random flights included).
+std::string DefaultScene(const RealismOptions& realism, const std::filesystem::path& trajectory);
 
 struct SimulationSummary {
   std::string layout;  // "euroc" | "tum_rgbd" | "bench" | "reference"
@@ -89,6 +104,8 @@ struct SimulationSummary {
   double total_seconds = 0.0;       // wall time of the frame loop including image files
   std::size_t cloud_points = 0;
   std::size_t observed_points = 0;  // reference_observed.ply
+  double mean_exposure_ms = 0.0;    // exposure model on: mean exposure of the frames
+  double saturated_share = 0.0;     // share of cam0 pixels at 255 (mean over frames)
   SceneBuildReport scene;
 };
 

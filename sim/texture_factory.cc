@@ -141,6 +141,61 @@ MipTexture BuildChecker(const TextureSpec& spec, bool colour) {
   return Finish(grey, {}, colour, false);
 }
 
+// Padded fabric: each channel bulges (lit centre, shaded flanks) between narrow seams, over a
+// faint weave of the finest noise octaves. Channels run along the texture's v axis.
+cv::Mat Quilted(const TextureSpec& spec, int max_cells, Rng* rng) {
+  const int n = spec.size;
+  const cv::Mat weave = Fbm(n, std::max(n / 8, 4), max_cells, 0.9, rng);
+  const cv::Mat lumps = Fbm(n, std::max(spec.base_cells, 2), std::max(n / 32, 4), 0.6, rng);
+  cv::Mat grey(n, n, CV_32F);
+  const double period = static_cast<double>(n) / std::min(spec.stripes, std::max(n / 4, 1));
+  const double seam_width = std::max(1.0, 0.04 * period);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      const double u = std::fmod(x + 0.5, period) / period;  // 0..1 across a channel
+      const double bulge = 0.5 - 0.5 * std::cos(2.0 * M_PI * u);  // 0 at the seams
+      const double to_seam = std::min(u, 1.0 - u) * period;
+      const double seam = std::exp(-0.5 * (to_seam / seam_width) * (to_seam / seam_width));
+      const double shade = 0.85 + 0.15 * bulge - spec.seam_depth * seam;
+      grey.at<float>(y, x) = static_cast<float>(
+          0.5 * shade + spec.contrast * (weave.at<float>(y, x) + 0.5 * lumps.at<float>(y, x)));
+    }
+  }
+  return grey;
+}
+
+// Dark tape with bright flakes: small rotated rectangles of random size, wrapped at the
+// borders so the texture tiles.
+cv::Mat Confetti(const TextureSpec& spec, Rng* rng) {
+  const int n = spec.size;
+  cv::Mat grey(n, n, CV_32F, cv::Scalar(0.07));
+  const cv::Mat grain = Fbm(n, std::max(n / 16, 4), n / 2, 0.8, rng);
+  grey += 0.015 * grain;
+  for (int i = 0; i < spec.flakes; ++i) {
+    const double cx = rng->Uniform(0, n);
+    const double cy = rng->Uniform(0, n);
+    const double length = spec.flake_size * n * rng->Uniform(0.5, 1.5);
+    const double width = length * rng->Uniform(0.25, 0.6);
+    const double angle = rng->Uniform(0.0, 180.0);
+    const double level = rng->Uniform(0.75, 0.95);
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const cv::RotatedRect r(cv::Point2f(static_cast<float>(cx + dx * n),
+                                            static_cast<float>(cy + dy * n)),
+                                cv::Size2f(static_cast<float>(length), static_cast<float>(width)),
+                                static_cast<float>(angle));
+        cv::Point2f corners[4];
+        r.points(corners);
+        std::vector<cv::Point> poly;
+        for (const auto& c : corners) poly.emplace_back(cv::Point(static_cast<int>(c.x * 16),
+                                                                  static_cast<int>(c.y * 16)));
+        cv::fillConvexPoly(grey, poly, cv::Scalar(level), cv::LINE_AA, 4);
+      }
+    }
+  }
+  return grey;
+}
+
 }  // namespace
 
 void TextureSpec::Check() const {
@@ -152,6 +207,12 @@ void TextureSpec::Check() const {
   PKSLAM_CHECK_OPTION(max_cells == 0 || IsPowerOfTwo(max_cells), "texture.max_cells", "{}",
                       max_cells);
   PKSLAM_CHECK_OPTION(speckle >= 0.0, "texture.speckle", "{}", speckle);
+  PKSLAM_CHECK_OPTION(stripes >= 1 && stripes <= 1024, "texture.stripes", "{}", stripes);
+  PKSLAM_CHECK_OPTION(seam_depth >= 0.0 && seam_depth <= 1.0, "texture.seam_depth", "{}",
+                      seam_depth);
+  PKSLAM_CHECK_OPTION(flakes >= 0 && flakes <= 100000, "texture.flakes", "{}", flakes);
+  PKSLAM_CHECK_OPTION(flake_size > 0.0 && flake_size <= 0.25, "texture.flake_size", "{}",
+                      flake_size);
   PKSLAM_CHECK_OPTION(checker_cols >= 2 && checker_rows >= 2 && checker_square_px >= 2,
                       "texture.checker", "{}x{} squares of {} px", checker_cols, checker_rows,
                       checker_square_px);
@@ -225,6 +286,14 @@ MipTexture BuildTexture(const TextureSpec& spec, const std::filesystem::path& ph
       const cv::Mat noise =
           Fbm(n, spec.base_cells, std::min(max_cells, spec.base_cells * 4), 0.5, &rng);
       const cv::Mat grey = 0.5 + spec.contrast * noise;
+      return Finish(grey, colour ? Tinted(grey, spec.tint) : cv::Mat(), colour, true);
+    }
+    case TextureKind::kQuilted: {
+      const cv::Mat grey = Quilted(spec, max_cells, &rng);
+      return Finish(grey, colour ? Tinted(grey, spec.tint) : cv::Mat(), colour, true);
+    }
+    case TextureKind::kConfetti: {
+      const cv::Mat grey = Confetti(spec, &rng);
       return Finish(grey, colour ? Tinted(grey, spec.tint) : cv::Mat(), colour, true);
     }
     case TextureKind::kNoise:

@@ -18,7 +18,9 @@ enum class TextureKind {
   kNoise,       // multi-octave value noise (+ optional speckle)
   kWeak,        // low-contrast, low-frequency noise only (hard case for feature trackers)
   kRepetitive,  // one motif repeated on a regular grid (hard case: ambiguous matches)
-  kChecker      // black/white checkerboard with a one-square white border, not tiled
+  kChecker,     // black/white checkerboard with a one-square white border, not tiled
+  kQuilted,     // foam mat / padded fabric: faint weave, padded channels between soft seams
+  kConfetti     // dark tape strewn with small bright flakes (EuRoC's floor markers)
 };
 
 struct TextureSpec {
@@ -34,6 +36,10 @@ struct TextureSpec {
   int checker_cols = 9;        // kChecker: squares across (inner corners: cols-1)
   int checker_rows = 7;        // kChecker: squares down (inner corners: rows-1)
   int checker_square_px = 64;  // kChecker: texels per square (a power of two keeps mips exact)
+  int stripes = 8;             // kQuilted: padded channels across the texture
+  double seam_depth = 0.25;    // kQuilted: darkening at a seam (0..1)
+  int flakes = 300;            // kConfetti: flakes per texture
+  double flake_size = 0.02;    // kConfetti: flake length as a fraction of the texture side
   std::uint64_t seed = 1;
 
   void Check() const;

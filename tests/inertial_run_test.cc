@@ -28,7 +28,7 @@ TEST(InertialRun, StereoInertialSimulatedReplayMeetsAteBar) {
   const auto out = dir / "out";
   const auto sim = RunPkslam(
       fmt::format("--log-level warn simulate --out '{}' --trajectory '{}' --start 5 --duration 8 "
-                  "--quality fast --quiet --no-cloud --gyro-bias 0.002,-0.003,0.001 "
+                  "--quality fast --quiet --no-cloud --realism ideal --gyro-bias 0.002,-0.003,0.001 "
                   "--accel-bias 0.05,-0.03,0.04",
                   seq.string(), (shared / "euroc/groundtruth/V1_02_medium.txt").string()));
   ASSERT_EQ(sim.exit_code, 0) << sim.output;

@@ -72,7 +72,8 @@ TEST(LoopClosingEndToEnd, TwoLapsCloseTheLoopInOneMap) {
   const auto dir = testing::MakeTempDir("loop_e2e");
   WriteCircleTrajectory(dir / "circle.txt", 0.8, 7.0, 2.0);
   const auto sim = RunPkslam(fmt::format(
-      "--log-level warn simulate --out '{}' --trajectory '{}' --quality fast --quiet --no-cloud",
+      "--log-level warn simulate --out '{}' --trajectory '{}' --quality fast --quiet --no-cloud "
+      "--realism ideal",
       (dir / "seq").string(), (dir / "circle.txt").string()));
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
 

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/util/error.h"
+#include "evaluation/bench/peer_import.h"
 #include "evaluation/bench/process.h"
 #include "evaluation/bench/run_evaluation.h"
 
@@ -255,17 +256,24 @@ std::optional<RunResult> ExecuteRun(const Suite& suite, const RunSpec& run,
   std::vector<std::string> argv = {options.pkslam.string()};
   const auto args = RunArguments(suite, run, dataset, run_dir);
   argv.insert(argv.end(), args.begin(), args.end());
-  const fs::path log = run_dir / "pkslam.log";
+  const bool peer = !run.peer_command.empty();
+  if (peer) {
+    argv = PeerArguments(run.peer_command, dataset, run.sensor, run_dir, run.seed,
+                         fs::absolute(suite.file).parent_path());
+  }
+  const fs::path log = run_dir / (peer ? "peer.log" : "pkslam.log");
   std::ofstream(run_dir / "command.txt") << ShellCommand(argv) << '\n';
   const ProcessResult p = RunProcess(argv, log, suite.timeout_s, cancel);
   if (cancel != nullptr && cancel->load()) return std::nullopt;
   if (!p.ok()) {
-    result.error = fmt::format("pkslam run {}: {}", p.Describe(), LastLine(log));
+    result.error = fmt::format("{} {}: {}", peer ? run.config : "pkslam run", p.Describe(),
+                               LastLine(log));
     result.wall_s = p.wall_s;
     WriteResult(run_dir, result);
     return result;
   }
   try {
+    if (peer) ImportPeerRun(run_dir, dataset, run.sensor);
     const DatasetSpec& d = DatasetOf(suite, run);
     EvaluateRun({run_dir, dataset, d.ground_truth, suite.rpe_delta_m}, &result);
   } catch (const Error& e) {

@@ -15,13 +15,14 @@ struct Config {
   std::string sweep_param;
   double sweep_value = 0.0;
   bool dense = false;
+  std::vector<std::string> peer_command;
 };
 
 // The configurations run on `dataset`: the suite's selectors, then the sweep points.
 std::vector<Config> Configurations(const Suite& suite, const std::string& dataset) {
   std::vector<Config> out;
   for (const auto& sel : suite.selectors) {
-    Config c{sel.label, sel.name, suite.params, "", 0.0, suite.dense};
+    Config c{sel.label, sel.name, suite.params, "", 0.0, suite.dense, {}};
     for (const auto& [k, v] : sel.params) c.params[k] = v;
     out.push_back(c);
   }
@@ -41,11 +42,19 @@ std::vector<Config> Configurations(const Suite& suite, const std::string& datase
                suite.params,
                sw.param,
                v,
-               suite.dense || sw.dense};
+               suite.dense || sw.dense,
+               {}};
       for (const auto& [k, x] : base->params) c.params[k] = x;
       c.params[sw.param] = v;
       out.push_back(c);
     }
+  }
+  for (const auto& peer : suite.peers) {
+    Config c;
+    c.label = peer.label;
+    c.selector = "peer";
+    c.peer_command = peer.command;
+    out.push_back(c);
   }
   return out;
 }
@@ -85,6 +94,7 @@ std::vector<RunSpec> ExpandSuite(const Suite& suite) {
           r.sweep_param = c.sweep_param;
           r.sweep_value = c.sweep_value;
           r.dense = c.dense;
+          r.peer_command = c.peer_command;
           r.run = k;
           r.seed = suite.seed + static_cast<std::uint64_t>(k);
           if (d.sim) {

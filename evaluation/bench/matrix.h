@@ -28,6 +28,9 @@ struct RunSpec {
   int run = 0;         // 0 .. runs-1
   std::uint64_t seed = 0;
   std::optional<SimRecipe> sim;  // with the seed of this run's rendering
+  // A peer system's run: its command (placeholders not yet substituted, see PeerSpec);
+  // empty for `pkslam run`.
+  std::vector<std::string> peer_command;
 };
 
 // "a=1;b=0.5" (sorted by name; numbers in shortest round-trip form).

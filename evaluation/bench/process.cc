@@ -52,7 +52,8 @@ ProcessResult RunProcess(const std::vector<std::string>& argv, const std::filesy
   args.push_back(nullptr);
   pid_t pid = 0;
   const auto start = Clock::now();
-  const int rc = posix_spawn(&pid, argv[0].c_str(), &actions, &attr, args.data(), environ);
+  // posix_spawnp: a bare program name (bash, python3) is looked up on PATH.
+  const int rc = posix_spawnp(&pid, argv[0].c_str(), &actions, &attr, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
   if (rc != 0) throw Error(fmt::format("cannot start {}: {}", argv[0], std::strerror(rc)));
@@ -72,11 +73,11 @@ ProcessResult RunProcess(const std::vector<std::string>& argv, const std::filesy
     const bool cancelled = cancel != nullptr && cancel->load();
     if (!terminated && (Seconds(start) > timeout_s || cancelled)) {
       result.timed_out = !cancelled;
-      kill(pid, SIGTERM);
+      kill(-pid, SIGTERM);  // the child's whole process group (scripts run programs)
       terminated = true;
       term_sent = Clock::now();
     } else if (terminated && Seconds(term_sent) > 5.0) {
-      kill(pid, SIGKILL);
+      kill(-pid, SIGKILL);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }

@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <map>
+#include <type_traits>
 
 #include "core/util/error.h"
 #include "evaluation/bench/bias_evaluation.h"
@@ -37,6 +38,10 @@ StatsJson ReadStats(const fs::path& file) {
   auto get = [&](const char* key, auto fallback) {
     using T = decltype(fallback);
     if (!root[key]) throw InputError(file, std::string("no '") + key + "' field");
+    // A measure the run could not take is null (JSON has no NaN).
+    if constexpr (std::is_floating_point_v<T>) {
+      if (root[key].IsNull()) return static_cast<T>(kNaN);
+    }
     try {
       return root[key].as<T>();
     } catch (const YAML::Exception&) {

@@ -184,6 +184,19 @@ SelectorSpec ParseSelector(const Context& c, const YAML::Node& node) {
   return s;
 }
 
+PeerSpec ParsePeer(const Context& c, const YAML::Node& node) {
+  CheckKeys(c, node, "a peer", {"label", "command"});
+  if (!node["label"] || !node["command"]) c.Fail(node, "a peer needs 'label' and 'command'");
+  PeerSpec p;
+  p.label = String(c, node["label"], "label");
+  if (p.label.empty() || p.label.find_first_of("/\\ \t@") != std::string::npos) {
+    c.Fail(node, "peer label '" + p.label + "' must be non-empty without '/', '@' or spaces");
+  }
+  p.command = StringList(c, node["command"], "command");
+  if (p.command.empty() || p.command.front().empty()) c.Fail(node, "peer command is empty");
+  return p;
+}
+
 SweepSpec ParseSweep(const Context& c, const YAML::Node& node) {
   CheckKeys(c, node, "a sweep", {"selector", "param", "values", "datasets", "dense"});
   SweepSpec s;
@@ -216,6 +229,11 @@ void Validate(const Context& c, const YAML::Node& root, Suite& s) {
   for (const auto& sel : s.selectors) {
     if (!labels.insert(sel.label).second) {
       c.Fail(root["selectors"], "selector label '" + sel.label + "' repeats: give 'label'");
+    }
+  }
+  for (const auto& peer : s.peers) {
+    if (!labels.insert(peer.label).second) {
+      c.Fail(root["peers"], "peer label '" + peer.label + "' repeats a selector or peer label");
     }
   }
   for (const auto& sw : s.sweeps) {
@@ -274,7 +292,7 @@ Suite ParseSuite(const std::string& text, const fs::path& file) {
   if (!root || root.IsNull()) throw InputError(file, "empty suite");
   CheckKeys(c, root, "the suite",
             {"name", "runs", "seed", "deterministic", "dense", "baseline", "alignment", "timeout_s",
-             "rpe_delta_m", "sensors", "selectors", "params", "sweeps", "datasets"});
+             "rpe_delta_m", "sensors", "selectors", "peers", "params", "sweeps", "datasets"});
   Suite s;
   s.file = file;
   s.name = root["name"] ? String(c, root["name"], "name") : file.stem().string();
@@ -298,6 +316,11 @@ Suite ParseSuite(const std::string& text, const fs::path& file) {
     const YAML::Node sel = root["selectors"];
     if (!sel.IsSequence()) c.Fail(sel, "'selectors' must be a list");
     for (const auto& n : sel) s.selectors.push_back(ParseSelector(c, n));
+  }
+  if (root["peers"]) {
+    const YAML::Node peers = root["peers"];
+    if (!peers.IsSequence()) c.Fail(peers, "'peers' must be a list");
+    for (const auto& n : peers) s.peers.push_back(ParsePeer(c, n));
   }
   if (root["params"]) s.params = Params(c, root["params"]);
   if (root["sweeps"]) {

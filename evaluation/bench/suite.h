@@ -14,6 +14,9 @@
 //   dense: false                # build a dense cloud of every run (pkslam dense)
 //   sweeps: [{selector: pks, param: delta, values: [10, 20, 30, 40], datasets: [V101],
 //             dense: true}]     # dense clouds for the sweep's runs (the paper's Eq. 13)
+//   peers:                      # other SLAM systems run on the same datasets (peer_import.h)
+//     - {label: orbslam3-peer, command: [bash, "{suite_dir}/../peer/run_peer.sh", "{dataset}",
+//        "{sensor}", "{out}"]}
 //   datasets:
 //     - {name: MH_01_easy, path: ${EUROC_ROOT}/MH_01_easy}         # real data on disk
 //     - {name: sim_V102, sim: {trajectory: ..., start: 20, duration: 10, args: [...]}}
@@ -76,6 +79,15 @@ struct SweepSpec {
   bool dense = false;
 };
 
+// Another SLAM system, run as a command on each dataset and sensor of the suite (`runs` times,
+// the repeats differing only in thread timing). The command's words may use {dataset} (the
+// dataset folder), {sensor}, {out} (the run folder), {seed} and {suite_dir} (the suite file's
+// folder); the program writes the peer output contract of peer_import.h into {out}.
+struct PeerSpec {
+  std::string label;  // its column in the tables (unique among selectors and peers)
+  std::vector<std::string> command;
+};
+
 struct Suite {
   std::filesystem::path file;  // where it was read from (for messages)
   std::string name;
@@ -91,6 +103,7 @@ struct Suite {
   std::string alignment = "auto";
   std::vector<std::string> sensors;
   std::vector<SelectorSpec> selectors;
+  std::vector<PeerSpec> peers;
   std::map<std::string, double> params;
   std::vector<SweepSpec> sweeps;
   std::vector<DatasetSpec> datasets;

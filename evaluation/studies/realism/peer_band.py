@@ -1,0 +1,83 @@
+#!/usr/bin/python3
+"""Reads the results.csv of evaluation/suites/realism.yaml and prints, per trajectory and sensor,
+each system's median ATE (SE(3), m) over its runs, coverage and failures, the peer's ratio to
+its published real-EuRoC ATE (the preset's bar: 0.5x to 2x) and pkslam's ratio to the peer.
+
+  /usr/bin/python3 evaluation/studies/realism/peer_band.py bench-realism/results.csv [--md OUT.md]
+"""
+import argparse
+import csv
+import statistics
+import sys
+from collections import defaultdict
+
+# ORB-SLAM3 paper (arXiv v1), real EuRoC, ATE RMSE (m).
+PUBLISHED = {
+    'stereo-inertial': {'MH_01': .037, 'MH_02': .031, 'V1_01': .037, 'V1_02': .014, 'V2_01': .037},
+    'mono-inertial': {'MH_01': .032, 'MH_02': .053, 'V1_01': .043, 'V1_02': .016, 'V2_01': .041},
+}
+PEER = 'orbslam3-peer'
+
+
+def sequence_key(dataset):
+    for key in PUBLISHED['stereo-inertial']:
+        if key in dataset:
+            return key
+    return None
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('results')
+    ap.add_argument('--md', help='also write the table as markdown here')
+    args = ap.parse_args()
+    runs = defaultdict(list)
+    with open(args.results) as f:
+        for row in csv.DictReader(f):
+            runs[(row['dataset'], row['sensor'], row['config'])].append(row)
+    configs = sorted({k[2] for k in runs}, key=lambda c: (c != PEER, c))
+    lines = ['| sequence | sensor | published | ' +
+             ' | '.join(f'{c} ATE (cov., fails)' for c in configs) +
+             ' | peer / published | in band | ' +
+             ' | '.join(f'{c} / peer' for c in configs if c != PEER) + ' |']
+    lines.append('|' + '---|' * (5 + 2 * len(configs) - 1))
+    in_band = 0
+    checked = 0
+    for dataset, sensor in sorted({(k[0], k[1]) for k in runs}):
+        key = sequence_key(dataset)
+        published = PUBLISHED.get(sensor, {}).get(key)
+        medians = {}
+        cells = []
+        for c in configs:
+            rows = runs.get((dataset, sensor, c), [])
+            ok = [r for r in rows if r['status'] == 'ok' and r['ate_se3_rmse_m']]
+            fails = len(rows) - len(ok)
+            if ok:
+                medians[c] = statistics.median(float(r['ate_se3_rmse_m']) for r in ok)
+                cov = statistics.median(float(r['coverage']) for r in ok)
+                cells.append(f'{medians[c]:.4f} ({100 * cov:.0f}%, {fails})')
+            else:
+                cells.append(f'- ({fails} failed)' if rows else '')
+        peer = medians.get(PEER)
+        ratio = peer / published if peer is not None and published else None
+        band = ratio is not None and 0.5 <= ratio <= 2.0
+        if ratio is not None:
+            checked += 1
+            in_band += band
+        rel = [f'{medians[c] / peer:.2f}' if c in medians and peer else ''
+               for c in configs if c != PEER]
+        lines.append(f'| {dataset} | {sensor} | {published if published else ""} | ' +
+                     ' | '.join(cells) +
+                     f' | {ratio:.2f} |' if ratio is not None else ' |  |')
+        lines[-1] += (' yes |' if band else ' no |') + ' ' + ' | '.join(rel) + ' |'
+    lines.append(f'\npeer within 0.5x-2x of its published value: {in_band} of {checked}')
+    text = '\n'.join(lines)
+    print(text)
+    if args.md:
+        with open(args.md, 'w') as f:
+            f.write(text + '\n')
+
+
+if __name__ == '__main__':
+    sys.exit(main())
