@@ -178,5 +178,59 @@ TEST(BenchCli, BadSuitesAreOneErrorLineWithFileAndLine) {
   EXPECT_THAT(Lines(dir / "out/results.csv").at(1), HasSubstr("no_such_dir is not a directory"));
 }
 
+// A peer system (here a stand-in script that "tracks" by copying the ground truth, like
+// scripts/run_peer would write ORB-SLAM3's outputs) runs on the same rendering, is imported
+// and evaluated like pkslam; a peer that crashes is a failed run with its last log line.
+TEST(BenchCli, PeersRunBesidePkslam) {
+  const fs::path dir = testing::MakeTempDir("bench_peer");
+  {
+    std::ofstream script(dir / "fake_peer.sh");
+    script << "set -e\nout=$3\nmkdir -p \"$out\"\n"
+              "if [ \"$2\" = stereo ]; then echo 'peer: crashed' >&2; exit 3; fi\n"
+              "awk -F, '!/^#/ && NR % 20 == 2 {printf \"%.9f %s %s %s %s %s %s %s\\n\", $1/1e9, "
+              "$2, $3, $4, $6, $7, $8, $5}' \"$1/mav0/state_groundtruth_estimate0/data.csv\" "
+              "> \"$out/traj_tum.txt\"\nhead -3 \"$out/traj_tum.txt\" > \"$out/kf_tum.txt\"\n"
+              "echo 'exit_status=0 wall_s=0.50' > \"$out/summary.txt\"\n";
+  }
+  {
+    std::ofstream suite(dir / "peer.yaml");
+    suite << "name: peer\nruns: 1\nseed: 1\ndeterministic: true\ntimeout_s: 300\n"
+             "sensors: [stereo-inertial, stereo]\nselectors: [orbslam3]\n"
+             "peers:\n  - {label: fake-peer, command: [/bin/sh, \"{suite_dir}/fake_peer.sh\", "
+             "\"{dataset}\", \"{sensor}\", \"{out}\"]}\n"
+             "datasets:\n  - name: flight\n    sim: {motion: medium, duration: 3, seed: 5, "
+             "quality: fast, args: [--no-cloud]}\n";
+  }
+  const auto r = RunPkslam(fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --quiet",
+                                       (dir / "peer.yaml").string(), (dir / "out").string(),
+                                       (dir / "cache").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("4 runs: 4 executed, 0 already finished, 1 failed"));
+  const auto rows = Lines(dir / "out/results.csv");
+  ASSERT_EQ(rows.size(), 5u);
+  const auto header = Fields(rows[0]);
+  const auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  int peers_ok = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const auto f = Fields(rows[i]);
+    if (f[column("config")] != "fake-peer") continue;
+    if (f[column("sensor")] == "stereo") {
+      EXPECT_EQ(f[column("status")], "failed") << rows[i];
+      EXPECT_THAT(rows[i], HasSubstr("peer: crashed"));
+      continue;
+    }
+    EXPECT_EQ(f[column("status")], "ok") << rows[i];
+    EXPECT_LT(std::stod(f[column("ate_se3_rmse_m")]), 1e-6) << rows[i];  // the truth itself
+    EXPECT_NEAR(std::stod(f[column("coverage")]), 0.5, 0.05) << rows[i];  // every 2nd frame
+    EXPECT_EQ(f[column("keyframes")], "3");
+    ++peers_ok;
+  }
+  EXPECT_EQ(peers_ok, 1);
+  EXPECT_TRUE(fs::exists(dir / "out/runs/flight/stereo-inertial/fake-peer/seed1/stats.json"));
+  EXPECT_TRUE(fs::exists(dir / "out/report.md"));
+}
+
 }  // namespace
 }  // namespace pkslam

@@ -1,6 +1,6 @@
 // Benchmark suites: which datasets, sensors, keyframe selectors, parameter sweeps and how many
-// runs `pkslam bench` executes. A suite is a YAML file (see evaluation/suites/*.yaml and the
-// README section on `pkslam bench`):
+// runs `pkslam bench` executes. A suite is a YAML file (see evaluation/suites/*.yaml and
+// docs/bench.md):
 //
 //   name: smoke                 # shown in the report
 //   runs: 10                    # runs per configuration (distinct seeds seed, seed+1, ...)

@@ -179,5 +179,35 @@ TEST(Matrix, FormatsNumbersShortestRoundTrip) {
   EXPECT_EQ(FormatParams({{"b", 1.5}, {"a", 2}}), "a=2;b=1.5");
 }
 
+// Peers are extra configurations: one per dataset x sensor x run, with their command.
+TEST(Suite, PeersExpandIntoTheMatrix) {
+  const std::string text = R"(runs: 2
+sensors: [stereo-inertial]
+selectors: [orbslam3]
+peers:
+  - {label: orbslam3-peer, command: [bash, "{suite_dir}/run_peer", "{dataset}", "{sensor}", "{out}"]}
+datasets:
+  - {name: a, path: /data/a}
+)";
+  const Suite s = ParseSuite(text, "dir/suite.yaml");
+  ASSERT_EQ(s.peers.size(), 1u);
+  EXPECT_EQ(s.peers[0].command.size(), 5u);
+  const auto runs = ExpandSuite(s);
+  ASSERT_EQ(runs.size(), 4u);  // (orbslam3 + peer) x 2 runs
+  EXPECT_TRUE(runs[0].peer_command.empty());
+  EXPECT_EQ(runs[2].config, "orbslam3-peer");
+  EXPECT_EQ(runs[2].selector, "peer");
+  EXPECT_EQ(runs[2].peer_command, s.peers[0].command);
+  EXPECT_EQ(runs[3].id, "a/stereo-inertial/orbslam3-peer/seed2");
+}
+
+TEST(Suite, BadPeersAreErrors) {
+  const std::string head = "sensors: [stereo]\nselectors: [orbslam3]\ndatasets: [{name: a, path: /a}]\n";
+  ExpectError(head + "peers:\n  - {label: x}\n", 5, "needs 'label' and 'command'");
+  ExpectError(head + "peers:\n  - {label: orbslam3, command: [x]}\n", 5, "repeats");
+  ExpectError(head + "peers:\n  - {label: 'a b', command: [x]}\n", 5, "without");
+  ExpectError(head + "peers:\n  - {label: p, command: [x], extra: 1}\n", 5, "unknown key");
+}
+
 }  // namespace
 }  // namespace pkslam::bench
