@@ -45,9 +45,9 @@ Eigen::Vector3d ToVector(const std::vector<double>& v, const char* name) {
 // named), sources switched off, sizes overridden.
 sim::RealismOptions ResolveRealism(const SimulateArgs& a) {
   const bool replay = !a.trajectory.empty() && !a.options.rgbd;
-  const sim::RealismPreset preset = a.realism.empty() ? (replay ? sim::RealismPreset::kEuroc
-                                                                : sim::RealismPreset::kIdeal)
-                                                      : sim::ParseRealismPreset(a.realism);
+  const sim::RealismPreset preset =
+      a.realism.empty() ? (replay ? sim::RealismPreset::kEuroc : sim::RealismPreset::kIdeal)
+                        : sim::ParseRealismPreset(a.realism);
   if (preset == sim::RealismPreset::kEuroc && a.options.rgbd) {
     throw OptionError(
         "--realism euroc models the EuRoC VI-Sensor (stereo + IMU); use --realism ideal with "

@@ -17,8 +17,8 @@ namespace pkslam::sim {
 
 // Deterministic errors a factory-calibrated MEMS IMU keeps (see sim/realism.h for their sizes).
 struct ImuSensorErrors {
-  Eigen::Matrix3d gyro_matrix = Eigen::Matrix3d::Identity();   // scale factor + misalignment
-  Eigen::Matrix3d accel_matrix = Eigen::Matrix3d::Identity();  // scale factor + misalignment
+  Eigen::Matrix3d gyro_matrix = Eigen::Matrix3d::Identity();     // scale factor + misalignment
+  Eigen::Matrix3d accel_matrix = Eigen::Matrix3d::Identity();    // scale factor + misalignment
   Eigen::Matrix3d gyro_g_sensitivity = Eigen::Matrix3d::Zero();  // rad/s per m/s^2
   double gyro_quantum = 0.0;   // output resolution, rad/s (0: none); applied last
   double accel_quantum = 0.0;  // output resolution, m/s^2 (0: none)

@@ -9,6 +9,7 @@
 #include "sim/euroc_writer.h"
 #include "sim/motion_generator.h"
 #include "sim/scene_builder.h"
+#include "sim/sim_testing.h"
 #include "tests/support/test_data.h"
 
 namespace pkslam::sim {
@@ -126,13 +127,7 @@ TEST(ImuSimulator, NoiseFreeImuIntegratesToTheGroundTruthReplay) {
 }
 
 TEST(ImuSimulator, NoiseFreeImuIntegratesToTheGroundTruthDifficultFlight) {
-  SceneBuildOptions so;
-  so.texture_size = 16;
-  const Scene scene = BuildScene(LoadSceneDescription("vicon_room"), so, {});
-  MotionOptions mo;
-  mo.level = MotionLevel::kDifficult;
-  mo.duration_s = 13;
-  const SplineTrajectory traj = GenerateMotion(scene, mo, EurocCam0().body_from_camera, 5, 0);
+  const SplineTrajectory traj = RandomTestFlight(MotionLevel::kDifficult, 13, 5);
   CheckIntegration(traj, 2'000'000'000, "difficult random flight");
 }
 
@@ -173,7 +168,8 @@ TEST(ImuSimulator, NoiseDensitiesAndRandomWalksMatchTheConfiguration) {
   double g_std = 0, a_std = 0;
   std::size_t n_samples = 0;
   for (int run = 0; run < 10; ++run) {
-    const auto imu = SimulateImu(BodyMotion(traj), 0, static_cast<std::int64_t>(seconds * 1e9), o, 100 + run);
+    const auto imu =
+        SimulateImu(BodyMotion(traj), 0, static_cast<std::int64_t>(seconds * 1e9), o, 100 + run);
     std::vector<Eigen::Vector3d> eg, ea;
     eg.reserve(imu.size());
     ea.reserve(imu.size());
@@ -257,14 +253,7 @@ TEST(ImuSimulator, BiasesVibrationAndDeterminism) {
 // Scale factors, misalignment and g-sensitivity act on the true rate and specific force as
 // documented (gyro = M_g w + G f + b, accel = M_a f + b), and quantisation rounds to LSBs.
 TEST(ImuSimulator, SensorErrorsFollowTheErrorModel) {
-  const SceneDescription description = LoadSceneDescription("vicon_room");
-  SceneBuildOptions build;
-  build.texture_size = 64;
-  const Scene scene = BuildScene(description, build, {});
-  MotionOptions mo;
-  mo.level = MotionLevel::kDifficult;
-  mo.duration_s = 4.0;
-  const SplineTrajectory traj = GenerateMotion(scene, mo, EurocCam0().body_from_camera, 5, 0);
+  const SplineTrajectory traj = RandomTestFlight(MotionLevel::kDifficult, 4.0, 5);
   ImuOptions o;
   o.noise = false;
   o.initial_gyro_bias = Eigen::Vector3d(0.01, -0.02, 0.003);
@@ -276,8 +265,8 @@ TEST(ImuSimulator, SensorErrorsFollowTheErrorModel) {
   for (const auto& s : imu) {
     Eigen::Vector3d w, f;
     IdealImu(traj.State(s.t_ns), o.gravity, &w, &f);
-    const Eigen::Vector3d gyro = o.errors.gyro_matrix * w + o.errors.gyro_g_sensitivity * f +
-                                 o.initial_gyro_bias;
+    const Eigen::Vector3d gyro =
+        o.errors.gyro_matrix * w + o.errors.gyro_g_sensitivity * f + o.initial_gyro_bias;
     const Eigen::Vector3d accel = o.errors.accel_matrix * f;
     worst = std::max({worst, (gyro - s.gyro).norm(), (accel - s.accel).norm()});
   }

@@ -70,8 +70,8 @@ void CalibrationErrorOptions::Check() const {
 }
 
 void TimingErrorOptions::Check() const {
-  PKSLAM_CHECK_OPTION(std::abs(camera_imu_offset_ms) <= 100.0, "timing.camera_imu_offset_ms",
-                      "{}", camera_imu_offset_ms);
+  PKSLAM_CHECK_OPTION(std::abs(camera_imu_offset_ms) <= 100.0, "timing.camera_imu_offset_ms", "{}",
+                      camera_imu_offset_ms);
   PKSLAM_CHECK_OPTION(jitter_ms >= 0 && jitter_ms <= 10.0, "timing.jitter_ms", "{}", jitter_ms);
 }
 
@@ -97,12 +97,12 @@ void ImuErrorOptions::Check() const {
 }
 
 void MotionRealismOptions::Check() const {
-  PKSLAM_CHECK_OPTION(position_knot_s >= 0.005 && position_knot_s <= 1.0,
-                      "motion.position_knot_s", "{}", position_knot_s);
-  PKSLAM_CHECK_OPTION(rotation_knot_s >= 0.005 && rotation_knot_s <= 1.0,
-                      "motion.rotation_knot_s", "{}", rotation_knot_s);
-  PKSLAM_CHECK_OPTION(vibration_scale >= 0 && vibration_scale <= 10, "motion.vibration_scale",
-                      "{}", vibration_scale);
+  PKSLAM_CHECK_OPTION(position_knot_s >= 0.005 && position_knot_s <= 1.0, "motion.position_knot_s",
+                      "{}", position_knot_s);
+  PKSLAM_CHECK_OPTION(rotation_knot_s >= 0.005 && rotation_knot_s <= 1.0, "motion.rotation_knot_s",
+                      "{}", rotation_knot_s);
+  PKSLAM_CHECK_OPTION(vibration_scale >= 0 && vibration_scale <= 10, "motion.vibration_scale", "{}",
+                      vibration_scale);
 }
 
 void GroundTruthErrorOptions::Check() const {
@@ -216,14 +216,15 @@ const std::vector<ParameterRow>& ParameterTable() {
        "measured", "cam1 / cam0 level at the same scene points of the real static pairs"},
       {S::kAppearance, "appearance.vignetting",
        [](RealismOptions& r) -> double& { return r.appearance.vignetting; }, "at 45 deg",
-       "0.14-0.43", "Basalt's EuRoC vignette (0.72 at 500 px); stereo-matched real pairs: 0.59 in "
+       "0.14-0.43",
+       "Basalt's EuRoC vignette (0.72 at 500 px); stereo-matched real pairs: 0.59 in "
        "the corners (sensor_noise.py)"},
       {S::kAppearance, "appearance.target_brightness",
        [](RealismOptions& r) -> double& { return r.appearance.target_brightness; }, "of 255",
        "measured", "mean level of the real static frames, window included (145.6 DN)"},
       {S::kAppearance, "appearance.max_exposure_ms",
-       [](RealismOptions& r) -> double& { return r.appearance.max_exposure_ms; }, "ms",
-       "3-16", "VI-Sensor driver shutter limit 100-500 rows (libvisensor, visensor_node)"},
+       [](RealismOptions& r) -> double& { return r.appearance.max_exposure_ms; }, "ms", "3-16",
+       "VI-Sensor driver shutter limit 100-500 rows (libvisensor, visensor_node)"},
       {S::kAppearance, "appearance.exposure_at_unit_gain_ms",
        [](RealismOptions& r) -> double& { return r.appearance.exposure_at_unit_gain_ms; }, "ms",
        "model", "exposure the renderer's radiance 1 needs for full scale (sets typical exposure)"},
@@ -245,7 +246,8 @@ const std::vector<ParameterRow>& ParameterTable() {
        "Kalibr sigma of p1, p2 (kalibr #502, #137)"},
       {S::kCalibration, "calibration.per_camera_fraction",
        [](RealismOptions& r) -> double& { return r.calibration.per_camera_fraction; }, "x",
-       "0.2-0.3", "VINS-Fusion's EuRoC re-calibration: cam0/cam1 differ by 0.7 px in f and "
+       "0.2-0.3",
+       "VINS-Fusion's EuRoC re-calibration: cam0/cam1 differ by 0.7 px in f and "
        "1.3 px in cx against common shifts of 2.8 and 5.2"},
       {S::kCalibration, "calibration.stereo_rotation_deg",
        [](RealismOptions& r) -> double& { return r.calibration.stereo_rotation_deg; }, "deg",
@@ -257,8 +259,8 @@ const std::vector<ParameterRow>& ParameterTable() {
        [](RealismOptions& r) -> double& { return r.calibration.imu_rotation_deg; }, "deg",
        "0.05-0.34", "Basalt's EuRoC camera-IMU rotation differs from the official by 0.34"},
       {S::kCalibration, "calibration.imu_translation_mm",
-       [](RealismOptions& r) -> double& { return r.calibration.imu_translation_mm; }, "mm",
-       "1-8", "Basalt's EuRoC camera-IMU translation differs from the official by 8"},
+       [](RealismOptions& r) -> double& { return r.calibration.imu_translation_mm; }, "mm", "1-8",
+       "Basalt's EuRoC camera-IMU translation differs from the official by 8"},
       {S::kTiming, "timing.camera_imu_offset_ms",
        [](RealismOptions& r) -> double& { return r.timing.camera_imu_offset_ms; }, "ms", "-2-2",
        "Kalibr repeatability on a hardware-triggered rig (kalibr #267); EuRoC treated as 0 by "
@@ -276,11 +278,11 @@ const std::vector<ParameterRow>& ParameterTable() {
        [](RealismOptions& r) -> double& { return r.imu.gyro_misalignment_deg; }, "deg", "0-0.05",
        "ADIS16448 datasheet: axis-to-axis alignment < 0.05"},
       {S::kImu, "imu.accel_misalignment_deg",
-       [](RealismOptions& r) -> double& { return r.imu.accel_misalignment_deg; }, "deg",
-       "0-0.05", "ADIS16448 datasheet: axis-to-axis alignment < 0.05"},
+       [](RealismOptions& r) -> double& { return r.imu.accel_misalignment_deg; }, "deg", "0-0.05",
+       "ADIS16448 datasheet: axis-to-axis alignment < 0.05"},
       {S::kImu, "imu.gyro_g_sensitivity_dps_per_g",
-       [](RealismOptions& r) -> double& { return r.imu.gyro_g_sensitivity_dps_per_g; },
-       "deg/s/g", "0-0.015", "ADIS16445 (sibling) linear-acceleration effect 0.015"},
+       [](RealismOptions& r) -> double& { return r.imu.gyro_g_sensitivity_dps_per_g; }, "deg/s/g",
+       "0-0.015", "ADIS16445 (sibling) linear-acceleration effect 0.015"},
       {S::kImu, "imu.gyro_bias_rad_s",
        [](RealismOptions& r) -> double& { return r.imu.gyro_bias_rad_s; }, "rad/s", "0.002-0.08",
        "EuRoC turn-on biases (-0.002, 0.024, 0.077) (Basalt EuRoC calibration; our V1_01 IMU)"},
@@ -288,11 +290,11 @@ const std::vector<ParameterRow>& ParameterTable() {
        [](RealismOptions& r) -> double& { return r.imu.accel_bias_m_s2; }, "m/s^2", "0.002-0.15",
        "EuRoC turn-on biases (0.002, 0.15, 0.067) (Basalt EuRoC calibration)"},
       {S::kImu, "imu.gyro_quantum_rad_s",
-       [](RealismOptions& r) -> double& { return r.imu.gyro_quantum_rad_s; }, "rad/s",
-       "6.98e-4", "VI-Sensor driver: 0.04 deg/s per LSB (libvisensor imu_adis16448.cpp)"},
+       [](RealismOptions& r) -> double& { return r.imu.gyro_quantum_rad_s; }, "rad/s", "6.98e-4",
+       "VI-Sensor driver: 0.04 deg/s per LSB (libvisensor imu_adis16448.cpp)"},
       {S::kImu, "imu.accel_quantum_m_s2",
-       [](RealismOptions& r) -> double& { return r.imu.accel_quantum_m_s2; }, "m/s^2",
-       "8.18e-3", "VI-Sensor driver: 1/1200 g per LSB"},
+       [](RealismOptions& r) -> double& { return r.imu.accel_quantum_m_s2; }, "m/s^2", "8.18e-3",
+       "VI-Sensor driver: 1/1200 g per LSB"},
       {S::kMotion, "motion.position_cutoff_hz",
        [](RealismOptions& r) -> double& { return r.motion.position_cutoff_hz; }, "Hz", "4-7",
        "twice the motion knee of the five ground truths (gt_smoothness.py); above it, "
@@ -311,14 +313,15 @@ const std::vector<ParameterRow>& ParameterTable() {
        "residual spectrum of the real V1_01 IMU in flight (imu_vibration.py)"},
       {S::kGroundTruth, "ground_truth.position_noise_mm",
        [](RealismOptions& r) -> double& { return r.ground_truth.position_noise_mm; }, "mm",
-       "0.15-2", "Vicon static 0.15 / dynamic < 2 (Merriaux et al. 2017); Leica ~1; the MH files "
+       "0.15-2",
+       "Vicon static 0.15 / dynamic < 2 (Merriaux et al. 2017); Leica ~1; the MH files "
        "step by up to 8 (gt_smoothness.py)"},
       {S::kGroundTruth, "ground_truth.rotation_noise_deg",
        [](RealismOptions& r) -> double& { return r.ground_truth.rotation_noise_deg; }, "deg",
        "0.01-0.1", "motion-capture orientation (inference)"},
       {S::kGroundTruth, "ground_truth.time_offset_ms",
-       [](RealismOptions& r) -> double& { return r.ground_truth.time_offset_ms; }, "ms",
-       "measured", "ground truth vs the real V1_01 IMU by cross-correlation (imu_vibration.py)"},
+       [](RealismOptions& r) -> double& { return r.ground_truth.time_offset_ms; }, "ms", "measured",
+       "ground truth vs the real V1_01 IMU by cross-correlation (imu_vibration.py)"},
   };
   return kTable;
 }
@@ -347,8 +350,7 @@ void SetRealismParameter(RealismOptions* options, const std::string& assignment)
   char* end = nullptr;
   const double value = std::strtod(value_text.c_str(), &end);
   if (value_text.empty() || end == nullptr || *end != '\0' || !std::isfinite(value)) {
-    throw OptionError("--realism-param " + assignment + ": '" + value_text +
-                      "' is not a number");
+    throw OptionError("--realism-param " + assignment + ": '" + value_text + "' is not a number");
   }
   SetRealismParameter(options, assignment.substr(0, eq), value);
 }
@@ -369,8 +371,8 @@ std::string FormatRealismReport(const RealismOptions& options) {
     text += fmt::format("  {:<13} {}\n", RealismSourceName(s), options.On(s) ? "on" : "off");
   }
   text += fmt::format("device seed (calibration, IMU axes): {}\n", options.device_seed);
-  text += fmt::format("{:<36} {:>10} {:<9} {:<11} {}\n", "parameter", "value", "unit",
-                      "documented", "source");
+  text += fmt::format("{:<36} {:>10} {:<9} {:<11} {}\n", "parameter", "value", "unit", "documented",
+                      "source");
   for (const RealismEntry& e : RealismReport(options)) {
     text += fmt::format("{:<36} {:>10.4g} {:<9} {:<11} {}\n", e.name, e.value, e.unit, e.range,
                         e.reference);

@@ -34,12 +34,12 @@ std::string RealismSourceName(RealismSource source);
 // moves the two cameras of a rig alike (EuRoC's re-calibrations shift cx by -4.6 and -5.9 px),
 // and stereo depth only sees the difference.
 struct CalibrationErrorOptions {
-  double focal_px = 0.0;            // fx, fy (pixels)
-  double principal_point_px = 0.0;  // cx, cy (pixels)
-  double k1 = 0.0;                  // radial k1
-  double k2 = 0.0;                  // radial k2
-  double tangential = 0.0;          // p1, p2
-  double per_camera_fraction = 0.0;  // sigma of each camera's own part / the common sigma
+  double focal_px = 0.0;               // fx, fy (pixels)
+  double principal_point_px = 0.0;     // cx, cy (pixels)
+  double k1 = 0.0;                     // radial k1
+  double k2 = 0.0;                     // radial k2
+  double tangential = 0.0;             // p1, p2
+  double per_camera_fraction = 0.0;    // sigma of each camera's own part / the common sigma
   double stereo_rotation_deg = 0.0;    // cam1 relative to cam0, per axis
   double stereo_translation_mm = 0.0;  // cam1 relative to cam0, per axis
   double imu_rotation_deg = 0.0;       // the camera rig relative to the IMU, per axis
@@ -58,13 +58,13 @@ struct TimingErrorOptions {
 };
 
 struct ImuErrorOptions {
-  double gyro_scale_pct = 0.0;           // per-axis scale-factor error (1-sigma, %)
-  double accel_scale_pct = 0.0;          // per-axis scale-factor error (1-sigma, %)
-  double gyro_misalignment_deg = 0.0;    // axis non-orthogonality, per off-diagonal (1-sigma)
-  double accel_misalignment_deg = 0.0;   // axis non-orthogonality, per off-diagonal (1-sigma)
+  double gyro_scale_pct = 0.0;                // per-axis scale-factor error (1-sigma, %)
+  double accel_scale_pct = 0.0;               // per-axis scale-factor error (1-sigma, %)
+  double gyro_misalignment_deg = 0.0;         // axis non-orthogonality, per off-diagonal (1-sigma)
+  double accel_misalignment_deg = 0.0;        // axis non-orthogonality, per off-diagonal (1-sigma)
   double gyro_g_sensitivity_dps_per_g = 0.0;  // per matrix entry (1-sigma, deg/s per g)
-  double gyro_bias_rad_s = 0.0;    // initial gyro bias per axis (1-sigma), drawn per sequence
-  double accel_bias_m_s2 = 0.0;    // initial accelerometer bias per axis (1-sigma), per sequence
+  double gyro_bias_rad_s = 0.0;     // initial gyro bias per axis (1-sigma), drawn per sequence
+  double accel_bias_m_s2 = 0.0;     // initial accelerometer bias per axis (1-sigma), per sequence
   double gyro_quantum_rad_s = 0.0;  // output resolution (0: none)
   double accel_quantum_m_s2 = 0.0;  // output resolution (0: none)
 
@@ -87,7 +87,7 @@ struct MotionRealismOptions {
 struct GroundTruthErrorOptions {
   double position_noise_mm = 0.0;   // white noise on the written positions (1-sigma, per axis)
   double rotation_noise_deg = 0.0;  // white noise on the written orientations (1-sigma, per axis)
-  double time_offset_ms = 0.0;  // the row stamped t holds the true state at t + offset
+  double time_offset_ms = 0.0;      // the row stamped t holds the true state at t + offset
 
   void Check() const;
 };
@@ -137,8 +137,8 @@ void SetRealismParameter(RealismOptions* options, const std::string& assignment)
 // One line of the realism report: an error source's size and where the size comes from.
 struct RealismEntry {
   RealismSource source;
-  std::string name;   // parameter name (SetRealismParameter)
-  double value;       // the size in use
+  std::string name;  // parameter name (SetRealismParameter)
+  double value;      // the size in use
   std::string unit;
   std::string range;  // the documented range
   std::string reference;

@@ -26,7 +26,8 @@ Eigen::Matrix3d AxisErrors(Rng* rng, double scale_pct, double misalignment_deg) 
   Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      m(i, j) += i == j ? 0.01 * scale_pct * rng->Normal() : misalignment_deg * kDeg * rng->Normal();
+      m(i, j) +=
+          i == j ? 0.01 * scale_pct * rng->Normal() : misalignment_deg * kDeg * rng->Normal();
     }
   }
   return m;
@@ -55,9 +56,9 @@ RealismDraw DrawRealism(const RealismOptions& options, const std::vector<CameraR
     const CalibrationErrorOptions& c = options.calibration;
     Rng rng(DeriveSeed(options.device_seed, 0x43414C4942));  // "CALIB"
     // fx fy cx cy k1 k2 p1 p2: one common draw, then each camera's own part.
-    const std::array<double, 8> sigma = {c.focal_px,   c.focal_px, c.principal_point_px,
-                                         c.principal_point_px, c.k1, c.k2,
-                                         c.tangential, c.tangential};
+    const std::array<double, 8> sigma = {c.focal_px,           c.focal_px,  c.principal_point_px,
+                                         c.principal_point_px, c.k1,        c.k2,
+                                         c.tangential,         c.tangential};
     std::array<double, 8> common{};
     for (int i = 0; i < 8; ++i) common[i] = sigma[i] * rng.Normal();
     for (std::size_t k = 0; k < true_cameras.size(); ++k) {
@@ -118,7 +119,8 @@ RealismDraw DrawRealism(const RealismOptions& options, const std::vector<CameraR
 }
 
 std::string RealismDrawYaml(const RealismDraw& d) {
-  std::string s = "# Errors drawn for this sequence (written calibration minus the rendering truth).\n";
+  std::string s =
+      "# Errors drawn for this sequence (written calibration minus the rendering truth).\n";
   s += "cameras:\n";
   for (std::size_t k = 0; k < d.intrinsic_errors.size(); ++k) {
     const CameraCalibrationError& e = d.intrinsic_errors[k];

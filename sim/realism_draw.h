@@ -21,7 +21,7 @@ struct CameraCalibrationError {
 };
 
 struct RealismDraw {
-  std::vector<CameraRig> written_cameras;     // the calibration SLAM reads
+  std::vector<CameraRig> written_cameras;                // the calibration SLAM reads
   std::vector<CameraCalibrationError> intrinsic_errors;  // per camera (written - true)
   Eigen::Matrix<double, 6, 1> rig_error = Eigen::Matrix<double, 6, 1>::Zero();  // [t m; rot rad]
   Eigen::Matrix<double, 6, 1> stereo_error = Eigen::Matrix<double, 6, 1>::Zero();

@@ -19,11 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Bytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 SimulationOptions EurocReplay(const fs::path& shared, const fs::path& out) {
   SimulationOptions o;
   o.output_dir = out;
@@ -107,7 +102,7 @@ TEST(RealismSimulation, WhatSlamReadsDiffersFromTheTruthByTheConfiguredErrors) {
     ++rows;
   }
   EXPECT_EQ(rows, 11);
-  EXPECT_NE(Bytes(out / "sim.yaml").find("preset: euroc"), std::string::npos);
+  EXPECT_NE(testing::ReadFileBytes(out / "sim.yaml").find("preset: euroc"), std::string::npos);
 }
 
 TEST(RealismSimulation, SameSeedSameBytes) {
@@ -120,7 +115,8 @@ TEST(RealismSimulation, SameSeedSameBytes) {
     if (!entry.is_regular_file()) continue;
     const fs::path rel = fs::relative(entry.path(), root / "a");
     if (rel == "sim.yaml") continue;  // names its output folder
-    ASSERT_EQ(Bytes(entry.path()), Bytes(root / "b" / rel)) << rel;
+    ASSERT_EQ(testing::ReadFileBytes(entry.path()), testing::ReadFileBytes(root / "b" / rel))
+        << rel;
     ++files;
   }
   EXPECT_GE(files, 38);  // 2 x 11 images, lists, IMU, ground truths, truth/ files, settings

@@ -19,14 +19,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Bytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 // Positions of a reference PLY as WriteReferenceCloud writes it (25-byte vertices).
 std::vector<Eigen::Vector3f> ReadPositions(const fs::path& file) {
-  const std::string bytes = Bytes(file);
+  const std::string bytes = testing::ReadFileBytes(file);
   const std::size_t header_end = bytes.find("end_header\n");
   EXPECT_NE(header_end, std::string::npos) << file;
   const std::size_t count_at = bytes.find("element vertex ");
@@ -67,7 +62,8 @@ TEST(ReferenceCloud, ObservedCloudIsWhatCam0SawWithinTheRange) {
   EXPECT_EQ(s.cloud_points, full.size());
   ASSERT_GT(observed.size(), 200u);
   EXPECT_LT(observed.size(), full.size() / 2);
-  EXPECT_NE(Bytes(out / "reference_observed.ply").find("comment max_depth_m 2"), std::string::npos);
+  EXPECT_NE(testing::ReadFileBytes(out / "reference_observed.ply").find("comment max_depth_m 2"),
+            std::string::npos);
 
   // Observed points are samples of the full cloud.
   std::set<std::tuple<float, float, float>> full_set;
@@ -116,8 +112,10 @@ TEST(ReferenceCloud, ObservedCloudIsWhatCam0SawWithinTheRange) {
   r.reference_only = true;
   const SimulationSummary rs = RunSimulation(r);
   EXPECT_EQ(rs.layout, "reference");
-  EXPECT_EQ(Bytes(ref_only / "reference_cloud.ply"), Bytes(out / "reference_cloud.ply"));
-  EXPECT_EQ(Bytes(ref_only / "reference_observed.ply"), Bytes(out / "reference_observed.ply"));
+  EXPECT_EQ(testing::ReadFileBytes(ref_only / "reference_cloud.ply"),
+            testing::ReadFileBytes(out / "reference_cloud.ply"));
+  EXPECT_EQ(testing::ReadFileBytes(ref_only / "reference_observed.ply"),
+            testing::ReadFileBytes(out / "reference_observed.ply"));
   EXPECT_FALSE(fs::exists(ref_only / "mav0"));
   EXPECT_FALSE(fs::exists(ref_only / "sim.yaml"));
 

@@ -365,9 +365,9 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
         // Quads lie on the floor, a few millimetres above it and each at its own height, so
         // neither the floor nor a crossing quad z-fights with them.
         const bool decal = s.type == ObjectType::kQuad;
-        o.position = Eigen::Vector3d((pos.x() - c.x()) / room.scale.x(),
-                                     (pos.y() - c.y()) / room.scale.y(),
-                                     decal ? 0.003 + 0.0002 * (i % 16) : 0.0);
+        o.position =
+            Eigen::Vector3d((pos.x() - c.x()) / room.scale.x(), (pos.y() - c.y()) / room.scale.y(),
+                            decal ? 0.003 + 0.0002 * (i % 16) : 0.0);
         std::vector<Shape> parts;
         builder.AddObject(o, room, group_id, &parts);
         // Decals may cross anything (tape over tape); solids keep apart.

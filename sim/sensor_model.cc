@@ -30,8 +30,8 @@ void SensorOptions::Check() const {
                       gain_min, gain_max);
   PKSLAM_CHECK_OPTION(gain_drift >= 0.0 && gain_drift <= 1.0, "sensor.gain_drift", "{}",
                       gain_drift);
-  PKSLAM_CHECK_OPTION(max_exposure_s >= 0.0 && max_exposure_s < 0.05, "sensor.max_exposure_s",
-                      "{}", max_exposure_s);
+  PKSLAM_CHECK_OPTION(max_exposure_s >= 0.0 && max_exposure_s < 0.05, "sensor.max_exposure_s", "{}",
+                      max_exposure_s);
   PKSLAM_CHECK_OPTION(exposure_at_unit_gain_s > 0.0 && exposure_at_unit_gain_s < 0.05,
                       "sensor.exposure_at_unit_gain_s", "{}", exposure_at_unit_gain_s);
 }

@@ -149,15 +149,14 @@ void WriteImuAndGroundTruth(const BodyMotion& motion, const std::vector<ImuSampl
   for (const ImuSample& s : imu) {
     if (o.write_imu) euroc->WriteImu(s);
     const BodyState exact = motion.State(s.t_ns);
-    const GroundTruthRow exact_row{s.t_ns, exact.world_from_body, exact.velocity_world,
-                                   s.gyro_bias, s.accel_bias};
+    const GroundTruthRow exact_row{s.t_ns, exact.world_from_body, exact.velocity_world, s.gyro_bias,
+                                   s.accel_bias};
     if (!gt_errors) {
       euroc->WriteGroundTruth(exact_row);
       continue;
     }
     euroc->WriteExactGroundTruth(exact_row);
-    const std::int64_t t_true =
-        std::clamp(s.t_ns + offset, motion.begin_ns(), motion.end_ns());
+    const std::int64_t t_true = std::clamp(s.t_ns + offset, motion.begin_ns(), motion.end_ns());
     const BodyState st = motion.State(t_true);
     Eigen::Vector3d dp;
     Eigen::Vector3d dr;

@@ -49,7 +49,7 @@ struct SimulationOptions {
   bool write_images = true;      // false: IMU + ground truth only (no rendering)
   double camera_rate_hz = 20.0;  // stereo cameras (EuRoC: 20)
   SensorOptions sensor;
-  double cam1_relative_gain = 1.0;  // cam1's response relative to cam0's (gain of its images)
+  double cam1_relative_gain = 1.0;      // cam1's response relative to cam0's (gain of its images)
   double motion_blur_exposure_s = 0.0;  // > 0: average sub-renders over this exposure
   int motion_blur_samples = 0;          // sub-renders (0: by quality: 3 / 5 / 9)
   bool rgbd = false;                    // TUM RGB-D output instead of EuRoC

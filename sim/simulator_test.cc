@@ -42,11 +42,6 @@ std::vector<std::string> Split(const std::string& s, char sep) {
   return out;
 }
 
-std::string Bytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 SimulationOptions ShortReplay(const fs::path& shared, const fs::path& out) {
   SimulationOptions o;
   o.output_dir = out;
@@ -178,9 +173,10 @@ TEST(Simulator, ReplayWritesEurocFormatLikeTheRealDataset) {
   ASSERT_NE(info.Find("imu0"), nullptr);
   EXPECT_NEAR(info.Find("imu0")->measured_rate_hz, 200.0, 1e-6);
   EXPECT_TRUE(info.Find("cam0")->missing_files.empty());
-  EXPECT_NE(Bytes(out / "sim.yaml").find("seed: 1"), std::string::npos);
+  EXPECT_NE(testing::ReadFileBytes(out / "sim.yaml").find("seed: 1"), std::string::npos);
   EXPECT_GT(s.cloud_points, 100u);
-  EXPECT_EQ(Bytes(out / "reference_cloud.ply").rfind("ply\nformat binary_little_endian 1.0", 0),
+  EXPECT_EQ(testing::ReadFileBytes(out / "reference_cloud.ply")
+                .rfind("ply\nformat binary_little_endian 1.0", 0),
             0u);
 }
 
@@ -203,9 +199,11 @@ TEST(Simulator, SameSeedGivesIdenticalBytes) {
     if (!entry.is_regular_file()) continue;
     const fs::path rel = fs::relative(entry.path(), a);
     ASSERT_TRUE(fs::exists(b / rel)) << rel;
-    EXPECT_EQ(Bytes(entry.path()), Bytes(b / rel)) << rel;
+    EXPECT_EQ(testing::ReadFileBytes(entry.path()), testing::ReadFileBytes(b / rel)) << rel;
     ++files;
-    if (fs::exists(c / rel) && Bytes(entry.path()) != Bytes(c / rel)) ++differ_c;
+    if (fs::exists(c / rel) &&
+        testing::ReadFileBytes(entry.path()) != testing::ReadFileBytes(c / rel))
+      ++differ_c;
   }
   EXPECT_GT(files, 20);
   EXPECT_GT(differ_c, 10);  // images, IMU, biases, sim.yaml change with the seed

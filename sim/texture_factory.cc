@@ -152,7 +152,7 @@ cv::Mat Quilted(const TextureSpec& spec, int max_cells, Rng* rng) {
   const double seam_width = std::max(1.0, 0.04 * period);
   for (int y = 0; y < n; ++y) {
     for (int x = 0; x < n; ++x) {
-      const double u = std::fmod(x + 0.5, period) / period;  // 0..1 across a channel
+      const double u = std::fmod(x + 0.5, period) / period;       // 0..1 across a channel
       const double bulge = 0.5 - 0.5 * std::cos(2.0 * M_PI * u);  // 0 at the seams
       const double to_seam = std::min(u, 1.0 - u) * period;
       const double seam = std::exp(-0.5 * (to_seam / seam_width) * (to_seam / seam_width));
@@ -180,15 +180,15 @@ cv::Mat Confetti(const TextureSpec& spec, Rng* rng) {
     const double level = rng->Uniform(0.75, 0.95);
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
-        const cv::RotatedRect r(cv::Point2f(static_cast<float>(cx + dx * n),
-                                            static_cast<float>(cy + dy * n)),
-                                cv::Size2f(static_cast<float>(length), static_cast<float>(width)),
-                                static_cast<float>(angle));
+        const cv::RotatedRect r(
+            cv::Point2f(static_cast<float>(cx + dx * n), static_cast<float>(cy + dy * n)),
+            cv::Size2f(static_cast<float>(length), static_cast<float>(width)),
+            static_cast<float>(angle));
         cv::Point2f corners[4];
         r.points(corners);
         std::vector<cv::Point> poly;
-        for (const auto& c : corners) poly.emplace_back(cv::Point(static_cast<int>(c.x * 16),
-                                                                  static_cast<int>(c.y * 16)));
+        for (const auto& c : corners)
+          poly.emplace_back(cv::Point(static_cast<int>(c.x * 16), static_cast<int>(c.y * 16)));
         cv::fillConvexPoly(grey, poly, cv::Scalar(level), cv::LINE_AA, 4);
       }
     }

@@ -48,8 +48,7 @@ struct VibrationOptions {
 
 class Vibration {
  public:
-  Vibration(const VibrationSpectrum& spectrum, const VibrationOptions& options,
-            std::uint64_t seed);
+  Vibration(const VibrationSpectrum& spectrum, const VibrationOptions& options, std::uint64_t seed);
 
   // Displacement (m) and rotation vector (rad) in body axes with their time derivatives.
   struct Sample {

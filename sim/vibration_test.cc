@@ -7,9 +7,7 @@
 #include "core/util/error.h"
 #include "sim/body_motion.h"
 #include "sim/imu_simulator.h"
-#include "sim/motion_generator.h"
-#include "sim/scene_builder.h"
-#include "sim/scene_description.h"
+#include "sim/sim_testing.h"
 
 namespace pkslam::sim {
 namespace {
@@ -56,14 +54,7 @@ TEST(Vibration, DerivativesMatchNumericDifferentiation) {
 // acceleration and angular rate of BodyMotion::State agree with the numeric derivatives of
 // BodyMotion::WorldFromBody.
 TEST(Vibration, PerturbedStateIsConsistentWithThePerturbedPose) {
-  const SceneDescription description = LoadSceneDescription("vicon_room");
-  SceneBuildOptions build;
-  build.texture_size = 64;
-  const Scene scene = BuildScene(description, build, {});
-  MotionOptions motion;
-  motion.level = MotionLevel::kDifficult;
-  motion.duration_s = 6.0;
-  const SplineTrajectory spline = GenerateMotion(scene, motion, SE3d(), 3, 0);
+  const SplineTrajectory spline = RandomTestFlight(MotionLevel::kDifficult, 6.0, 3);
   VibrationOptions options;
   options.scale = 3.0;  // make the perturbation dominate the numeric check
   const BodyMotion body(spline, Vibration(EurocVibrationSpectrum(), options, 4));

@@ -201,9 +201,9 @@ TEST(BenchCli, PeersRunBesidePkslam) {
              "datasets:\n  - name: flight\n    sim: {motion: medium, duration: 3, seed: 5, "
              "quality: fast, args: [--no-cloud]}\n";
   }
-  const auto r = RunPkslam(fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --quiet",
-                                       (dir / "peer.yaml").string(), (dir / "out").string(),
-                                       (dir / "cache").string()));
+  const auto r = RunPkslam(
+      fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --quiet",
+                  (dir / "peer.yaml").string(), (dir / "out").string(), (dir / "cache").string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("4 runs: 4 executed, 0 already finished, 1 failed"));
   const auto rows = Lines(dir / "out/results.csv");
@@ -222,7 +222,7 @@ TEST(BenchCli, PeersRunBesidePkslam) {
       continue;
     }
     EXPECT_EQ(f[column("status")], "ok") << rows[i];
-    EXPECT_LT(std::stod(f[column("ate_se3_rmse_m")]), 1e-6) << rows[i];  // the truth itself
+    EXPECT_LT(std::stod(f[column("ate_se3_rmse_m")]), 1e-6) << rows[i];   // the truth itself
     EXPECT_NEAR(std::stod(f[column("coverage")]), 0.5, 0.05) << rows[i];  // every 2nd frame
     EXPECT_EQ(f[column("keyframes")], "3");
     ++peers_ok;

@@ -40,10 +40,10 @@ TEST(SimulateCli, ReplayThenInfo) {
 TEST(SimulateCli, ReplaysAreRealisticByDefault) {
   PKSLAM_REQUIRE_SHARED_DATA(shared);
   const auto dir = testing::MakeTempDir("cli_simulate_realism");
-  const std::string replay =
-      fmt::format("--log-level warn simulate --trajectory '{}' --start 30 --duration 0.3 "
-                  "--quality fast --quiet --no-cloud",
-                  (shared / "euroc/groundtruth/V1_02_medium.txt").string());
+  const std::string replay = fmt::format(
+      "--log-level warn simulate --trajectory '{}' --start 30 --duration 0.3 "
+      "--quality fast --quiet --no-cloud",
+      (shared / "euroc/groundtruth/V1_02_medium.txt").string());
   const auto euroc = RunPkslam(replay + fmt::format(" --out '{}'", (dir / "euroc").string()));
   ASSERT_EQ(euroc.exit_code, 0) << euroc.output;
   EXPECT_THAT(euroc.output, HasSubstr("realism euroc: appearance on calibration on timing on"));
@@ -61,8 +61,9 @@ TEST(SimulateCli, ReplaysAreRealisticByDefault) {
   const auto info_off = RunPkslam(fmt::format("info '{}'", (dir / "off").string()));
   EXPECT_THAT(info_off.output, HasSubstr("baseline 0.110078 m"));
 
-  const auto report = RunPkslam("simulate --realism euroc --realism-report "
-                                "--realism-param calibration.focal_px=2.5");
+  const auto report = RunPkslam(
+      "simulate --realism euroc --realism-report "
+      "--realism-param calibration.focal_px=2.5");
   ASSERT_EQ(report.exit_code, 0) << report.output;
   EXPECT_THAT(report.output, HasSubstr("calibration.focal_px"));
   EXPECT_THAT(report.output, HasSubstr("2.5"));
@@ -84,10 +85,10 @@ TEST(SimulateCli, BadInputIsOneErrorLine) {
   EXPECT_THAT(r.output, HasSubstr("machine_hall"));
   EXPECT_THAT(r.output, HasSubstr("euroc_vicon_room"));
   for (const char* bad : {"--realism real", "--realism-off lighting",
-                          "--realism-param calibration.focal_px=x",
-                          "--realism-param no.such=1", "--realism euroc --rgbd",
-                          "--realism ideal --realism-off timing"}) {
-    r = RunPkslam(fmt::format("simulate --out '{}' --quiet {} --realism-report", out.string(), bad));
+                          "--realism-param calibration.focal_px=x", "--realism-param no.such=1",
+                          "--realism euroc --rgbd", "--realism ideal --realism-off timing"}) {
+    r = RunPkslam(
+        fmt::format("simulate --out '{}' --quiet {} --realism-report", out.string(), bad));
     EXPECT_NE(r.exit_code, 0) << bad;
     EXPECT_THAT(r.output, StartsWith("pkslam: error: ")) << bad;
   }

@@ -26,11 +26,11 @@ TEST(InertialRun, StereoInertialSimulatedReplayMeetsAteBar) {
   const auto dir = testing::MakeTempDir("inertial_run");
   const auto seq = dir / "seq";
   const auto out = dir / "out";
-  const auto sim = RunPkslam(
-      fmt::format("--log-level warn simulate --out '{}' --trajectory '{}' --start 5 --duration 8 "
-                  "--quality fast --quiet --no-cloud --realism ideal --gyro-bias 0.002,-0.003,0.001 "
-                  "--accel-bias 0.05,-0.03,0.04",
-                  seq.string(), (shared / "euroc/groundtruth/V1_02_medium.txt").string()));
+  const auto sim = RunPkslam(fmt::format(
+      "--log-level warn simulate --out '{}' --trajectory '{}' --start 5 --duration 8 "
+      "--quality fast --quiet --no-cloud --realism ideal --gyro-bias 0.002,-0.003,0.001 "
+      "--accel-bias 0.05,-0.03,0.04",
+      seq.string(), (shared / "euroc/groundtruth/V1_02_medium.txt").string()));
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
   const auto run = RunPkslam(
       fmt::format("--log-level info run --dataset '{}' --sensor stereo-inertial --out '{}' --quiet "

@@ -266,8 +266,8 @@ std::optional<RunResult> ExecuteRun(const Suite& suite, const RunSpec& run,
   const ProcessResult p = RunProcess(argv, log, suite.timeout_s, cancel);
   if (cancel != nullptr && cancel->load()) return std::nullopt;
   if (!p.ok()) {
-    result.error = fmt::format("{} {}: {}", peer ? run.config : "pkslam run", p.Describe(),
-                               LastLine(log));
+    result.error =
+        fmt::format("{} {}: {}", peer ? run.config : "pkslam run", p.Describe(), LastLine(log));
     result.wall_s = p.wall_s;
     WriteResult(run_dir, result);
     return result;

@@ -27,8 +27,7 @@ void ImportPeerRun(const std::filesystem::path& run_dir, const std::filesystem::
 // The peer command with {dataset}, {sensor}, {out}, {seed} and {suite_dir} substituted.
 std::vector<std::string> PeerArguments(const std::vector<std::string>& command,
                                        const std::filesystem::path& dataset,
-                                       const std::string& sensor,
-                                       const std::filesystem::path& out, std::uint64_t seed,
-                                       const std::filesystem::path& suite_dir);
+                                       const std::string& sensor, const std::filesystem::path& out,
+                                       std::uint64_t seed, const std::filesystem::path& suite_dir);
 
 }  // namespace pkslam::bench

@@ -35,8 +35,8 @@ PeerRun MakePeerRun(const std::string& name) {
     traj << fmt::format("{:.9f} {} 0 0 0 0 0 1\n", 1e-9 * static_cast<double>(p.fixture.FrameT(i)),
                         0.1 * i);
   }
-  std::ofstream(p.run / "kf_tum.txt") << fmt::format(
-      "{:.9f} 0.1 0 0 0 0 0 1\n", 1e-9 * static_cast<double>(p.fixture.FrameT(1)));
+  std::ofstream(p.run / "kf_tum.txt")
+      << fmt::format("{:.9f} 0.1 0 0 0 0 0 1\n", 1e-9 * static_cast<double>(p.fixture.FrameT(1)));
   std::ofstream(p.run / "track_times.txt") << "0.05 0.020\n0.10 0.030\n0.15 0.010\n";
   std::ofstream(p.run / "summary.txt")
       << "images=5 seq_duration_s=0.25 wall_s=1.50 realtime_factor=0.17\n";
@@ -86,9 +86,9 @@ TEST(PeerImport, MissingOrEmptyTrajectoryIsAnInputError) {
 }
 
 TEST(PeerImport, CommandPlaceholdersAreSubstituted) {
-  const auto argv = PeerArguments({"bash", "{suite_dir}/run.sh", "{dataset}", "{sensor}", "{out}",
-                                   "--seed={seed}"},
-                                  "/d/seq", "mono-inertial", "/o/run", 7, "/s");
+  const auto argv = PeerArguments(
+      {"bash", "{suite_dir}/run.sh", "{dataset}", "{sensor}", "{out}", "--seed={seed}"}, "/d/seq",
+      "mono-inertial", "/o/run", 7, "/s");
   const std::vector<std::string> expected = {"bash",          "/s/run.sh", "/d/seq",
                                              "mono-inertial", "/o/run",    "--seed=7"};
   EXPECT_EQ(argv, expected);

@@ -202,7 +202,8 @@ datasets:
 }
 
 TEST(Suite, BadPeersAreErrors) {
-  const std::string head = "sensors: [stereo]\nselectors: [orbslam3]\ndatasets: [{name: a, path: /a}]\n";
+  const std::string head =
+      "sensors: [stereo]\nselectors: [orbslam3]\ndatasets: [{name: a, path: /a}]\n";
   ExpectError(head + "peers:\n  - {label: x}\n", 5, "needs 'label' and 'command'");
   ExpectError(head + "peers:\n  - {label: orbslam3, command: [x]}\n", 5, "repeats");
   ExpectError(head + "peers:\n  - {label: 'a b', command: [x]}\n", 5, "without");

@@ -5,11 +5,18 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <mutex>
 #include <random>
 #include <vector>
 
 namespace pkslam::testing {
+
+std::string ReadFileBytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
 
 std::optional<std::filesystem::path> SharedDataDir() {
   namespace fs = std::filesystem;

@@ -15,6 +15,9 @@ std::optional<std::filesystem::path> SharedDataDir();
 // when the test process exits (kept if PKSLAM_KEEP_TEST_DIRS is set).
 std::filesystem::path MakeTempDir(const std::string& prefix);
 
+// The whole content of a file ("" when it cannot be read): byte-for-byte comparisons.
+std::string ReadFileBytes(const std::filesystem::path& file);
+
 // The built pkslam executable (build/bin/pkslam) for end-to-end CLI tests.
 std::filesystem::path PkslamExecutable();
 

@@ -1,0 +1,25 @@
+// Helpers shared by the sim/ tests.
+#pragma once
+
+#include <cstdint>
+
+#include "sim/euroc_writer.h"
+#include "sim/motion_generator.h"
+#include "sim/scene_builder.h"
+#include "sim/scene_description.h"
+
+namespace pkslam::sim {
+
+// A random flight of `level` through the Vicon room (tiny textures: the motion planner needs
+// only the geometry), the camera mounted like EuRoC's cam0, starting at t = 0.
+inline SplineTrajectory RandomTestFlight(MotionLevel level, double seconds, std::uint64_t seed) {
+  SceneBuildOptions build;
+  build.texture_size = 16;
+  const Scene scene = BuildScene(LoadSceneDescription("vicon_room"), build, {});
+  MotionOptions motion;
+  motion.level = level;
+  motion.duration_s = seconds;
+  return GenerateMotion(scene, motion, EurocCam0().body_from_camera, seed, 0);
+}
+
+}  // namespace pkslam::sim
