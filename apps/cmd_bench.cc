@@ -103,6 +103,7 @@ void Run(const BenchArgs& a) {
   h.quiet = a.quiet;
   h.retry_failed = a.retry_failed;
   h.reevaluate = a.reevaluate;
+  h.simulator_id = bench::ExecutableId(h.pkslam);
   if (!a.emit_jobs.empty()) {
     const auto e = bench::EmitJobs(suite, runs, h);
     std::cout << fmt::format(

@@ -143,9 +143,9 @@ RealismOptions MakeRealism(RealismPreset preset) {
   c.k1 = 0.0015;
   c.k2 = 0.0015;
   c.tangential = 2e-4;
-  c.per_camera_fraction = 0.3;
-  c.stereo_rotation_deg = 0.03;
-  c.stereo_translation_mm = 0.3;
+  c.per_camera_fraction = 0.2;
+  c.stereo_rotation_deg = 0.014;
+  c.stereo_translation_mm = 0.1;
   c.imu_rotation_deg = 0.15;
   c.imu_translation_mm = 3.0;
   r.timing.camera_imu_offset_ms = 1.0;

@@ -69,8 +69,8 @@ void ParallelFor(int n, int jobs, const std::atomic<bool>* cancel,
   if (failure) std::rethrow_exception(failure);
 }
 
-std::string SimKey(const fs::path& cache, const RunSpec& run) {
-  return SimCacheDir(cache, run.dataset, *run.sim).string();
+std::string SimKey(const HarnessOptions& options, const RunSpec& run) {
+  return SimCacheDir(options, run.dataset, *run.sim).string();
 }
 
 }  // namespace
@@ -117,8 +117,8 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
   std::vector<const RunSpec*> recipes;
   std::set<std::string> seen;
   for (const RunSpec* r : pending) {
-    if (r->sim && seen.insert(SimKey(options.cache, *r)).second &&
-        !fs::exists(SimCacheDir(options.cache, r->dataset, *r->sim) / ".complete")) {
+    if (r->sim && seen.insert(SimKey(options, *r)).second &&
+        !fs::exists(SimCacheDir(options, r->dataset, *r->sim) / ".complete")) {
       recipes.push_back(r);
     }
   }
@@ -134,7 +134,7 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
             EnsureSimulated(options, r.dataset, *r.sim, cancel);
           } catch (const Error& e) {
             std::lock_guard<std::mutex> lock(sim_errors_mutex);
-            sim_errors[SimKey(options.cache, r)] = e.what();
+            sim_errors[SimKey(options, r)] = e.what();
           }
         },
         [&](int) { progress.Add(); });
@@ -149,7 +149,7 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
         [&](int i) {
           const RunSpec& r = *pending[i];
           if (r.sim) {
-            const auto it = sim_errors.find(SimKey(options.cache, r));
+            const auto it = sim_errors.find(SimKey(options, r));
             if (it != sim_errors.end()) {
               RunResult failed = ResultSkeleton(r, suite);
               failed.error = it->second;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "core/util/error.h"
@@ -110,17 +111,25 @@ std::vector<std::string> SimulateArguments(const SimRecipe& r, const fs::path& o
   return a;
 }
 
-fs::path SimCacheDir(const fs::path& cache, const std::string& dataset, const SimRecipe& recipe) {
+fs::path SimCacheDir(const HarnessOptions& options, const std::string& dataset,
+                     const SimRecipe& recipe) {
   std::vector<std::string> args = SimulateArguments(recipe, "");
-  std::string key;
-  for (const auto& a : args) key += a + '\x1f';
-  return cache / fmt::format("{}-seed{}-{:08x}", dataset, recipe.seed,
-                             static_cast<std::uint32_t>(Fnv1a(key) & 0xffffffffu));
+  std::string key = options.simulator_id;
+  for (const auto& a : args) key += '\x1f' + a;
+  return options.cache / fmt::format("{}-seed{}-{:08x}", dataset, recipe.seed,
+                                     static_cast<std::uint32_t>(Fnv1a(key) & 0xffffffffu));
+}
+
+std::string ExecutableId(const fs::path& executable) {
+  std::ifstream in(executable, std::ios::binary);
+  if (!in) throw Error(fmt::format("{}: cannot read the executable", executable.string()));
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return fmt::format("{:016x}", Fnv1a(bytes));
 }
 
 fs::path EnsureSimulated(const HarnessOptions& options, const std::string& dataset,
                          const SimRecipe& recipe, const std::atomic<bool>* cancel) {
-  const fs::path dir = SimCacheDir(options.cache, dataset, recipe);
+  const fs::path dir = SimCacheDir(options, dataset, recipe);
   const fs::path done = dir / ".complete";
   if (fs::exists(done)) return dir;
   FileLock lock(dir.string() + ".lock");

@@ -25,6 +25,9 @@ struct HarnessOptions {
   bool quiet = false;            // no progress bars
   bool retry_failed = false;     // re-execute runs whose result.csv says failed
   bool reevaluate = false;       // measure finished runs again (new evaluation code or truth)
+  // Part of every cache key (ExecutableId of `pkslam`): a rebuilt simulator may render the same
+  // command line differently, so its renders are never mistaken for an older build's.
+  std::string simulator_id;
 
   void Check() const;
 };
@@ -32,9 +35,11 @@ struct HarnessOptions {
 // OUT/runs/<run id>.
 std::filesystem::path RunDir(const std::filesystem::path& out, const RunSpec& run);
 
-// The cache folder of a recipe: CACHE/<dataset>-seed<S>-<hash of the recipe>.
-std::filesystem::path SimCacheDir(const std::filesystem::path& cache, const std::string& dataset,
+// The cache folder of a recipe: CACHE/<dataset>-seed<S>-<hash of the recipe and simulator_id>.
+std::filesystem::path SimCacheDir(const HarnessOptions& options, const std::string& dataset,
                                   const SimRecipe& recipe);
+// A content hash of an executable (hex); throws Error naming the file when it cannot be read.
+std::string ExecutableId(const std::filesystem::path& executable);
 // The `pkslam simulate` command line of a recipe (without the executable).
 std::vector<std::string> SimulateArguments(const SimRecipe& recipe,
                                            const std::filesystem::path& out_dir);

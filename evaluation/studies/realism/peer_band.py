@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 """Reads the results.csv of evaluation/suites/realism.yaml and prints, per trajectory and sensor,
-each system's median ATE (SE(3), m) over its runs, coverage and failures, the peer's ratio to
+each system's median ATE (SE(3), m) over its runs (a failed run counts as the worst),
+coverage and failures, the peer's ratio to
 its published real-EuRoC ATE (the preset's bar: 0.5x to 2x) and pkslam's ratio to the peer.
 
   /usr/bin/python3 evaluation/studies/realism/peer_band.py bench-realism/results.csv [--md OUT.md]
 """
 import argparse
 import csv
+import math
 import statistics
 import sys
 from collections import defaultdict
@@ -38,7 +40,7 @@ def main():
             runs[(row['dataset'], row['sensor'], row['config'])].append(row)
     configs = sorted({k[2] for k in runs}, key=lambda c: (c != PEER, c))
     lines = ['| sequence | sensor | published | ' +
-             ' | '.join(f'{c} ATE (cov., fails)' for c in configs) +
+             ' | '.join(f'{c} ATE [range] (cov., fails)' for c in configs) +
              ' | peer / published | in band | ' +
              ' | '.join(f'{c} / peer' for c in configs if c != PEER) + ' |']
     lines.append('|' + '---|' * (5 + 2 * len(configs) - 1))
@@ -53,24 +55,32 @@ def main():
             rows = runs.get((dataset, sensor, c), [])
             ok = [r for r in rows if r['status'] == 'ok' and r['ate_se3_rmse_m']]
             fails = len(rows) - len(ok)
-            if ok:
-                medians[c] = statistics.median(float(r['ate_se3_rmse_m']) for r in ok)
-                cov = statistics.median(float(r['coverage']) for r in ok)
-                cells.append(f'{medians[c]:.4f} ({100 * cov:.0f}%, {fails})')
-            else:
-                cells.append(f'- ({fails} failed)' if rows else '')
+            if not rows:
+                cells.append('')
+                continue
+            # A failed run counts as the worst result, so failures move the median.
+            values = [float(r['ate_se3_rmse_m']) for r in ok] + [math.inf] * fails
+            medians[c] = statistics.median(values)
+            if math.isinf(medians[c]):
+                cells.append(f'failed ({fails} of {len(rows)})')
+                continue
+            cov = statistics.median(float(r['coverage']) for r in ok)
+            spread = f' [{min(values):.3f}-{max(values):.3f}]' if len(values) > 1 else ''
+            cells.append(f'{medians[c]:.4f}{spread} ({100 * cov:.0f}%, {fails})')
         peer = medians.get(PEER)
         ratio = peer / published if peer is not None and published else None
         band = ratio is not None and 0.5 <= ratio <= 2.0
         if ratio is not None:
             checked += 1
             in_band += band
-        rel = [f'{medians[c] / peer:.2f}' if c in medians and peer else ''
-               for c in configs if c != PEER]
+        rel = [f'{medians[c] / peer:.2f}'
+               if c in medians and peer and not math.isinf(peer) and not math.isinf(medians[c])
+               else '' for c in configs if c != PEER]
+        ratio_cell = ('failed' if math.isinf(ratio) else f'{ratio:.2f}') if ratio is not None else ''
+        band_cell = ('yes' if band else 'no') if ratio is not None else ''
         lines.append(f'| {dataset} | {sensor} | {published if published else ""} | ' +
-                     ' | '.join(cells) +
-                     f' | {ratio:.2f} |' if ratio is not None else ' |  |')
-        lines[-1] += (' yes |' if band else ' no |') + ' ' + ' | '.join(rel) + ' |'
+                     ' | '.join(cells) + f' | {ratio_cell} | {band_cell} | ' + ' | '.join(rel) +
+                     ' |')
     lines.append(f'\npeer within 0.5x-2x of its published value: {in_band} of {checked}')
     text = '\n'.join(lines)
     print(text)
