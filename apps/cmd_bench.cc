@@ -131,6 +131,14 @@ void Run(const BenchArgs& a) {
   report.out = h.out;
   report.title = suite.name;
   PrintReport(results, bench::WriteReport(results, report), h.out);
+  // A sweep with failed runs is not a success: scripts and CI must see it (the report and
+  // results.csv are written first, so the finished runs are not lost).
+  if (counts.failed > 0) {
+    throw Error(fmt::format(
+        "{} of {} runs failed (status and error per run in {}/results.csv; --retry-failed runs "
+        "them again)",
+        counts.failed, counts.total, h.out.string()));
+  }
 }
 
 }  // namespace

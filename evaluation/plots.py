@@ -272,7 +272,8 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     rows = read_results(a.results)
     index = Index(a.out)
-    if rows:
+    # Plots need at least one finished run; a suite where every run failed gets its tables only.
+    if any(r["ok"] for r in rows):
         main_rows = [r for r in rows if not r["sweep_param"]] or rows
         per_sensor_bars(index, main_rows, "ate_m", "ATE RMSE [m]", "ate_bars.png", "accuracy",
                         "ATE per sequence: mean over runs, error bars one standard deviation")

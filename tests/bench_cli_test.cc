@@ -20,6 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 testing::CommandResult RunPkslam(const std::string& args) {
@@ -171,10 +172,12 @@ TEST(BenchCli, BadSuitesAreOneErrorLineWithFileAndLine) {
   // A dataset that does not exist fails its runs (recorded, reported) without aborting.
   std::ofstream(dir / "nodata.yaml") << "runs: 1\nselectors: [orbslam3]\nsensors: [stereo]\n"
                                         "datasets: [{name: a, path: no_such_dir}]\n";
-  r = RunPkslam(fmt::format("--log-level error bench '{}' --out '{}' --quiet --no-plots",
+  r = RunPkslam(fmt::format("--log-level error bench '{}' --out '{}' --quiet",
                             (dir / "nodata.yaml").string(), (dir / "out").string()));
-  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.exit_code, 1) << r.output;  // every run failed: the sweep did not succeed
+  EXPECT_THAT(r.output, Not(HasSubstr("plots unavailable")));  // no plots, but no crash either
   EXPECT_THAT(r.output, HasSubstr("1 runs: 1 executed, 0 already finished, 1 failed"));
+  EXPECT_THAT(r.output, HasSubstr("pkslam: error: 1 of 1 runs failed"));
   EXPECT_THAT(Lines(dir / "out/results.csv").at(1), HasSubstr("no_such_dir is not a directory"));
 }
 
@@ -204,8 +207,10 @@ TEST(BenchCli, PeersRunBesidePkslam) {
   const auto r = RunPkslam(
       fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --quiet",
                   (dir / "peer.yaml").string(), (dir / "out").string(), (dir / "cache").string()));
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_EQ(r.exit_code, 1) << r.output;  // the crashed peer run fails the sweep
   EXPECT_THAT(r.output, HasSubstr("4 runs: 4 executed, 0 already finished, 1 failed"));
+  EXPECT_THAT(r.output, HasSubstr("pkslam: error: 1 of 4 runs failed"));
+  EXPECT_TRUE(fs::exists(dir / "out/report.html"));  // the report is still written
   const auto rows = Lines(dir / "out/results.csv");
   ASSERT_EQ(rows.size(), 5u);
   const auto header = Fields(rows[0]);
