@@ -117,10 +117,9 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
   std::vector<const RunSpec*> recipes;
   std::set<std::string> seen;
   for (const RunSpec* r : pending) {
-    if (r->sim && seen.insert(SimKey(options, *r)).second &&
-        !fs::exists(SimCacheDir(options, r->dataset, *r->sim) / ".complete")) {
-      recipes.push_back(r);
-    }
+    if (!r->sim) continue;
+    const std::string key = SimKey(options, *r);  // the recipe's cache folder
+    if (seen.insert(key).second && !fs::exists(fs::path(key) / ".complete")) recipes.push_back(r);
   }
   std::map<std::string, std::string> sim_errors;
   std::mutex sim_errors_mutex;
