@@ -85,6 +85,16 @@ void RegisterRunCommand(CLI::App& app) {
       "Inertial sensors: keep gravity fixed after the 15 s visual-inertial BA, as ORB-SLAM3 "
       "(for experiments)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
+  cmd->add_option("--mapping-sync", args->options.mapping_sync,
+                  "How tracking meets local mapping: live (offline default: local mapping as a "
+                  "live run at real-time pace would see it, without sleeping), lockstep (each "
+                  "keyframe mapped before the next frame; --deterministic), free (no coupling; "
+                  "--realtime default)")
+      ->check(CLI::IsMember({"live", "lockstep", "free"}));
+  cmd->add_option("--live-pace", args->options.system.live_pace,
+                  "--mapping-sync live: playback speed of the emulated live run (2: as if frames "
+                  "came twice as fast as their timestamps)")
+      ->capture_default_str();
   cmd->add_option("--max-frames", args->options.max_frames, "Stop after N frames (0: all)");
   cmd->add_flag("--trace", args->options.system.trace, "Write OUT/keyframe_trace.csv");
   cmd->add_flag("--quiet", args->options.quiet, "No progress line");

@@ -108,6 +108,7 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
   o.imu.noise = !a.no_imu_noise;
   o.write_cloud = !a.no_cloud && !a.no_images;
   o.write_images = !a.no_images;
+  if (o.camera == "kitti") o.camera_rate_hz = 10.0;  // KITTI odometry's frame rate
   if (o.realism.On(sim::RealismSource::kAppearance)) ApplyAppearanceUnderFlags(cmd, &o);
   o.sensor.auto_exposure = !a.no_auto_exposure;
   const sim::SimulationSummary s = sim::RunSimulation(o);
@@ -117,7 +118,7 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
         "bench: {} {} frames ({}x{} x{} camera{}) in {:.2f} s: {:.1f} frames/s wall "
         "(render + image formation, no files); CPU {:.1f} ms/frame = {:.1f} frames/s on 2 "
         "idle cores\n",
-        s.frames, o.rgbd ? "RGB-D" : "stereo", o.rgbd ? 640 : 752, 480, o.rgbd ? 1 : 2,
+        s.frames, o.rgbd ? "RGB-D" : "stereo", s.image_width, s.image_height, o.rgbd ? 1 : 2,
         o.rgbd ? "" : "s", s.render_seconds, s.frames_per_second,
         1e3 * s.render_cpu_seconds / std::max(s.frames, 1),
         2.0 * s.frames / std::max(s.render_cpu_seconds, 1e-9));
@@ -193,6 +194,13 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("--seed", o.seed, "Random seed (same seed -> identical bytes)")
       ->capture_default_str();
   cmd->add_flag("--rgbd", o.rgbd, "TUM RGB-D output (colour + depth) instead of EuRoC stereo");
+  cmd->add_option("--camera", o.camera,
+                  "Stereo rig of EuRoC-format output: euroc (752x480, 20 Hz), kitti (KITTI "
+                  "odometry's 1241x376 pair, 0.537 m baseline, 10 Hz, settings.yaml with 2000 "
+                  "ORB features), vga (640x480, 20 Hz, 1000 features); run with --settings "
+                  "DATASET/settings.yaml to use its feature count")
+      ->check(CLI::IsMember({"euroc", "kitti", "vga"}))
+      ->capture_default_str();
   cmd->add_option("--blackout", args->blackout, "Black images between T0 and T1 (s from start)")
       ->expected(2);
   cmd->add_option("--noise", o.sensor.read_noise_dn, "Image read noise sigma (8-bit levels)")

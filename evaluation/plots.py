@@ -86,6 +86,11 @@ def grouped_bars(ax, rows, datasets, configs, key, ylabel):
                              and r["ok"]])
             means.append(m)
             stds.append(s)
+        # A configuration without a successful run here (a peer that failed on every
+        # dataset of this sensor) draws no bars: matplotlib cannot draw all-NaN error bars.
+        if not any(math.isfinite(m) for m in means):
+            continue
+        stds = [s if math.isfinite(s) else 0.0 for s in stds]
         ax.bar(x + (i - (len(configs) - 1) / 2) * width, means, width, yerr=stds, capsize=3,
                label=config)
     ax.set_xticks(x)

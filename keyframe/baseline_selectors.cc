@@ -13,11 +13,11 @@ void BaselineOptions::Check() const {
   PKSLAM_CHECK_OPTION(interval_frames >= 0 && interval_seconds >= 0 &&
                           (interval_frames > 0 || interval_seconds > 0),
                       "Keyframe.frames/seconds", "{} / {}", interval_frames, interval_seconds);
-  PKSLAM_CHECK_OPTION(ptam_min_frames >= 0 && ptam_min_distance_ratio >= 0,
-                      "Keyframe.ptam", "{} / {}", ptam_min_frames, ptam_min_distance_ratio);
+  PKSLAM_CHECK_OPTION(ptam_min_frames >= 0 && ptam_min_distance_ratio >= 0, "Keyframe.ptam",
+                      "{} / {}", ptam_min_frames, ptam_min_distance_ratio);
   PKSLAM_CHECK_OPTION(match_count_min > 0, "Keyframe.min_matches", "{}", match_count_min);
-  PKSLAM_CHECK_OPTION(vins_parallax_px > 0 && vins_min_tracked >= 0, "Keyframe.parallax",
-                      "{} / {}", vins_parallax_px, vins_min_tracked);
+  PKSLAM_CHECK_OPTION(vins_parallax_px > 0 && vins_min_tracked >= 0, "Keyframe.parallax", "{} / {}",
+                      vins_parallax_px, vins_min_tracked);
 }
 
 BaselineSelector::BaselineSelector(BaselineKind kind, BaselineOptions options)
@@ -104,7 +104,12 @@ SelectorDecision BaselineSelector::Decide(const SelectorInput& in) {
     }
   }
   trace["A_c"] = static_cast<double>(in.points.size());
-  if (!want) return {false, false, "no", std::move(trace)};
+  if (!want) {
+    SelectorDecision no;
+    no.reason = "no";
+    no.trace = std::move(trace);
+    return no;
+  }
   SelectorDecision d = AcceptIfMappingCanTakeIt(in, reason);
   d.trace = std::move(trace);
   return d;

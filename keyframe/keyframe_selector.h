@@ -3,15 +3,15 @@
 // values, keyframe snapshots) and is reset on map reset / new map.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/features/descriptor.h"
 #include "core/frame/sensor.h"
@@ -26,13 +26,13 @@ struct SelectorPoint {
   Eigen::Vector3d position_world = Eigen::Vector3d::Zero();
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // undistorted pixel in the current frame
   int keypoint_index = -1;
-  bool in_last_keyframe = false;  // the point is observed by the last keyframe
+  bool in_last_keyframe = false;           // the point is observed by the last keyframe
   const Descriptor* descriptor = nullptr;  // valid during Decide / OnKeyFrameInserted only
 };
 
 // IMU summary over an interval (from preintegration; body frame at the interval start).
 struct SelectorImuInterval {
-  double dt = 0;                                        // seconds
+  double dt = 0;                                         // seconds
   Eigen::Vector3d mean_accel = Eigen::Vector3d::Zero();  // bias-corrected, rotated to start
   Eigen::Vector3d mean_gyro = Eigen::Vector3d::Zero();
   // Mean gravity-compensated specific force in the world frame (needs gravity estimate).
@@ -49,10 +49,10 @@ struct SelectorInput {
   SE3d camera_from_world;
 
   // Tracking results of the current frame.
-  int inliers = 0;                // map-point matches surviving pose optimisation
-  int tracked_close = 0;          // inliers with depth < th_depth (stereo/RGB-D)
-  int untracked_close = 0;        // keypoints with depth < th_depth and no map point
-  bool recently_lost = false;     // tracking state RECENTLY_LOST (IMU prediction)
+  int inliers = 0;                    // map-point matches surviving pose optimisation
+  int tracked_close = 0;              // inliers with depth < th_depth (stereo/RGB-D)
+  int untracked_close = 0;            // keypoints with depth < th_depth and no map point
+  bool recently_lost = false;         // tracking state RECENTLY_LOST (IMU prediction)
   std::vector<SelectorPoint> points;  // filled only when the selector NeedsTrackedPoints()
 
   // Map and keyframe context.
@@ -66,8 +66,8 @@ struct SelectorInput {
 
   // Local mapping and mode.
   bool only_tracking = false;
-  bool local_mapping_stopped = false;     // stopped or stop requested (loop closure)
-  bool local_mapping_idle = true;         // accepts keyframes
+  bool local_mapping_stopped = false;       // stopped or stop requested (loop closure)
+  bool local_mapping_idle = true;           // accepts keyframes
   bool local_mapping_initializing = false;  // IMU initialisation running
   int local_mapping_queue = 0;
   bool imu_initialized = false;
@@ -92,9 +92,18 @@ struct SelectorDecision {
   bool insert = false;
   // Ask local mapping to interrupt its bundle adjustment (it is busy and we want a keyframe).
   bool interrupt_local_ba = false;
+  // Refused only because local mapping is busy (with mapping idle it would insert); tracking
+  // may still insert when its map is about to starve (TrackingOptions::starving_inliers).
+  bool deferred_busy = false;
   // Short machine-readable reason, e.g. "c1a+c2", "imu-time", "busy", "no".
   std::string reason;
   SelectorTrace trace;
+
+  static SelectorDecision No(std::string why) {
+    SelectorDecision d;
+    d.reason = std::move(why);
+    return d;
+  }
 };
 
 class KeyframeSelector {

@@ -7,12 +7,12 @@ namespace pkslam {
 
 void OrbSlam3SelectorOptions::Check() const {
   PKSLAM_CHECK_OPTION(min_frames >= 0, "Keyframe.min_frames", "{}", min_frames);
-  PKSLAM_CHECK_OPTION(imu_uninitialised_interval_s > 0, "Keyframe.imu_uninitialised_interval",
-                      "{}", imu_uninitialised_interval_s);
+  PKSLAM_CHECK_OPTION(imu_uninitialised_interval_s > 0, "Keyframe.imu_uninitialised_interval", "{}",
+                      imu_uninitialised_interval_s);
   PKSLAM_CHECK_OPTION(inertial_interval_s > 0, "Keyframe.inertial_interval", "{}",
                       inertial_interval_s);
-  PKSLAM_CHECK_OPTION(close_tracked_max >= 0 && close_untracked_min >= 0,
-                      "Keyframe.close_points", "{} / {}", close_tracked_max, close_untracked_min);
+  PKSLAM_CHECK_OPTION(close_tracked_max >= 0 && close_untracked_min >= 0, "Keyframe.close_points",
+                      "{} / {}", close_tracked_max, close_untracked_min);
 }
 
 OrbSlam3Selector::OrbSlam3Selector(OrbSlam3SelectorOptions options) : options_(options) {
@@ -31,6 +31,7 @@ SelectorDecision AcceptIfMappingCanTakeIt(const SelectorInput& input, std::strin
     d.insert = true;
   } else {
     d.reason += ";busy";
+    d.deferred_busy = true;
   }
   return d;
 }
@@ -59,9 +60,14 @@ SelectorDecision OrbSlam3Selector::Decide(const SelectorInput& in) {
   const bool c1c = !IsMonocular(s) && !IsInertial(s) && (in.inliers < ref * 0.25 || need_close);
   const bool c2 = (in.inliers < ref * th_ref_ratio || need_close) && in.inliers > 15;
   const bool c3 = IsInertial(s) && since_kf >= options_.inertial_interval_s;
-  const bool c4 = s == Sensor::kMonocularInertial &&
-                  ((in.inliers < 75 && in.inliers > 15) || in.recently_lost);
+  const bool c4 =
+      s == Sensor::kMonocularInertial && ((in.inliers < 75 && in.inliers > 15) || in.recently_lost);
 
+  SelectorTrace trace;
+  trace["inliers"] = in.inliers;
+  trace["reference_tracked"] = ref;
+  trace["mapping_idle"] = in.local_mapping_idle ? 1 : 0;
+  no.trace = trace;
   if (!(((c1a || c1b || c1c) && c2) || c3 || c4)) return no;
   std::string reason;
   auto add = [&reason](bool c, const char* name) {
@@ -76,7 +82,9 @@ SelectorDecision OrbSlam3Selector::Decide(const SelectorInput& in) {
   add(c3, "c3");
   add(c4, "c4");
   add(need_close, "close");
-  return AcceptIfMappingCanTakeIt(in, reason);
+  SelectorDecision d = AcceptIfMappingCanTakeIt(in, reason);
+  d.trace = std::move(trace);
+  return d;
 }
 
 }  // namespace pkslam

@@ -197,7 +197,7 @@ SelectorDecision PksSelector::Decide(const SelectorInput& in) {
   const Eigen::Vector3d center = in.camera_from_world.Inverse().translation();
   const Eigen::Vector3d kf_center = in.last_keyframe_camera_from_world.Inverse().translation();
   if (in.keyframes_in_map > 2 && (center - kf_center).norm() < options_.min_translation_m) {
-    return {false, false, "still", {}};
+    return SelectorDecision::No("still");
   }
 
   SelectorTrace trace;

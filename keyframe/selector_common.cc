@@ -10,12 +10,12 @@ std::optional<SelectorDecision> CommonSafetyExits(const SelectorInput& in,
     d.reason = d.insert ? "imu-uninit-time" : "no";
     return d;
   }
-  if (in.only_tracking) return SelectorDecision{false, false, "only-tracking", {}};
-  if (in.local_mapping_stopped) return SelectorDecision{false, false, "mapping-stopped", {}};
+  if (in.only_tracking) return SelectorDecision::No("only-tracking");
+  if (in.local_mapping_stopped) return SelectorDecision::No("mapping-stopped");
   const int max_frames = static_cast<int>(in.fps + 0.5);
   if (in.frame_id < in.last_relocalisation_frame_id + max_frames &&
       in.keyframes_in_map > max_frames) {
-    return SelectorDecision{false, false, "after-reloc", {}};
+    return SelectorDecision::No("after-reloc");
   }
   return std::nullopt;
 }

@@ -1,6 +1,9 @@
 // LocalMapper: the thread, its queue and the stop/reset handshakes.
 #include "mapping/local_mapper.h"
 
+#include <algorithm>
+
+#include "core/map/keyframe.h"
 #include "core/util/error.h"
 
 namespace pkslam {
@@ -84,6 +87,40 @@ void LocalMapper::WaitUntilIdle() {
   idle_.wait(lock, [this] { return (queue_.empty() && !busy_) || stopped_ || finish_requested_; });
 }
 
+bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
+  if (!emulate_live_ || !thread_.joinable()) return AcceptsKeyFrames();
+  const auto wait_start = std::chrono::steady_clock::now();
+  std::unique_lock lock(mutex_);
+  while (true) {
+    if (stopped_ || stop_requested_ || finish_requested_ || reset_requested_) break;
+    if (!busy_ && queue_.empty()) break;
+    if (busy_) {
+      // Where the current keyframe's processing has got to on the data clock, at least.
+      const auto elapsed = std::chrono::steady_clock::now() - live_job_wall_start_;
+      const std::int64_t reached =
+          live_job_start_ns_ + DataNs(std::chrono::duration<double>(elapsed).count());
+      if (reached >= t_ns) break;  // still busy at t_ns, for certain
+      idle_.wait_for(lock, std::chrono::duration<double>(static_cast<double>(t_ns - reached) *
+                                                         1e-9 / live_pace_));
+    } else {
+      idle_.wait(lock);  // a queued keyframe is about to be taken
+    }
+  }
+  live_wait_ms_ +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start)
+          .count();
+  return !busy_ && queue_.empty() && !stopped_ && !stop_requested_ && live_free_ns_ <= t_ns;
+}
+
+std::int64_t LocalMapper::DataNs(double wall_s) const {
+  return static_cast<std::int64_t>(wall_s * live_pace_ * 1e9);
+}
+
+double LocalMapper::live_wait_ms() const {
+  std::lock_guard lock(mutex_);
+  return live_wait_ms_;
+}
+
 void LocalMapper::ResetQueue() {
   if (!thread_.joinable()) {
     std::lock_guard lock(mutex_);
@@ -131,6 +168,7 @@ void LocalMapper::Run() {
       return finish_requested_ || reset_requested_ || stop_requested_ || !queue_.empty();
     });
     if (reset_requested_) {
+      live_free_ns_ = std::numeric_limits<std::int64_t>::min();
       queue_.clear();
       recent_points_.clear();
       reset_requested_ = false;
@@ -152,9 +190,16 @@ void LocalMapper::Run() {
     }
     busy_ = true;
     accept_keyframes_.store(false);
+    live_job_start_ns_ = std::max(queue_.front()->t_ns(), live_free_ns_);
+    live_job_wall_start_ = std::chrono::steady_clock::now();
+    idle_.notify_all();  // AcceptsKeyFramesAt waits for a queued keyframe to be taken
     lock.unlock();
     ProcessNext();
     lock.lock();
+    live_free_ns_ =
+        live_job_start_ns_ + DataNs(std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                                                  live_job_wall_start_)
+                                        .count());
     busy_ = false;
     if (queue_.empty()) accept_keyframes_.store(true);
     idle_.notify_all();

@@ -9,9 +9,12 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -106,6 +109,17 @@ class LocalMapper : public MappingBackend {
   int QueueSize() const override;
   void InterruptBundleAdjustment() override { abort_ba_.store(true); }
   void WaitUntilIdle() override;
+  bool AcceptsKeyFramesAt(std::int64_t t_ns) override;
+  bool EmulatesLive() const override { return emulate_live_; }
+  // Offline runs: emulate a live run's timing (AcceptsKeyFramesAt); set before Start().
+  // `pace`: playback speed of the emulated live run (2: frames arrive twice as fast as their
+  // timestamps say, so mapping's work spans twice as much data time).
+  void EmulateLive(bool on, double pace = 1.0) {
+    emulate_live_ = on;
+    live_pace_ = pace;
+  }
+  // Total wall ms AcceptsKeyFramesAt blocked.
+  double live_wait_ms() const;
   void ResetQueue() override;
 
   // Loop closing pauses local mapping while it corrects the map.
@@ -117,6 +131,8 @@ class LocalMapper : public MappingBackend {
 
  private:
   void Run();
+  // Live emulation: data-clock nanoseconds spanned by `wall_s` seconds of work.
+  std::int64_t DataNs(double wall_s) const;
   bool HasQueued() const;
   void ProcessNext();
   void ProcessNewKeyFrame(const KeyFramePtr& kf);
@@ -147,6 +163,14 @@ class LocalMapper : public MappingBackend {
   std::condition_variable idle_;
   std::deque<KeyFramePtr> queue_;
   bool busy_ = false;
+  // Live emulation (guarded by mutex_): the data-clock time at which the last finished
+  // keyframe's processing ends, and the data-clock start and wall start of the current one.
+  bool emulate_live_ = false;
+  double live_pace_ = 1.0;
+  std::int64_t live_free_ns_ = std::numeric_limits<std::int64_t>::min();
+  std::int64_t live_job_start_ns_ = 0;
+  std::chrono::steady_clock::time_point live_job_wall_start_;
+  double live_wait_ms_ = 0;
   bool finish_requested_ = false;
   bool stop_requested_ = false;
   bool stopped_ = false;

@@ -36,6 +36,33 @@ CameraRig EurocCam1() {
   return c;
 }
 
+std::vector<CameraRig> StereoRig(const std::string& camera) {
+  if (camera == "euroc") return {EurocCam0(), EurocCam1()};
+  CameraRig left = EurocCam0();
+  CameraRig right = EurocCam1();
+  double baseline_m = 0;
+  if (camera == "kitti") {
+    left.camera = CameraModel::Pinhole(1241, 376, 718.856, 718.856, 607.1928, 185.2157);
+    baseline_m = 0.537;
+  } else if (camera == "vga") {
+    left.camera = CameraModel::Pinhole(640, 480, 525.0, 525.0, 319.5, 239.5);
+    baseline_m = 0.11;
+  } else {
+    throw OptionError(fmt::format("unknown --camera '{}' (euroc|kitti|vga)", camera));
+  }
+  right.camera = left.camera;
+  // A rectified pair: the right camera sits `baseline_m` along the left camera's x axis.
+  right.body_from_camera =
+      left.body_from_camera * SE3d(SO3d(), Eigen::Vector3d(baseline_m, 0.0, 0.0));
+  return {left, right};
+}
+
+int OrbFeaturesFor(const std::string& camera) {
+  if (camera == "kitti") return 2000;
+  if (camera == "vga") return 1000;
+  return 1200;
+}
+
 std::string FormatDouble(double v) {
   std::string s = fmt::format("{}", v);
   if (s.find_first_of(".eEn") == std::string::npos) s += ".0";

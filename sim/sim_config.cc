@@ -33,6 +33,12 @@ void SimulationOptions::Check() const {
   PKSLAM_CHECK_OPTION(duration_s >= 0.0, "--duration", "{}", duration_s);
   PKSLAM_CHECK_OPTION(trajectory.empty() || duration_s == 0.0 || duration_s >= 0.1, "--duration",
                       "replay windows must be >= 0.1 s, got {}", duration_s);
+  PKSLAM_CHECK_OPTION(camera == "euroc" || camera == "kitti" || camera == "vga", "camera",
+                      "'{}' (euroc|kitti|vga)", camera);
+  PKSLAM_CHECK_OPTION(!(rgbd && camera != "euroc"), "camera",
+                      "'{}' with --rgbd (its camera is "
+                      "TUM's 640x480 Kinect)",
+                      camera);
   PKSLAM_CHECK_OPTION(camera_rate_hz > 0.0 && camera_rate_hz <= imu.rate_hz, "camera_rate_hz", "{}",
                       camera_rate_hz);
   const auto cam_period = static_cast<std::int64_t>(std::llround(1e9 / camera_rate_hz));
@@ -167,6 +173,7 @@ void WriteSimYaml(const std::filesystem::path& file, const SimulationOptions& o,
 
   e << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "rate_hz" << YAML::Value << (o.rgbd ? o.rgbd_rate_hz : o.camera_rate_hz);
+  if (!o.rgbd) e << YAML::Key << "rig" << YAML::Value << o.camera;
   e << YAML::Key << "vignetting" << YAML::Value << o.sensor.vignetting;
   e << YAML::Key << "blur_sigma_px" << YAML::Value << o.sensor.blur_sigma_px;
   e << YAML::Key << "read_noise_dn" << YAML::Value << o.sensor.read_noise_dn;

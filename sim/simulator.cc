@@ -97,6 +97,7 @@ void WriteSettings(const std::filesystem::path& file, const std::vector<CameraRi
       settings.depth_noise_k = KinectDepthModel().EffectiveNoiseK(o.depth_noise);
     }
   } else {
+    settings.orb.n_features = OrbFeaturesFor(o.camera);
     settings.camera2 = cameras[1].camera;
     settings.right_from_left = cameras[1].body_from_camera.Inverse() * cameras[0].body_from_camera;
     if (o.write_imu) {
@@ -225,7 +226,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   if (o.rgbd) {
     cameras.push_back(RgbdCamera(o.rgbd_rate_hz));
   } else {
-    cameras = {EurocCam0(), EurocCam1()};
+    cameras = StereoRig(o.camera);
     for (auto& c : cameras) c.rate_hz = o.camera_rate_hz;
   }
   // Realism: the calibration SLAM will read, the IMU's axis errors and biases, the replay fit.
@@ -458,6 +459,8 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
   writers.wait();
   progress.Finish();
   summary.frames = frames;
+  summary.image_width = cameras[0].camera.width();
+  summary.image_height = cameras[0].camera.height();
   summary.total_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   summary.render_seconds = render_seconds;

@@ -47,7 +47,9 @@ struct SimulationOptions {
   ImuOptions imu;
   bool write_imu = true;
   bool write_images = true;      // false: IMU + ground truth only (no rendering)
-  double camera_rate_hz = 20.0;  // stereo cameras (EuRoC: 20)
+  double camera_rate_hz = 20.0;  // stereo cameras (EuRoC: 20, KITTI: 10)
+  // Stereo rig of EuRoC-format output: euroc | kitti | vga (StereoRig in euroc_writer.h).
+  std::string camera = "euroc";
   SensorOptions sensor;
   double cam1_relative_gain = 1.0;      // cam1's response relative to cam0's (gain of its images)
   double motion_blur_exposure_s = 0.0;  // > 0: average sub-renders over this exposure
@@ -92,6 +94,8 @@ struct SimulationSummary {
   std::int64_t begin_ns = 0;
   std::int64_t end_ns = 0;
   int frames = 0;  // camera frames (stereo pairs or RGB-D frames)
+  int image_width = 0;
+  int image_height = 0;
   int imu_samples = 0;
   double path_length_m = 0.0;  // of the body over [begin, end] at the IMU rate
   double mean_speed_mps = 0.0;

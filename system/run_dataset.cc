@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <future>
 #include <thread>
 
 #include "core/util/error.h"
@@ -119,14 +120,19 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary_path));
 
   SystemOptions system_options = options.system;
-  // Offline monocular runs (with or without IMU) keep tracking in lock-step with local mapping
-  // (each keyframe is mapped before the next frame is tracked). A monocular map gets its points
-  // only from local mapping, and ORB-SLAM's rule refuses monocular keyframes while local mapping
-  // is busy; fed frames faster than it maps (no --realtime, or a loaded machine) the map starves
-  // of keyframes and tracking is lost in fast turns (mono-inertial V1_02 replay, free-running:
-  // lost after 13 s in 3 of 3 runs, 56% coverage; lock-step: 599/601 frames, one map). Offline
-  // there is no deadline to meet; --realtime keeps ORB-SLAM3's live behaviour.
-  if (!options.realtime && IsMonocular(sensor)) system_options.tracking.lockstep = true;
+  // Offline runs feed frames as fast as tracking takes them (hundreds per second). A
+  // monocular map gets its points only from local mapping, and ORB-SLAM's rule refuses
+  // monocular keyframes while local mapping is busy: uncoupled ("free"), the map starved of
+  // keyframes and tracking was lost in fast turns (mono-inertial V1_02 replay: lost after
+  // 13 s in 3 of 3 runs); lock-step ran at 0.4x real time. Offline monocular runs therefore
+  // emulate a live run ("live", SystemOptions::live_pace): tracking sees local mapping as a
+  // live run fed at twice real time would, waiting only when that is not yet known. On the
+  // 40 s V1_02 replay (3 seeds, docs/speed.md) that keeps lock-step's accuracy (mono ATE
+  // 7.6 vs 7.3 mm, mono-inertial 17.3 vs 17.5 mm) at 2.7x and 3.1x real time. Stereo and
+  // RGB-D insert keyframes while mapping is busy and stay "free", as are --realtime runs.
+  std::string sync = options.mapping_sync;
+  if (sync.empty()) sync = !options.realtime && IsMonocular(sensor) ? "live" : "free";
+  system_options.mapping_sync = sync;
   SlamSystem system(settings, vocabulary, system_options);
 
   // --- the frame loop ---
@@ -142,7 +148,10 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     throw InputError(options.dataset,
                      fmt::format("sensor {} needs IMU data (mav0/imu0)", SensorName(sensor)));
   }
-  // Images are decoded in a thread of their own, a couple of frames ahead of tracking.
+  // Images are decoded in a thread of their own, a couple of frames ahead of tracking; a pair's
+  // second image (right / depth) concurrently with its first: decoding a 640x480 colour PNG
+  // takes about 8 ms and its depth PNG 3 ms, so one loader thread in series capped 30 Hz RGB-D
+  // at 2.8x real time.
   struct LoadedImages {
     cv::Mat a;  // left / rgb
     cv::Mat b;  // right / depth (empty for monocular)
@@ -151,12 +160,16 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
       sources.size(),
       [&](std::size_t k) {
         const FrameSource& s = sources[k];
-        if (euroc) {
-          return LoadedImages{euroc->LoadCam0(s.a),
-                              IsStereo(sensor) ? euroc->LoadCam1(s.b) : cv::Mat()};
+        std::future<cv::Mat> second;  // its destructor waits, also when the first one throws
+        if (euroc && IsStereo(sensor)) {
+          second = std::async(std::launch::async, [&] { return euroc->LoadCam1(s.b); });
+        } else if (tum && IsRgbd(sensor)) {
+          second = std::async(std::launch::async, [&] { return tum->LoadDepthRaw(s.b); });
         }
-        if (IsRgbd(sensor)) return LoadedImages{tum->LoadRgbGrey(s.a), tum->LoadDepthRaw(s.b)};
-        return LoadedImages{tum->LoadRgbGrey(s.a), cv::Mat()};
+        LoadedImages loaded;
+        loaded.a = euroc ? euroc->LoadCam0(s.a) : tum->LoadRgbGrey(s.a);
+        if (second.valid()) loaded.b = second.get();
+        return loaded;
       },
       2);
   for (const FrameSource& s : sources) {

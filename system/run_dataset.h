@@ -2,10 +2,10 @@
 // run's outputs. Used by `pkslam run` and `pkslam bench`.
 //
 // OUT/trajectory.txt   every tracked frame, TUM format (seconds), camera pose world_from_camera
-// OUT/trajectory_body.txt  the same as body (IMU) poses world_from_body (EuRoC ground truth's frame)
-// OUT/keyframes.txt    keyframes of the final map, same format
-// OUT/map_points.ply   map points (binary PLY)
-// OUT/sparse_model.txt keyframes with keypoints and map points with observations
+// OUT/trajectory_body.txt  the same as body (IMU) poses world_from_body (EuRoC ground truth's
+// frame) OUT/keyframes.txt    keyframes of the final map, same format OUT/map_points.ply   map
+// points (binary PLY) OUT/sparse_model.txt keyframes with keypoints and map points with
+// observations
 //                      (io/sparse_model.h; for `pkslam export-colmap`)
 // OUT/stats.json       timings, counts, tracking states, memory
 // OUT/run.log          the log of the run
@@ -33,6 +33,8 @@ struct RunOptions {
   bool realtime = false;
   // Stop after this many frames (0: all).
   int max_frames = 0;
+  // SystemOptions::mapping_sync; empty: "live" for offline monocular runs, "free" otherwise.
+  std::string mapping_sync;
   // No progress line.
   bool quiet = false;
   SystemOptions system;

@@ -15,6 +15,10 @@
 namespace pkslam {
 
 void SystemOptions::Check() const {
+  PKSLAM_CHECK_OPTION(
+      mapping_sync == "live" || mapping_sync == "lockstep" || mapping_sync == "free",
+      "mapping_sync", "'{}' (live|lockstep|free)", mapping_sync);
+  PKSLAM_CHECK_OPTION(live_pace > 0 && live_pace <= 100, "live_pace", "{}", live_pace);
   tracking.Check();
   mapping.Check();
   loop.Check();
@@ -26,7 +30,9 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
       setup_(MakeRig(settings, options_.sensor)),
       vocabulary_(std::move(vocabulary)) {
   PKSLAM_CHECK(vocabulary_ != nullptr, "no vocabulary");
+  if (options_.mapping_sync == "lockstep") options_.tracking.lockstep = true;
   if (options_.deterministic) {
+    options_.mapping_sync = "lockstep";
     options_.tracking.lockstep = true;
     options_.tracking.pose.num_threads = 1;
     options_.mapping.ba.num_threads = 1;
@@ -64,6 +70,7 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
     mapper_->SetKeyFrameConsumer([loop](const KeyFramePtr& kf) { loop->InsertKeyFrame(kf); });
     loop_->Start();
   }
+  mapper_->EmulateLive(options_.mapping_sync == "live", options_.live_pace);
   mapper_->Start();
   PKSLAM_LOG_INFO("sensor {}, camera {}, baseline {:.4f} m, selector {}{}",
                   SensorName(options_.sensor), setup_.rig->camera.ToString(), setup_.rig->baseline,

@@ -31,6 +31,14 @@ struct SystemOptions {
   // Run seed (--seed): passed to tracking and loop closing, so repeated research runs draw
   // different RANSAC samples; combined with `deterministic` each seed is reproducible.
   std::uint64_t seed = 0;
+  // How tracking meets local mapping: "live" (local mapping's state as a live run at
+  // real-time pace would see it; LocalMapper::AcceptsKeyFramesAt), "lockstep" (each keyframe
+  // mapped before the next frame; forced by `deterministic`), "free" (no coupling: what a
+  // live run does, and what --realtime uses).
+  std::string mapping_sync = "free";
+  // "live": playback speed of the emulated live run (1: frames at their timestamps; 2: twice
+  // as fast, so local mapping's work spans twice as much data time).
+  double live_pace = 2.0;
   // Record per-frame keyframe decisions (keyframe_trace.csv).
   bool trace = false;
   TrackingOptions tracking;

@@ -70,6 +70,30 @@ TEST(SimulateCli, ReplaysAreRealisticByDefault) {
   EXPECT_THAT(report.output, HasSubstr("Kalibr"));
 }
 
+// --camera kitti: KITTI odometry's grey pair (1241x376, 0.537 m, 10 Hz) and its ORB-SLAM3
+// feature count in settings.yaml, which `run --settings` then uses.
+TEST(SimulateCli, KittiCameraSizeRateBaselineAndFeatures) {
+  PKSLAM_REQUIRE_SHARED_DATA(shared);
+  const auto out = testing::MakeTempDir("cli_simulate_kitti");
+  const auto sim = RunPkslam(
+      fmt::format("--log-level warn simulate --out '{}' --trajectory '{}' --start 30 --duration 1 "
+                  "--quality fast --quiet --no-cloud --realism ideal --camera kitti",
+                  out.string(), (shared / "euroc/groundtruth/V1_02_medium.txt").string()));
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  EXPECT_THAT(sim.output, HasSubstr("11 frames, 201 IMU samples"));  // 10 Hz
+  const auto info = RunPkslam(fmt::format("info '{}'", out.string()));
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_THAT(info.output, HasSubstr("1241x376"));
+  EXPECT_THAT(info.output, HasSubstr("baseline 0.537000 m"));
+  const std::string settings = testing::ReadFileBytes(out / "settings.yaml");
+  EXPECT_THAT(settings, HasSubstr("ORBextractor.nFeatures: 2000"));
+  EXPECT_THAT(settings, HasSubstr("Camera.width: 1241"));
+  const auto bad = RunPkslam(
+      fmt::format("simulate --out '{}' --camera fisheye --quiet", (out / "bad").string()));
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_THAT(bad.output, HasSubstr("--camera"));
+}
+
 TEST(SimulateCli, BadInputIsOneErrorLine) {
   const auto out = testing::MakeTempDir("cli_simulate_bad");
   auto r =

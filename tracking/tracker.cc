@@ -14,6 +14,13 @@
 #include "tracking/pose_optimizer.h"
 
 namespace pkslam {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
 
 const char* TrackingStateName(TrackingState s) {
   switch (s) {
@@ -32,6 +39,8 @@ const char* TrackingStateName(TrackingState s) {
 void TrackingOptions::Check() const {
   PKSLAM_CHECK_OPTION(min_features_stereo_init > 0, "Tracking.min_features_stereo_init", "{}",
                       min_features_stereo_init);
+  PKSLAM_CHECK_OPTION(starving_inliers >= 0 && starving_ratio >= 0 && starving_ratio < 1,
+                      "Tracking.starving", "{} / {}", starving_inliers, starving_ratio);
   PKSLAM_CHECK_OPTION(max_local_keyframes > 0, "Tracking.max_local_keyframes", "{}",
                       max_local_keyframes);
   PKSLAM_CHECK_OPTION(min_inliers > 0 && min_inliers_after_reloc > 0, "Tracking.min_inliers",
@@ -67,16 +76,20 @@ Tracker::~Tracker() = default;
 TrackResult Tracker::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
   PKSLAM_CHECK(IsStereo(rig_->sensor), "TrackStereo with a {} rig", SensorName(rig_->sensor));
   const double cpu = ThreadCpuSeconds();
+  const auto wall = std::chrono::steady_clock::now();
   Frame frame = builder_.BuildStereo(atlas_->NextFrameId(), t_ns, left, right);
   build_cpu_ms_ = 1e3 * (ThreadCpuSeconds() - cpu);
+  build_ms_ = MsSince(wall);
   return Track(std::move(frame));
 }
 
 TrackResult Tracker::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns) {
   PKSLAM_CHECK(IsRgbd(rig_->sensor), "TrackRgbd with a {} rig", SensorName(rig_->sensor));
   const double cpu = ThreadCpuSeconds();
+  const auto wall = std::chrono::steady_clock::now();
   Frame frame = builder_.BuildRgbd(atlas_->NextFrameId(), t_ns, image, depth);
   build_cpu_ms_ = 1e3 * (ThreadCpuSeconds() - cpu);
+  build_ms_ = MsSince(wall);
   return Track(std::move(frame));
 }
 
@@ -84,13 +97,16 @@ TrackResult Tracker::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
   PKSLAM_CHECK(IsMonocular(rig_->sensor), "TrackMonocular with a {} rig", SensorName(rig_->sensor));
   const bool initialising = state_ == TrackingState::kNotInitialized;
   const double cpu = ThreadCpuSeconds();
+  const auto wall = std::chrono::steady_clock::now();
   Frame frame = builder_.BuildMonocular(atlas_->NextFrameId(), t_ns, image, initialising);
   build_cpu_ms_ = 1e3 * (ThreadCpuSeconds() - cpu);
+  build_ms_ = MsSince(wall);
   return Track(std::move(frame));
 }
 
 TrackResult Tracker::Track(Frame frame) {
   const auto start = std::chrono::steady_clock::now();
+  double frame_wait_ms = 0;
   const double cpu_start = ThreadCpuSeconds();
   current_ = std::move(frame);
   if (imu_) PreintegrateImu();
@@ -107,6 +123,17 @@ TrackResult Tracker::Track(Frame frame) {
   } else {
     bool ok = false;
     SelectorInput selector_input;
+    // Live emulation (offline runs): whether local mapping takes keyframes at this frame's
+    // time. It may block until that is known, so it is asked before the Atlas lock is taken
+    // (mapping needs the lock to finish); the wait is not tracking time. Without emulation
+    // the selector sees local mapping's state after the frame is tracked, as ORB-SLAM3.
+    const auto wait_start = std::chrono::steady_clock::now();
+    const bool emulated = mapping_->EmulatesLive();
+    const bool idle_at_frame = emulated && mapping_->AcceptsKeyFramesAt(current_.t_ns());
+    frame_wait_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start)
+            .count();
+    mapping_wait_ms_ += frame_wait_ms;
     {
       std::shared_lock lock(atlas_->mutex());
       if (imu_) SyncWithInertialMapLocked(/*correct_current=*/false);  // the world tracked in
@@ -153,8 +180,14 @@ TrackResult Tracker::Track(Frame frame) {
             current_.outliers[i] = 0;
           }
         }
-        selector_input = BuildSelectorInput();
+        selector_input =
+            BuildSelectorInput(emulated ? idle_at_frame : mapping_->AcceptsKeyFrames());
         last_decision_ = selector_->Decide(selector_input);
+        if (MapStarving(selector_input)) {
+          last_decision_.insert = true;
+          last_decision_.interrupt_local_ba = true;
+          last_decision_.reason += ";starving";
+        }
         if (trace_enabled_) {
           trace_.push_back({current_.t_ns(), current_.id(), last_decision_,
                             selector_input.FramesSinceLastKeyFrame()});
@@ -181,7 +214,8 @@ TrackResult Tracker::Track(Frame frame) {
   if (state_ == TrackingState::kLost) HandleLost();
 
   const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() -
+      frame_wait_ms;
   RecordFrame(new_keyframe, ms, 1e3 * (ThreadCpuSeconds() - cpu_start));
   result.state = state_;
   result.new_keyframe = new_keyframe;
@@ -202,7 +236,7 @@ void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
   r.frame_id = current_.id();
   r.state = state_;
   r.keyframe = keyframe;
-  r.tracking_ms = ms;
+  r.tracking_ms = build_ms_ + ms;
   r.tracking_cpu_ms = cpu_ms;
   r.build_cpu_ms = build_cpu_ms_;
   r.inliers = inliers_;
@@ -226,6 +260,16 @@ void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
     r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
   }
   records_.push_back(std::move(r));
+}
+
+bool Tracker::MapStarving(const SelectorInput& in) const {
+  if (last_decision_.insert || !IsMonocular(rig_->sensor) || in.local_mapping_idle ||
+      in.local_mapping_stopped || in.only_tracking || in.local_mapping_queue >= 3) {
+    return false;
+  }
+  if (last_decision_.deferred_busy && inliers_ < options_.starving_inliers) return true;
+  return in.reference_tracked_points > 0 &&
+         inliers_ < options_.starving_ratio * in.reference_tracked_points;
 }
 
 void Tracker::StereoInitialization() {

@@ -38,6 +38,8 @@ struct FrameRecord {
   // optimisation does not move it): what a live user saw; inertial runs write it out.
   std::optional<SE3d> camera_from_world_online;
   bool keyframe = false;
+  // Wall time from image to pose: building the frame (ORB extraction, stereo matching) and
+  // tracking it, as ORB-SLAM3's examples time Track*(); live-emulation waits excluded.
   double tracking_ms = 0;
   // CPU time of the tracking thread: building the frame (ORB, stereo matching) and tracking it
   // (the wall-clock tracking_ms also counts waits for the Atlas lock and preemption).
@@ -84,6 +86,8 @@ class Tracker {
   };
   const std::vector<TraceRow>& trace() const { return trace_; }
   void EnableTrace(bool on) { trace_enabled_ = on; }
+  // Wall time spent waiting for local mapping's state (live emulation of offline runs).
+  double mapping_wait_ms() const { return mapping_wait_ms_; }
   int relocalisations() const { return relocalisations_; }
 
   // Drops the current map (a reset) and starts again from NOT_INITIALIZED.
@@ -91,6 +95,8 @@ class Tracker {
 
  private:
   TrackResult Track(Frame frame);
+  // Monocular: the map is about to starve of keyframes (TrackingOptions::starving_*).
+  bool MapStarving(const SelectorInput& in) const;
   void StereoInitialization();
   void MonocularInitialization();
   void CreateInitialMapMonocular(const TwoViewResult& reconstruction);
@@ -101,7 +107,8 @@ class Tracker {
   void UpdateLocalKeyFrames();
   void UpdateLocalPoints();
   int SearchLocalPoints();
-  SelectorInput BuildSelectorInput() const;
+  // `mapping_idle`: whether local mapping takes keyframes at this frame's time.
+  SelectorInput BuildSelectorInput(bool mapping_idle) const;
   void CreateNewKeyFrame(const SelectorInput& input);
   // Finds the frame's pose in the current map from BoW candidates (tracking/relocalization.cc).
   bool Relocalize();
@@ -144,7 +151,10 @@ class Tracker {
   KeyFramePtr reference_kf_;
   KeyFramePtr last_kf_;
   FrameId last_reloc_frame_id_ = -1000000;
-  double build_cpu_ms_ = 0;  // CPU ms building the frame being tracked (for its FrameRecord)
+  double mapping_wait_ms_ = 0;  // total wall ms waited in MappingBackend::AcceptsKeyFramesAt
+  double build_cpu_ms_ = 0;
+  double build_ms_ = 0;  // wall ms building the frame being tracked  // CPU ms building the frame
+                         // being tracked (for its FrameRecord)
   int inliers_ = 0;
   std::int64_t lost_since_t_ns_ = 0;
   int relocalisations_ = 0;

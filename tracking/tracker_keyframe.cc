@@ -14,7 +14,7 @@
 
 namespace pkslam {
 
-SelectorInput Tracker::BuildSelectorInput() const {
+SelectorInput Tracker::BuildSelectorInput(bool mapping_idle) const {
   SelectorInput in;
   const CameraRig& rig = *rig_;
   const Map* map = atlas_->current_map();
@@ -41,7 +41,7 @@ SelectorInput Tracker::BuildSelectorInput() const {
   in.last_relocalisation_frame_id = last_reloc_frame_id_;
   FillImuSelectorInput(&in);
   in.local_mapping_stopped = mapping_->IsStoppedOrStopRequested();
-  in.local_mapping_idle = mapping_->AcceptsKeyFrames();
+  in.local_mapping_idle = mapping_idle;
   in.local_mapping_initializing = mapping_->IsInitializingImu();
   in.local_mapping_queue = mapping_->QueueSize();
 

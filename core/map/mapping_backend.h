@@ -2,6 +2,8 @@
 // mapping/ stay peers: mapping/LocalMapper implements it; system/ wires them together.
 #pragma once
 
+#include <cstdint>
+
 #include "core/map/ids.h"
 
 namespace pkslam {
@@ -22,6 +24,16 @@ class MappingBackend {
   virtual void InterruptBundleAdjustment() = 0;
   // Deterministic mode: blocks until every queued keyframe is processed (and handed on).
   virtual void WaitUntilIdle() = 0;
+  // Whether local mapping takes keyframes for a frame at data time `t_ns`. Without live
+  // emulation this is AcceptsKeyFrames(). With it (offline runs, EmulateLive), local mapping
+  // is idle at t_ns only if its work, laid out on the data clock (a keyframe's processing
+  // starts at its timestamp or when the previous one ends, and lasts its wall time), ended
+  // by t_ns; the call blocks while that cannot be known yet (mapping is still working on a
+  // keyframe whose data-clock span has not yet reached t_ns). Tracking thereby sees mapping
+  // as a live run at real-time pace would, without sleeping when mapping is idle.
+  virtual bool AcceptsKeyFramesAt(std::int64_t t_ns) = 0;
+  // Whether AcceptsKeyFramesAt emulates a live run (else it is AcceptsKeyFrames()).
+  virtual bool EmulatesLive() const = 0;
   // Map reset by tracking: drop queued keyframes (called with no Atlas lock held).
   virtual void ResetQueue() = 0;
 };

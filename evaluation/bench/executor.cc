@@ -86,6 +86,17 @@ bool AddDenseCloud(const Suite& suite, const RunSpec& run, const HarnessOptions&
 
 }  // namespace
 
+std::optional<fs::path> SettingsFile(const DatasetSpec& d, const fs::path& dataset) {
+  if (!d.settings) return std::nullopt;
+  std::string text = d.settings->string();
+  const std::string key = kDatasetPlaceholder;
+  for (std::size_t at = text.find(key); at != std::string::npos;
+       at = text.find(key, at + dataset.string().size())) {
+    text.replace(at, key.size(), dataset.string());
+  }
+  return fs::path(text);
+}
+
 void HarnessOptions::Check() const {
   PKSLAM_CHECK_OPTION(jobs >= 1, "--jobs", "{} < 1", jobs);
   PKSLAM_CHECK_OPTION(!out.empty(), "--out", "empty");
@@ -172,7 +183,9 @@ std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
       "run",      "--dataset",  dataset.string(), "--out",  run_dir.string(),         "--sensor",
       run.sensor, "--selector", run.selector,     "--seed", std::to_string(run.seed), "--quiet"};
   for (const auto& [k, v] : run.params) a.insert(a.end(), {"--param", k + "=" + FormatNumber(v)});
-  if (d.settings) a.insert(a.end(), {"--settings", d.settings->string()});
+  if (const auto settings = SettingsFile(d, dataset)) {
+    a.insert(a.end(), {"--settings", settings->string()});
+  }
   if (d.max_frames > 0) a.insert(a.end(), {"--max-frames", std::to_string(d.max_frames)});
   if (suite.deterministic) a.push_back("--deterministic");
   return a;
@@ -191,7 +204,9 @@ std::vector<std::string> DenseArguments(const Suite& suite, const RunSpec& run,
                                 "--json",
                                 (run_dir / "dense.json").string(),
                                 "--quiet"};
-  if (d.settings) a.insert(a.end(), {"--settings", d.settings->string()});
+  if (const auto settings = SettingsFile(d, dataset)) {
+    a.insert(a.end(), {"--settings", settings->string()});
+  }
   return a;
 }
 

@@ -54,6 +54,10 @@ std::filesystem::path PrepareDataset(const Suite& suite, const RunSpec& run,
                                      const HarnessOptions& options,
                                      const std::atomic<bool>* cancel = nullptr);
 
+// The dataset's settings file with {dataset} replaced by `dataset` (nullopt: none given).
+std::optional<std::filesystem::path> SettingsFile(const DatasetSpec& d,
+                                                  const std::filesystem::path& dataset);
+
 // The `pkslam run` command line (without the executable).
 std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
                                       const std::filesystem::path& dataset,

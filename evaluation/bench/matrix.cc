@@ -16,13 +16,14 @@ struct Config {
   double sweep_value = 0.0;
   bool dense = false;
   std::vector<std::string> peer_command;
+  std::vector<std::string> peer_sensors;  // empty: all
 };
 
 // The configurations run on `dataset`: the suite's selectors, then the sweep points.
 std::vector<Config> Configurations(const Suite& suite, const std::string& dataset) {
   std::vector<Config> out;
   for (const auto& sel : suite.selectors) {
-    Config c{sel.label, sel.name, suite.params, "", 0.0, suite.dense, {}};
+    Config c{sel.label, sel.name, suite.params, "", 0.0, suite.dense, {}, {}};
     for (const auto& [k, v] : sel.params) c.params[k] = v;
     out.push_back(c);
   }
@@ -43,6 +44,7 @@ std::vector<Config> Configurations(const Suite& suite, const std::string& datase
                sw.param,
                v,
                suite.dense || sw.dense,
+               {},
                {}};
       for (const auto& [k, x] : base->params) c.params[k] = x;
       c.params[sw.param] = v;
@@ -54,6 +56,7 @@ std::vector<Config> Configurations(const Suite& suite, const std::string& datase
     c.label = peer.label;
     c.selector = "peer";
     c.peer_command = peer.command;
+    c.peer_sensors = peer.sensors;
     out.push_back(c);
   }
   return out;
@@ -83,6 +86,10 @@ std::vector<RunSpec> ExpandSuite(const Suite& suite) {
     const auto& sensors = d.sensors.empty() ? suite.sensors : d.sensors;
     for (const auto& sensor : sensors) {
       for (const auto& c : configs) {
+        if (!c.peer_sensors.empty() && std::find(c.peer_sensors.begin(), c.peer_sensors.end(),
+                                                 sensor) == c.peer_sensors.end()) {
+          continue;
+        }
         for (int k = 0; k < suite.runs; ++k) {
           RunSpec r;
           r.index = static_cast<int>(out.size());

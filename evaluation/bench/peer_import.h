@@ -6,11 +6,15 @@
 //                    for inertial sensors, cam0 otherwise; lost frames are absent
 //   kf_tum.txt       the keyframes, same frame and format (optional)
 //   track_times.txt  "t_frame_s tracking_s" per frame (optional)
-//   summary.txt      key=value lines, wall_s=... (optional)
+//   summary.txt      key=value words, wall_s=... peak_rss_mb=... (optional)
+//   time.txt         /usr/bin/time -v of the peer process: user and system time (optional)
 // What is written: trajectory_body.txt (inertial sensors) or trajectory.txt plus
 // body_from_camera.txt (visual sensors: cam0's T_BS from the dataset, the extrinsic the peer
 // was given), keyframes.txt and a stats.json with frames = the dataset's cam0 frames,
-// lost_frames = frames without a pose, keyframes, wall time and the median tracking time.
+// lost_frames = frames without a pose, keyframes, wall time, sequence duration (last - first
+// cam0 timestamp, as `pkslam run` measures it), realtime factor (sequence / wall), median and
+// 95th-percentile tracking time, process CPU time and peak memory; what the peer's files lack
+// is null.
 #pragma once
 
 #include <cstdint>

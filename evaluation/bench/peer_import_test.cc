@@ -39,7 +39,10 @@ PeerRun MakePeerRun(const std::string& name) {
       << fmt::format("{:.9f} 0.1 0 0 0 0 0 1\n", 1e-9 * static_cast<double>(p.fixture.FrameT(1)));
   std::ofstream(p.run / "track_times.txt") << "0.05 0.020\n0.10 0.030\n0.15 0.010\n";
   std::ofstream(p.run / "summary.txt")
-      << "images=5 seq_duration_s=0.25 wall_s=1.50 realtime_factor=0.17\n";
+      << "images=5 seq_duration_s=0.25 wall_s=1.50 realtime_factor=0.17\npeak_rss_mb=321\n";
+  std::ofstream(p.run / "time.txt") << "\tCommand being timed: \"nice -n 19 peer\"\n"
+                                    << "\tUser time (seconds): 2.25\n"
+                                    << "\tSystem time (seconds): 0.50\n";
   return p;
 }
 
@@ -63,15 +66,49 @@ TEST(PeerImport, InertialRunBecomesABodyTrajectoryWithStats) {
   EXPECT_DOUBLE_EQ(stats["median_tracking_ms"].as<double>(), 20.0);
 }
 
+// The peer's speed in the keys `pkslam run` uses, so the speed table holds both systems.
+TEST(PeerImport, SpeedStatsMatchPkslamRunKeys) {
+  const PeerRun p = MakePeerRun("peer_import_speed");
+  ImportPeerRun(p.run, p.dataset, "stereo");
+  const YAML::Node stats = YAML::LoadFile((p.run / "stats.json").string());
+  // 5 frames 50 ms apart: last - first = 0.2 s (pkslam's definition, not summary.txt's 0.25).
+  EXPECT_NEAR(stats["sequence_duration_s"].as<double>(), 0.2, 1e-9);
+  // Over its frame loop (the sum of the Track*() times, 60 ms), not the process's 1.5 s.
+  EXPECT_NEAR(stats["tracking_loop_s"].as<double>(), 0.06, 1e-9);
+  EXPECT_NEAR(stats["realtime_factor"].as<double>(), 0.2 / 0.06, 1e-9);
+  EXPECT_DOUBLE_EQ(stats["p95_tracking_ms"].as<double>(), 30.0);  // of 10, 20, 30 ms
+  EXPECT_DOUBLE_EQ(stats["process_cpu_s"].as<double>(), 2.75);    // user + system
+  EXPECT_DOUBLE_EQ(stats["peak_memory_mib"].as<double>(), 321.0);
+  // Without time.txt, summary.txt and track_times.txt: no CPU time, memory or realtime
+  // factor (null).
+  fs::remove(p.run / "time.txt");
+  fs::remove(p.run / "summary.txt");
+  fs::remove(p.run / "track_times.txt");
+  ImportPeerRun(p.run, p.dataset, "stereo");
+  const YAML::Node bare = YAML::LoadFile((p.run / "stats.json").string());
+  EXPECT_TRUE(bare["process_cpu_s"].IsNull());
+  EXPECT_TRUE(bare["peak_memory_mib"].IsNull());
+  EXPECT_TRUE(bare["realtime_factor"].IsNull());
+}
+
 TEST(PeerImport, VisualRunKeepsCameraPosesAndTheExtrinsicThePeerRead) {
   const PeerRun p = MakePeerRun("peer_import_visual");
   fs::remove(p.run / "track_times.txt");
   fs::remove(p.run / "summary.txt");
-  ImportPeerRun(p.run, p.dataset, "stereo");
+  ImportPeerRun(p.run, p.dataset, "mono");
   ASSERT_TRUE(fs::exists(p.run / "trajectory.txt"));
-  EXPECT_FALSE(fs::exists(p.run / "trajectory_body.txt"));
+  EXPECT_FALSE(
+      fs::exists(p.run / "trajectory_body.txt"));  // a monocular map has no metric lever arm
   const SE3d body_from_camera = ReadRigidTransform(p.run / "body_from_camera.txt");
   EXPECT_NEAR(body_from_camera.translation().x(), -0.0216401454975, 1e-12);
+  // Stereo: also the body trajectory (camera poses moved through the extrinsic), which the
+  // bench compares stereo runs by.
+  ImportPeerRun(p.run, p.dataset, "stereo");
+  const Trajectory camera = ReadTrajectory(p.run / "trajectory.txt", TrajectoryFormat::kTum);
+  const Trajectory body = ReadTrajectory(p.run / "trajectory_body.txt", TrajectoryFormat::kTum);
+  ASSERT_EQ(body.poses.size(), camera.poses.size());
+  const SE3d expected = camera.poses[1].pose * body_from_camera.Inverse();
+  EXPECT_NEAR((body.poses[1].pose.translation() - expected.translation()).norm(), 0.0, 1e-6);
   const YAML::Node stats = YAML::LoadFile((p.run / "stats.json").string());
   EXPECT_TRUE(stats["wall_time_s"].IsNull());  // no summary.txt: not measured
   EXPECT_TRUE(stats["median_tracking_ms"].IsNull());

@@ -122,6 +122,29 @@ struct Document {
   }
 };
 
+// The Speed section, when the runs measured their speed (pkslam run's stats.json since
+// realtime_factor; peers through peer_import.cc).
+void AddSpeed(Document* doc, const std::vector<GroupSummary>& groups) {
+  const Table speed = SpeedTable(groups);
+  if (speed.rows.empty()) return;
+  doc->Heading(2, "Speed");
+  std::string text =
+      "Timings compare only between runs on an otherwise idle machine (--jobs 1). pkslam's wall "
+      "time is its frame loop (after loading the vocabulary); mapping [ms/KF] is the median local "
+      "mapping time per keyframe; CPU is the whole process's (every thread).";
+  const bool peers = std::any_of(groups.begin(), groups.end(),
+                                 [](const GroupSummary& g) { return g.selector == "peer"; });
+  if (peers) {
+    text +=
+        " A peer's realtime factor is over its frame loop: the sum of its per-frame Track*() "
+        "times (it decodes images outside them, and loads its vocabulary before); its CPU is "
+        "its whole process's; RT pkslam/PEER is the ratio of realtime factors on the same "
+        "dataset and sensor (> 1: pkslam is faster).";
+  }
+  doc->Paragraph(text);
+  doc->AddTable(speed);
+}
+
 std::string Now() {
   const std::time_t t = std::time(nullptr);
   std::tm tm{};
@@ -213,6 +236,7 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
   doc.Heading(2, "Keyframes, maps and run time");
   doc.AddTable(DetailTable(groups));
   doc.Images(plots, "keyframes");
+  AddSpeed(&doc, groups);
   const Table biases = BiasTable(groups);
   if (!biases.rows.empty()) {
     doc.Heading(2, "IMU biases");

@@ -91,7 +91,12 @@ std::vector<std::string> ResultColumns() {
           "median_tracking_ms",
           "dense_points",
           "gyro_bias_err_pct",
-          "accel_bias_err_pct"};
+          "accel_bias_err_pct",
+          "realtime_factor",
+          "p95_tracking_ms",
+          "mapping_ms_per_kf",
+          "cpu_s",
+          "peak_memory_mib"};
 }
 
 std::string CsvField(const std::string& text) {
@@ -168,7 +173,12 @@ std::string ResultCsvRow(const RunResult& r) {
                                       Num(r.median_tracking_ms),
                                       Num(r.dense_points),
                                       Num(r.gyro_bias_err_pct),
-                                      Num(r.accel_bias_err_pct)};
+                                      Num(r.accel_bias_err_pct),
+                                      Num(r.realtime_factor),
+                                      Num(r.p95_tracking_ms),
+                                      Num(r.mapping_ms_per_kf),
+                                      Num(r.cpu_s),
+                                      Num(r.peak_memory_mib)};
   std::string out;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (i > 0) out.push_back(',');
@@ -250,7 +260,10 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
     r.lost_frames = static_cast<int>(ParseInt(next(), file, n, "lost_frames"));
     r.wall_s = ParseDouble(next(), file, n, "wall_s");
     r.median_tracking_ms = ParseDouble(next(), file, n, "median_tracking_ms");
-    double* optional[] = {&r.dense_points, &r.gyro_bias_err_pct, &r.accel_bias_err_pct};
+    // In the order of ResultColumns(); a file holds a prefix of them.
+    double* optional[] = {&r.dense_points,    &r.gyro_bias_err_pct, &r.accel_bias_err_pct,
+                          &r.realtime_factor, &r.p95_tracking_ms,   &r.mapping_ms_per_kf,
+                          &r.cpu_s,           &r.peak_memory_mib};
     PKSLAM_CHECK(required + std::size(optional) == columns.size(), "optional columns");
     for (std::size_t k = 0; required + k < header.size(); ++k) {
       *optional[k] = ParseDouble(next(), file, n, header[required + k]);

@@ -49,6 +49,12 @@ struct RunResult {
   // from 15 s after the first one (bias_evaluation.h); empty otherwise.
   double gyro_bias_err_pct = kNaN;
   double accel_bias_err_pct = kNaN;
+  // Speed, from the run's stats.json (empty when it lacks them: older pkslam runs, peers).
+  double realtime_factor = kNaN;    // sequence duration / wall time (> 1: faster than real time)
+  double p95_tracking_ms = kNaN;    // 95th percentile of the per-frame tracking times
+  double mapping_ms_per_kf = kNaN;  // median local mapping time per keyframe
+  double cpu_s = kNaN;              // CPU time of the whole process (every thread)
+  double peak_memory_mib = kNaN;    // peak resident memory
 };
 
 // The headline alignment of a run: `suite_choice` when "se3"/"sim3"; for "auto" "sim3" for

@@ -50,6 +50,11 @@ TEST(ResultsCsv, RoundTripsEveryField) {
   ok.median_tracking_ms = 20.25;
   ok.dense_points = 123456;
   ok.accel_bias_err_pct = 12.5;
+  ok.realtime_factor = 1.75;
+  ok.p95_tracking_ms = 31.5;
+  ok.mapping_ms_per_kf = 48.25;
+  ok.cpu_s = 60.5;
+  ok.peak_memory_mib = 812;
   RunResult failed = ok;
   failed.index = 5;
   failed.run_id = "d/mono/pks/seed4";
@@ -73,32 +78,74 @@ TEST(ResultsCsv, RoundTripsEveryField) {
   EXPECT_DOUBLE_EQ(back[0].accel_bias_err_pct, 12.5);
   EXPECT_TRUE(std::isnan(back[0].gyro_bias_err_pct));
   EXPECT_TRUE(std::isnan(back[0].rpe_trans_m));
+  EXPECT_DOUBLE_EQ(back[0].realtime_factor, 1.75);
+  EXPECT_DOUBLE_EQ(back[0].p95_tracking_ms, 31.5);
+  EXPECT_DOUBLE_EQ(back[0].mapping_ms_per_kf, 48.25);
+  EXPECT_DOUBLE_EQ(back[0].cpu_s, 60.5);
+  EXPECT_DOUBLE_EQ(back[0].peak_memory_mib, 812);
   EXPECT_FALSE(back[1].ok);
   EXPECT_EQ(back[1].error, failed.error);
   EXPECT_TRUE(std::isnan(back[1].ate_m));
 }
 
-// result.csv files of runs finished before the optional trailing columns still read (a resumed or
-// collected bench must not run them again).
-TEST(ResultsCsv, ReadsFilesWithoutTheDenseColumn) {
+// result.csv of `r` as written by a version without the last `dropped` columns.
+std::vector<RunResult> ReadWithoutTrailingColumns(const RunResult& r, int dropped,
+                                                  const std::string& name) {
+  std::string header = ResultCsvHeader();
+  std::string row = ResultCsvRow(r);
+  for (int k = 0; k < dropped; ++k) {
+    header = header.substr(0, header.rfind(','));
+    row = row.substr(0, row.rfind(','));
+  }
+  const auto dir = testing::MakeTempDir(name);
+  std::ofstream(dir / "result.csv") << header << '\n' << row << '\n';
+  return ReadResultsCsv(dir / "result.csv");
+}
+
+RunResult MeasuredRun() {
   RunResult r;
   r.run_id = "d/stereo/pks/seed1";
   r.ok = true;
   r.ate_m = 0.01;
   r.dense_points = 5;
-  std::string header = ResultCsvHeader();
-  std::string row = ResultCsvRow(r);
-  for (int k = 0; k < 3; ++k) {  // dense_points and the bias errors came later
-    header = header.substr(0, header.rfind(','));
-    row = row.substr(0, row.rfind(','));
-  }
-  const auto dir = testing::MakeTempDir("bench_results_legacy");
-  std::ofstream(dir / "result.csv") << header << '\n' << row << '\n';
-  const auto back = ReadResultsCsv(dir / "result.csv");
+  r.gyro_bias_err_pct = 7;
+  r.realtime_factor = 2.5;
+  r.cpu_s = 12;
+  return r;
+}
+
+// result.csv files of runs finished before the optional trailing columns still read (a resumed or
+// collected bench must not run them again).
+TEST(ResultsCsv, ReadsFilesWithoutTheDenseColumn) {
+  // dense_points, the bias errors and the 5 speed columns came later.
+  const auto back = ReadWithoutTrailingColumns(MeasuredRun(), 8, "bench_results_legacy");
   ASSERT_EQ(back.size(), 1u);
   EXPECT_TRUE(back[0].ok);
   EXPECT_DOUBLE_EQ(back[0].ate_m, 0.01);
   EXPECT_TRUE(std::isnan(back[0].dense_points));
+  EXPECT_TRUE(std::isnan(back[0].realtime_factor));
+}
+
+TEST(ResultsCsv, ReadsFilesWithoutTheSpeedColumns) {
+  const auto back = ReadWithoutTrailingColumns(MeasuredRun(), 5, "bench_results_no_speed");
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_DOUBLE_EQ(back[0].dense_points, 5);  // the older optional columns still read
+  EXPECT_DOUBLE_EQ(back[0].gyro_bias_err_pct, 7);
+  EXPECT_TRUE(std::isnan(back[0].realtime_factor));
+  EXPECT_TRUE(std::isnan(back[0].cpu_s));
+  EXPECT_TRUE(std::isnan(back[0].peak_memory_mib));
+  // Only the speed columns a file has are read: with realtime_factor, without cpu_s.
+  const auto partial = ReadWithoutTrailingColumns(MeasuredRun(), 4, "bench_results_part_speed");
+  EXPECT_DOUBLE_EQ(partial[0].realtime_factor, 2.5);
+  EXPECT_TRUE(std::isnan(partial[0].cpu_s));
+}
+
+TEST(ResultsCsv, SpeedColumnsTrailTheOlderOptionalOnes) {
+  const auto columns = ResultColumns();
+  const std::vector<std::string> tail(columns.end() - 6, columns.end());
+  EXPECT_EQ(tail,
+            (std::vector<std::string>{"accel_bias_err_pct", "realtime_factor", "p95_tracking_ms",
+                                      "mapping_ms_per_kf", "cpu_s", "peak_memory_mib"}));
 }
 
 TEST(ResultsCsv, MalformedFilesNameTheLine) {

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <type_traits>
@@ -24,7 +25,20 @@ struct StatsJson {
   int lost_frames = 0;
   double wall_s = kNaN;
   double median_tracking_ms = kNaN;
+  // Optional (older pkslam versions and peers write fewer keys): NaN when absent.
+  double realtime_factor = kNaN;
+  double p95_tracking_ms = kNaN;
+  double mapping_ms_per_kf = kNaN;
+  double cpu_s = kNaN;
+  double peak_memory_mib = kNaN;
 };
+
+// realtime_factor from stats.json, else sequence_duration_s / wall time. A factor <= 0 is
+// what `pkslam run` writes when it measured no wall time: not a measure.
+double RealtimeFactor(double written, double sequence_s, double wall_s) {
+  const double factor = std::isfinite(written) ? written : sequence_s / wall_s;
+  return std::isfinite(factor) && factor > 0 ? factor : kNaN;
+}
 
 // stats.json is plain JSON, which yaml-cpp reads as YAML flow style.
 StatsJson ReadStats(const fs::path& file) {
@@ -48,6 +62,7 @@ StatsJson ReadStats(const fs::path& file) {
       throw InputError(file, root[key].Mark().line + 1, std::string("bad '") + key + "'");
     }
   };
+  auto optional = [&](const char* key) { return root[key] ? get(key, 0.0) : kNaN; };
   StatsJson s;
   s.frames = get("frames", 0);
   s.keyframes = get("keyframes", 0);
@@ -55,6 +70,12 @@ StatsJson ReadStats(const fs::path& file) {
   s.lost_frames = get("lost_frames", 0);
   s.wall_s = get("wall_time_s", 0.0);
   s.median_tracking_ms = get("median_tracking_ms", 0.0);
+  s.realtime_factor =
+      RealtimeFactor(optional("realtime_factor"), optional("sequence_duration_s"), s.wall_s);
+  s.p95_tracking_ms = optional("p95_tracking_ms");
+  s.mapping_ms_per_kf = optional("median_local_mapping_ms");
+  s.cpu_s = optional("process_cpu_s");
+  s.peak_memory_mib = optional("peak_memory_mib");
   return s;
 }
 
@@ -107,6 +128,11 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   result->lost_frames = stats.lost_frames;
   result->wall_s = stats.wall_s;
   result->median_tracking_ms = stats.median_tracking_ms;
+  result->realtime_factor = stats.realtime_factor;
+  result->p95_tracking_ms = stats.p95_tracking_ms;
+  result->mapping_ms_per_kf = stats.mapping_ms_per_kf;
+  result->cpu_s = stats.cpu_s;
+  result->peak_memory_mib = stats.peak_memory_mib;
 
   const fs::path gt_file = files.ground_truth.value_or(FindGroundTruth(files.dataset));
   // Visual-only monocular maps have no metric scale: their camera poses are compared with the

@@ -84,6 +84,54 @@ TEST(EvaluateRun, MeasuresAteBothAlignmentsAndReadsStats) {
   EXPECT_TRUE(fs::exists(f.run / "plot_keyframes.csv"));
 }
 
+// Speed measures of stats.json fill the speed columns; absent ones (older runs, peers) stay
+// empty rather than failing the evaluation.
+TEST(EvaluateRun, ReadsSpeedFromStatsWhenPresent) {
+  const Fixture f = MakeRun("bench_eval_speed", 1.0, 0.0);
+  RunResult r;
+  r.alignment = "se3";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);  // the fixture's stats lack them
+  EXPECT_TRUE(r.ok);
+  EXPECT_TRUE(std::isnan(r.realtime_factor));
+  EXPECT_TRUE(std::isnan(r.p95_tracking_ms));
+  EXPECT_TRUE(std::isnan(r.mapping_ms_per_kf));
+  EXPECT_TRUE(std::isnan(r.cpu_s));
+  EXPECT_TRUE(std::isnan(r.peak_memory_mib));
+
+  std::ofstream(f.run / "stats.json", std::ios::trunc)
+      << R"({"frames": 120, "keyframes": 10, "map_points": 900, "lost_frames": 3,
+            "wall_time_s": 4.5, "median_tracking_ms": 21.5, "realtime_factor": 1.25,
+            "p95_tracking_ms": 40.5, "median_local_mapping_ms": 55.0, "process_cpu_s": 9.75,
+            "peak_memory_mib": 512.0, "mapping_wait_s": 0.5, "keyframes_created": 12})";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_DOUBLE_EQ(r.realtime_factor, 1.25);
+  EXPECT_DOUBLE_EQ(r.p95_tracking_ms, 40.5);
+  EXPECT_DOUBLE_EQ(r.mapping_ms_per_kf, 55.0);
+  EXPECT_DOUBLE_EQ(r.cpu_s, 9.75);
+  EXPECT_DOUBLE_EQ(r.peak_memory_mib, 512.0);
+
+  // Without realtime_factor: sequence duration / wall time; null measures stay empty.
+  std::ofstream(f.run / "stats.json", std::ios::trunc)
+      << R"({"frames": 120, "keyframes": 10, "map_points": 0, "lost_frames": 3,
+            "wall_time_s": 4.5, "median_tracking_ms": 21.5, "sequence_duration_s": 9.0,
+            "p95_tracking_ms": null})";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_DOUBLE_EQ(r.realtime_factor, 2.0);
+  EXPECT_TRUE(std::isnan(r.p95_tracking_ms));
+
+  // `pkslam run` writes 0 when it measured no wall time: not a realtime factor.
+  std::ofstream(f.run / "stats.json", std::ios::trunc)
+      << R"({"frames": 120, "keyframes": 10, "map_points": 0, "lost_frames": 3,
+            "wall_time_s": 0.0, "median_tracking_ms": 21.5, "realtime_factor": 0.0})";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_TRUE(std::isnan(r.realtime_factor));
+
+  std::ofstream(f.run / "stats.json", std::ios::trunc)
+      << R"({"frames": 120, "keyframes": 10, "map_points": 0, "lost_frames": 3,
+            "wall_time_s": 4.5, "median_tracking_ms": 21.5, "process_cpu_s": "lots"})";
+  EXPECT_THROW(EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r), InputError);
+}
+
 TEST(EvaluateRun, MonocularUsesSim3AndRecoversScale) {
   const Fixture f = MakeRun("bench_eval_mono", 0.5, 0.0);
   RunResult r;

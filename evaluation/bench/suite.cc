@@ -158,7 +158,14 @@ DatasetSpec ParseDataset(const Context& c, const YAML::Node& node) {
     c.Fail(node, "dataset '" + d.name + "' needs 'path' (data on disk) or 'sim' (a recipe)");
   }
   if (node["ground_truth"]) d.ground_truth = Path(c, node["ground_truth"], "ground_truth");
-  if (node["settings"]) d.settings = Path(c, node["settings"], "settings");
+  if (node["settings"]) {
+    // A path inside the dataset folder is only known when the run starts (a rendering's cache
+    // folder): the executor substitutes it.
+    const std::string text = String(c, node["settings"], "settings");
+    d.settings = text.find(kDatasetPlaceholder) != std::string::npos
+                     ? fs::path(text)
+                     : Path(c, node["settings"], "settings");
+  }
   if (node["sensors"]) d.sensors = StringList(c, node["sensors"], "sensors");
   if (node["max_frames"]) {
     d.max_frames = static_cast<int>(Integer(c, node["max_frames"], "max_frames", 0));
@@ -185,7 +192,7 @@ SelectorSpec ParseSelector(const Context& c, const YAML::Node& node) {
 }
 
 PeerSpec ParsePeer(const Context& c, const YAML::Node& node) {
-  CheckKeys(c, node, "a peer", {"label", "command"});
+  CheckKeys(c, node, "a peer", {"label", "command", "sensors"});
   if (!node["label"] || !node["command"]) c.Fail(node, "a peer needs 'label' and 'command'");
   PeerSpec p;
   p.label = String(c, node["label"], "label");
@@ -194,6 +201,7 @@ PeerSpec ParsePeer(const Context& c, const YAML::Node& node) {
   }
   p.command = StringList(c, node["command"], "command");
   if (p.command.empty() || p.command.front().empty()) c.Fail(node, "peer command is empty");
+  if (node["sensors"]) p.sensors = StringList(c, node["sensors"], "sensors");
   return p;
 }
 

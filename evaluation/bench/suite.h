@@ -19,7 +19,8 @@
 //        "{sensor}", "{out}"]}
 //   datasets:
 //     - {name: MH_01_easy, path: ${EUROC_ROOT}/MH_01_easy}         # real data on disk
-//     - {name: sim_V102, sim: {trajectory: ..., start: 20, duration: 10, args: [...]}}
+//     - {name: sim_V102, sim: {trajectory: ..., start: 20, duration: 10, args: [...]},
+//        settings: "{dataset}/settings.yaml"}  # the rendering's own settings (DatasetSpec)
 //
 // Paths may use ${VAR} and ${VAR:-default}; relative paths are relative to the suite file.
 // Every error is an InputError naming the suite file and the line of the offending node.
@@ -56,10 +57,16 @@ struct DatasetSpec {
   // Ground truth; default: mav0/state_groundtruth_estimate0/data.csv (EuRoC layout) or
   // groundtruth.txt (TUM RGB-D layout) inside the dataset.
   std::optional<std::filesystem::path> ground_truth;
-  std::optional<std::filesystem::path> settings;  // pkslam run --settings
-  std::vector<std::string> sensors;               // empty: the suite's sensors
-  int max_frames = 0;                             // pkslam run --max-frames (0: all)
+  // pkslam run --settings. "{dataset}" in it stands for the dataset folder the run reads (a
+  // simulator recipe's rendering in the cache: "{dataset}/settings.yaml" is the settings file
+  // `pkslam simulate` wrote); such a path is not resolved against the suite's folder.
+  std::optional<std::filesystem::path> settings;
+  std::vector<std::string> sensors;  // empty: the suite's sensors
+  int max_frames = 0;                // pkslam run --max-frames (0: all)
 };
+
+// Stands for the dataset folder in DatasetSpec::settings (and in peer commands).
+inline constexpr const char* kDatasetPlaceholder = "{dataset}";
 
 // One selector configuration (a column of the summary tables).
 struct SelectorSpec {
@@ -86,6 +93,9 @@ struct SweepSpec {
 struct PeerSpec {
   std::string label;  // its column in the tables (unique among selectors and peers)
   std::vector<std::string> command;
+  // The sensors it runs (empty: every sensor of the suite); others are skipped, not failed
+  // (the ORB-SLAM3 peer has no RGB-D mode).
+  std::vector<std::string> sensors;
 };
 
 struct Suite {

@@ -12,6 +12,8 @@
 namespace pkslam::bench {
 namespace {
 
+namespace fs = std::filesystem;
+
 const char* kSuite = R"(name: demo
 runs: 3
 seed: 10
@@ -199,6 +201,51 @@ datasets:
   EXPECT_EQ(runs[2].selector, "peer");
   EXPECT_EQ(runs[2].peer_command, s.peers[0].command);
   EXPECT_EQ(runs[3].id, "a/stereo-inertial/orbslam3-peer/seed2");
+}
+
+// A peer's `sensors` limits it to those sensors; the suite's selectors still run every sensor.
+TEST(Suite, PeerSensorsLimitItsRuns) {
+  const Suite s = ParseSuite(R"(runs: 1
+sensors: [stereo, rgbd]
+selectors: [orbslam3]
+peers:
+  - {label: p, command: [x], sensors: [stereo]}
+datasets:
+  - {name: a, path: /data/a}
+)",
+                             "suite.yaml");
+  const auto runs = ExpandSuite(s);
+  ASSERT_EQ(runs.size(), 3u);  // stereo: orbslam3 + p; rgbd: orbslam3 only
+  EXPECT_EQ(runs[1].id, "a/stereo/p/seed1");
+  EXPECT_EQ(runs[2].id, "a/rgbd/orbslam3/seed1");
+}
+
+// A simulated dataset's own settings.yaml lives in its cache folder, known only at run time:
+// "{dataset}" in `settings` is left for the executor to fill in.
+TEST(Suite, SettingsInsideTheDatasetFolder) {
+  const Suite s = ParseSuite(R"(runs: 1
+sensors: [mono]
+selectors: [orbslam3]
+dense: true
+datasets:
+  - {name: a, sim: {motion: easy, duration: 5}, settings: "{dataset}/settings.yaml"}
+  - {name: b, path: /data/b, settings: conf/b.yaml}
+)",
+                             "dir/suite.yaml");
+  EXPECT_EQ(*s.datasets[0].settings, fs::path("{dataset}/settings.yaml"));  // not resolved
+  EXPECT_EQ(*s.datasets[1].settings, fs::absolute("dir/conf/b.yaml"));
+  const auto runs = ExpandSuite(s);
+  ASSERT_EQ(runs.size(), 2u);
+  auto settings_of = [](const std::vector<std::string>& a) {
+    const auto it = std::find(a.begin(), a.end(), "--settings");
+    return it == a.end() || it + 1 == a.end() ? std::string() : *(it + 1);
+  };
+  EXPECT_EQ(settings_of(RunArguments(s, runs[0], "/cache/a-seed1-0abc", "out")),
+            "/cache/a-seed1-0abc/settings.yaml");
+  EXPECT_EQ(settings_of(DenseArguments(s, runs[0], "/cache/a-seed1-0abc", "out")),
+            "/cache/a-seed1-0abc/settings.yaml");
+  EXPECT_EQ(settings_of(RunArguments(s, runs[1], "/data/b", "out")),
+            fs::absolute("dir/conf/b.yaml").string());
 }
 
 TEST(Suite, BadPeersAreErrors) {

@@ -24,6 +24,39 @@ double Median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+// "—" for a value not measured.
+std::string Fixed(double v, int decimals) {
+  return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : "—";
+}
+
+SpeedMedians MedianSpeed(const std::vector<const RunResult*>& runs) {
+  std::vector<double> rt, track, p95, mapping, cpu, memory;
+  for (const RunResult* r : runs) {
+    if (!r->ok) continue;
+    rt.push_back(r->realtime_factor);
+    track.push_back(r->median_tracking_ms);
+    p95.push_back(r->p95_tracking_ms);
+    mapping.push_back(r->mapping_ms_per_kf);
+    cpu.push_back(r->cpu_s);
+    memory.push_back(r->peak_memory_mib);
+  }
+  return {Median(rt), Median(track), Median(p95), Median(mapping), Median(cpu), Median(memory)};
+}
+
+// Realtime factor of `g` over that of the peer configuration `peer` on the same dataset and
+// sensor (NaN for the peers themselves and where either is missing).
+double RealtimeRatio(const GroupSummary& g, const std::string& peer,
+                     const std::vector<GroupSummary>& groups) {
+  if (g.selector == "peer") return kNaN;
+  for (const auto& p : groups) {
+    if (p.config == peer && p.dataset == g.dataset && p.sensor == g.sensor &&
+        p.speed.realtime_factor > 0) {
+      return g.speed.realtime_factor / p.speed.realtime_factor;
+    }
+  }
+  return kNaN;
+}
+
 std::string Percent(double p) {
   if (!std::isfinite(p)) return "";
   return fmt::format("{:+.1f}%", p);
@@ -139,6 +172,7 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
     g.gyro_bias_err_pct = ComputeMeanStd(bg);
     g.accel_bias_err_pct = ComputeMeanStd(ba);
     g.ate_median_m = Median(ate);
+    g.speed = MedianSpeed(runs);
     groups.push_back(std::move(g));
   }
   std::sort(groups.begin(), groups.end(),
@@ -354,6 +388,47 @@ Table BiasTable(const std::vector<GroupSummary>& groups) {
     if (g.gyro_bias_err_pct.n == 0) continue;
     t.rows.push_back({g.dataset, g.sensor, g.config, FormatMeanStd(g.gyro_bias_err_pct, 1),
                       FormatMeanStd(g.accel_bias_err_pct, 1)});
+  }
+  return t;
+}
+
+Table SpeedTable(const std::vector<GroupSummary>& groups) {
+  Table t;
+  t.title =
+      "Speed: median over the successful runs (realtime factor = sequence duration / wall time, "
+      "> 1 is faster than real time)";
+  t.header = {"dataset",           "sensor",          "config",
+              "ok/runs",           "realtime factor", "median tracking [ms]",
+              "p95 tracking [ms]", "mapping [ms/KF]", "CPU [s]",
+              "peak memory [MiB]"};
+  const bool measured = std::any_of(groups.begin(), groups.end(), [](const GroupSummary& g) {
+    return std::isfinite(g.speed.realtime_factor);
+  });
+  if (!measured) return t;
+  std::vector<std::string> peers;
+  for (const auto& g : groups) {
+    if (g.selector == "peer" && std::find(peers.begin(), peers.end(), g.config) == peers.end()) {
+      peers.push_back(g.config);
+    }
+  }
+  for (const auto& peer : peers) t.header.push_back("RT pkslam/" + peer);
+  for (const auto& g : groups) {
+    const SpeedMedians& s = g.speed;
+    std::vector<std::string> row = {g.dataset,
+                                    g.sensor,
+                                    g.config,
+                                    fmt::format("{}/{}", g.ok, g.runs),
+                                    Fixed(s.realtime_factor, 2),
+                                    Fixed(s.tracking_ms, 1),
+                                    Fixed(s.p95_tracking_ms, 1),
+                                    Fixed(s.mapping_ms_per_kf, 1),
+                                    Fixed(s.cpu_s, 1),
+                                    Fixed(s.peak_memory_mib, 0)};
+    for (const auto& peer : peers) {
+      const double ratio = RealtimeRatio(g, peer, groups);
+      row.push_back(std::isfinite(ratio) ? fmt::format("{:.2f}", ratio) : "");
+    }
+    t.rows.push_back(std::move(row));
   }
   return t;
 }

@@ -19,6 +19,17 @@ struct MeanStd {
 };
 MeanStd ComputeMeanStd(const std::vector<double>& values);
 
+// Speed of a configuration: medians over its successful runs (robust to one run slowed by a
+// busy machine). NaN where no run measured it.
+struct SpeedMedians {
+  double realtime_factor = kNaN;  // sequence duration / wall time
+  double tracking_ms = kNaN;      // of the runs' median tracking times
+  double p95_tracking_ms = kNaN;
+  double mapping_ms_per_kf = kNaN;
+  double cpu_s = kNaN;
+  double peak_memory_mib = kNaN;
+};
+
 struct GroupSummary {
   int order = 0;  // smallest run index of the group (tables keep the matrix order)
   std::string dataset;
@@ -46,6 +57,7 @@ struct GroupSummary {
   MeanStd gyro_bias_err_pct;  // inertial runs (bias_evaluation.h)
   MeanStd accel_bias_err_pct;
   double ate_median_m = kNaN;
+  SpeedMedians speed;
   double improvement_pct = kNaN;  // vs the baseline group of the same dataset and sensor
   // Sweep points with dense clouds: the PKS paper's Eq. 13 criterion, mean density and mean
   // ATE each min-max normalised over the sweep's values, density_n - ATE_n (the paper picks
@@ -81,6 +93,10 @@ Table DetailTable(const std::vector<GroupSummary>& groups);
 std::vector<Table> SweepTables(const std::vector<GroupSummary>& groups);
 // Inertial runs: gyro and accelerometer bias errors (%) per group (no rows when none).
 Table BiasTable(const std::vector<GroupSummary>& groups);
+// Speed per group: ok/runs, then the SpeedMedians; for each peer configuration of the suite
+// (selector "peer") a column with the ratio of realtime factors group / peer on the same dataset
+// and sensor. No rows when no group has a realtime factor (runs from before it was measured).
+Table SpeedTable(const std::vector<GroupSummary>& groups);
 // Failed runs with their error (empty table when none).
 Table FailureTable(const std::vector<RunResult>& results);
 

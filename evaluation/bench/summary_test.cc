@@ -79,6 +79,52 @@ TEST(Summary, GroupsInMatrixOrderWithImprovementOverBaseline) {
   EXPECT_NE(md.find("| dataset | orbslam3 | pks |"), std::string::npos) << md;
 }
 
+RunResult Timed(int index, const std::string& config, double realtime_factor, double tracking_ms,
+                double cpu_s, bool ok = true) {
+  RunResult r = Result(index, "A", config, 0.1, 20, ok);
+  r.realtime_factor = realtime_factor;
+  r.median_tracking_ms = tracking_ms;
+  r.p95_tracking_ms = 2 * tracking_ms;
+  r.mapping_ms_per_kf = 10 * tracking_ms;
+  r.cpu_s = cpu_s;
+  r.peak_memory_mib = 100 * cpu_s;
+  return r;
+}
+
+// Speed cells are medians over the successful runs; the peer column is the ratio of realtime
+// factors on the same dataset and sensor.
+TEST(Summary, SpeedTableHoldsMediansAndThePeerRatio) {
+  std::vector<RunResult> results = {
+      Timed(0, "orbslam3", 2.0, 20.0, 30.0),      Timed(1, "orbslam3", 4.0, 10.0, 50.0),
+      Timed(2, "orbslam3", 3.0, 12.0, 40.0),      Timed(3, "orbslam3", 100.0, 1.0, 1.0, false),
+      Timed(4, "orbslam3-peer", 1.5, 25.0, 60.0), Timed(5, "orbslam3-peer", 0.5, 35.0, 80.0),
+      Timed(6, "pks", kNaN, kNaN, kNaN)};
+  results[4].selector = results[5].selector = "peer";
+  const Table t = SpeedTable(Summarize(results));
+  ASSERT_EQ(t.rows.size(), 3u);
+  ASSERT_EQ(t.header.size(), 11u);
+  EXPECT_EQ(t.header[4], "realtime factor");
+  EXPECT_EQ(t.header.back(), "RT pkslam/orbslam3-peer");
+  for (const auto& row : t.rows) EXPECT_EQ(row.size(), t.header.size());
+  // orbslam3: 3 of 4 runs ok; the failed run's 100x does not count.
+  EXPECT_EQ(t.rows[0], (std::vector<std::string>{"A", "stereo", "orbslam3", "3/4", "3.00", "12.0",
+                                                 "24.0", "120.0", "40.0", "4000", "3.00"}));
+  // The peer: median of two runs is their mean; no ratio against itself.
+  EXPECT_EQ(t.rows[1][4], "1.00");
+  EXPECT_EQ(t.rows[1][5], "30.0");
+  EXPECT_EQ(t.rows[1].back(), "");
+  // A configuration without speed measures shows dashes and no ratio.
+  EXPECT_EQ(t.rows[2][4], "—");
+  EXPECT_EQ(t.rows[2][9], "—");
+  EXPECT_EQ(t.rows[2].back(), "");
+
+  // Without a peer there is no ratio column; without realtime factors no table.
+  results.resize(4);
+  EXPECT_EQ(SpeedTable(Summarize(results)).header.back(), "peak memory [MiB]");
+  for (auto& r : results) r.realtime_factor = kNaN;
+  EXPECT_TRUE(SpeedTable(Summarize(results)).rows.empty());
+}
+
 // Eq. 13: density and ATE normalised over the sweep, the largest density - ATE wins.
 TEST(Summary, SweepScoreFollowsEquation13) {
   std::vector<RunResult> results;

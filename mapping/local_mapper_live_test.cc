@@ -1,0 +1,105 @@
+// LocalMapper's live emulation (offline runs, MappingBackend::AcceptsKeyFramesAt): local
+// mapping's work laid out on the data clock decides whether tracking at a frame's time finds it
+// busy, as a live run would, whatever the wall clock says.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "core/map/keyframe.h"
+#include "core/testing/synthetic_map.h"
+#include "mapping/local_mapper.h"
+
+namespace pkslam {
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr std::int64_t kMs = 1'000'000;
+
+// Three keyframes of a synthetic stereo map (50 ms apart on the data clock).
+struct Fixture {
+  Atlas atlas;
+  std::shared_ptr<CameraRig> rig = testing::MakeStereoRig();
+  testing::SyntheticMap map;
+
+  Fixture() {
+    const testing::SyntheticScene scene = testing::MakeScene(400, 3);
+    std::vector<SE3d> camera_from_world;
+    for (int k = 0; k < 3; ++k) {
+      camera_from_world.push_back(SE3d(SO3d(), Eigen::Vector3d(-0.1 * k, 0.0, 0.0)));
+    }
+    map = testing::MakeMap(&atlas, scene, rig, camera_from_world, testing::FrameOptions());
+  }
+};
+
+// A started mapper whose every keyframe takes at least `work` of wall time (the consumer runs
+// inside the processing); live emulation at `pace` (0: off).
+std::unique_ptr<LocalMapper> StartMapper(Fixture* f, std::chrono::milliseconds work, double pace) {
+  LocalMappingOptions options;
+  options.cull_keyframes = false;
+  auto mapper = std::make_unique<LocalMapper>(&f->atlas, f->rig, options);
+  mapper->SetKeyFrameConsumer([work](const KeyFramePtr&) { std::this_thread::sleep_for(work); });
+  if (pace > 0) mapper->EmulateLive(true, pace);
+  mapper->Start();
+  return mapper;
+}
+
+TEST(LocalMapperLive, BusyOnTheDataClockForTheWallTimeOfItsWork) {
+  Fixture f;
+  auto owned = StartMapper(&f, 1000ms, 1.0);
+  LocalMapper& mapper = *owned;
+  const std::int64_t t0 = f.map.keyframes[0]->t_ns();
+  mapper.InsertKeyFrame(f.map.keyframes[0]);
+  // 100 ms of data later a live run would still be mapping the keyframe (it takes >= 1 s):
+  // busy, known once 100 ms of its work have passed, long before it ends.
+  EXPECT_FALSE(mapper.AcceptsKeyFramesAt(t0 + 100 * kMs));
+  EXPECT_FALSE(mapper.AcceptsKeyFrames());  // still working: the answer did not wait for it
+  // 10 s of data later it would be idle: the call waits for the work to end, then says so.
+  EXPECT_TRUE(mapper.AcceptsKeyFramesAt(t0 + 10'000 * kMs));
+  EXPECT_TRUE(mapper.AcceptsKeyFrames());
+  // Idle now on the wall clock, but its work spans >= 1 s of data from t0: a frame 500 ms
+  // after t0 still finds it busy.
+  EXPECT_FALSE(mapper.AcceptsKeyFramesAt(t0 + 500 * kMs));
+  // A keyframe inserted later starts when it arrives on the data clock (or when the previous
+  // one ends, whichever is later): 1.1 s after t0 it starts at >= t0 + 1 s.
+  mapper.InsertKeyFrame(f.map.keyframes[1]);
+  EXPECT_FALSE(mapper.AcceptsKeyFramesAt(t0 + 1'500 * kMs));
+  EXPECT_TRUE(mapper.AcceptsKeyFramesAt(t0 + 60'000 * kMs));
+  EXPECT_GT(mapper.live_wait_ms(), 500.0);
+  mapper.Finish();
+}
+
+// Pace 2: the emulated live run gets frames twice as fast, so the same work spans twice the
+// data time.
+TEST(LocalMapperLive, PaceScalesTheDataTimeOfTheWork) {
+  Fixture f;
+  auto owned = StartMapper(&f, 300ms, 2.0);
+  LocalMapper& mapper = *owned;
+  const std::int64_t t0 = f.map.keyframes[0]->t_ns();
+  mapper.InsertKeyFrame(f.map.keyframes[0]);
+  EXPECT_TRUE(mapper.AcceptsKeyFramesAt(t0 + 10'000 * kMs));  // waits for the end
+  EXPECT_FALSE(mapper.AcceptsKeyFramesAt(t0 + 500 * kMs));    // >= 300 ms x 2 of data
+  mapper.Finish();
+}
+
+// Without emulation the answer is the wall-clock state, whatever the data time.
+TEST(LocalMapperLive, OffMeansAcceptsKeyFrames) {
+  Fixture f;
+  auto owned = StartMapper(&f, 300ms, 0.0);
+  LocalMapper& mapper = *owned;
+  const std::int64_t t0 = f.map.keyframes[0]->t_ns();
+  EXPECT_TRUE(mapper.AcceptsKeyFramesAt(t0));
+  mapper.InsertKeyFrame(f.map.keyframes[0]);
+  std::this_thread::sleep_for(50ms);
+  EXPECT_FALSE(mapper.AcceptsKeyFramesAt(t0 + 60'000 * kMs));  // busy now; no waiting
+  mapper.WaitUntilIdle();
+  EXPECT_TRUE(mapper.AcceptsKeyFramesAt(t0));
+  EXPECT_DOUBLE_EQ(mapper.live_wait_ms(), 0.0);
+  mapper.Finish();
+}
+
+}  // namespace
+}  // namespace pkslam
