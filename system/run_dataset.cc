@@ -143,6 +143,8 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   // Inertial sensors: IMU samples are fed up to a little past each frame (the preintegration
   // needs one at or after the frame's time).
   constexpr std::int64_t kImuLookaheadNs = 20'000'000;
+  // Frames further apart than this (or not increasing) are reported as a timestamp jump.
+  constexpr std::int64_t kMaxFrameGapNs = 1'000'000'000;
   std::int64_t imu_fed_ns = t0 - kImuLookaheadNs;
   if (IsInertial(sensor) && (!euroc || !euroc->has_imu() || euroc->imu().empty())) {
     throw InputError(options.dataset,
@@ -172,15 +174,35 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
         return loaded;
       },
       2);
+  // --realtime paces frames to their timestamps from this origin; a timestamp jump moves it
+  // (a recording pause or a broken stamp is not slept through).
+  auto pace_wall = wall_start;
+  std::int64_t pace_t_ns = t0;
+  std::int64_t previous_t_ns = t0;
+  const auto interrupted = [&] { return interrupt != nullptr && interrupt->load(); };
   for (const FrameSource& s : sources) {
-    if (interrupt != nullptr && interrupt->load()) {
+    if (!interrupted() && summary.frames > 0 &&
+        (s.t_ns - previous_t_ns > kMaxFrameGapNs || s.t_ns <= previous_t_ns)) {
+      PKSLAM_LOG_WARN("{}: timestamp jump of {:.3f} s after frame {} (t = {} ns){}",
+                      options.dataset.string(), 1e-9 * static_cast<double>(s.t_ns - previous_t_ns),
+                      summary.frames, previous_t_ns,
+                      options.realtime ? "; --realtime pacing restarts after it" : "");
+      pace_wall = std::chrono::steady_clock::now();
+      pace_t_ns = s.t_ns;
+    }
+    previous_t_ns = s.t_ns;
+    if (options.realtime) {
+      // In slices, so that Ctrl-C or SIGTERM ends the wait promptly.
+      const auto due = pace_wall + std::chrono::nanoseconds(s.t_ns - pace_t_ns);
+      while (!interrupted() && std::chrono::steady_clock::now() < due) {
+        std::this_thread::sleep_until(
+            std::min(due, std::chrono::steady_clock::now() + std::chrono::milliseconds(50)));
+      }
+    }
+    if (interrupted()) {
       summary.interrupted = true;
       PKSLAM_LOG_WARN("interrupted after {} frames; writing what exists", summary.frames);
       break;
-    }
-    if (options.realtime) {
-      const auto due = wall_start + std::chrono::nanoseconds(s.t_ns - t0);
-      std::this_thread::sleep_until(due);
     }
     TrackResult r;
     if (IsInertial(sensor)) {

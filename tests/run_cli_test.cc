@@ -1,0 +1,63 @@
+// End-to-end: `pkslam run` on inputs whose timestamps are wrong (issue 20): a jump is reported
+// and --realtime does not sleep through it.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/support/test_data.h"
+
+namespace pkslam {
+namespace {
+
+using ::testing::HasSubstr;
+
+testing::CommandResult RunPkslam(const std::string& args) {
+  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
+}
+
+// Rewrites cam0's data.csv so that the last `rows` frames come `jump_s` later (file names keep
+// their old stamps: only the listed times change).
+void ShiftLastFrames(const std::filesystem::path& dataset, int rows, double jump_s) {
+  const auto csv = dataset / "mav0/cam0/data.csv";
+  std::ifstream in(csv);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  in.close();
+  const std::size_t first = lines.size() - static_cast<std::size_t>(rows);
+  for (std::size_t i = first; i < lines.size(); ++i) {
+    const std::size_t comma = lines[i].find(',');
+    const long long t = std::stoll(lines[i].substr(0, comma));
+    lines[i] =
+        fmt::format("{}{}", t + static_cast<long long>(jump_s * 1e9), lines[i].substr(comma));
+  }
+  std::ofstream out(csv, std::ios::trunc);
+  for (const std::string& line : lines) out << line << '\n';
+}
+
+// A 1000 s jump in cam0's stamps: run warns naming the dataset, and --realtime paces on after
+// it instead of sleeping 1000 s (ctest's timeout would catch a hang).
+TEST(RunCli, TimestampJumpIsReportedAndNotSleptThrough) {
+  const auto dir = testing::MakeTempDir("run_cli_jump");
+  const auto seq = dir / "seq";
+  const auto sim = RunPkslam(fmt::format(
+      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
+      "--no-cloud --seed 3",
+      seq.string()));
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  ShiftLastFrames(seq, 3, 1000.0);
+  const auto run =
+      RunPkslam(fmt::format("run --dataset '{}' --sensor mono --realtime --quiet --out '{}'",
+                            seq.string(), (dir / "out").string()));
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("timestamp jump of 1000.0"));
+  EXPECT_THAT(run.output, HasSubstr("--realtime pacing restarts after it"));
+  EXPECT_THAT(run.output, HasSubstr(seq.filename().string()));
+}
+
+}  // namespace
+}  // namespace pkslam
