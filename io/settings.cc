@@ -232,11 +232,25 @@ Settings ReadOrbSlam3Settings(const std::filesystem::path& file) {
   if (yaml.Has("RGBD.DepthMapFactor")) s.depth_map_factor = Positive(yaml, "RGBD.DepthMapFactor");
   if (yaml.Has("RGBD.DepthNoise")) s.depth_noise_k = Positive(yaml, "RGBD.DepthNoise");
 
-  if (const auto v = yaml.OptionalInt("ORBextractor.nFeatures")) s.orb.n_features = *v;
-  if (const auto v = yaml.OptionalDouble("ORBextractor.scaleFactor")) s.orb.scale_factor = *v;
-  if (const auto v = yaml.OptionalInt("ORBextractor.nLevels")) s.orb.n_levels = *v;
-  if (const auto v = yaml.OptionalInt("ORBextractor.iniThFAST")) s.orb.ini_th_fast = *v;
-  if (const auto v = yaml.OptionalInt("ORBextractor.minThFAST")) s.orb.min_th_fast = *v;
+  // ORB settings within what an extractor can do: a feature count like 2e9 overflowed (the
+  // initialisation extractor doubles it) into a negative count far from the file's line.
+  const auto int_in = [&yaml](const std::string& key, int lo, int hi, int* out) {
+    const auto v = yaml.OptionalInt(key);
+    if (!v) return;
+    if (*v < lo || *v > hi)
+      yaml.Fail(key, fmt::format("must be in [{}, {}], found {}", lo, hi, *v));
+    *out = *v;
+  };
+  int_in("ORBextractor.nFeatures", 1, 100000, &s.orb.n_features);
+  int_in("ORBextractor.nLevels", 1, 32, &s.orb.n_levels);
+  int_in("ORBextractor.iniThFAST", 1, 255, &s.orb.ini_th_fast);
+  int_in("ORBextractor.minThFAST", 1, 255, &s.orb.min_th_fast);
+  if (const auto v = yaml.OptionalDouble("ORBextractor.scaleFactor")) {
+    if (!(*v > 1.0 && *v <= 4.0)) {
+      yaml.Fail("ORBextractor.scaleFactor", fmt::format("must be in (1, 4], found {}", *v));
+    }
+    s.orb.scale_factor = *v;
+  }
 
   const std::string keyframe_prefix = "Keyframe.";
   for (const std::string& key : yaml.Keys()) {

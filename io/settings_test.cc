@@ -5,6 +5,9 @@
 
 #include <opencv2/core/persistence.hpp>
 #include <regex>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include "core/util/error.h"
 #include "io/settings_euroc.h"
@@ -251,6 +254,23 @@ TEST_F(SettingsFiles, KeyframeParametersAndOptionalDefaults) {
   EXPECT_FALSE(s.IsStereo());
   EXPECT_EQ(s.Bf(), 0);
   EXPECT_EQ(s.keyframe, (std::map<std::string, double>{{"cone_threshold", 0.4}, {"max_gap_s", 2}}));
+}
+
+// ORB settings out of what an extractor can do name the key (and its line), instead of
+// overflowing far away (2e9 features became -294967296).
+TEST_F(SettingsFiles, OrbValuesOutOfRangeNameTheKey) {
+  for (const auto& [pattern, replacement, key] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"ORBextractor.nFeatures: *[0-9]+", "ORBextractor.nFeatures: 2e9", "nFeatures"},
+           {"ORBextractor.nFeatures: *[0-9]+", "ORBextractor.nFeatures: 0", "nFeatures"},
+           {"ORBextractor.nLevels: *[0-9]+", "ORBextractor.nLevels: 100", "nLevels"},
+           {"ORBextractor.iniThFAST: *[0-9]+", "ORBextractor.iniThFAST: 300", "iniThFAST"},
+           {"ORBextractor.scaleFactor: *[0-9.]+", "ORBextractor.scaleFactor: 1.0",
+            "scaleFactor"}}) {
+    const std::string error = ReadError(Edited(pattern, replacement));
+    EXPECT_NE(error.find(key), std::string::npos) << replacement << ": " << error;
+    EXPECT_NE(error.find("must be in"), std::string::npos) << replacement << ": " << error;
+  }
 }
 
 TEST(SettingsCheck, RejectsInconsistentValues) {

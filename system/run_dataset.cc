@@ -116,6 +116,10 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   if (!fs::exists(vocabulary_path)) {
     throw InputError(vocabulary_path, "vocabulary not found (pass --vocabulary)");
   }
+  if (!fs::is_regular_file(vocabulary_path)) {
+    // A directory read as a file failed with "basic_filebuf::underflow error".
+    throw InputError(vocabulary_path, "vocabulary is not a file (pass the .bin or .txt file)");
+  }
   PKSLAM_LOG_INFO("loading vocabulary {}", vocabulary_path.string());
   auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary_path));
 

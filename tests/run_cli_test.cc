@@ -59,5 +59,22 @@ TEST(RunCli, TimestampJumpIsReportedAndNotSleptThrough) {
   EXPECT_THAT(run.output, HasSubstr(seq.filename().string()));
 }
 
+// A vocabulary path that is a directory is a one-line error naming it (it was
+// "basic_filebuf::underflow error").
+TEST(RunCli, VocabularyDirectoryIsNamed) {
+  const auto dir = testing::MakeTempDir("run_cli_vocab");
+  const auto seq = dir / "seq";
+  const auto sim = RunPkslam(fmt::format(
+      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
+      "--no-cloud",
+      seq.string()));
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const auto run = RunPkslam(fmt::format("run --dataset '{}' --vocabulary '{}' --quiet --out '{}'",
+                                         seq.string(), dir.string(), (dir / "out").string()));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.output, HasSubstr("vocabulary is not a file"));
+  EXPECT_THAT(run.output, HasSubstr(dir.filename().string()));
+}
+
 }  // namespace
 }  // namespace pkslam
