@@ -20,6 +20,9 @@ void EurocOptions::Check() const {
 
 namespace {
 
+constexpr double kMaxGyroRadS = 35.0;   // 2000 deg/s
+constexpr double kMaxAccelMs2 = 490.0;  // 50 g
+
 void RequireRows(std::size_t rows, const fs::path& file) {
   if (rows == 0) throw InputError(file, "no data rows (empty file)");
 }
@@ -79,6 +82,20 @@ std::vector<ImuSample> ReadEurocImu(const fs::path& data_csv) {
     previous = s.t_ns;
     s.gyro = Vec3Fields(r, 1, data_csv, "gyro");
     s.accel = Vec3Fields(r, 4, data_csv, "accel");
+    // Beyond the widest MEMS ranges (2000 deg/s, 50 g) a value is not a measurement; a single
+    // 1e30 sample went into the IMU initialisation (accelerometer bias ~1e28).
+    if (s.gyro.cwiseAbs().maxCoeff() > kMaxGyroRadS || !s.gyro.allFinite()) {
+      throw InputError(data_csv, r.line,
+                       fmt::format("gyro ({}, {}, {}) beyond +-{} rad/s (2000 deg/s): not a "
+                                   "measurement in rad/s",
+                                   s.gyro.x(), s.gyro.y(), s.gyro.z(), kMaxGyroRadS));
+    }
+    if (s.accel.cwiseAbs().maxCoeff() > kMaxAccelMs2 || !s.accel.allFinite()) {
+      throw InputError(data_csv, r.line,
+                       fmt::format("accelerometer ({}, {}, {}) beyond +-{} m/s^2 (50 g): not a "
+                                   "measurement in m/s^2",
+                                   s.accel.x(), s.accel.y(), s.accel.z(), kMaxAccelMs2));
+    }
     samples.push_back(s);
   });
   RequireRows(rows, data_csv);

@@ -161,6 +161,11 @@ TEST_F(EurocSynthetic, BadInputsAreInputErrorsWithFileAndLine) {
   EXPECT_THAT(OpenError(), HasSubstr(imu.string() + ":3: expected 7 fields"));
   testing::WriteText(imu, "100,0,0,0,0,0,9.8\n105,0,0,zero,0,0,9.8\n");
   EXPECT_THAT(OpenError(), HasSubstr(imu.string() + ":2: gyro[2]: 'zero' is not a finite number"));
+  // Values no MEMS sensor gives: a 1e30 glitch, a gyro in deg/s during a turn (90 "rad/s").
+  testing::WriteText(imu, "100,0,0,0,0,0,9.8\n105,0,0,0,1e30,0,9.8\n");
+  EXPECT_THAT(OpenError(), HasSubstr(imu.string() + ":2: accelerometer (1e+30, 0, 9.8) beyond"));
+  testing::WriteText(imu, "100,0,0,0,0,0,9.8\n105,0,90,0,0,0,9.8\n");
+  EXPECT_THAT(OpenError(), HasSubstr(imu.string() + ":2: gyro (0, 90, 0) beyond +-35 rad/s"));
 
   fixture_.Write(root_);
   const fs::path yaml = Mav0("cam1/sensor.yaml");

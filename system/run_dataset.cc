@@ -154,6 +154,25 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     throw InputError(options.dataset,
                      fmt::format("sensor {} needs IMU data (mav0/imu0)", SensorName(sensor)));
   }
+  if (IsInertial(sensor)) {
+    // An "inertial" run over frames the IMU does not cover is silently visual-only there.
+    const auto& imu = euroc->imu();
+    const std::int64_t t_last = sources.back().t_ns;
+    if (imu.size() < 2) {
+      throw InputError(options.dataset / "mav0/imu0/data.csv",
+                       "a single IMU sample: an inertial run needs IMU data over its frames");
+    }
+    constexpr std::int64_t kSlackNs = 100'000'000;
+    if (imu.front().t_ns > t0 + kSlackNs || imu.back().t_ns < t_last - kSlackNs) {
+      PKSLAM_LOG_WARN(
+          "{}: the IMU covers {:.3f}..{:.3f} s of frames spanning 0..{:.3f} s (from the first "
+          "frame): frames outside it are tracked without IMU",
+          (options.dataset / "mav0/imu0/data.csv").string(),
+          1e-9 * static_cast<double>(imu.front().t_ns - t0),
+          1e-9 * static_cast<double>(imu.back().t_ns - t0),
+          1e-9 * static_cast<double>(t_last - t0));
+    }
+  }
   // Images are decoded in a thread of their own, a couple of frames ahead of tracking; a pair's
   // second image (right / depth) concurrently with its first: decoding a 640x480 colour PNG
   // takes about 8 ms and its depth PNG 3 ms, so one loader thread in series capped 30 Hz RGB-D

@@ -76,5 +76,40 @@ TEST(RunCli, VocabularyDirectoryIsNamed) {
   EXPECT_THAT(run.output, HasSubstr(dir.filename().string()));
 }
 
+// Keeps the header and the first `rows` samples of imu0/data.csv.
+void TruncateImu(const std::filesystem::path& dataset, int rows) {
+  const auto csv = dataset / "mav0/imu0/data.csv";
+  std::ifstream in(csv);
+  std::string kept;
+  std::string line;
+  for (int n = 0; n <= rows && std::getline(in, line); ++n) kept += line + '\n';
+  in.close();
+  std::ofstream(csv, std::ios::trunc) << kept;
+}
+
+// IMU that ends early is reported (those frames are tracked without IMU); a single sample is
+// an error naming the file.
+TEST(RunCli, ImuCoverageIsChecked) {
+  const auto dir = testing::MakeTempDir("run_cli_imu");
+  const auto seq = dir / "seq";
+  const auto sim = RunPkslam(fmt::format(
+      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
+      "--no-cloud",
+      seq.string()));
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  TruncateImu(seq, 200);  // the first second of 3
+  const std::string run =
+      fmt::format("run --dataset '{}' --sensor stereo-inertial --quiet --out '{}'", seq.string(),
+                  (dir / "out").string());
+  const auto early = RunPkslam(run);
+  EXPECT_EQ(early.exit_code, 0) << early.output;
+  EXPECT_THAT(early.output,
+              HasSubstr("the IMU covers 0.000..0.995 s of frames spanning 0..3.000 s"));
+  TruncateImu(seq, 1);
+  const auto single = RunPkslam(run);
+  EXPECT_NE(single.exit_code, 0);
+  EXPECT_THAT(single.output, HasSubstr("imu0/data.csv: a single IMU sample"));
+}
+
 }  // namespace
 }  // namespace pkslam
