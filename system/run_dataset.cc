@@ -194,6 +194,24 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
         LoadedImages loaded;
         loaded.a = euroc ? euroc->LoadCam0(s.a) : tum->LoadRgbGrey(s.a);
         if (second.valid()) loaded.b = second.get();
+        // Images of another size than the calibration's were tracked with wrong intrinsics
+        // (monocular) or failed deep in the rectification (stereo, RGB-D), naming no image.
+        const auto require_size = [&](const cv::Mat& image, const CameraModel& camera,
+                                      const fs::path& path) {
+          if (image.cols != camera.width() || image.rows != camera.height()) {
+            throw InputError(path,
+                             fmt::format("{}x{} image, but the calibration is {}x{}", image.cols,
+                                         image.rows, camera.width(), camera.height()));
+          }
+        };
+        require_size(loaded.a, settings.camera1,
+                     euroc ? euroc->cam0().images[s.a].path : tum->rgb().images[s.a].path);
+        if (euroc && IsStereo(sensor)) {
+          require_size(loaded.b, settings.camera2.value_or(settings.camera1),
+                       euroc->cam1().images[s.b].path);
+        } else if (tum && IsRgbd(sensor)) {
+          require_size(loaded.b, settings.camera1, tum->depth().images[s.b].path);
+        }
         return loaded;
       },
       2);

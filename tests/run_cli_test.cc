@@ -4,7 +4,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -109,6 +113,34 @@ TEST(RunCli, ImuCoverageIsChecked) {
   const auto single = RunPkslam(run);
   EXPECT_NE(single.exit_code, 0);
   EXPECT_THAT(single.output, HasSubstr("imu0/data.csv: a single IMU sample"));
+}
+
+// A frame of another size than the calibration is an error naming that image (mono tracked it
+// with the wrong intrinsics; stereo failed inside the rectification, naming a source file).
+TEST(RunCli, ImageSizeMustMatchTheCalibration) {
+  const auto dir = testing::MakeTempDir("run_cli_size");
+  const auto seq = dir / "seq";
+  const auto sim = RunPkslam(fmt::format(
+      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
+      "--no-cloud",
+      seq.string()));
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  std::vector<std::filesystem::path> frames;
+  for (const auto& e : std::filesystem::directory_iterator(seq / "mav0/cam1/data")) {
+    frames.push_back(e.path());
+  }
+  std::sort(frames.begin(), frames.end());
+  ASSERT_GT(frames.size(), 10u);
+  const auto& bad = frames[5];
+  const cv::Mat image = cv::imread(bad.string(), cv::IMREAD_GRAYSCALE);
+  cv::Mat small;
+  cv::resize(image, small, cv::Size(640, 480));
+  ASSERT_TRUE(cv::imwrite(bad.string(), small));
+  const auto run = RunPkslam(fmt::format("run --dataset '{}' --sensor stereo --quiet --out '{}'",
+                                         seq.string(), (dir / "out").string()));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.output, HasSubstr(bad.filename().string() + ": 640x480 image, but the "
+                                                              "calibration is 752x480"));
 }
 
 }  // namespace
