@@ -61,6 +61,7 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     throw InputError(options.dataset, "dataset directory does not exist");
   }
   fs::create_directories(options.out);
+  RemoveRunOutputs(options.out);
   AddLogFile(options.out / "run.log");
   struct LogGuard {
     ~LogGuard() { RemoveLogFiles(); }

@@ -126,6 +126,24 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
 
 }  // namespace
 
+void RemoveRunOutputs(const std::filesystem::path& out) {
+  // Every file WriteRunOutputs and WriteInertialOutputs may write (run.log is truncated by its
+  // logger).
+  static constexpr const char* kOutputs[] = {
+      "trajectory.txt", "trajectory_body.txt", "trajectory_online_body.txt",
+      "keyframes.txt",  "keyframes_imu.csv",   "body_from_camera.txt",
+      "map_points.ply", "sparse_model.txt",    "keyframe_trace.csv",
+      "stats.json"};
+  for (const char* name : kOutputs) {
+    std::error_code ec;
+    std::filesystem::remove(out / name, ec);
+    if (ec) {
+      throw Error(fmt::format("cannot remove the earlier run's {}: {}", (out / name).string(),
+                              ec.message()));
+    }
+  }
+}
+
 double PeakMemoryMiB() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);

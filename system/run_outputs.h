@@ -8,6 +8,11 @@ namespace pkslam {
 // Fills the map/keyframe/timing fields of `summary` and writes every output file.
 void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSummary* summary);
 
+// Removes the files an earlier run may have left in `out` (a re-run into the same folder left
+// e.g. a stereo run's trajectory_body.txt beside a monocular run's outputs, or a trace from an
+// earlier --trace run). Throws Error naming the file when one cannot be removed.
+void RemoveRunOutputs(const std::filesystem::path& out);
+
 // Peak resident memory of this process in MiB (getrusage).
 double PeakMemoryMiB();
 

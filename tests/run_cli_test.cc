@@ -143,5 +143,29 @@ TEST(RunCli, ImageSizeMustMatchTheCalibration) {
                                                               "calibration is 752x480"));
 }
 
+// A re-run into the same --out leaves none of the earlier run's files: a stereo run's metric
+// trajectory_body.txt beside a monocular run's outputs would be scored by mistake.
+TEST(RunCli, RerunIntoTheSameFolderLeavesNoStaleFiles) {
+  const auto dir = testing::MakeTempDir("run_cli_rerun");
+  const auto seq = dir / "seq";
+  const auto sim = RunPkslam(fmt::format(
+      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
+      "--no-cloud",
+      seq.string()));
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const auto out = dir / "out";
+  const auto stereo = RunPkslam(fmt::format(
+      "run --dataset '{}' --sensor stereo --trace --quiet --out '{}'", seq.string(), out.string()));
+  ASSERT_EQ(stereo.exit_code, 0) << stereo.output;
+  ASSERT_TRUE(std::filesystem::exists(out / "trajectory_body.txt"));
+  ASSERT_TRUE(std::filesystem::exists(out / "keyframe_trace.csv"));
+  const auto mono = RunPkslam(fmt::format("run --dataset '{}' --sensor mono --quiet --out '{}'",
+                                          seq.string(), out.string()));
+  ASSERT_EQ(mono.exit_code, 0) << mono.output;
+  EXPECT_FALSE(std::filesystem::exists(out / "trajectory_body.txt"));
+  EXPECT_FALSE(std::filesystem::exists(out / "keyframe_trace.csv"));
+  EXPECT_TRUE(std::filesystem::exists(out / "stats.json"));
+}
+
 }  // namespace
 }  // namespace pkslam
