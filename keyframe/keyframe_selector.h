@@ -66,8 +66,11 @@ struct SelectorInput {
 
   // Local mapping and mode.
   bool only_tracking = false;
-  bool local_mapping_stopped = false;       // stopped or stop requested (loop closure)
-  bool local_mapping_idle = true;           // accepts keyframes
+  bool local_mapping_stopped = false;  // stopped or stop requested (loop closure)
+  bool local_mapping_idle = true;      // accepts keyframes
+  // keyframe_trace.csv is written (--trace): selectors whose trace is extra work fill it only
+  // then.
+  bool trace_wanted = false;
   bool local_mapping_initializing = false;  // IMU initialisation running
   int local_mapping_queue = 0;
   bool imu_initialized = false;

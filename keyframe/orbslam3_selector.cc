@@ -63,11 +63,13 @@ SelectorDecision OrbSlam3Selector::Decide(const SelectorInput& in) {
   const bool c4 =
       s == Sensor::kMonocularInertial && ((in.inliers < 75 && in.inliers > 15) || in.recently_lost);
 
-  SelectorTrace trace;
-  trace["inliers"] = in.inliers;
-  trace["reference_tracked"] = ref;
-  trace["mapping_idle"] = in.local_mapping_idle ? 1 : 0;
-  no.trace = trace;
+  SelectorTrace trace;  // per frame, so only when a trace is written
+  if (in.trace_wanted) {
+    trace["inliers"] = in.inliers;
+    trace["reference_tracked"] = ref;
+    trace["mapping_idle"] = in.local_mapping_idle ? 1 : 0;
+    no.trace = trace;
+  }
   if (!(((c1a || c1b || c1c) && c2) || c3 || c4)) return no;
   std::string reason;
   auto add = [&reason](bool c, const char* name) {

@@ -106,7 +106,7 @@ bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
       idle_.wait(lock);  // a queued keyframe is about to be taken
     }
   }
-  live_wait_ms_ +=
+  stats_.live_wait_ms +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start)
           .count();
   return !busy_ && queue_.empty() && !stopped_ && !stop_requested_ && live_free_ns_ <= t_ns;
@@ -114,11 +114,6 @@ bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
 
 std::int64_t LocalMapper::DataNs(double wall_s) const {
   return static_cast<std::int64_t>(wall_s * live_pace_ * 1e9);
-}
-
-double LocalMapper::live_wait_ms() const {
-  std::lock_guard lock(mutex_);
-  return live_wait_ms_;
 }
 
 void LocalMapper::ResetQueue() {

@@ -74,6 +74,8 @@ struct LocalMappingStats {
   // times above also count lock waits and preemption on a busy machine).
   std::vector<double> keyframe_cpu_ms;
   std::vector<double> ba_cpu_ms;
+  // Live emulation: total wall ms tracking waited in AcceptsKeyFramesAt.
+  double live_wait_ms = 0;
   int ba_aborted = 0;
   // Local inertial BAs whose anchor carried a marginalisation prior / was fixed.
   int inertial_ba_with_prior = 0;
@@ -119,7 +121,7 @@ class LocalMapper : public MappingBackend {
     live_pace_ = pace;
   }
   // Total wall ms AcceptsKeyFramesAt blocked.
-  double live_wait_ms() const;
+  double live_wait_ms() const { return stats().live_wait_ms; }
   void ResetQueue() override;
 
   // Loop closing pauses local mapping while it corrects the map.
@@ -170,7 +172,6 @@ class LocalMapper : public MappingBackend {
   std::int64_t live_free_ns_ = std::numeric_limits<std::int64_t>::min();
   std::int64_t live_job_start_ns_ = 0;
   std::chrono::steady_clock::time_point live_job_wall_start_;
-  double live_wait_ms_ = 0;
   bool finish_requested_ = false;
   bool stop_requested_ = false;
   bool stopped_ = false;

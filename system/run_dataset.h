@@ -2,14 +2,15 @@
 // run's outputs. Used by `pkslam run` and `pkslam bench`.
 //
 // OUT/trajectory.txt   every tracked frame, TUM format (seconds), camera pose world_from_camera
-// OUT/trajectory_body.txt  the same as body (IMU) poses world_from_body (EuRoC ground truth's
-// frame) OUT/keyframes.txt    keyframes of the final map, same format OUT/map_points.ply   map
-// points (binary PLY) OUT/sparse_model.txt keyframes with keypoints and map points with
-// observations
+// OUT/trajectory_body.txt  the same as body (IMU) poses world_from_body (ground truth's frame)
+// OUT/keyframes.txt    keyframes of the final map, same format
+// OUT/map_points.ply   map points (binary PLY)
+// OUT/sparse_model.txt keyframes with keypoints and map points with observations
 //                      (io/sparse_model.h; for `pkslam export-colmap`)
 // OUT/stats.json       timings, counts, tracking states, memory
 // OUT/run.log          the log of the run
 // OUT/keyframe_trace.csv  per-frame keyframe decisions (with trace enabled)
+// (system/run_outputs.h lists them again to clear them before a re-run into the same OUT.)
 #pragma once
 
 #include <atomic>

@@ -30,16 +30,15 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
       setup_(MakeRig(settings, options_.sensor)),
       vocabulary_(std::move(vocabulary)) {
   PKSLAM_CHECK(vocabulary_ != nullptr, "no vocabulary");
-  if (options_.mapping_sync == "lockstep") options_.tracking.lockstep = true;
   if (options_.deterministic) {
     options_.mapping_sync = "lockstep";
-    options_.tracking.lockstep = true;
     options_.tracking.pose.num_threads = 1;
     options_.mapping.ba.num_threads = 1;
     options_.loop.synchronous = true;
     options_.loop.num_threads = 1;
     options_.loop.global_ba_options.num_threads = 1;
   }
+  if (options_.mapping_sync == "lockstep") options_.tracking.lockstep = true;
   options_.tracking.seed = options_.seed;
   options_.loop.seed = options_.seed;
   options_.Check();

@@ -24,6 +24,17 @@ testing::CommandResult RunPkslam(const std::string& args) {
   return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
 }
 
+// A 3 s simulated flight (EuRoC layout, fast rendering) with `seed` into `seq`; gtest failure
+// with the simulator's output when it fails.
+::testing::AssertionResult Simulate(const std::filesystem::path& seq, int seed) {
+  const auto sim = RunPkslam(fmt::format(
+      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast "
+      "--quiet --no-cloud --seed {}",
+      seq.string(), seed));
+  if (sim.exit_code == 0) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << sim.output;
+}
+
 // Rewrites cam0's data.csv so that the last `rows` frames come `jump_s` later (file names keep
 // their old stamps: only the listed times change).
 void ShiftLastFrames(const std::filesystem::path& dataset, int rows, double jump_s) {
@@ -48,11 +59,7 @@ void ShiftLastFrames(const std::filesystem::path& dataset, int rows, double jump
 TEST(RunCli, TimestampJumpIsReportedAndNotSleptThrough) {
   const auto dir = testing::MakeTempDir("run_cli_jump");
   const auto seq = dir / "seq";
-  const auto sim = RunPkslam(fmt::format(
-      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
-      "--no-cloud --seed 3",
-      seq.string()));
-  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  ASSERT_TRUE(Simulate(seq, 3));
   ShiftLastFrames(seq, 3, 1000.0);
   const auto run =
       RunPkslam(fmt::format("run --dataset '{}' --sensor mono --realtime --quiet --out '{}'",
@@ -68,11 +75,7 @@ TEST(RunCli, TimestampJumpIsReportedAndNotSleptThrough) {
 TEST(RunCli, VocabularyDirectoryIsNamed) {
   const auto dir = testing::MakeTempDir("run_cli_vocab");
   const auto seq = dir / "seq";
-  const auto sim = RunPkslam(fmt::format(
-      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
-      "--no-cloud",
-      seq.string()));
-  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  ASSERT_TRUE(Simulate(seq, 1));
   const auto run = RunPkslam(fmt::format("run --dataset '{}' --vocabulary '{}' --quiet --out '{}'",
                                          seq.string(), dir.string(), (dir / "out").string()));
   EXPECT_NE(run.exit_code, 0);
@@ -96,11 +99,7 @@ void TruncateImu(const std::filesystem::path& dataset, int rows) {
 TEST(RunCli, ImuCoverageIsChecked) {
   const auto dir = testing::MakeTempDir("run_cli_imu");
   const auto seq = dir / "seq";
-  const auto sim = RunPkslam(fmt::format(
-      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
-      "--no-cloud",
-      seq.string()));
-  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  ASSERT_TRUE(Simulate(seq, 1));
   TruncateImu(seq, 200);  // the first second of 3
   const std::string run =
       fmt::format("run --dataset '{}' --sensor stereo-inertial --quiet --out '{}'", seq.string(),
@@ -120,11 +119,7 @@ TEST(RunCli, ImuCoverageIsChecked) {
 TEST(RunCli, ImageSizeMustMatchTheCalibration) {
   const auto dir = testing::MakeTempDir("run_cli_size");
   const auto seq = dir / "seq";
-  const auto sim = RunPkslam(fmt::format(
-      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
-      "--no-cloud",
-      seq.string()));
-  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  ASSERT_TRUE(Simulate(seq, 1));
   std::vector<std::filesystem::path> frames;
   for (const auto& e : std::filesystem::directory_iterator(seq / "mav0/cam1/data")) {
     frames.push_back(e.path());
@@ -148,11 +143,7 @@ TEST(RunCli, ImageSizeMustMatchTheCalibration) {
 TEST(RunCli, RerunIntoTheSameFolderLeavesNoStaleFiles) {
   const auto dir = testing::MakeTempDir("run_cli_rerun");
   const auto seq = dir / "seq";
-  const auto sim = RunPkslam(fmt::format(
-      "--log-level warn simulate --out '{}' --motion medium --duration 3 --quality fast --quiet "
-      "--no-cloud",
-      seq.string()));
-  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  ASSERT_TRUE(Simulate(seq, 1));
   const auto out = dir / "out";
   const auto stereo = RunPkslam(fmt::format(
       "run --dataset '{}' --sensor stereo --trace --quiet --out '{}'", seq.string(), out.string()));

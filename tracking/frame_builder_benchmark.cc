@@ -16,11 +16,13 @@
 #include <ctime>
 #include <memory>
 #include <opencv2/imgproc.hpp>
+#include <utility>
 #include <vector>
 
 #include "core/features/orb_extractor.h"
 #include "core/features/synthetic_texture.h"
 #include "core/frame/camera_rig.h"
+#include "core/util/quantile.h"
 #include "tracking/frame_builder.h"
 
 namespace pkslam {
@@ -47,11 +49,7 @@ double ProcessCpuMs() {
   return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+double Median(std::vector<double> v) { return Quantile(std::move(v), 0.5).value_or(0.0); }
 
 OrbOptions OrbFor(const ImageSize& size, bool parallel) {
   OrbOptions o;

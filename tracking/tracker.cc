@@ -20,6 +20,17 @@ double MsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
 }
 
+// CPU and wall time of building a frame (for its FrameRecord).
+struct BuildTimer {
+  double cpu_start = ThreadCpuSeconds();
+  std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
+
+  void Stop(double* cpu_ms, double* wall_ms) const {
+    *cpu_ms = 1e3 * (ThreadCpuSeconds() - cpu_start);
+    *wall_ms = MsSince(wall_start);
+  }
+};
+
 }  // namespace
 
 const char* TrackingStateName(TrackingState s) {
@@ -75,32 +86,26 @@ Tracker::~Tracker() = default;
 
 TrackResult Tracker::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
   PKSLAM_CHECK(IsStereo(rig_->sensor), "TrackStereo with a {} rig", SensorName(rig_->sensor));
-  const double cpu = ThreadCpuSeconds();
-  const auto wall = std::chrono::steady_clock::now();
+  const BuildTimer timer;
   Frame frame = builder_.BuildStereo(atlas_->NextFrameId(), t_ns, left, right);
-  build_cpu_ms_ = 1e3 * (ThreadCpuSeconds() - cpu);
-  build_ms_ = MsSince(wall);
+  timer.Stop(&build_cpu_ms_, &build_ms_);
   return Track(std::move(frame));
 }
 
 TrackResult Tracker::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns) {
   PKSLAM_CHECK(IsRgbd(rig_->sensor), "TrackRgbd with a {} rig", SensorName(rig_->sensor));
-  const double cpu = ThreadCpuSeconds();
-  const auto wall = std::chrono::steady_clock::now();
+  const BuildTimer timer;
   Frame frame = builder_.BuildRgbd(atlas_->NextFrameId(), t_ns, image, depth);
-  build_cpu_ms_ = 1e3 * (ThreadCpuSeconds() - cpu);
-  build_ms_ = MsSince(wall);
+  timer.Stop(&build_cpu_ms_, &build_ms_);
   return Track(std::move(frame));
 }
 
 TrackResult Tracker::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
   PKSLAM_CHECK(IsMonocular(rig_->sensor), "TrackMonocular with a {} rig", SensorName(rig_->sensor));
   const bool initialising = state_ == TrackingState::kNotInitialized;
-  const double cpu = ThreadCpuSeconds();
-  const auto wall = std::chrono::steady_clock::now();
+  const BuildTimer timer;
   Frame frame = builder_.BuildMonocular(atlas_->NextFrameId(), t_ns, image, initialising);
-  build_cpu_ms_ = 1e3 * (ThreadCpuSeconds() - cpu);
-  build_ms_ = MsSince(wall);
+  timer.Stop(&build_cpu_ms_, &build_ms_);
   return Track(std::move(frame));
 }
 
@@ -130,10 +135,7 @@ TrackResult Tracker::Track(Frame frame) {
     const auto wait_start = std::chrono::steady_clock::now();
     const bool emulated = mapping_->EmulatesLive();
     const bool idle_at_frame = emulated && mapping_->AcceptsKeyFramesAt(current_.t_ns());
-    frame_wait_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start)
-            .count();
-    mapping_wait_ms_ += frame_wait_ms;
+    frame_wait_ms = MsSince(wait_start);
     {
       std::shared_lock lock(atlas_->mutex());
       if (imu_) SyncWithInertialMapLocked(/*correct_current=*/false);  // the world tracked in

@@ -86,8 +86,6 @@ class Tracker {
   };
   const std::vector<TraceRow>& trace() const { return trace_; }
   void EnableTrace(bool on) { trace_enabled_ = on; }
-  // Wall time spent waiting for local mapping's state (live emulation of offline runs).
-  double mapping_wait_ms() const { return mapping_wait_ms_; }
   int relocalisations() const { return relocalisations_; }
 
   // Drops the current map (a reset) and starts again from NOT_INITIALIZED.
@@ -151,10 +149,9 @@ class Tracker {
   KeyFramePtr reference_kf_;
   KeyFramePtr last_kf_;
   FrameId last_reloc_frame_id_ = -1000000;
-  double mapping_wait_ms_ = 0;  // total wall ms waited in MappingBackend::AcceptsKeyFramesAt
+  // CPU and wall ms building the frame being tracked (for its FrameRecord).
   double build_cpu_ms_ = 0;
-  double build_ms_ = 0;  // wall ms building the frame being tracked  // CPU ms building the frame
-                         // being tracked (for its FrameRecord)
+  double build_ms_ = 0;
   int inliers_ = 0;
   std::int64_t lost_since_t_ns_ = 0;
   int relocalisations_ = 0;

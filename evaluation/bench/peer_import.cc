@@ -7,6 +7,7 @@
 
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
+#include "core/util/quantile.h"
 #include "io/euroc_dataset.h"
 #include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
@@ -71,14 +72,6 @@ std::vector<double> TrackingMs(const fs::path& file) {
     if (row >> t >> seconds) ms.push_back(1e3 * seconds);
   }
   return ms;
-}
-
-// The value of rank round(q (n - 1)), as `pkslam run` computes its percentiles (NaN for none).
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return kNaN;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
 }
 
 // Last minus first cam0 timestamp: `pkslam run`'s sequence_duration_s for the same dataset.
@@ -153,8 +146,9 @@ void ImportPeerRun(const fs::path& run_dir, const fs::path& dataset, const std::
   json.Member("tracking_loop_s", loop_s);
   json.Member("sequence_duration_s", sequence_s);
   json.Member("realtime_factor", loop_s > 0 ? sequence_s / loop_s : kNaN);
-  json.Member("median_tracking_ms", Quantile(tracking_ms, 0.5));
-  json.Member("p95_tracking_ms", Quantile(tracking_ms, 0.95));
+  // As `pkslam run` computes its percentiles (core/util/quantile.h); NaN for none.
+  json.Member("median_tracking_ms", Quantile(tracking_ms, 0.5).value_or(kNaN));
+  json.Member("p95_tracking_ms", Quantile(tracking_ms, 0.95).value_or(kNaN));
   json.Member("process_cpu_s", CpuSeconds(run_dir / "time.txt"));
   // run_orbslam3.sh: peak_rss_mb = "Maximum resident set size (kbytes)" / 1024, i.e. MiB.
   json.Member("peak_memory_mib", NumberAfter(run_dir / "summary.txt", "peak_rss_mb="));
