@@ -14,6 +14,7 @@
 #include "apps/commands.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
+#include "core/util/output_file.h"
 #include "dense/cloud_compare.h"
 #include "dense/histogram_plot.h"
 #include "dense/keyframe_images.h"
@@ -215,9 +216,7 @@ void RunCompare(const CompareArgs& args) {
     }
     json.EndArray();
     json.EndObject();
-    std::ofstream out(args.json);
-    out << json.str();
-    if (!out) throw Error(fmt::format("cannot write {}", args.json));
+    WriteFileAtomically(args.json, json.str());
   }
   if (!args.hist.empty()) {
     dense::PlotDistanceHistograms({{"cloud -> reference (accuracy)", r.accuracy_distances},

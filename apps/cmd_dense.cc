@@ -9,7 +9,9 @@
 #include "apps/commands.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
+#include "core/util/output_file.h"
 #include "dense/dense_cloud.h"
+#include "io/dataset_fingerprint.h"
 
 namespace pkslam::apps {
 namespace {
@@ -37,6 +39,7 @@ void RunDense(const DenseArgs& args) {
   const auto source = dense::KeyframeImageSource::Open(
       args.dataset, args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings),
       args.options.full_view);
+  RequireRunOfDataset(args.run, args.dataset);
   dense::DenseStats stats;
   const dense::PointCloud cloud = BuildDenseCloud(keyframes, source, args.options, &stats);
   if (cloud.empty()) {
@@ -103,9 +106,7 @@ void RunDense(const DenseArgs& args) {
     json.Member("points", static_cast<std::uint64_t>(stats.points));
     json.Member("seconds", stats.seconds);
     json.EndObject();
-    std::ofstream out(args.json);
-    out << json.str();
-    if (!out) throw Error(fmt::format("cannot write {}", args.json));
+    WriteFileAtomically(args.json, json.str());
   }
 }
 

@@ -8,6 +8,7 @@
 
 #include "apps/commands.h"
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 #include "evaluation/evaluate.h"
 #include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
@@ -57,10 +58,7 @@ void RunEval(const EvalArgs& args) {
                            est.size(), DurationSeconds(est), PathLengthMeters(est))
             << FormatEvaluationTable(result);
   if (!args.json_file.empty()) {
-    std::ofstream out(args.json_file, std::ios::trunc);
-    out << EvaluationJson(result);
-    out.close();
-    if (!out) throw Error(fmt::format("{}: cannot write the JSON result", args.json_file));
+    WriteFileAtomically(args.json_file, EvaluationJson(result));
     std::cout << "json          " << args.json_file << '\n';
   }
 }

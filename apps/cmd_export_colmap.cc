@@ -10,6 +10,7 @@
 #include "apps/commands.h"
 #include "core/util/error.h"
 #include "dense/colmap_export.h"
+#include "io/dataset_fingerprint.h"
 #include "io/sparse_model.h"
 
 namespace pkslam::apps {
@@ -38,6 +39,7 @@ void RunExport(ExportArgs args) {
   if (model.keyframes.empty()) throw InputError(model_file, "the sparse model has no keyframes");
   const auto source = dense::KeyframeImageSource::Open(
       args.dataset, args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings));
+  RequireRunOfDataset(args.run, args.dataset);
   const dense::ColmapExportStats s = dense::ExportColmap(model, source, args.options, args.out);
   fmt::print("images {}, points {} ({} with shorter tracks left out), observations {}\n", s.images,
              s.points, s.points_dropped, s.observations);

@@ -6,6 +6,7 @@
 
 #include "apps/commands.h"
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 #include "io/dataset_info.h"
 
 namespace pkslam::apps {
@@ -21,11 +22,7 @@ void RunInfo(const InfoArgs& args) {
   const DatasetInfo info = ComputeDatasetInfo(args.dataset);
   std::cout << FormatDatasetInfo(info) << std::flush;
   if (!args.json_out.empty()) {
-    std::ofstream out(args.json_out, std::ios::trunc);
-    if (!out) throw Error(args.json_out + ": cannot open for writing");
-    out << DatasetInfoToJson(info);
-    out.close();
-    if (!out) throw Error(args.json_out + ": write failed");
+    WriteFileAtomically(args.json_out, DatasetInfoToJson(info));
   }
 }
 

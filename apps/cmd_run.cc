@@ -11,11 +11,15 @@
 namespace pkslam::apps {
 namespace {
 
-// Set by SIGINT/SIGTERM; the run loop polls it and still writes its outputs. A second signal
-// gets the default action (immediate exit).
+// Set by SIGINT/SIGTERM; the run loop polls it and still writes its outputs, the trajectory
+// first. A second signal gets the default action (immediate exit); what is then on disk is
+// the trajectory written at the stop, or trajectory.txt.partial. Signal handlers can only
+// reach process-wide state, hence these two atomics.
 std::atomic<bool> interrupted{false};
+std::atomic<int> interrupt_signal{0};
 
 void OnSignal(int signal) {
+  interrupt_signal.store(signal);
   interrupted.store(true);
   std::signal(signal, SIG_DFL);
 }
@@ -27,6 +31,7 @@ struct RunArgs {
   std::string vocabulary;
   std::string out = "out";
   std::vector<std::string> params;
+  bool strict = false;
 };
 
 std::map<std::string, double> ParseParams(const std::vector<std::string>& params) {
@@ -98,6 +103,18 @@ void RegisterRunCommand(CLI::App& app) {
   cmd->add_option("--max-frames", args->options.max_frames, "Stop after N frames (0: all)");
   cmd->add_flag("--trace", args->options.system.trace, "Write OUT/keyframe_trace.csv");
   cmd->add_flag("--quiet", args->options.quiet, "No progress line");
+  cmd->add_flag("--allow-imu-gaps", args->options.allow_imu_gaps,
+                "Inertial sensors: run although some frames have no IMU samples (tracked "
+                "without IMU; the run is flagged degraded)");
+  cmd->add_option("--imu-max-gyro", args->options.imu_limits.max_gyro_rad_s,
+                  "IMU plausibility: a gyro sample beyond this (rad/s) is an error")
+      ->capture_default_str();
+  cmd->add_option("--imu-max-accel", args->options.imu_limits.max_accel_m_s2,
+                  "IMU plausibility: an accelerometer sample beyond this (m/s^2) is an error")
+      ->capture_default_str();
+  cmd->add_flag("--strict", args->strict,
+                "Exit 3 when the run finished on degraded input (skipped frames, timestamp "
+                "jumps, frames without IMU or depth; see stats.json \"input\")");
   cmd->callback([args] {
     RunOptions& o = args->options;
     const auto sensor = ParseSensor(args->sensor);
@@ -118,7 +135,20 @@ void RegisterRunCommand(CLI::App& app) {
     fmt::print(
         "outputs: {}/{{trajectory.txt, keyframes.txt, map_points.ply, stats.json, run.log}}\n",
         o.out.string());
-    if (s.interrupted) throw Error("interrupted (partial outputs written)");
+    if (s.input.degraded()) {
+      fmt::print("degraded input: {} warning(s), see {}/stats.json \"input\"\n",
+                 s.input.warnings.size(), o.out.string());
+    }
+    if (s.interrupted) {
+      const int signal = interrupt_signal.load();
+      throw CommandExit{128 + signal,
+                        fmt::format("interrupted by {} after {} frames (outputs "
+                                    "written for them)",
+                                    signal == SIGTERM ? "SIGTERM" : "SIGINT", s.frames)};
+    }
+    if (args->strict && s.input.degraded()) {
+      throw CommandExit{kExitDegraded, "--strict: the run finished on degraded input"};
+    }
   });
 }
 

@@ -3,8 +3,20 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace pkslam::apps {
+
+// Exit codes (docs/run.md): 0 success, 1 error (bad input, failed write), 2 internal error,
+// 3 finished on degraded input under --strict, 128 + signal when interrupted (outputs written).
+inline constexpr int kExitDegraded = 3;
+
+// Thrown by a command that finished its work but must exit with `code`; main() prints
+// `message` (when not empty) as one line.
+struct CommandExit {
+  int code = 0;
+  std::string message;
+};
 
 void RegisterEvalCommand(CLI::App& app);
 void RegisterInfoCommand(CLI::App& app);

@@ -1,8 +1,7 @@
 // pkslam: one executable, one subcommand per capability (see README.md).
+#include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
-
-#include <CLI/CLI.hpp>
 
 #include "apps/commands.h"
 #include "core/util/error.h"
@@ -13,7 +12,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("pkslam ") + PKSLAM_VERSION);
   std::string log_level = "info";
-  app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off")->capture_default_str();
+  app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off")
+      ->capture_default_str();
   app.parse_complete_callback([&log_level] { pkslam::SetLogLevel(log_level); });
 
   pkslam::apps::RegisterEvalCommand(app);
@@ -32,6 +32,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const pkslam::apps::CommandExit& e) {
+    if (!e.message.empty()) std::cerr << "pkslam: " << e.message << '\n';
+    return e.code;
   } catch (const pkslam::Error& e) {
     std::cerr << "pkslam: error: " << e.what() << '\n';
     return 1;

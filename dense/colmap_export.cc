@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 #include "core/util/progress.h"
 
 namespace pkslam::dense {
@@ -19,12 +20,6 @@ namespace {
 
 // COLMAP's pixel convention puts the top-left pixel's centre at (0.5, 0.5).
 constexpr double kColmapPixelShift = 0.5;
-
-std::ofstream OpenForWriting(const fs::path& file) {
-  std::ofstream out(file);
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
-  return out;
-}
 
 }  // namespace
 
@@ -59,14 +54,17 @@ ColmapExportStats WriteColmapText(const SparseModel& model,
   }
 
   {
-    std::ofstream out = OpenForWriting(sparse_dir / "cameras.txt");
+    OutputFile output(sparse_dir / "cameras.txt");
+    std::ostream& out = output.stream();
     out << "# Camera list with one line of data per camera:\n"
         << "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n# Number of cameras: 1\n"
         << fmt::format("1 PINHOLE {} {} {:.9g} {:.9g} {:.9g} {:.9g}\n", cam.width, cam.height,
                        cam.fx, cam.fy, cam.cx + kColmapPixelShift, cam.cy + kColmapPixelShift);
+    output.Commit();
   }
   {
-    std::ofstream out = OpenForWriting(sparse_dir / "images.txt");
+    OutputFile output(sparse_dir / "images.txt");
+    std::ostream& out = output.stream();
     std::size_t observations = 0;
     for (const SparseKeyframe& kf : model.keyframes) {
       for (const SparseKeypoint& k : kf.keypoints) observations += exported.count(k.point_id);
@@ -96,6 +94,7 @@ ColmapExportStats WriteColmapText(const SparseModel& model,
       b.push_back('\n');
     }
     out.write(b.data(), static_cast<std::streamsize>(b.size()));
+    output.Commit();
     stats.observations = observations;
   }
   {
@@ -131,13 +130,14 @@ ColmapExportStats WriteColmapText(const SparseModel& model,
     stats.mean_track_length =
         stats.points > 0 ? static_cast<double>(stats.observations) / stats.points : 0.0;
     stats.mean_reprojection_error_px = stats.points > 0 ? error_sum / stats.points : 0.0;
-    std::ofstream out = OpenForWriting(sparse_dir / "points3D.txt");
+    OutputFile output(sparse_dir / "points3D.txt");
+    std::ostream& out = output.stream();
     out << "# 3D point list with one line of data per point:\n"
         << "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
         << fmt::format("# Number of points: {}, mean track length: {:.6g}\n", stats.points,
                        stats.mean_track_length);
     out.write(b.data(), static_cast<std::streamsize>(b.size()));
-    if (!out) throw Error(fmt::format("cannot write {}", (sparse_dir / "points3D.txt").string()));
+    output.Commit();
   }
   return stats;
 }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 
 namespace pkslam::dense {
 namespace {
@@ -252,20 +253,19 @@ void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyCol
   cloud.CheckSizes();
   PKSLAM_CHECK(colour == PlyColour::kNone || cloud.has_colour(), "colour output needs colours");
   PKSLAM_CHECK(comment.find('\n') == std::string::npos, "multi-line PLY comment");
-  std::ofstream out(file, std::ios::binary);
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
-  out << "ply\nformat binary_little_endian 1.0\n";
-  if (!comment.empty()) out << "comment " << comment << '\n';
-  out << "element vertex " << cloud.size() << "\nproperty float x\nproperty float y\n"
-      << "property float z\n";
-  if (colour == PlyColour::kGrey) out << "property uchar intensity\n";
+  std::string header = "ply\nformat binary_little_endian 1.0\n";
+  if (!comment.empty()) header += "comment " + comment + '\n';
+  header += fmt::format("element vertex {}\nproperty float x\nproperty float y\n", cloud.size());
+  header += "property float z\n";
+  if (colour == PlyColour::kGrey) header += "property uchar intensity\n";
   if (colour == PlyColour::kRgb) {
-    out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+    header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   }
-  if (cloud.has_views()) out << "property uchar views\n";
-  out << "end_header\n";
+  if (cloud.has_views()) header += "property uchar views\n";
+  header += "end_header\n";
   std::vector<char> buffer;
-  buffer.reserve(cloud.size() * 17);
+  buffer.reserve(header.size() + cloud.size() * 17);
+  buffer.insert(buffer.end(), header.begin(), header.end());
   auto put = [&buffer](const void* p, std::size_t n) {
     const char* c = static_cast<const char*>(p);
     buffer.insert(buffer.end(), c, c + n);
@@ -281,8 +281,7 @@ void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyCol
     }
     if (cloud.has_views()) put(&cloud.views[i], 1);
   }
-  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  WriteFileAtomically(file, std::string_view(buffer.data(), buffer.size()));
 }
 
 }  // namespace pkslam::dense

@@ -10,19 +10,29 @@
 
 namespace pkslam {
 
+namespace {
+
+// t1 - t0 for t1 > t0, exact even where it exceeds int64 (timestamps near both ends of the
+// range are legal input: the signed subtraction overflowed).
+std::uint64_t Interval(std::int64_t t0, std::int64_t t1) {
+  return static_cast<std::uint64_t>(t1) - static_cast<std::uint64_t>(t0);
+}
+
+}  // namespace
+
 std::vector<TimeGap> FindTimeGaps(const std::vector<std::int64_t>& t_ns, double nominal_period_ns,
                                   double max_periods) {
   std::vector<TimeGap> gaps;
   if (t_ns.size() < 2) return gaps;
   if (nominal_period_ns <= 0) {
-    std::vector<std::int64_t> dt(t_ns.size() - 1);
-    for (std::size_t i = 1; i < t_ns.size(); ++i) dt[i - 1] = t_ns[i] - t_ns[i - 1];
+    std::vector<std::uint64_t> dt(t_ns.size() - 1);
+    for (std::size_t i = 1; i < t_ns.size(); ++i) dt[i - 1] = Interval(t_ns[i - 1], t_ns[i]);
     std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
     nominal_period_ns = static_cast<double>(dt[dt.size() / 2]);
     if (nominal_period_ns <= 0) return gaps;
   }
   for (std::size_t i = 1; i < t_ns.size(); ++i) {
-    const double periods = static_cast<double>(t_ns[i] - t_ns[i - 1]) / nominal_period_ns;
+    const double periods = static_cast<double>(Interval(t_ns[i - 1], t_ns[i])) / nominal_period_ns;
     if (periods > max_periods) gaps.push_back({t_ns[i - 1], t_ns[i], periods});
   }
   return gaps;
@@ -77,7 +87,24 @@ cv::Mat LoadImage(const std::filesystem::path& path, int flags) {
 }  // namespace
 
 cv::Mat LoadGreyImage(const std::filesystem::path& path) {
-  return LoadImage(path, cv::IMREAD_GRAYSCALE);
+  cv::Mat grey = LoadImage(path, cv::IMREAD_GRAYSCALE);
+  // OpenCV reads a 16-bit image as 8-bit by dropping its low byte: one that holds 8-bit
+  // (0-255) or 12-bit values comes out black or nearly so, and tracking silently found no
+  // features. Such frames are recognised (the check costs a look only at dark frames).
+  double max_grey = 0;
+  cv::minMaxLoc(grey, nullptr, &max_grey);
+  if (max_grey < 16) {
+    const cv::Mat raw = LoadImage(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
+    double max_raw = 0;
+    cv::minMaxLoc(raw, nullptr, &max_raw);
+    if (raw.depth() == CV_16U && max_raw > 0) {
+      throw InputError(path, fmt::format("16-bit image whose values reach only {} (8- or 12-bit "
+                                         "data): pkslam reads 16-bit images as full-range and "
+                                         "it would be black; save the images as 8-bit",
+                                         max_raw));
+    }
+  }
+  return grey;
 }
 
 cv::Mat LoadColourImage(const std::filesystem::path& path) {

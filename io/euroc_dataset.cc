@@ -13,15 +13,18 @@ namespace pkslam {
 
 namespace fs = std::filesystem;
 
+void ImuLimits::Check() const {
+  PKSLAM_CHECK_OPTION(max_gyro_rad_s > 0, "--imu-max-gyro", "{}", max_gyro_rad_s);
+  PKSLAM_CHECK_OPTION(max_accel_m_s2 > 0, "--imu-max-accel", "{}", max_accel_m_s2);
+}
+
 void EurocOptions::Check() const {
+  imu_limits.Check();
   PKSLAM_CHECK_OPTION(imu_gap_periods > 1.0, "imu_gap_periods", "{}", imu_gap_periods);
   PKSLAM_CHECK_OPTION(frame_gap_periods > 1.0, "frame_gap_periods", "{}", frame_gap_periods);
 }
 
 namespace {
-
-constexpr double kMaxGyroRadS = 35.0;   // 2000 deg/s
-constexpr double kMaxAccelMs2 = 490.0;  // 50 g
 
 void RequireRows(std::size_t rows, const fs::path& file) {
   if (rows == 0) throw InputError(file, "no data rows (empty file)");
@@ -71,7 +74,7 @@ std::vector<ImageEntry> ReadEurocImageList(const fs::path& data_csv, const fs::p
   return entries;
 }
 
-std::vector<ImuSample> ReadEurocImu(const fs::path& data_csv) {
+std::vector<ImuSample> ReadEurocImu(const fs::path& data_csv, const ImuLimits& limits) {
   std::vector<ImuSample> samples;
   std::optional<std::int64_t> previous;
   const std::size_t rows = ForEachDataRow(data_csv, FieldSeparator::kComma, [&](const TextRow& r) {
@@ -82,19 +85,19 @@ std::vector<ImuSample> ReadEurocImu(const fs::path& data_csv) {
     previous = s.t_ns;
     s.gyro = Vec3Fields(r, 1, data_csv, "gyro");
     s.accel = Vec3Fields(r, 4, data_csv, "accel");
-    // Beyond the widest MEMS ranges (2000 deg/s, 50 g) a value is not a measurement; a single
-    // 1e30 sample went into the IMU initialisation (accelerometer bias ~1e28).
-    if (s.gyro.cwiseAbs().maxCoeff() > kMaxGyroRadS || !s.gyro.allFinite()) {
+    // Beyond the sensor's range a value is not a measurement; a single 1e30 sample went into
+    // the IMU initialisation (accelerometer bias ~1e28).
+    if (s.gyro.cwiseAbs().maxCoeff() > limits.max_gyro_rad_s || !s.gyro.allFinite()) {
       throw InputError(data_csv, r.line,
-                       fmt::format("gyro ({}, {}, {}) beyond +-{} rad/s (2000 deg/s): not a "
+                       fmt::format("gyro ({}, {}, {}) beyond +-{} rad/s (--imu-max-gyro): not a "
                                    "measurement in rad/s",
-                                   s.gyro.x(), s.gyro.y(), s.gyro.z(), kMaxGyroRadS));
+                                   s.gyro.x(), s.gyro.y(), s.gyro.z(), limits.max_gyro_rad_s));
     }
-    if (s.accel.cwiseAbs().maxCoeff() > kMaxAccelMs2 || !s.accel.allFinite()) {
+    if (s.accel.cwiseAbs().maxCoeff() > limits.max_accel_m_s2 || !s.accel.allFinite()) {
       throw InputError(data_csv, r.line,
-                       fmt::format("accelerometer ({}, {}, {}) beyond +-{} m/s^2 (50 g): not a "
-                                   "measurement in m/s^2",
-                                   s.accel.x(), s.accel.y(), s.accel.z(), kMaxAccelMs2));
+                       fmt::format("accelerometer ({}, {}, {}) beyond +-{} m/s^2 "
+                                   "(--imu-max-accel): not a measurement in m/s^2",
+                                   s.accel.x(), s.accel.y(), s.accel.z(), limits.max_accel_m_s2));
     }
     samples.push_back(s);
   });
@@ -171,15 +174,15 @@ EurocDataset EurocDataset::Open(const fs::path& root, const EurocOptions& option
     }
     const std::size_t unpaired = left.size() + right.size() - 2 * d.stereo_pairs_.size();
     if (unpaired > 0) {
-      PKSLAM_LOG_INFO("{}: {} usable images have no partner with the same timestamp",
-                      d.mav0_.string(), unpaired);
+      PKSLAM_LOG_DEBUG("{}: {} usable images have no partner with the same timestamp",
+                       d.mav0_.string(), unpaired);
     }
   }
 
   const fs::path imu_dir = d.mav0_ / "imu0";
   if (options.read_imu && fs::is_directory(imu_dir)) {
     d.imu_sensor_ = ReadEurocImuSensor(imu_dir / "sensor.yaml");
-    d.imu_ = ReadEurocImu(imu_dir / "data.csv");
+    d.imu_ = ReadEurocImu(imu_dir / "data.csv", options.imu_limits);
     std::vector<std::int64_t> t_ns;
     t_ns.reserve(d.imu_.size());
     for (const ImuSample& s : d.imu_) t_ns.push_back(s.t_ns);

@@ -19,6 +19,16 @@
 
 namespace pkslam {
 
+// Plausibility limits of IMU samples: beyond them a value is not a measurement in rad/s and
+// m/s^2. Defaults: the widest MEMS ranges (2000 deg/s, 50 g); EuRoC's ADIS16448 measures up
+// to 1000 deg/s and 18 g.
+struct ImuLimits {
+  double max_gyro_rad_s = 35.0;
+  double max_accel_m_s2 = 490.0;
+
+  void Check() const;
+};
+
 struct EurocOptions {
   // Read imu0/ when present.
   bool read_imu = true;
@@ -28,6 +38,7 @@ struct EurocOptions {
   double imu_gap_periods = 2.5;
   // A camera interval longer than this many nominal periods is reported as a frame gap.
   double frame_gap_periods = 1.5;
+  ImuLimits imu_limits;
 
   void Check() const;
 };
@@ -102,7 +113,9 @@ class EurocDataset {
 std::vector<ImageEntry> ReadEurocImageList(const std::filesystem::path& data_csv,
                                            const std::filesystem::path& image_dir);
 // imu0/data.csv: t_ns, w_x, w_y, w_z [rad/s], a_x, a_y, a_z [m/s^2].
-std::vector<ImuSample> ReadEurocImu(const std::filesystem::path& data_csv);
+// Samples beyond `limits` (or not finite) are errors naming the line.
+std::vector<ImuSample> ReadEurocImu(const std::filesystem::path& data_csv,
+                                    const ImuLimits& limits = {});
 // state_groundtruth_estimate0/data.csv: t_ns, p(3), q(w,x,y,z), v(3), b_w(3), b_a(3).
 std::vector<EurocGroundTruthState> ReadEurocGroundTruth(const std::filesystem::path& data_csv);
 

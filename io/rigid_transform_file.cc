@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 #include "io/text_rows.h"
 
 namespace pkslam {
@@ -18,11 +19,7 @@ void WriteRigidTransform(const SE3d& transform, const std::filesystem::path& fil
   for (int r = 0; r < 4; ++r) {
     text += fmt::format("{:.12f} {:.12f} {:.12f} {:.12f}\n", m(r, 0), m(r, 1), m(r, 2), m(r, 3));
   }
-  std::ofstream out(file, std::ios::trunc);
-  if (!out) throw Error(fmt::format("{}: cannot open for writing", file.string()));
-  out << text;
-  out.close();
-  if (!out) throw Error(fmt::format("{}: write failed", file.string()));
+  WriteFileAtomically(file, text);
 }
 
 SE3d ReadRigidTransform(const std::filesystem::path& file) {

@@ -45,6 +45,11 @@ Settings SettingsFromEuroc(const EurocDataset& dataset) {
     s.camera2 = CameraOf(cam1, cam1_yaml);
     // p_cam1 = T_BS1^-1 * T_BS0 * p_cam0.
     s.right_from_left = cam1.body_from_camera.Inverse() * cam0.body_from_camera;
+    if (s.right_from_left->translation().norm() <= 1e-6) {
+      throw InputError(cam1_yaml,
+                       "T_BS places cam1 where cam0 is (zero stereo baseline): "
+                       "check cam1's T_BS against cam0's");
+    }
   }
   if (dataset.has_imu()) {
     const EurocImuSensor& imu = dataset.imu_sensor();

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 #include "io/text_rows.h"
 
 namespace pkslam {
@@ -57,8 +58,6 @@ void SparseModel::CheckConsistency() const {
 #undef CONSISTENT
 
 void WriteSparseModel(const SparseModel& model, const fs::path& file) {
-  std::ofstream out(file);
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
   fmt::memory_buffer b;
   auto app = std::back_inserter(b);
   fmt::format_to(app, "pkslam_sparse_model 1\n# camera W H fx fy cx cy bf\n");
@@ -87,8 +86,7 @@ void WriteSparseModel(const SparseModel& model, const fs::path& file) {
     for (const auto& [kf, index] : p.observations) fmt::format_to(app, " {} {}", kf, index);
     fmt::format_to(app, "\n");
   }
-  out.write(b.data(), static_cast<std::streamsize>(b.size()));
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  WriteFileAtomically(file, std::string_view(b.data(), b.size()));
 }
 
 SparseModel ReadSparseModel(const fs::path& file) {

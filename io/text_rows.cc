@@ -159,6 +159,13 @@ void RequireFieldCount(const TextRow& row, std::size_t expected, const std::file
 
 void RequireIncreasing(std::optional<std::int64_t> previous_t_ns, std::int64_t t_ns,
                        const std::filesystem::path& file, std::size_t line) {
+  // A negative stamp (a sign error, a clock before its epoch) made "1.6e9 s of data" of a
+  // 3 s sequence and a realtime run that slept for it.
+  if (t_ns < 0) {
+    throw InputError(
+        file, line,
+        fmt::format("negative timestamp {} (sensor timestamps count from an epoch)", t_ns));
+  }
   if (!previous_t_ns || t_ns > *previous_t_ns) return;
   throw InputError(
       file, line,

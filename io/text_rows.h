@@ -51,7 +51,8 @@ std::int64_t SecondsFieldToNs(std::string_view text, const std::filesystem::path
 void RequireFieldCount(const TextRow& row, std::size_t expected, const std::filesystem::path& file,
                        std::string_view layout);
 
-// Throws InputError(file, line) unless t_ns > previous_t_ns (duplicates are errors too).
+// Throws InputError(file, line) unless 0 <= t_ns and t_ns > previous_t_ns (duplicates and
+// negative stamps are errors too).
 // `previous_t_ns` is nullopt for the first row.
 void RequireIncreasing(std::optional<std::int64_t> previous_t_ns, std::int64_t t_ns,
                        const std::filesystem::path& file, std::size_t line);

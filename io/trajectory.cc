@@ -11,6 +11,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/output_file.h"
 
 namespace pkslam {
 namespace {
@@ -165,11 +166,7 @@ TrajectoryFormat DetectFormat(const std::vector<TextLine>& lines,
 }
 
 void WriteFileOrThrow(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error(fmt::format("{}: cannot open for writing", file.string()));
-  out << text;
-  out.close();
-  if (!out) throw Error(fmt::format("{}: write failed", file.string()));
+  WriteFileAtomically(file, text);
 }
 
 // Seconds with exactly 9 decimals from integer nanoseconds (exact; handles negative times).
@@ -261,7 +258,9 @@ Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
     const Eigen::Quaterniond q = layout.quaternion_w_first
                                      ? Eigen::Quaterniond(v[3], v[4], v[5], v[6])
                                      : Eigen::Quaterniond(v[6], v[3], v[4], v[5]);
-    const double norm = q.norm();
+    // stableNorm, and q scaled by it before SO3 normalises: with components beyond ~1e154,
+    // q.norm() overflowed to inf and the normalised quaternion came out zero (not a rotation).
+    const double norm = q.coeffs().stableNorm();
     if (norm < kQuaternionNormMinimum) {
       throw InputError(file, line.number, "zero quaternion (not a rotation)");
     }
@@ -269,7 +268,7 @@ Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
       first_far_line = line.number;
       first_far_norm = norm;
     }
-    stamped.pose = SE3d(q, Eigen::Vector3d(v[0], v[1], v[2]));  // SO3 normalises q
+    stamped.pose = SE3d(Eigen::Quaterniond(q.coeffs() / norm), Eigen::Vector3d(v[0], v[1], v[2]));
 
     if (!trajectory.poses.empty() && stamped.t_ns <= trajectory.poses.back().t_ns) {
       const bool repeat = stamped.t_ns == trajectory.poses.back().t_ns;
@@ -309,14 +308,16 @@ Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
   return trajectory;
 }
 
+std::string FormatTumLine(const StampedPose& p) {
+  const Eigen::Vector3d& t = p.pose.translation();
+  const Eigen::Quaterniond& q = p.pose.quaternion();
+  return fmt::format("{} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n", FormatSeconds(p.t_ns),
+                     t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+}
+
 void WriteTrajectoryTum(const Trajectory& trajectory, const std::filesystem::path& file) {
-  std::string text = "# timestamp[s] tx ty tz qx qy qz qw\n";
-  for (const StampedPose& p : trajectory.poses) {
-    const Eigen::Vector3d& t = p.pose.translation();
-    const Eigen::Quaterniond& q = p.pose.quaternion();
-    text += fmt::format("{} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n",
-                        FormatSeconds(p.t_ns), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-  }
+  std::string text = kTumHeader;
+  for (const StampedPose& p : trajectory.poses) text += FormatTumLine(p);
   WriteFileOrThrow(file, text);
 }
 
@@ -383,7 +384,10 @@ double PathLengthMeters(const Trajectory& trajectory) {
 
 double DurationSeconds(const Trajectory& trajectory) {
   if (trajectory.poses.size() < 2) return 0.0;
-  return static_cast<double>(trajectory.poses.back().t_ns - trajectory.poses.front().t_ns) * 1e-9;
+  // In 128 bits: the span of a file's timestamps can exceed int64 (pkslam eval overflowed).
+  const __int128 span =
+      static_cast<__int128>(trajectory.poses.back().t_ns) - trajectory.poses.front().t_ns;
+  return static_cast<double>(span) * 1e-9;
 }
 
 std::optional<std::int64_t> ParseDecimalAsInt64(std::string_view text, int decimal_shift) {

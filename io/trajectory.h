@@ -93,11 +93,15 @@ Trajectory ReadTrajectory(const std::filesystem::path& file,
 // Writers (kAuto is not allowed). tum: seconds with exactly 9 decimals, so nanosecond
 // timestamps survive a write/read round trip; positions and quaternions with 9 decimals.
 // euroc: integer nanoseconds, 17 columns when the trajectory has extras, 8 otherwise.
-// orbslam3: integer nanoseconds in TUM column order. Throw pkslam::Error when the file cannot
-// be written.
+// orbslam3: integer nanoseconds in TUM column order. Written atomically (core/util/
+// output_file.h); throw OutputError naming the file when it cannot be written.
 void WriteTrajectory(const Trajectory& trajectory, const std::filesystem::path& file,
                      TrajectoryFormat format);
 void WriteTrajectoryTum(const Trajectory& trajectory, const std::filesystem::path& file);
+// One pose line of the tum format (with its newline), and the header line the writer puts
+// first; for writers that append pose by pose.
+std::string FormatTumLine(const StampedPose& pose);
+inline constexpr const char* kTumHeader = "# timestamp[s] tx ty tz qx qy qz qw\n";
 void WriteTrajectoryEuroc(const Trajectory& trajectory, const std::filesystem::path& file);
 
 // Sum of distances between consecutive positions (m).

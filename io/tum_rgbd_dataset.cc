@@ -68,9 +68,13 @@ std::vector<std::pair<std::size_t, std::size_t>> AssociateTimestamps(
     std::int64_t max_difference_ns) {
   // Candidates (|difference|, i, j); b is sorted, so each a only looks at a window of b.
   std::vector<std::tuple<std::int64_t, std::size_t, std::size_t>> candidates;
+  // The window bounds in 128 bits: a +- max overflowed int64 for timestamps near its ends.
   for (std::size_t i = 0; i < a_ns.size(); ++i) {
-    auto j = std::upper_bound(b_ns.begin(), b_ns.end(), a_ns[i] - max_difference_ns);
-    for (; j != b_ns.end() && *j < a_ns[i] + max_difference_ns; ++j) {
+    const __int128 low = static_cast<__int128>(a_ns[i]) - max_difference_ns;
+    const __int128 high = static_cast<__int128>(a_ns[i]) + max_difference_ns;
+    auto j = std::upper_bound(b_ns.begin(), b_ns.end(), low,
+                              [](__int128 bound, std::int64_t b) { return bound < b; });
+    for (; j != b_ns.end() && *j < high; ++j) {
       candidates.emplace_back(std::abs(*j - a_ns[i]), i,
                               static_cast<std::size_t>(j - b_ns.begin()));
     }
@@ -157,6 +161,18 @@ cv::Mat TumRgbdDataset::LoadDepthRaw(std::size_t i) const {
                                  depth.channels(), depth.depth()));
   }
   return depth;
+}
+
+void TumRgbdDataset::RequireValidDepth(std::size_t images) const {
+  const std::size_t n = std::min(images, associations_.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    if (cv::countNonZero(LoadDepthRaw(associations_[k].depth)) > 0) return;
+  }
+  if (n == 0) return;
+  throw InputError(depth_.images[associations_.front().depth].path,
+                   fmt::format("this and the next {} depth images hold no valid depth (all "
+                               "zero): check the depth images and the depth factor",
+                               n - 1));
 }
 
 cv::Mat TumRgbdDataset::LoadDepthMetres(std::size_t i) const {

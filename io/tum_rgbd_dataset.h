@@ -62,6 +62,10 @@ class TumRgbdDataset {
   cv::Mat LoadRgbColour(std::size_t rgb_index) const;   // CV_8UC3 BGR
   cv::Mat LoadRgbGrey(std::size_t rgb_index) const;     // CV_8UC1
   cv::Mat LoadDepthRaw(std::size_t depth_index) const;  // CV_16UC1 as stored
+  // Throws InputError naming the first depth image when the first `images` associated depth
+  // images hold no valid (non-zero) pixel: runs on an all-zero depth folder "tracked" with no
+  // depth at all (an empty trajectory, identity poses evaluated as accurate).
+  void RequireValidDepth(std::size_t images = 10) const;
   // CV_32FC1 metres (raw / depth_factor); 0 stays 0 (no measurement).
   cv::Mat LoadDepthMetres(std::size_t depth_index) const;
 

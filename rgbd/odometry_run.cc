@@ -8,6 +8,7 @@
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
+#include "core/util/output_file.h"
 #include "core/util/progress.h"
 #include "io/trajectory.h"
 #include "rgbd/cpu_time.h"
@@ -30,10 +31,7 @@ void WriteStageTimes(JsonWriter& json, const StageTimesMs& t) {
   json.EndObject();
 }
 
-void WriteFile(const fs::path& file, const std::string& text) {
-  std::ofstream out(file);
-  if (!out || !(out << text)) throw Error(fmt::format("cannot write {}", file.string()));
-}
+void WriteFile(const fs::path& file, const std::string& text) { WriteFileAtomically(file, text); }
 
 }  // namespace
 

@@ -10,6 +10,7 @@
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
+#include "core/util/output_file.h"
 #include "core/util/progress.h"
 #include "evaluation/evaluate.h"
 #include "evaluation/statistics.h"
@@ -26,10 +27,7 @@ using Clock = std::chrono::steady_clock;
 
 double MsSince(double start_cpu_ms) { return ProcessCpuMs() - start_cpu_ms; }
 
-void WriteFile(const fs::path& file, const std::string& text) {
-  std::ofstream out(file);
-  if (!out || !(out << text)) throw Error(fmt::format("cannot write {}", file.string()));
-}
+void WriteFile(const fs::path& file, const std::string& text) { WriteFileAtomically(file, text); }
 
 cv::Mat GateDepth(const cv::Mat& depth_m, double min_m, double max_m) {
   if (min_m <= 0 && max_m <= 0) return depth_m;

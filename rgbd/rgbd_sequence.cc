@@ -100,6 +100,7 @@ RgbdSequence OpenRgbdSequence(const RgbdSequenceOptions& options) {
   if (options.max_frames > 0)
     end = std::min(end, first + static_cast<std::size_t>(options.max_frames));
   for (std::size_t i = first; i < end; ++i) seq.frames.push_back(i);
+  seq.dataset.RequireValidDepth();
   PKSLAM_LOG_INFO("rgbd: {} frames from {}; camera {} ({})", seq.frames.size(),
                   options.dataset.string(), seq.camera.ToString(), seq.camera_source);
   return seq;

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 
 namespace pkslam::rgbd {
 namespace {
@@ -71,8 +72,8 @@ void VoxelMap::WritePly(const std::filesystem::path& file) const {
 
 void WriteColouredPly(const std::vector<VoxelMap::Point>& points, const std::filesystem::path& file,
                       const std::string& comment) {
-  std::ofstream out(file, std::ios::binary);
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  OutputFile output(file);
+  std::ostream& out = output.stream();
   out << "ply\nformat binary_little_endian 1.0\ncomment " << comment << "\nelement vertex "
       << points.size()
       << "\nproperty float x\nproperty float y\nproperty float z\n"
@@ -84,7 +85,7 @@ void WriteColouredPly(const std::vector<VoxelMap::Point>& points, const std::fil
                          static_cast<char>(p.bgr[0])};
     out.write(rgb, sizeof(rgb));
   }
-  if (!out) throw Error(fmt::format("failed writing {}", file.string()));
+  output.Commit();
 }
 
 }  // namespace pkslam::rgbd

@@ -9,6 +9,7 @@
 #include "core/map/keyframe.h"
 #include "core/map/map.h"
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 #include "io/trajectory.h"
 
 namespace pkslam {
@@ -34,8 +35,8 @@ void WriteInertialOutputs(const SlamSystem& system, const std::filesystem::path&
                     TrajectoryFormat::kTum);
   }
   const std::filesystem::path file = out_dir / "keyframes_imu.csv";
-  std::ofstream out(file);
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  OutputFile output(file);
+  std::ostream& out = output.stream();
   out << "time,vx,vy,vz,bgx,bgy,bgz,bax,bay,baz,valid,map_imu_initialized\n";
   const Atlas& atlas = system.atlas();
   std::shared_lock lock(atlas.mutex());
@@ -43,15 +44,18 @@ void WriteInertialOutputs(const SlamSystem& system, const std::filesystem::path&
   for (const Map* m : atlas.maps()) {
     if (best == nullptr || m->NumKeyFrames() > best->NumKeyFrames()) best = m;
   }
-  if (best == nullptr) return;
-  for (const auto& [id, kf] : best->keyframes()) {
-    const InertialState& s = kf->imu.state;
-    out << fmt::format(
-        "{:.9f},{:.6f},{:.6f},{:.6f},{:.7f},{:.7f},{:.7f},{:.6f},{:.6f},{:.6f},{},{}\n", kf->t_s(),
-        s.velocity_world.x(), s.velocity_world.y(), s.velocity_world.z(), s.bias.gyro.x(),
-        s.bias.gyro.y(), s.bias.gyro.z(), s.bias.accel.x(), s.bias.accel.y(), s.bias.accel.z(),
-        s.valid ? 1 : 0, best->imu_initialized ? 1 : 0);
+  if (best != nullptr) {
+    for (const auto& [id, kf] : best->keyframes()) {
+      const InertialState& s = kf->imu.state;
+      out << fmt::format(
+          "{:.9f},{:.6f},{:.6f},{:.6f},{:.7f},{:.7f},{:.7f},{:.6f},{:.6f},{:.6f},{},{}\n",
+          kf->t_s(), s.velocity_world.x(), s.velocity_world.y(), s.velocity_world.z(),
+          s.bias.gyro.x(), s.bias.gyro.y(), s.bias.gyro.z(), s.bias.accel.x(), s.bias.accel.y(),
+          s.bias.accel.z(), s.valid ? 1 : 0, best->imu_initialized ? 1 : 0);
+    }
   }
+  lock.unlock();
+  output.Commit();
 }
 
 }  // namespace pkslam

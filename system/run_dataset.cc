@@ -12,10 +12,14 @@
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
+#include "core/util/output_file.h"
 #include "core/util/prefetch.h"
 #include "core/util/progress.h"
+#include "io/dataset_fingerprint.h"
 #include "io/euroc_dataset.h"
+#include "io/rigid_transform_file.h"
 #include "io/settings_euroc.h"
+#include "io/trajectory.h"
 #include "io/tum_rgbd_dataset.h"
 #include "system/run_outputs.h"
 
@@ -36,6 +40,7 @@ struct FrameSource {
 void RunOptions::Check() const {
   if (dataset.empty()) throw OptionError("--dataset is required");
   if (max_frames < 0) throw OptionError(fmt::format("--max-frames {} < 0", max_frames));
+  imu_limits.Check();
   system.Check();
 }
 
@@ -67,6 +72,8 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     ~LogGuard() { RemoveLogFiles(); }
   } log_guard;
 
+  RunSummary summary;
+  InputReport& report = summary.input;
   // --- dataset and settings ---
   std::optional<EurocDataset> euroc;
   std::optional<TumRgbdDataset> tum;
@@ -76,10 +83,31 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     EurocOptions eo;
     // The IMU sensor carries the body frame (EuRoC ground truth) even for visual-only runs.
     eo.read_imu = true;
+    eo.imu_limits = options.imu_limits;
     euroc = EurocDataset::Open(options.dataset, eo);
     if (IsRgbd(sensor)) throw OptionError("an EuRoC dataset has no depth: use stereo or mono");
+    if (IsInertial(sensor) && !euroc->has_imu()) {
+      throw InputError(euroc->mav0() / "imu0", fmt::format("sensor {} needs IMU data (imu0/ "
+                                                           "with sensor.yaml and data.csv): "
+                                                           "missing",
+                                                           SensorName(sensor)));
+    }
     if (IsStereo(sensor)) {
+      if (!euroc->has_cam1()) {
+        throw InputError(euroc->mav0() / "cam1",
+                         fmt::format("sensor {} needs cam1 (missing)", SensorName(sensor)));
+      }
       for (const auto& p : euroc->stereo_pairs()) sources.push_back({p.t_ns, p.left, p.right});
+      // cam1 with fewer rows dropped frames with an info-level note only.
+      const std::size_t listed = std::max(euroc->cam0().images.size(), euroc->cam1().images.size());
+      report.frames_skipped = static_cast<int>(listed - sources.size());
+      if (report.frames_skipped > 0) {
+        report.Warn(fmt::format(
+            "{}: {} of {} frames skipped: cam0 has {} images, cam1 {}, {} with the same "
+            "timestamp in both",
+            euroc->mav0().string(), report.frames_skipped, listed, euroc->cam0().images.size(),
+            euroc->cam1().images.size(), sources.size()));
+      }
     } else {
       const auto& images = euroc->cam0().images;
       for (std::size_t i = 0; i < images.size(); ++i) sources.push_back({images[i].t_ns, i, 0});
@@ -92,6 +120,14 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     if (IsRgbd(sensor)) {
       for (const auto& a : tum->associations()) {
         sources.push_back({tum->rgb().images[a.rgb].t_ns, a.rgb, a.depth});
+      }
+      tum->RequireValidDepth();
+      report.frames_skipped = static_cast<int>(tum->rgb().images.size() - sources.size());
+      if (report.frames_skipped > 0) {
+        report.Warn(
+            fmt::format("{}: {} of {} rgb frames skipped: no depth image within the "
+                        "association window",
+                        options.dataset.string(), report.frames_skipped, tum->rgb().images.size()));
       }
     } else {
       const auto& images = tum->rgb().images;
@@ -109,8 +145,28 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
                      "not a EuRoC (mav0/cam0/data.csv) or TUM RGB-D (rgb.txt, depth.txt) dataset");
   }
   if (sources.empty()) throw InputError(options.dataset, "no frames to process");
+  summary.dataset_fingerprint = DatasetFingerprint(options.dataset);
   if (options.max_frames > 0 && static_cast<int>(sources.size()) > options.max_frames) {
     sources.resize(options.max_frames);
+  }
+  std::vector<std::int64_t> frame_t_ns;
+  frame_t_ns.reserve(sources.size());
+  for (const FrameSource& s : sources) frame_t_ns.push_back(s.t_ns);
+  // Jumps of more than a few frame periods: a recording pause, a dropped stretch, a broken
+  // stamp. Listed, and --realtime restarts its pacing after those over kMaxFrameGapNs.
+  const std::vector<TimestampJump> jumps = FindTimestampJumps(frame_t_ns);
+  report.timestamp_jumps = static_cast<int>(jumps.size());
+  if (!jumps.empty()) {
+    std::string list;
+    for (std::size_t i = 0; i < std::min<std::size_t>(jumps.size(), 5); ++i) {
+      const TimestampJump& j = jumps[i];
+      list +=
+          fmt::format("{}{:.3f} s after frame {} (t = {} ns)", i ? ", " : "",
+                      1e-9 * static_cast<double>(j.dt_ns), j.frame - 1, frame_t_ns[j.frame - 1]);
+    }
+    report.Warn(fmt::format("{}: {} timestamp jump(s) beyond {} frame periods: {}{}",
+                            options.dataset.string(), jumps.size(), kJumpPeriods, list,
+                            jumps.size() > 5 ? ", ..." : ""));
   }
 
   const fs::path vocabulary_path = options.vocabulary.value_or(DefaultVocabularyPath());
@@ -142,9 +198,12 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     system_options.mapping_sync = !options.realtime && IsMonocular(sensor) ? "live" : "free";
   }
   SlamSystem system(settings, vocabulary, system_options);
+  // Written now as well as at the end: evaluating a killed run's partial trajectory against
+  // body-frame ground truth needs it.
+  WriteRigidTransform(system.rig().body_from_camera, options.out / "body_from_camera.txt",
+                      "body_from_camera (row-major 4x4, metres)");
 
   // --- the frame loop ---
-  RunSummary summary;
   Progress progress("tracking", sources.size(), options.quiet);
   const auto wall_start = std::chrono::steady_clock::now();
   const std::int64_t t0 = sources.front().t_ns;
@@ -161,20 +220,34 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   if (IsInertial(sensor)) {
     // An "inertial" run over frames the IMU does not cover is silently visual-only there.
     const auto& imu = euroc->imu();
-    const std::int64_t t_last = sources.back().t_ns;
+    const fs::path imu_csv = euroc->mav0() / "imu0/data.csv";
     if (imu.size() < 2) {
-      throw InputError(options.dataset / "mav0/imu0/data.csv",
-                       "a single IMU sample: an inertial run needs IMU data over its frames");
+      throw InputError(imu_csv,
+                       "a single IMU sample: an inertial run needs IMU data over its "
+                       "frames");
     }
-    constexpr std::int64_t kSlackNs = 100'000'000;
-    if (imu.front().t_ns > t0 + kSlackNs || imu.back().t_ns < t_last - kSlackNs) {
-      PKSLAM_LOG_WARN(
-          "{}: the IMU covers {:.3f}..{:.3f} s of frames spanning 0..{:.3f} s (from the first "
-          "frame): frames outside it are tracked without IMU",
-          (options.dataset / "mav0/imu0/data.csv").string(),
+    CheckImuUnits(imu, imu_csv);
+    report.imu_gaps = static_cast<int>(euroc->imu_gaps().size());
+    std::vector<std::int64_t> imu_t_ns;
+    imu_t_ns.reserve(imu.size());
+    for (const ImuSample& s : imu) imu_t_ns.push_back(s.t_ns);
+    const std::vector<std::size_t> uncovered =
+        FramesWithoutImu(frame_t_ns, imu_t_ns, kImuLookaheadNs);
+    report.frames_without_imu = static_cast<int>(uncovered.size());
+    if (!uncovered.empty()) {
+      const std::string what = fmt::format(
+          "{} of {} frames have no IMU sample since the previous frame (frames {}; the IMU "
+          "covers {:.3f}..{:.3f} s of frames spanning 0..{:.3f} s)",
+          uncovered.size(), sources.size(), FormatIndexRanges(uncovered),
           1e-9 * static_cast<double>(imu.front().t_ns - t0),
           1e-9 * static_cast<double>(imu.back().t_ns - t0),
-          1e-9 * static_cast<double>(t_last - t0));
+          1e-9 * static_cast<double>(sources.back().t_ns - t0));
+      if (!options.allow_imu_gaps) {
+        throw InputError(imu_csv, what +
+                                      ": an inertial run would track them without IMU; "
+                                      "--allow-imu-gaps runs anyway");
+      }
+      report.Warn(fmt::format("{}: {}: tracked without IMU", imu_csv.string(), what));
     }
   }
   // Images are decoded in a thread of their own, a couple of frames ahead of tracking; a pair's
@@ -225,13 +298,15 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   std::int64_t pace_t_ns = t0;
   std::int64_t previous_t_ns = t0;
   const auto interrupted = [&] { return interrupt != nullptr && interrupt->load(); };
+  // The trajectory so far, for a run that is killed before it writes its outputs.
+  AppendFile partial(options.out / kPartialTrajectory);
+  partial.Append(kTumHeader);
+  bool partial_warned = false;
   for (const FrameSource& s : sources) {
-    if (!interrupted() && summary.frames > 0 &&
+    if (options.realtime && summary.frames > 0 &&
         (s.t_ns - previous_t_ns > kMaxFrameGapNs || s.t_ns <= previous_t_ns)) {
-      PKSLAM_LOG_WARN("{}: timestamp jump of {:.3f} s after frame {} (t = {} ns){}",
-                      options.dataset.string(), 1e-9 * static_cast<double>(s.t_ns - previous_t_ns),
-                      summary.frames, previous_t_ns,
-                      options.realtime ? "; --realtime pacing restarts after it" : "");
+      PKSLAM_LOG_INFO("--realtime pacing restarts after the timestamp jump at frame {}",
+                      summary.frames);
       pace_wall = std::chrono::steady_clock::now();
       pace_t_ns = s.t_ns;
     }
@@ -255,6 +330,7 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
       imu_fed_ns = s.t_ns + kImuLookaheadNs;
     }
     const LoadedImages loaded = *images.Next();
+    if (IsRgbd(sensor) && cv::countNonZero(loaded.b) == 0) ++report.frames_without_depth;
     if (IsStereo(sensor)) {
       r = system.TrackStereo(loaded.a, loaded.b, s.t_ns);
     } else if (IsRgbd(sensor)) {
@@ -264,21 +340,52 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     }
     ++summary.frames;
     if (r.state == TrackingState::kOk) ++summary.tracked;
+    if (r.camera_from_world) {
+      partial.Append(FormatTumLine({s.t_ns, r.camera_from_world->Inverse()}));
+      if (!partial.ok() && !partial_warned) {
+        partial_warned = true;
+        PKSLAM_LOG_WARN("cannot write {}: {} (the run goes on; its outputs follow at the end)",
+                        partial.path().string(), partial.error());
+      }
+    }
     progress.SetSuffix(fmt::format("{} KFs {}", TrackingStateName(r.state), system.NumKeyFrames()));
     progress.Add();
   }
   progress.Finish();
+  if (report.frames_without_depth > 0) {
+    report.Warn(fmt::format("{}: {} of {} depth images hold no valid depth (all zero)",
+                            options.dataset.string(), report.frames_without_depth, summary.frames));
+  }
+  // An interrupted run writes its trajectory before the shutdown, which waits for local
+  // mapping and loop closing (a global BA can take seconds): a second Ctrl-C then ends the
+  // process with the trajectory on disk.
+  if (summary.interrupted) WriteTrajectoryOutputs(system, options);
   system.Shutdown();
   summary.wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  // Data time without the timestamp jumps --realtime does not sleep through (the real-time
+  // factor of a run with a 1000 s jump is not 200).
+  std::int64_t skipped_ns = 0;
+  for (const TimestampJump& j : jumps) {
+    if (static_cast<int>(j.frame) < summary.frames && j.dt_ns > kMaxFrameGapNs) {
+      skipped_ns += j.dt_ns;
+    }
+  }
   summary.sequence_s =
-      static_cast<double>(sources[std::max(0, summary.frames - 1)].t_ns - t0) * 1e-9;
+      static_cast<double>(sources[std::max(0, summary.frames - 1)].t_ns - t0 - skipped_ns) * 1e-9;
   WriteRunOutputs(system, options, &summary);
+  // The outputs are complete: the crash copy has served its purpose.
+  std::error_code ec;
+  fs::remove(options.out / kPartialTrajectory, ec);
   PKSLAM_LOG_INFO(
       "{} frames ({} tracked), {} keyframes, {} map points, {} map(s); "
       "{:.1f} s wall for {:.1f} s of data; outputs in {}",
       summary.frames, summary.tracked, summary.keyframes, summary.map_points, summary.maps,
       summary.wall_s, summary.sequence_s, options.out.string());
+  if (report.degraded()) {
+    PKSLAM_LOG_WARN("degraded input: {} warning(s) (stats.json \"input\"): {}",
+                    report.warnings.size(), report.warnings.front());
+  }
   return summary;
 }
 

@@ -10,6 +10,8 @@
 // OUT/stats.json       timings, counts, tracking states, memory
 // OUT/run.log          the log of the run
 // OUT/keyframe_trace.csv  per-frame keyframe decisions (with trace enabled)
+// OUT/trajectory.txt.partial  online poses appended frame by frame while the run goes; left
+//                      only by a run that did not finish (SIGKILL, crash)
 // (system/run_outputs.h lists them again to clear them before a re-run into the same OUT.)
 #pragma once
 
@@ -18,6 +20,8 @@
 #include <filesystem>
 #include <optional>
 
+#include "io/euroc_dataset.h"
+#include "system/input_report.h"
 #include "system/slam_system.h"
 
 namespace pkslam {
@@ -38,6 +42,11 @@ struct RunOptions {
   std::string mapping_sync;
   // No progress line.
   bool quiet = false;
+  // Inertial sensors: frames the IMU does not cover are an error unless this is set (then a
+  // warning, and the run is flagged degraded).
+  bool allow_imu_gaps = false;
+  // Plausibility limits of IMU samples (EuRoC reader).
+  ImuLimits imu_limits;
   SystemOptions system;
 
   void Check() const;
@@ -54,6 +63,9 @@ struct RunSummary {
   double sequence_s = 0;
   double median_tracking_ms = 0;
   bool interrupted = false;
+  std::string dataset_fingerprint;  // io/dataset_fingerprint.h
+  // What was wrong with the input without stopping the run (degraded() when anything was).
+  InputReport input;
 };
 
 // The vocabulary shipped with pkslam (Vocabulary/ in the source tree or next to the binary).

@@ -11,6 +11,7 @@
 #include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
+#include "core/util/output_file.h"
 #include "core/util/quantile.h"
 #include "io/rigid_transform_file.h"
 #include "system/inertial_outputs.h"
@@ -34,8 +35,8 @@ void WriteTrace(const Tracker& tracker, const std::filesystem::path& file) {
   for (const auto& row : tracker.trace()) {
     for (const auto& [k, v] : row.decision.trace) keys.insert(k);
   }
-  std::ofstream out(file);
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  OutputFile output(file);
+  std::ostream& out = output.stream();
   out << "time,frame,selector,decision,reason,frames_since_keyframe";
   for (const auto& k : keys) out << ',' << k;
   out << '\n';
@@ -52,6 +53,7 @@ void WriteTrace(const Tracker& tracker, const std::filesystem::path& file) {
     }
     out << '\n';
   }
+  output.Commit();
 }
 
 void WriteLoopEvents(JsonWriter* json, std::string_view key, const std::vector<LoopEvent>& events) {
@@ -114,6 +116,20 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
   json->EndObject();
 }
 
+// What the run found wrong with its input (system/input_report.h).
+void WriteInputReport(const InputReport& input, JsonWriter* json) {
+  json->Key("input").BeginObject();
+  json->Member("frames_skipped", input.frames_skipped);
+  json->Member("timestamp_jumps", input.timestamp_jumps);
+  json->Member("imu_gaps", input.imu_gaps);
+  json->Member("frames_without_imu", input.frames_without_imu);
+  json->Member("frames_without_depth", input.frames_without_depth);
+  json->Key("warnings").BeginArray();
+  for (const std::string& w : input.warnings) json->Value(w);
+  json->EndArray();
+  json->EndObject();
+}
+
 }  // namespace
 
 void RemoveRunOutputs(const std::filesystem::path& out) {
@@ -123,13 +139,22 @@ void RemoveRunOutputs(const std::filesystem::path& out) {
       "trajectory.txt", "trajectory_body.txt", "trajectory_online_body.txt",
       "keyframes.txt",  "keyframes_imu.csv",   "body_from_camera.txt",
       "map_points.ply", "sparse_model.txt",    "keyframe_trace.csv",
-      "stats.json"};
-  for (const char* name : kOutputs) {
-    std::error_code ec;
-    std::filesystem::remove(out / name, ec);
+      "stats.json",     kPartialTrajectory};
+  std::vector<std::filesystem::path> files;
+  for (const char* name : kOutputs) files.push_back(out / name);
+  // WriteInertialOutputs' keyframe chains, one per IMU initialisation stage.
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(out, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with("imu_stage") && name.ends_with("_keyframes_body.txt")) {
+      files.push_back(entry.path());
+    }
+  }
+  for (const auto& file : files) {
+    std::filesystem::remove(file, ec);
     if (ec) {
-      throw Error(fmt::format("cannot remove the earlier run's {}: {}", (out / name).string(),
-                              ec.message()));
+      throw Error(
+          fmt::format("cannot remove the earlier run's {}: {}", file.string(), ec.message()));
     }
   }
 }
@@ -140,7 +165,7 @@ double PeakMemoryMiB() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
-void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSummary* summary) {
+int WriteTrajectoryOutputs(const SlamSystem& system, const RunOptions& options) {
   const auto& out = options.out;
   const Trajectory frames = system.FrameTrajectory();
   WriteTrajectory(frames, out / "trajectory.txt", TrajectoryFormat::kTum);
@@ -156,6 +181,14 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
     for (auto& p : body.poses) p.pose = p.pose * camera_from_body;
     WriteTrajectory(body, out / "trajectory_body.txt", TrajectoryFormat::kTum);
   }
+  return static_cast<int>(frames.poses.size());
+}
+
+void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSummary* summary) {
+  const auto& out = options.out;
+  // The trajectory first: when a later file fails (full disk) or a second signal ends the
+  // process, the most valuable output is already complete.
+  const int frames_in_trajectory = WriteTrajectoryOutputs(system, options);
   WriteRigidTransform(system.rig().body_from_camera, out / "body_from_camera.txt",
                       "body_from_camera (row-major 4x4, metres)");
   WriteTrajectory(system.KeyFrameTrajectory(), out / "keyframes.txt", TrajectoryFormat::kTum);
@@ -189,12 +222,15 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   JsonWriter json;
   json.BeginObject();
   json.Member("dataset", options.dataset.string());
+  json.Member("dataset_fingerprint", summary->dataset_fingerprint);
   json.Member("sensor", SensorName(options.system.sensor));
   json.Member("selector", options.system.selector);
   json.Member("deterministic", options.system.deterministic);
   json.Member("interrupted", summary->interrupted);
+  json.Member("degraded", summary->input.degraded());
+  WriteInputReport(summary->input, &json);
   json.Member("frames", summary->frames);
-  json.Member("frames_in_trajectory", static_cast<int>(frames.poses.size()));
+  json.Member("frames_in_trajectory", frames_in_trajectory);
   json.Member("lost_frames", lost);
   json.Member("keyframes", summary->keyframes);
   json.Member("keyframes_created",
@@ -252,9 +288,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   WriteArray(&json, "local_mapping_cpu_ms", mapping.keyframe_cpu_ms);
   WriteArray(&json, "local_ba_cpu_ms", mapping.ba_cpu_ms);
   json.EndObject();
-  std::ofstream file(out / "stats.json");
-  if (!file) throw Error(fmt::format("cannot write {}", (out / "stats.json").string()));
-  file << json.str() << '\n';
+  WriteFileAtomically(out / "stats.json", json.str() + '\n');
 }
 
 }  // namespace pkslam

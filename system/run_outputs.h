@@ -5,6 +5,15 @@
 
 namespace pkslam {
 
+// The trajectory-so-far, appended frame by frame while a run goes (online poses as tracking
+// estimated them); removed when the run's outputs are complete. A run killed with SIGKILL or
+// by a crash leaves it, readable by `pkslam eval`.
+inline constexpr const char* kPartialTrajectory = "trajectory.txt.partial";
+
+// Writes trajectory.txt (and trajectory_body.txt); returns the number of poses. Called first
+// by WriteRunOutputs, and before the shutdown of an interrupted run.
+int WriteTrajectoryOutputs(const SlamSystem& system, const RunOptions& options);
+
 // Fills the map/keyframe/timing fields of `summary` and writes every output file.
 void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSummary* summary);
 

@@ -10,6 +10,7 @@
 #include "core/map/map_point.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/output_file.h"
 #include "keyframe/selector_factory.h"
 
 namespace pkslam {
@@ -152,22 +153,25 @@ Trajectory SlamSystem::KeyFrameTrajectory() const {
 void SlamSystem::WriteMapPly(const std::filesystem::path& file) const {
   std::shared_lock lock(atlas_.mutex());
   const Map* map = LargestMap();
-  std::ofstream out(file, std::ios::binary);
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  OutputFile output(file);
+  std::ostream& out = output.stream();
   const std::size_t n = map != nullptr ? map->map_points().size() : 0;
   out << "ply\nformat binary_little_endian 1.0\ncomment pkslam map points (world frame)\n"
       << "element vertex " << n << "\nproperty float x\nproperty float y\nproperty float z\n"
       << "property uchar observations\nend_header\n";
-  if (map == nullptr) return;
-  for (const auto& [id, mp] : map->map_points()) {
-    const float xyz[3] = {static_cast<float>(mp->position().x()),
-                          static_cast<float>(mp->position().y()),
-                          static_cast<float>(mp->position().z())};
-    out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
-    const auto obs =
-        static_cast<unsigned char>(std::min<std::size_t>(255, mp->observations().size()));
-    out.put(static_cast<char>(obs));
+  if (map != nullptr) {
+    for (const auto& [id, mp] : map->map_points()) {
+      const float xyz[3] = {static_cast<float>(mp->position().x()),
+                            static_cast<float>(mp->position().y()),
+                            static_cast<float>(mp->position().z())};
+      out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
+      const auto obs =
+          static_cast<unsigned char>(std::min<std::size_t>(255, mp->observations().size()));
+      out.put(static_cast<char>(obs));
+    }
   }
+  lock.unlock();
+  output.Commit();
 }
 
 int SlamSystem::NumKeyFrames() const {

@@ -115,7 +115,8 @@ TEST(RgbdCli, MalformedGroundTruthNamesFileAndLine) {
 
 TEST(RgbdCli, CorruptImageNamesTheFile) {
   const fs::path dir = TumFolder("rgbd_cli_png");
-  ExpectOneLineError(dir, {(dir / "rgb" / "1.png").string(), "cannot decode"});
+  // The depth images are looked at first (an all-zero depth folder is refused up front).
+  ExpectOneLineError(dir, {(dir / "depth" / "1.png").string(), "cannot decode"});
 }
 
 TEST(RgbdCli, BadSettingsNameTheFile) {

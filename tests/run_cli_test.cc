@@ -65,9 +65,12 @@ TEST(RunCli, TimestampJumpIsReportedAndNotSleptThrough) {
       RunPkslam(fmt::format("run --dataset '{}' --sensor mono --realtime --quiet --out '{}'",
                             seq.string(), (dir / "out").string()));
   EXPECT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_THAT(run.output, HasSubstr("timestamp jump of 1000.0"));
-  EXPECT_THAT(run.output, HasSubstr("--realtime pacing restarts after it"));
+  EXPECT_THAT(run.output, HasSubstr("1 timestamp jump(s) beyond 5 frame periods: 1000.050 s "
+                                    "after frame 57"));
+  EXPECT_THAT(run.output, HasSubstr("--realtime pacing restarts after the timestamp jump at "
+                                    "frame 58"));
   EXPECT_THAT(run.output, HasSubstr(seq.filename().string()));
+  EXPECT_THAT(testing::ReadFileBytes(dir / "out/stats.json"), HasSubstr("\"timestamp_jumps\": 1"));
 }
 
 // A vocabulary path that is a directory is a one-line error naming it (it was
@@ -104,10 +107,23 @@ TEST(RunCli, ImuCoverageIsChecked) {
   const std::string run =
       fmt::format("run --dataset '{}' --sensor stereo-inertial --quiet --out '{}'", seq.string(),
                   (dir / "out").string());
+  // An inertial run over frames without IMU is an error naming the IMU file and the frames...
   const auto early = RunPkslam(run);
-  EXPECT_EQ(early.exit_code, 0) << early.output;
-  EXPECT_THAT(early.output,
-              HasSubstr("the IMU covers 0.000..0.995 s of frames spanning 0..3.000 s"));
+  EXPECT_EQ(early.exit_code, 1) << early.output;
+  EXPECT_THAT(early.output, HasSubstr("imu0/data.csv: 40 of 61 frames have no IMU sample"));
+  EXPECT_THAT(early.output, HasSubstr("frames 21-60; the IMU covers 0.000..0.995 s of frames "
+                                      "spanning 0..3.000 s"));
+  // ... unless allowed: then a warning and a degraded run in stats.json.
+  const auto allowed = RunPkslam(run + " --allow-imu-gaps");
+  EXPECT_EQ(allowed.exit_code, 0) << allowed.output;
+  EXPECT_THAT(allowed.output, HasSubstr("tracked without IMU"));
+  EXPECT_THAT(allowed.output, HasSubstr("degraded input: 1 warning(s)"));
+  const std::string stats = testing::ReadFileBytes(dir / "out/stats.json");
+  EXPECT_THAT(stats, HasSubstr("\"degraded\": true"));
+  EXPECT_THAT(stats, HasSubstr("\"frames_without_imu\": 40"));
+  // A finished run keeps no crash copy of its trajectory.
+  EXPECT_FALSE(std::filesystem::exists(dir / "out/trajectory.txt.partial"));
+  EXPECT_EQ(RunPkslam(run + " --allow-imu-gaps --strict").exit_code, 3);
   TruncateImu(seq, 1);
   const auto single = RunPkslam(run);
   EXPECT_NE(single.exit_code, 0);

@@ -50,6 +50,8 @@ const char* TrackingStateName(TrackingState s) {
 void TrackingOptions::Check() const {
   PKSLAM_CHECK_OPTION(min_features_stereo_init > 0, "Tracking.min_features_stereo_init", "{}",
                       min_features_stereo_init);
+  PKSLAM_CHECK_OPTION(min_depth_points_stereo_init > 0, "Tracking.min_depth_points_stereo_init",
+                      "{}", min_depth_points_stereo_init);
   PKSLAM_CHECK_OPTION(starving_inliers >= 0 && starving_ratio >= 0 && starving_ratio < 1,
                       "Tracking.starving", "{} / {}", starving_inliers, starving_ratio);
   PKSLAM_CHECK_OPTION(max_local_keyframes > 0, "Tracking.max_local_keyframes", "{}",
@@ -276,6 +278,9 @@ bool Tracker::MapStarving(const SelectorInput& in) const {
 
 void Tracker::StereoInitialization() {
   if (current_.size() <= options_.min_features_stereo_init) return;
+  int with_depth = 0;
+  for (int i = 0; i < current_.size(); ++i) with_depth += current_.HasDepth(i) ? 1 : 0;
+  if (with_depth < options_.min_depth_points_stereo_init) return;
   KeyFramePtr kf;
   int points = 0;
   {

@@ -10,6 +10,11 @@ namespace pkslam {
 struct TrackingOptions {
   // Stereo/RGB-D: features needed in the first frame to initialise a map.
   int min_features_stereo_init = 500;
+  // ... of which at least this many with depth. Without it an all-zero depth image (or a
+  // stereo pair without one match) started a map of zero points and the run reported its
+  // frames as tracked while it wrote an empty trajectory. (ORB-SLAM3 checks the feature count
+  // only.)
+  int min_depth_points_stereo_init = 50;
   // Stereo/RGB-D initialisation creates points for keypoints closer than this many
   // th_depth... ORB-SLAM uses every keypoint with positive depth; kept as a switch.
   bool init_only_close_points = false;

@@ -3,12 +3,12 @@
 // message and a non-zero exit code.
 #pragma once
 
+#include <fmt/format.h>
+
 #include <cstddef>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
-
-#include <fmt/format.h>
 
 namespace pkslam {
 
@@ -38,6 +38,19 @@ class InputError : public Error {
   std::size_t line_ = 0;
 };
 
+// An output file that could not be written (disk full, no permission, a directory in the
+// way). The message names the file and the system's reason.
+class OutputError : public Error {
+ public:
+  OutputError(const std::filesystem::path& file, const std::string& what)
+      : Error(fmt::format("cannot write {}: {}", file.string(), what)), file_(file) {}
+
+  const std::filesystem::path& file() const { return file_; }
+
+ private:
+  std::filesystem::path file_;
+};
+
 // Bad option value (command line or options struct). Message names the option.
 class OptionError : public Error {
  public:
@@ -47,19 +60,19 @@ class OptionError : public Error {
 }  // namespace pkslam
 
 // PKSLAM_CHECK(cond, "fmt {}", args...) throws pkslam::Error with file:line context.
-#define PKSLAM_CHECK(cond, ...)                                                        \
-  do {                                                                                 \
-    if (!(cond)) {                                                                     \
-      throw ::pkslam::Error(::fmt::format("{}:{}: check '{}' failed: {}", __FILE__,    \
-                                          __LINE__, #cond, ::fmt::format(__VA_ARGS__))); \
-    }                                                                                  \
+#define PKSLAM_CHECK(cond, ...)                                                               \
+  do {                                                                                        \
+    if (!(cond)) {                                                                            \
+      throw ::pkslam::Error(::fmt::format("{}:{}: check '{}' failed: {}", __FILE__, __LINE__, \
+                                          #cond, ::fmt::format(__VA_ARGS__)));                \
+    }                                                                                         \
   } while (false)
 
 // PKSLAM_CHECK_OPTION(cond, "name", "reason") for options structs' Check().
-#define PKSLAM_CHECK_OPTION(cond, name, ...)                                              \
-  do {                                                                                    \
-    if (!(cond)) {                                                                        \
-      throw ::pkslam::OptionError(                                                        \
+#define PKSLAM_CHECK_OPTION(cond, name, ...)                                                      \
+  do {                                                                                            \
+    if (!(cond)) {                                                                                \
+      throw ::pkslam::OptionError(                                                                \
           ::fmt::format("option {}: {} (requires {})", name, ::fmt::format(__VA_ARGS__), #cond)); \
-    }                                                                                     \
+    }                                                                                             \
   } while (false)

@@ -7,6 +7,7 @@
 
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
+#include "core/util/output_file.h"
 #include "core/util/quantile.h"
 #include "io/euroc_dataset.h"
 #include "io/rigid_transform_file.h"
@@ -154,9 +155,7 @@ void ImportPeerRun(const fs::path& run_dir, const fs::path& dataset, const std::
   json.Member("peak_memory_mib", NumberAfter(run_dir / "summary.txt", "peak_rss_mb="));
   json.EndObject();
   const fs::path stats = run_dir / "stats.json";
-  std::ofstream out(stats, std::ios::trunc);
-  out << json.str();
-  if (!out) throw Error("cannot write " + stats.string());
+  WriteFileAtomically(stats, json.str());
 }
 
 std::vector<std::string> PeerArguments(const std::vector<std::string>& command,

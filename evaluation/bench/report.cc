@@ -8,6 +8,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/output_file.h"
 #include "evaluation/bench/process.h"
 
 namespace pkslam::bench {
@@ -255,12 +256,10 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
   }
   if (!files.plot_error.empty()) doc.Paragraph("Plots unavailable: " + files.plot_error);
 
-  std::ofstream md(options.out / "report.md", std::ios::trunc);
-  md << doc.md;
-  std::ofstream html(options.out / "report.html", std::ios::trunc);
-  html << fmt::format(fmt::runtime(kHtmlHead), Html(options.title)) << doc.html
-       << "</body></html>\n";
-  if (!md || !html) throw Error("cannot write the report in " + options.out.string());
+  WriteFileAtomically(options.out / "report.md", doc.md);
+  WriteFileAtomically(
+      options.out / "report.html",
+      fmt::format(fmt::runtime(kHtmlHead), Html(options.title)) + doc.html + "</body></html>\n");
   return files;
 }
 

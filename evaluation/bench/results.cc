@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 
 namespace pkslam::bench {
 namespace {
@@ -189,14 +190,10 @@ std::string ResultCsvRow(const RunResult& r) {
 
 void WriteResultsCsv(const fs::path& file, const std::vector<RunResult>& results) {
   if (file.has_parent_path()) fs::create_directories(file.parent_path());
-  const fs::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << ResultCsvHeader() << '\n';
-    for (const auto& r : results) out << ResultCsvRow(r) << '\n';
-    if (!out) throw Error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, file);
+  OutputFile output(file);
+  output.stream() << ResultCsvHeader() << '\n';
+  for (const auto& r : results) output.stream() << ResultCsvRow(r) << '\n';
+  output.Commit();
 }
 
 std::vector<RunResult> ReadResultsCsv(const fs::path& file) {

@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 #include "evaluation/bench/matrix.h"
 
 namespace pkslam::bench {
@@ -190,7 +191,8 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
 }
 
 void WriteSummaryCsv(const fs::path& file, const std::vector<GroupSummary>& groups) {
-  std::ofstream out(file, std::ios::trunc);
+  OutputFile output(file);
+  std::ostream& out = output.stream();
   out << "dataset,sensor,config,selector,sweep_param,sweep_value,runs,ok,alignment,"
          "ate_mean_m,ate_std_m,ate_median_m,ate_se3_mean_m,ate_sim3_mean_m,scale_mean,"
          "rpe_trans_mean_m,improvement_pct,keyframes_mean,keyframes_std,map_points_mean,"
@@ -207,7 +209,7 @@ void WriteSummaryCsv(const fs::path& file, const std::vector<GroupSummary>& grou
         Num(g.wall_s.mean), Num(g.median_tracking_ms.mean), Num(g.dense_points.mean),
         Num(g.sweep_score), Num(g.gyro_bias_err_pct.mean), Num(g.accel_bias_err_pct.mean));
   }
-  if (!out) throw Error("cannot write " + file.string());
+  output.Commit();
 }
 
 std::string FormatMeanStd(const MeanStd& m, int decimals) {

@@ -1,0 +1,95 @@
+#include "system/input_report.h"
+
+#include <algorithm>
+
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "core/util/quantile.h"
+
+namespace pkslam {
+
+void InputReport::Warn(std::string message) {
+  PKSLAM_LOG_WARN("{}", message);
+  warnings.push_back(std::move(message));
+}
+
+std::vector<TimestampJump> FindTimestampJumps(const std::vector<std::int64_t>& frame_t_ns,
+                                              double max_periods) {
+  std::vector<TimestampJump> jumps;
+  if (frame_t_ns.size() < 2) return jumps;
+  std::vector<double> dt;
+  dt.reserve(frame_t_ns.size() - 1);
+  for (std::size_t i = 1; i < frame_t_ns.size(); ++i) {
+    dt.push_back(static_cast<double>(frame_t_ns[i] - frame_t_ns[i - 1]));
+  }
+  const double period = Quantile(dt, 0.5).value_or(0.0);
+  for (std::size_t i = 1; i < frame_t_ns.size(); ++i) {
+    const std::int64_t d = frame_t_ns[i] - frame_t_ns[i - 1];
+    if (d <= 0 || (period > 0 && static_cast<double>(d) > max_periods * period)) {
+      jumps.push_back({i, d});
+    }
+  }
+  return jumps;
+}
+
+std::vector<std::size_t> FramesWithoutImu(const std::vector<std::int64_t>& frame_t_ns,
+                                          const std::vector<std::int64_t>& imu_t_ns,
+                                          std::int64_t lookahead_ns) {
+  std::vector<std::size_t> frames;
+  // The first frame integrates nothing; frame i > 0 needs the first sample after frame i-1 to
+  // come no later than the lookahead past frame i.
+  for (std::size_t i = 1; i < frame_t_ns.size(); ++i) {
+    const auto it = std::upper_bound(imu_t_ns.begin(), imu_t_ns.end(), frame_t_ns[i - 1]);
+    if (it == imu_t_ns.end() || *it > frame_t_ns[i] + lookahead_ns) frames.push_back(i);
+  }
+  return frames;
+}
+
+std::string FormatIndexRanges(const std::vector<std::size_t>& indices, std::size_t max_ranges) {
+  std::string out;
+  std::size_t ranges = 0;
+  for (std::size_t i = 0; i < indices.size();) {
+    std::size_t j = i;
+    while (j + 1 < indices.size() && indices[j + 1] == indices[j] + 1) ++j;
+    if (ranges == max_ranges) {
+      out += ", ...";
+      break;
+    }
+    if (!out.empty()) out += ", ";
+    out += i == j ? fmt::format("{}", indices[i]) : fmt::format("{}-{}", indices[i], indices[j]);
+    ++ranges;
+    i = j + 1;
+  }
+  return out;
+}
+
+void CheckImuUnits(const std::vector<ImuSample>& samples, const std::filesystem::path& file) {
+  if (samples.empty()) return;
+  std::vector<double> accel;
+  std::vector<double> gyro;
+  accel.reserve(samples.size());
+  gyro.reserve(samples.size());
+  for (const ImuSample& s : samples) {
+    accel.push_back(s.accel.norm());
+    gyro.push_back(s.gyro.norm());
+  }
+  const double a = *Quantile(accel, 0.5);
+  const double w = *Quantile(gyro, 0.9);
+  constexpr double kGravity = 9.81;
+  if (a < 0.5 * kGravity || a > 2.0 * kGravity) {
+    const bool in_g = a > 0.5 && a < 2.0;
+    throw InputError(file, fmt::format("median |accelerometer| is {:.3g}, not near gravity "
+                                       "(9.81 m/s^2){}",
+                                       a,
+                                       in_g ? ": the data look like g, multiply by 9.81"
+                                            : ": expected m/s^2 including gravity"));
+  }
+  if (w > 5.0) {
+    throw InputError(file, fmt::format("|gyro| is above {:.3g} rad/s in 10% of the samples, a "
+                                       "spin of {:.0f} deg/s: the data look like deg/s, "
+                                       "expected rad/s",
+                                       w, w * 180.0 / 3.141592653589793));
+  }
+}
+
+}  // namespace pkslam

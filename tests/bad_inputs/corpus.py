@@ -1,0 +1,505 @@
+#!/usr/bin/env python3
+"""Bad-input corpus: broken datasets, settings and runs made on the fly from small simulated
+sequences, each run through pkslam and classified.
+
+  corpus.py make --pkslam BIN --work DIR      simulate the base sequences into DIR
+  corpus.py run  --pkslam BIN --work DIR [--case NAME ...] [--json FILE]
+  corpus.py list                              case names (CTest registers one test per case)
+
+Classes: clean (exit != 0, one "pkslam: error:" line naming the bad input, no stats.json),
+warned (exit 0, the expected warning, a stats.json flag), crashed (killed by a signal, abort,
+sanitizer report, or exit 2 = internal error), hung (timeout), silent (exit 0 without the
+warning, or an error run that left a stats.json), unnamed (exit != 0 without naming the
+input). `run` exits 1 unless every case is clean or warned.
+"""
+import argparse
+import json
+import os
+import re
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+TIMEOUT_S = 120
+
+
+# --------------------------------------------------------------------------------------------
+# Helpers that change a copy of a base sequence. Copies hard-link the images; a helper that
+# changes a file first unlinks it, so the base stays intact.
+
+def copy_tree(src, dst):
+    if os.path.exists(dst):
+        shutil.rmtree(dst)
+    shutil.copytree(src, dst, copy_function=os.link)
+
+
+def read_lines(path):
+    with open(path) as f:
+        return f.read().splitlines()
+
+
+def write_lines(path, lines):
+    os.unlink(path)
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def data_rows(lines):
+    """Indices of the non-comment lines."""
+    return [i for i, l in enumerate(lines) if l and not l.startswith("#")]
+
+
+def edit_csv(path, fn):
+    """fn(list of data rows as field lists) -> new list of field lists."""
+    lines = read_lines(path)
+    header = [l for l in lines if l.startswith("#")]
+    rows = [l.split(",") for l in lines if l and not l.startswith("#")]
+    write_lines(path, header + [",".join(r) for r in fn(rows)])
+
+
+def imu_csv(seq):
+    return os.path.join(seq, "mav0/imu0/data.csv")
+
+
+def cam_csv(seq, cam):
+    return os.path.join(seq, f"mav0/{cam}/data.csv")
+
+
+def cam_images(seq, cam):
+    d = os.path.join(seq, f"mav0/{cam}/data")
+    return sorted(os.path.join(d, f) for f in os.listdir(d))
+
+
+def rewrite_image(path, fn):
+    import cv2
+    img = cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    out = fn(img)
+    os.unlink(path)
+    cv2.imwrite(path, out)
+
+
+def scale_imu(seq, gyro=1.0, accel=1.0):
+    def fn(rows):
+        for r in rows:
+            r[1:4] = [repr(float(v) * gyro) for v in r[1:4]]
+            r[4:7] = [repr(float(v) * accel) for v in r[4:7]]
+        return rows
+    edit_csv(imu_csv(seq), fn)
+
+
+def keep_imu_fraction(seq, lo, hi):
+    edit_csv(imu_csv(seq), lambda rows: rows[int(lo * len(rows)):int(hi * len(rows))])
+
+
+# --------------------------------------------------------------------------------------------
+# Cases. args: pkslam arguments with {seq}, {out}, {work}; expect "error" (substrings that must
+# appear in the output: the bad input's name and the reason) or "warn" (substrings + a
+# stats.json key that must be non-zero / true).
+
+class Case:
+    def __init__(self, name, base, mutate, args, expect, needles, stats_key=None, runner=None,
+                 limit_file_kb=None):
+        self.name = name
+        self.base = base
+        self.mutate = mutate
+        self.args = args
+        self.expect = expect
+        self.needles = needles
+        self.stats_key = stats_key
+        self.runner = runner
+        self.limit_file_kb = limit_file_kb
+
+
+RUN_SI = "run --dataset {seq} --sensor stereo-inertial --quiet --out {out}"
+RUN_S = "run --dataset {seq} --sensor stereo --quiet --out {out}"
+RUN_M = "run --dataset {seq} --sensor mono --quiet --out {out}"
+RUN_RGBD = "run --dataset {seq} --sensor rgbd --quiet --out {out}"
+
+
+def m_imu_huge(seq):
+    edit_csv(imu_csv(seq), lambda rows: rows[:50] + [[rows[50][0], "0", "0", "0", "1e30", "0",
+                                                      "9.8"]] + rows[51:])
+
+
+def m_imu_nan(seq):
+    def fn(rows):
+        rows[70][2] = "nan"
+        return rows
+    edit_csv(imu_csv(seq), fn)
+
+
+def m_imu_deg(seq):
+    scale_imu(seq, gyro=57.29577951308232)
+
+
+def m_imu_g(seq):
+    scale_imu(seq, accel=1 / 9.81)
+
+
+def m_imu_late(seq):
+    keep_imu_fraction(seq, 0.4, 1.0)
+
+
+def m_imu_early(seq):
+    keep_imu_fraction(seq, 0.0, 0.6)
+
+
+def m_imu_single(seq):
+    edit_csv(imu_csv(seq), lambda rows: rows[:1])
+
+
+def m_imu_hole(seq):
+    edit_csv(imu_csv(seq), lambda rows: rows[:400] + rows[600:])
+
+
+def m_imu_missing(seq):
+    shutil.rmtree(os.path.join(seq, "mav0/imu0"))
+
+
+def m_mono_size(seq):
+    import cv2
+    for p in cam_images(seq, "cam0"):
+        rewrite_image(p, lambda im: cv2.resize(im, (640, 480)))
+
+
+def m_stereo_size(seq):
+    import cv2
+    rewrite_image(cam_images(seq, "cam1")[5], lambda im: cv2.resize(im, (640, 480)))
+
+
+def m_png16(seq):
+    import numpy as np
+    for p in cam_images(seq, "cam0"):
+        rewrite_image(p, lambda im: im.astype(np.uint16))
+
+
+def m_negative_stamp(seq):
+    def fn(rows):
+        rows[0][0] = "-5"
+        return rows
+    edit_csv(cam_csv(seq, "cam0"), fn)
+
+
+def m_jump(seq):
+    """The last 3 frames 1000 s later (both cameras; the image files keep their names)."""
+    def fn(rows):
+        for r in rows[-3:]:
+            r[0] = str(int(r[0]) + 1000 * 10**9)
+        return rows
+    edit_csv(cam_csv(seq, "cam0"), fn)
+    edit_csv(cam_csv(seq, "cam1"), fn)
+
+
+def m_cam1_short(seq):
+    edit_csv(cam_csv(seq, "cam1"), lambda rows: rows[:-12])
+
+
+def m_zero_baseline(seq):
+    p = os.path.join(seq, "mav0/cam1/sensor.yaml")
+    os.unlink(p)
+    shutil.copy(os.path.join(seq, "mav0/cam0/sensor.yaml"), p)
+
+
+def m_nfeatures(seq):
+    p = os.path.join(seq, "settings.yaml")
+    lines = [re.sub(r"^ORBextractor\.nFeatures:.*", "ORBextractor.nFeatures: 2e9", l)
+             for l in read_lines(p)]
+    write_lines(p, lines)
+
+
+def m_corrupt_image(seq):
+    p = cam_images(seq, "cam0")[7]
+    with open(p, "rb") as f:
+        head = f.read(100)
+    os.unlink(p)
+    with open(p, "wb") as f:
+        f.write(head)
+
+
+def m_empty_list(seq):
+    write_lines(cam_csv(seq, "cam0"), ["#timestamp [ns],filename"])
+
+
+def m_zero_depth(seq):
+    import numpy as np
+    d = os.path.join(seq, "depth")
+    for f in os.listdir(d):
+        rewrite_image(os.path.join(d, f), lambda im: np.zeros_like(im))
+
+
+def m_none(seq):
+    pass
+
+
+def m_flip_images(seq):
+    """Another recording with the same frame list: every image differs."""
+    import cv2
+    for cam in ("cam0", "cam1"):
+        for p in cam_images(seq, cam):
+            rewrite_image(p, lambda im: cv2.flip(im, 1))
+
+
+def bad_bench(seq, work):
+    suite = os.path.join(work, "all_failed.yaml")
+    with open(suite, "w") as f:
+        f.write("runs: 1\nselectors: [orbslam3]\nsensors: [stereo]\n"
+                "datasets: [{name: a, path: no_such_dir}]\n")
+    return suite
+
+
+CASES = [
+    Case("imu_huge_sample", "euroc", m_imu_huge, RUN_SI, "error",
+         ["imu0/data.csv:52", "beyond"]),
+    Case("imu_nan", "euroc", m_imu_nan, RUN_SI, "error", ["imu0/data.csv:72", "nan"]),
+    Case("imu_gyro_in_deg_s", "euroc", m_imu_deg, RUN_SI, "error", ["imu0/data.csv", "rad/s"]),
+    Case("imu_accel_in_g", "euroc", m_imu_g, RUN_SI, "error", ["imu0/data.csv", "look like g"]),
+    Case("imu_starts_late", "euroc", m_imu_late, RUN_SI, "error",
+         ["imu0/data.csv", "have no IMU sample"]),
+    Case("imu_ends_early", "euroc", m_imu_early, RUN_SI, "error",
+         ["imu0/data.csv", "have no IMU sample"]),
+    Case("imu_hole", "euroc", m_imu_hole, RUN_SI, "error", ["imu0/data.csv", "have no IMU sample"]),
+    Case("imu_gaps_allowed", "euroc", m_imu_hole, RUN_SI + " --allow-imu-gaps", "warn",
+         ["tracked without IMU"], "frames_without_imu"),
+    Case("imu_single_row", "euroc", m_imu_single, RUN_SI, "error",
+         ["imu0/data.csv", "single IMU sample"]),
+    Case("imu_folder_missing", "euroc", m_imu_missing, RUN_SI, "error", ["imu0", "missing"]),
+    Case("mono_image_size", "euroc", m_mono_size, RUN_M, "error",
+         ["cam0/data/", "640x480 image, but the calibration is 752x480"]),
+    Case("stereo_image_size", "euroc", m_stereo_size, RUN_S, "error",
+         ["cam1/data/", "640x480 image"]),
+    Case("png_16bit_8bit_values", "euroc", m_png16, RUN_M, "error", ["cam0/data/", "16-bit"]),
+    Case("corrupt_image", "euroc", m_corrupt_image, RUN_S, "error", ["cam0/data/", "decode"]),
+    Case("negative_first_stamp", "euroc", m_negative_stamp, RUN_M, "error",
+         ["cam0/data.csv:2", "negative timestamp"]),
+    Case("empty_image_list", "euroc", m_empty_list, RUN_M, "error", ["cam0/data.csv"]),
+    Case("timestamp_jump", "euroc", m_jump, RUN_S + " --realtime", "warn",
+         ["timestamp jump(s)", "1000.050 s"], "timestamp_jumps"),
+    Case("cam1_fewer_rows", "euroc", m_cam1_short, RUN_S, "warn", ["12 of 101 frames skipped"],
+         "frames_skipped"),
+    Case("zero_stereo_baseline", "euroc", m_zero_baseline, RUN_S, "error",
+         ["cam1/sensor.yaml", "zero stereo baseline"]),
+    Case("vocabulary_is_directory", "euroc", m_none, RUN_S + " --vocabulary {work}", "error",
+         ["vocabulary is not a file"]),
+    Case("settings_missing", "euroc", m_none, RUN_S + " --settings {work}/no_such.yaml", "error",
+         ["no_such.yaml"]),
+    Case("nfeatures_overflow", "euroc", m_nfeatures, RUN_S + " --settings {seq}/settings.yaml",
+         "error", ["settings.yaml", "ORBextractor.nFeatures"]),
+    Case("rgbd_zero_depth_run", "tum", m_zero_depth, RUN_RGBD, "error",
+         ["depth/", "no valid depth"]),
+    Case("rgbd_zero_depth_planar", "tum", m_zero_depth, "planar --dataset {seq} --out {out}",
+         "error", ["depth/", "no valid depth"]),
+    Case("rgbd_zero_depth_odometry", "tum", m_zero_depth,
+         "rgbd-odometry --dataset {seq} --out {out}", "error", ["depth/", "no valid depth"]),
+    Case("dense_other_dataset", "euroc", m_flip_images,
+         "dense --run {work}/base_run --dataset {seq} --out {out}/cloud.ply", "error",
+         ["not the dataset run", "base_run"]),
+    Case("export_colmap_other_dataset", "euroc", m_flip_images,
+         "export-colmap --run {work}/base_run --dataset {seq} --out {out}", "error",
+         ["not the dataset run"]),
+    Case("bench_every_run_failed", "euroc", m_none, "bench {suite} --out {out} --quiet "
+         "--no-plots", "error", ["1 of 1 runs failed"]),
+    Case("full_disk", "euroc", m_none, RUN_S, "error", ["cannot write", "File too large"],
+         limit_file_kb=16),
+]
+
+
+# --------------------------------------------------------------------------------------------
+# Signals: the trajectory so far must be readable by `pkslam eval`.
+
+def wait_for_partial_lines(out, n, proc, timeout_s=60):
+    path = os.path.join(out, "trajectory.txt.partial")
+    end = time.time() + timeout_s
+    while time.time() < end and proc.poll() is None:
+        if os.path.exists(path):
+            with open(path) as f:
+                if sum(1 for l in f if l and not l.startswith("#")) >= n:
+                    return True
+        time.sleep(0.05)
+    return False
+
+
+def evaluates(pkslam, seq, est, out):
+    gt = os.path.join(seq, "mav0/state_groundtruth_estimate0/data.csv")
+    r = subprocess.run([pkslam, "eval", "--gt", gt, "--est", est, "--body-from-camera",
+                        os.path.join(out, "body_from_camera.txt")],
+                       capture_output=True, text=True, timeout=60)
+    return r.returncode == 0, r.stdout + r.stderr
+
+
+def signal_runner(signals, expect_rc, est_name):
+    def run(pkslam, seq, out, work):
+        cmd = [pkslam, "run", "--dataset", seq, "--sensor", "stereo", "--realtime", "--quiet",
+               "--out", out]
+        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if not wait_for_partial_lines(out, 20, proc):
+            proc.kill()
+            return None, "the run never wrote 20 poses to trajectory.txt.partial"
+        for i, sig in enumerate(signals):
+            if i:
+                time.sleep(0.01)
+            proc.send_signal(sig)
+        try:
+            output, _ = proc.communicate(timeout=TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            return None, "hung after the signal"
+        rc = proc.returncode
+        est = os.path.join(out, est_name)
+        ok_eval, eval_out = evaluates(pkslam, seq, est, out) if os.path.exists(est) else (
+            False, f"{est_name} missing")
+        detail = f"exit {rc}; {est_name}: {'evaluates' if ok_eval else eval_out.strip()}"
+        # A run killed by the second signal reports -SIGINT; interrupted runs 128 + signal.
+        good = rc in expect_rc and ok_eval
+        return ("warned" if good else "silent"), output + "\n" + detail
+    return run
+
+
+def first_existing(out, names):
+    for n in names:
+        if os.path.exists(os.path.join(out, n)):
+            return n
+    return names[0]
+
+
+def double_sigint_runner(pkslam, seq, out, work):
+    # The second SIGINT 10 ms after the first may end the process before or after the stop wrote
+    # trajectory.txt: one of trajectory.txt and the partial file must evaluate.
+    res, detail = signal_runner([signal.SIGINT, signal.SIGINT], (130, -signal.SIGINT),
+                                "trajectory.txt")(pkslam, seq, out, work)
+    if res == "warned":
+        return res, detail
+    partial = os.path.join(out, "trajectory.txt.partial")
+    ok, eval_out = evaluates(pkslam, seq, partial, out) if os.path.exists(partial) else (
+        False, "no partial")
+    return ("warned" if ok else "silent"), detail + f"\npartial: {'evaluates' if ok else eval_out}"
+
+
+SIGNAL_CASES = [
+    Case("sigint_realtime", "euroc", m_none, None, "signal", [], runner=signal_runner(
+        [signal.SIGINT], (130,), "trajectory.txt")),
+    Case("sigterm_realtime", "euroc", m_none, None, "signal", [], runner=signal_runner(
+        [signal.SIGTERM], (143,), "trajectory.txt")),
+    Case("double_sigint", "euroc", m_none, None, "signal", [], runner=double_sigint_runner),
+    Case("sigkill_partial", "euroc", m_none, None, "signal", [], runner=signal_runner(
+        [signal.SIGKILL], (-signal.SIGKILL,), "trajectory.txt.partial")),
+]
+
+ALL = {c.name: c for c in CASES + SIGNAL_CASES}
+
+
+# --------------------------------------------------------------------------------------------
+
+def simulate(pkslam, out, extra):
+    cmd = [pkslam, "--log-level", "warn", "simulate", "--out", out, "--quality", "fast",
+           "--quiet", "--no-cloud", "--seed", "1"] + extra
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+
+
+def make(pkslam, work):
+    os.makedirs(work, exist_ok=True)
+    simulate(pkslam, os.path.join(work, "base_euroc"), ["--motion", "difficult", "--duration", "5"])
+    simulate(pkslam, os.path.join(work, "base_tum"), ["--rgbd", "--motion", "medium",
+                                                       "--duration", "3"])
+    subprocess.run([pkslam, "run", "--dataset", os.path.join(work, "base_euroc"), "--sensor",
+                    "stereo", "--quiet", "--out", os.path.join(work, "base_run")], check=True,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def classify(case, rc, output, out):
+    if rc is None:
+        return "hung"
+    if rc < 0 or rc in (134, 139) or rc == 2 or "Sanitizer" in output or \
+            "terminate called" in output:
+        return "crashed"
+    found = all(n in output for n in case.needles)
+    stats_path = os.path.join(out, "stats.json")
+    if case.expect == "error":
+        if rc == 0:
+            return "silent"
+        if os.path.exists(stats_path) and case.name != "bench_every_run_failed":
+            return "silent"  # a failed run must not leave a success marker
+        return "clean" if found and "pkslam: error:" in output else "unnamed"
+    # warn
+    if rc != 0 or not found:
+        return "silent"
+    try:
+        with open(stats_path) as f:
+            stats = json.load(f)
+        flagged = stats.get("degraded") is True and stats["input"].get(case.stats_key, 0) > 0
+    except (OSError, ValueError, KeyError):
+        flagged = False
+    return "warned" if flagged else "silent"
+
+
+def run_case(pkslam, work, case):
+    seq = os.path.join(work, "cases", case.name, "seq")
+    out = os.path.join(work, "cases", case.name, "out")
+    copy_tree(os.path.join(work, "base_" + case.base), seq)
+    if os.path.exists(out):
+        shutil.rmtree(out)
+    os.makedirs(out)
+    case.mutate(seq)
+    if case.runner:
+        result, output = case.runner(pkslam, seq, out, work)
+        return (result or "hung"), output
+    args = case.args.format(seq=seq, out=out, work=work, suite=bad_bench(seq, work))
+
+    def limits():
+        if case.limit_file_kb:
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            n = case.limit_file_kb * 1024
+            resource.setrlimit(resource.RLIMIT_FSIZE, (n, n))
+    try:
+        r = subprocess.run([pkslam] + args.split(), capture_output=True, text=True,
+                           timeout=TIMEOUT_S, preexec_fn=limits)
+        rc, output = r.returncode, r.stdout + r.stderr
+    except subprocess.TimeoutExpired as e:
+        rc, output = None, str(e)
+    return classify(case, rc, output, out), output
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("command", choices=["make", "run", "list"])
+    p.add_argument("--pkslam")
+    p.add_argument("--work")
+    p.add_argument("--case", action="append", default=[])
+    p.add_argument("--json", help="write the classification per case here")
+    p.add_argument("--verbose", action="store_true", help="print every case's output")
+    a = p.parse_args()
+    if a.command == "list":
+        print(";".join(ALL))
+        return 0
+    if not a.pkslam or not a.work:
+        p.error("--pkslam and --work are required")
+    pkslam = os.path.abspath(a.pkslam)
+    work = os.path.abspath(a.work)
+    if a.command == "make":
+        make(pkslam, work)
+        return 0
+    names = a.case or list(ALL)
+    unknown = [n for n in names if n not in ALL]
+    if unknown:
+        p.error(f"unknown case(s): {', '.join(unknown)}")
+    results = {}
+    for name in names:
+        result, output = run_case(pkslam, work, ALL[name])
+        results[name] = result
+        last = [l for l in output.strip().splitlines() if l.strip()][-1:] or [""]
+        print(f"{name:32s} {result:8s} {last[0][:150]}")
+        if a.verbose or result not in ("clean", "warned"):
+            print("    " + output.strip().replace("\n", "\n    "))
+    totals = {k: sum(1 for v in results.values() if v == k)
+              for k in ("clean", "warned", "crashed", "hung", "silent", "unnamed")}
+    print("totals: " + ", ".join(f"{k} {v}" for k, v in totals.items()))
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump({"cases": results, "totals": totals}, f, indent=1)
+    return 0 if all(v in ("clean", "warned") for v in results.values()) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
