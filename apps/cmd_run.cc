@@ -11,17 +11,32 @@
 namespace pkslam::apps {
 namespace {
 
-// Set by SIGINT/SIGTERM; the run loop polls it and still writes its outputs, the trajectory
-// first. A second signal gets the default action (immediate exit); what is then on disk is
-// the trajectory written at the stop, or trajectory.txt.partial. Signal handlers can only
-// reach process-wide state, hence these two atomics.
+// SIGINT/SIGTERM: the first stops the run at the next frame (the loop polls `interrupted`)
+// and it writes its outputs, the trajectory first. A second one ends the process as soon as
+// trajectory.txt is complete (at most a frame and the write later: a double Ctrl-C 10 ms apart
+// left only run.log), a third at once. Signal handlers can only reach process-wide state,
+// hence these atomics.
 std::atomic<bool> interrupted{false};
 std::atomic<int> interrupt_signal{0};
+std::atomic<int> signals_received{0};
 
 void OnSignal(int signal) {
-  interrupt_signal.store(signal);
-  interrupted.store(true);
-  std::signal(signal, SIG_DFL);
+  const int n = signals_received.fetch_add(1) + 1;
+  if (n == 1) {
+    interrupt_signal.store(signal);
+    interrupted.store(true);
+  } else if (n >= 3) {
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+  }
+}
+
+// From the moment trajectory.txt is complete a signal takes its default action; one that came
+// while it was written takes it now.
+void OnTrajectoryWritten() {
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  if (signals_received.load() >= 2) std::raise(interrupt_signal.load());
 }
 
 struct RunArgs {
@@ -126,7 +141,7 @@ void RegisterRunCommand(CLI::App& app) {
     o.system.selector_parameters = ParseParams(args->params);
     std::signal(SIGINT, OnSignal);
     std::signal(SIGTERM, OnSignal);
-    const RunSummary s = RunDataset(o, &interrupted);
+    const RunSummary s = RunDataset(o, &interrupted, OnTrajectoryWritten);
     fmt::print("frames {} tracked {} lost {} keyframes {} map points {} maps {}\n", s.frames,
                s.tracked, s.lost, s.keyframes, s.map_points, s.maps);
     fmt::print(

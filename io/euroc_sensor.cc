@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <limits>
+
 #include "io/opencv_yaml.h"
 
 namespace pkslam {
@@ -21,8 +24,11 @@ EurocCameraSensor ReadEurocCameraSensor(const std::filesystem::path& sensor_yaml
   camera.body_from_camera = SE3d(yaml.RigidTransform("T_BS"));
   camera.rate_hz = PositiveDouble(yaml, "rate_hz");
   const std::vector<double> resolution = yaml.DoubleSequence("resolution", 2);
-  if (resolution[0] < 1 || resolution[1] < 1 || resolution[0] != static_cast<int>(resolution[0]) ||
-      resolution[1] != static_cast<int>(resolution[1])) {
+  // Range first: converting a double beyond int (1e10) to int is undefined behaviour.
+  const auto positive_int = [](double v) {
+    return v >= 1 && v <= std::numeric_limits<int>::max() && v == std::floor(v);
+  };
+  if (!positive_int(resolution[0]) || !positive_int(resolution[1])) {
     yaml.Fail("resolution", "expected two positive integers [width, height]");
   }
   camera.width = static_cast<int>(resolution[0]);

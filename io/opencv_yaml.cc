@@ -43,6 +43,16 @@ OpenCvYamlFile::OpenCvYamlFile(const std::filesystem::path& file) : file_(file) 
       throw InputError(file, std::stoul(match[1].str()), "malformed YAML: " + match[2].str());
     }
     throw InputError(file, "malformed YAML: " + e.err);
+  } catch (const std::exception& e) {
+    // OpenCV 4.6's parser fails with std::length_error, not its own error, on an indented
+    // empty key (" : 1"); name that line.
+    for (std::size_t i = 0; i < lines_.size(); ++i) {
+      const std::size_t start = lines_[i].find_first_not_of(" \t");
+      if (start != std::string::npos && lines_[i][start] == ':') {
+        throw InputError(file, i + 1, "malformed YAML: an empty key");
+      }
+    }
+    throw InputError(file, fmt::format("malformed YAML (OpenCV's parser failed: {})", e.what()));
   }
   if (!storage_.isOpened()) throw InputError(file, "cannot parse as OpenCV YAML");
   if (!storage_.root().isMap()) throw InputError(file, "expected a map of keys at top level");
@@ -178,7 +188,8 @@ Eigen::Matrix4d OpenCvYamlFile::RigidTransform(const std::string& key) const {
   }
   const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
   const double orthonormality = (r.transpose() * r - Eigen::Matrix3d::Identity()).norm();
-  if (orthonormality > 1e-4 || r.determinant() < 0) {
+  // Negated so that NaN fails: with entries like 1e200, R^T R is inf - inf.
+  if (!(orthonormality <= 1e-4) || !(r.determinant() > 0)) {
     Fail(key, fmt::format("not a rigid transform: the rotation block is not a rotation "
                           "(|R^T R - I| = {:.2e}, det = {:.4f})",
                           orthonormality, r.determinant()));

@@ -180,6 +180,7 @@ Settings ReadOrbSlam3Settings(const std::filesystem::path& file) {
   const int height = PositiveInt(yaml, "Camera.height");
   s.camera1 = ReadCamera(yaml, "Camera1", type, width, height);
   s.fps = Positive(yaml, "Camera.fps");
+  if (s.fps > 10000) yaml.Fail("Camera.fps", fmt::format("must be at most 10000, found {}", s.fps));
   if (const auto rgb = yaml.OptionalInt("Camera.RGB")) {
     if (*rgb != 0 && *rgb != 1) yaml.Fail("Camera.RGB", "must be 0 (BGR) or 1 (RGB)");
     s.rgb_order = *rgb == 1;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <string>
 
@@ -92,7 +93,8 @@ void WriteOrbSlam3Settings(const Settings& s, const std::filesystem::path& file)
   if (s.camera2) WriteCamera(*s.camera2, "Camera2", &w);
   w.IntKey("Camera.width", s.camera1.width());
   w.IntKey("Camera.height", s.camera1.height());
-  if (s.fps == static_cast<int>(s.fps)) {
+  // Range first: converting a double beyond int to int is undefined behaviour.
+  if (s.fps <= 1e6 && s.fps == std::floor(s.fps)) {
     w.IntKey("Camera.fps", static_cast<int>(s.fps));  // ORB-SLAM3 reads fps as an integer
   } else {
     w.RealKey("Camera.fps", s.fps);

@@ -59,7 +59,8 @@ fs::path DefaultVocabularyPath() {
   return fs::path(PKSLAM_SOURCE_DIR) / name;
 }
 
-RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interrupt) {
+RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interrupt,
+                      const std::function<void()>& trajectory_written) {
   options.Check();
   const Sensor sensor = options.system.sensor;
   if (!fs::is_directory(options.dataset)) {
@@ -356,10 +357,11 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
     report.Warn(fmt::format("{}: {} of {} depth images hold no valid depth (all zero)",
                             options.dataset.string(), report.frames_without_depth, summary.frames));
   }
-  // An interrupted run writes its trajectory before the shutdown, which waits for local
-  // mapping and loop closing (a global BA can take seconds): a second Ctrl-C then ends the
-  // process with the trajectory on disk.
-  if (summary.interrupted) WriteTrajectoryOutputs(system, options);
+  // The trajectory before the shutdown, which waits for local mapping and loop closing (a
+  // global BA can take seconds): a second Ctrl-C or a kill then ends the process with the
+  // trajectory of every frame on disk. WriteRunOutputs writes it again from the final map.
+  WriteTrajectoryOutputs(system, options);
+  if (trajectory_written) trajectory_written();
   system.Shutdown();
   summary.wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

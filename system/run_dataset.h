@@ -18,6 +18,7 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 
 #include "io/euroc_dataset.h"
@@ -71,8 +72,12 @@ struct RunSummary {
 // The vocabulary shipped with pkslam (Vocabulary/ in the source tree or next to the binary).
 std::filesystem::path DefaultVocabularyPath();
 
-// Throws InputError / OptionError on bad input. `interrupt` (may be null) stops the run
-// early; outputs are still written for the frames processed so far.
-RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interrupt = nullptr);
+// Throws InputError / OptionError on bad input, OutputError when an output cannot be written.
+// `interrupt` (may be null) stops the run early; outputs are still written for the frames
+// processed so far. `trajectory_written` (may be empty) is called once trajectory.txt holds
+// every frame processed, before the shutdown of local mapping and loop closing and the other
+// outputs (apps/cmd_run.cc lets a second Ctrl-C end the process from then on).
+RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interrupt = nullptr,
+                      const std::function<void()>& trajectory_written = {});
 
 }  // namespace pkslam
