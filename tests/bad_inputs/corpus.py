@@ -7,11 +7,11 @@ sequences, each run through pkslam and classified.
   corpus.py list                              case names (CTest registers one test per case)
 
 Classes: clean (exit != 0, one "pkslam: error:" line naming the bad input, no stats.json),
-warned (exit 0, the expected warning, a stats.json flag; signal cases: clean when what is left
-evaluates), crashed (killed by a signal, abort,
+warned (exit 0, the expected warning, a stats.json flag), crashed (killed by a signal, abort,
 sanitizer report, or exit 2 = internal error), hung (timeout), silent (exit 0 without the
 warning, or an error run that left a stats.json), unnamed (exit != 0 without naming the
-input). `run` exits 1 unless every case is clean or warned.
+input). Signal cases are clean when the trajectory left behind evaluates against the ground
+truth. `run` exits 1 unless every case is clean or warned.
 """
 import argparse
 import json
