@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/bow/vocabulary.h"
+#include "core/bow/vocabulary_internal.h"
 #include "core/util/error.h"
 #include "fuzz/fuzz_support.h"
 
@@ -24,47 +25,28 @@ namespace {
 
 using namespace pkslam;
 
-constexpr char kMagic[] = "PKVOCAB\n";
-constexpr std::size_t kHeaderSize = 36;
-constexpr std::size_t kRecordSize = 45;
-constexpr std::size_t kChecksumSize = 8;
-
-std::uint64_t GetLE64(const unsigned char* p) {
-  std::uint64_t v = 0;
-  for (int i = 0; i < 8; ++i) v |= std::uint64_t{p[i]} << (8 * i);
-  return v;
-}
+using bow_internal::kBinaryChecksumSize;
+using bow_internal::kBinaryHeaderSize;
+using bow_internal::kBinaryMagic;
+using bow_internal::kBinaryNodeCountAt;
+using bow_internal::kBinaryRecordSize;
 
 void PutLE64(unsigned char* p, std::uint64_t v) {
   for (int i = 0; i < 8; ++i) p[i] = static_cast<unsigned char>(v >> (8 * i));
 }
 
-// The binary format's checksum (a copy of core/bow/vocabulary_binary_io.cc: Checksum).
-std::uint64_t Checksum(const unsigned char* data, std::size_t size) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  constexpr std::uint64_t kPrime = 0x100000001b3ULL;
-  std::size_t i = 0;
-  for (; i + 8 <= size; i += 8) {
-    h ^= GetLE64(data + i);
-    h *= kPrime;
-    h ^= h >> 29;
-  }
-  for (; i < size; ++i) {
-    h ^= data[i];
-    h *= kPrime;
-  }
-  return h;
-}
-
 // A binary input with a consistent node count, length and checksum; empty if not binary.
 std::vector<unsigned char> Repaired(const std::uint8_t* data, std::size_t size) {
-  if (size < kHeaderSize || std::memcmp(data, kMagic, 8) != 0) return {};
-  const std::size_t count = (size - kHeaderSize) / kRecordSize;
-  const std::size_t body = kHeaderSize + count * kRecordSize;
+  if (size < kBinaryHeaderSize ||
+      std::memcmp(data, kBinaryMagic.data(), kBinaryMagic.size()) != 0) {
+    return {};
+  }
+  const std::size_t count = (size - kBinaryHeaderSize) / kBinaryRecordSize;
+  const std::size_t body = kBinaryHeaderSize + count * kBinaryRecordSize;
   std::vector<unsigned char> out(data, data + body);
-  PutLE64(out.data() + 28, count);
-  out.resize(body + kChecksumSize);
-  PutLE64(out.data() + body, Checksum(out.data(), body));
+  PutLE64(out.data() + kBinaryNodeCountAt, count);
+  out.resize(body + kBinaryChecksumSize);
+  PutLE64(out.data() + body, bow_internal::BinaryChecksum(out.data(), body));
   return out;
 }
 

@@ -20,15 +20,21 @@
 #include "core/bow/vocabulary.h"
 #include "core/bow/vocabulary_internal.h"
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 
 namespace pkslam {
 namespace {
 
-constexpr std::array<char, 8> kMagic = {'P', 'K', 'V', 'O', 'C', 'A', 'B', '\n'};
+using bow_internal::kBinaryChecksumSize;
+using bow_internal::kBinaryHeaderSize;
+using bow_internal::kBinaryMagic;
+using bow_internal::kBinaryNodeCountAt;
+using bow_internal::kBinaryRecordSize;
 constexpr std::uint32_t kVersion = 1;
-constexpr std::size_t kHeaderSize = 36;
-constexpr std::size_t kRecordSize = 45;
-constexpr std::size_t kChecksumSize = 8;
+constexpr std::size_t kHeaderSize = kBinaryHeaderSize;
+constexpr std::size_t kRecordSize = kBinaryRecordSize;
+constexpr std::size_t kChecksumSize = kBinaryChecksumSize;
+constexpr const auto& kMagic = kBinaryMagic;
 
 template <typename T>
 void PutLE(std::string* out, T value) {
@@ -46,22 +52,6 @@ T GetLE(const unsigned char* p) {
   U u = 0;
   for (std::size_t i = 0; i < sizeof(T); ++i) u = static_cast<U>(u | (U(p[i]) << (8 * i)));
   return static_cast<T>(u);
-}
-
-std::uint64_t Checksum(const unsigned char* data, std::size_t size) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  constexpr std::uint64_t kPrime = 0x100000001b3ULL;
-  std::size_t i = 0;
-  for (; i + 8 <= size; i += 8) {
-    h ^= GetLE<std::uint64_t>(data + i);
-    h *= kPrime;
-    h ^= h >> 29;
-  }
-  for (; i < size; ++i) {
-    h ^= data[i];
-    h *= kPrime;
-  }
-  return h;
 }
 
 std::vector<unsigned char> ReadBytes(const std::filesystem::path& file) {
@@ -83,6 +73,22 @@ InputError AtOffset(const std::filesystem::path& file, std::size_t offset,
 }
 
 }  // namespace
+
+std::uint64_t bow_internal::BinaryChecksum(const unsigned char* data, std::size_t size) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  constexpr std::uint64_t kPrime = 0x100000001b3ULL;
+  std::size_t i = 0;
+  for (; i + 8 <= size; i += 8) {
+    h ^= GetLE<std::uint64_t>(data + i);
+    h *= kPrime;
+    h ^= h >> 29;
+  }
+  for (; i < size; ++i) {
+    h ^= data[i];
+    h *= kPrime;
+  }
+  return h;
+}
 
 bool IsBinaryVocabularyFile(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -111,7 +117,7 @@ Vocabulary Vocabulary::LoadBinary(const std::filesystem::path& file) {
   params.scoring = static_cast<Scoring>(GetLE<std::uint32_t>(p + 20));
   params.weighting = static_cast<Weighting>(GetLE<std::uint32_t>(p + 24));
   if (auto problem = bow_internal::ParamsProblem(params)) throw AtOffset(file, 12, *problem);
-  const auto count = GetLE<std::uint64_t>(p + 28);
+  const auto count = GetLE<std::uint64_t>(p + kBinaryNodeCountAt);
   const std::size_t room = (data.size() - kHeaderSize) / kRecordSize;
   if (count > room || data.size() < kHeaderSize + count * kRecordSize + kChecksumSize) {
     throw AtOffset(
@@ -125,7 +131,7 @@ Vocabulary Vocabulary::LoadBinary(const std::filesystem::path& file) {
                    fmt::format("{} trailing bytes after the checksum",
                                data.size() - checksum_at - kChecksumSize));
   }
-  if (GetLE<std::uint64_t>(p + checksum_at) != Checksum(p, checksum_at)) {
+  if (GetLE<std::uint64_t>(p + checksum_at) != bow_internal::BinaryChecksum(p, checksum_at)) {
     throw AtOffset(file, checksum_at, "checksum mismatch: the file is corrupt");
   }
 
@@ -165,13 +171,9 @@ void Vocabulary::SaveBinary(const std::filesystem::path& file) const {
     out.append(reinterpret_cast<const char*>(descriptors_[i].bytes.data()), 32);
     PutLE<std::uint64_t>(&out, std::bit_cast<std::uint64_t>(weights_[i]));
   }
-  PutLE<std::uint64_t>(&out,
-                       Checksum(reinterpret_cast<const unsigned char*>(out.data()), out.size()));
-  std::ofstream f(file, std::ios::binary | std::ios::trunc);
-  if (!f) throw InputError(file, "cannot open for writing");
-  f.write(out.data(), static_cast<std::streamsize>(out.size()));
-  f.close();
-  if (!f) throw InputError(file, "write failed");
+  PutLE<std::uint64_t>(&out, bow_internal::BinaryChecksum(
+                                 reinterpret_cast<const unsigned char*>(out.data()), out.size()));
+  WriteFileAtomically(file, out);
 }
 
 Vocabulary Vocabulary::Load(const std::filesystem::path& file) {

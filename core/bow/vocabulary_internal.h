@@ -1,6 +1,9 @@
 // Helpers shared by the vocabulary's construction, file formats and training (not public API).
 #pragma once
 
+#include <array>
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +30,16 @@ inline bool CpuHasPopcnt() {
   return false;
 #endif
 }
+
+// pkslam's binary format (vocabulary_binary_io.cc): magic and header, one record per node
+// after the root, then a checksum of every byte before it (little-endian u64). Shared with
+// the vocabulary fuzzer (fuzz/), which repairs inputs to reach the checks behind it.
+inline constexpr std::array<char, 8> kBinaryMagic = {'P', 'K', 'V', 'O', 'C', 'A', 'B', '\n'};
+inline constexpr std::size_t kBinaryHeaderSize = 36;
+inline constexpr std::size_t kBinaryNodeCountAt = 28;  // u64 in the header
+inline constexpr std::size_t kBinaryRecordSize = 45;
+inline constexpr std::size_t kBinaryChecksumSize = 8;
+std::uint64_t BinaryChecksum(const unsigned char* data, std::size_t size);
 
 // Limits we accept in files and options.
 inline constexpr int kMaxBranching = 255;

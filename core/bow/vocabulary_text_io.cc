@@ -18,6 +18,7 @@
 #include "core/bow/vocabulary.h"
 #include "core/bow/vocabulary_internal.h"
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 
 namespace pkslam {
 namespace {
@@ -194,11 +195,7 @@ void Vocabulary::SaveText(const std::filesystem::path& file) const {
     out += bow_internal::FormatWeight(n.weight);
     out += '\n';
   }
-  std::ofstream f(file, std::ios::binary | std::ios::trunc);
-  if (!f) throw InputError(file, "cannot open for writing");
-  f.write(out.data(), static_cast<std::streamsize>(out.size()));
-  f.close();
-  if (!f) throw InputError(file, "write failed");
+  WriteFileAtomically(file, out);
 }
 
 }  // namespace pkslam
