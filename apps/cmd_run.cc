@@ -139,9 +139,16 @@ void RegisterRunCommand(CLI::App& app) {
     if (!args->vocabulary.empty()) o.vocabulary = args->vocabulary;
     o.out = args->out;
     o.system.selector_parameters = ParseParams(args->params);
-    std::signal(SIGINT, OnSignal);
-    std::signal(SIGTERM, OnSignal);
-    const RunSummary s = RunDataset(o, &interrupted, OnTrajectoryWritten);
+    RunControl control;
+    control.interrupt = &interrupted;
+    // Until the first frame a signal takes its default action: reading a dataset polls no flag
+    // (and OpenCV's parser has been seen to loop on a bad file).
+    control.frames_starting = [] {
+      std::signal(SIGINT, OnSignal);
+      std::signal(SIGTERM, OnSignal);
+    };
+    control.trajectory_written = OnTrajectoryWritten;
+    const RunSummary s = RunDataset(o, control);
     fmt::print("frames {} tracked {} lost {} keyframes {} map points {} maps {}\n", s.frames,
                s.tracked, s.lost, s.keyframes, s.map_points, s.maps);
     fmt::print(

@@ -11,6 +11,12 @@ endif()
 if(PKSLAM_SANITIZE STREQUAL "address")
   target_compile_options(pkslam_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -g)
   target_link_options(pkslam_options INTERFACE -fsanitize=address,undefined)
+  # GCC 12's flow analysis under ASan instrumentation reports std::function inside std::regex
+  # (io/opencv_yaml.cc) as maybe uninitialised; a false positive that -Werror would turn into
+  # a failed sanitizer build. The optimised build keeps the warning.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(pkslam_options INTERFACE -Wno-maybe-uninitialized)
+  endif()
 elseif(PKSLAM_SANITIZE STREQUAL "thread")
   target_compile_options(pkslam_options INTERFACE -fsanitize=thread -g)
   target_link_options(pkslam_options INTERFACE -fsanitize=thread)

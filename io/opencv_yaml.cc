@@ -25,8 +25,13 @@ OpenCvYamlFile::OpenCvYamlFile(const std::filesystem::path& file) : file_(file) 
     }
   }
   bool blank = true;
-  for (const std::string& line : lines_) {
-    if (line.find_first_not_of(" \t") != std::string::npos) blank = false;
+  for (std::size_t i = 0; i < lines_.size(); ++i) {
+    if (lines_[i].find_first_not_of(" \t") != std::string::npos) blank = false;
+    // OpenCV 4.6's YAML parser loops forever on some inputs with a NUL byte (found by
+    // fuzz/settings_fuzzer.cc); a text settings file has none.
+    if (lines_[i].find('\0') != std::string::npos) {
+      throw InputError(file, i + 1, "NUL byte: not a text file");
+    }
   }
   if (blank) throw InputError(file, "empty file");
   if (lines_.front().rfind("%YAML", 0) != 0) {

@@ -59,8 +59,8 @@ fs::path DefaultVocabularyPath() {
   return fs::path(PKSLAM_SOURCE_DIR) / name;
 }
 
-RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interrupt,
-                      const std::function<void()>& trajectory_written) {
+RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
+  const std::atomic<bool>* interrupt = control.interrupt;
   options.Check();
   const Sensor sensor = options.system.sensor;
   if (!fs::is_directory(options.dataset)) {
@@ -303,6 +303,7 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   AppendFile partial(options.out / kPartialTrajectory);
   partial.Append(kTumHeader);
   bool partial_warned = false;
+  if (control.frames_starting) control.frames_starting();
   for (const FrameSource& s : sources) {
     if (options.realtime && summary.frames > 0 &&
         (s.t_ns - previous_t_ns > kMaxFrameGapNs || s.t_ns <= previous_t_ns)) {
@@ -361,7 +362,7 @@ RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interr
   // global BA can take seconds): a second Ctrl-C or a kill then ends the process with the
   // trajectory of every frame on disk. WriteRunOutputs writes it again from the final map.
   WriteTrajectoryOutputs(system, options);
-  if (trajectory_written) trajectory_written();
+  if (control.trajectory_written) control.trajectory_written();
   system.Shutdown();
   summary.wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

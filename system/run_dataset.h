@@ -72,12 +72,22 @@ struct RunSummary {
 // The vocabulary shipped with pkslam (Vocabulary/ in the source tree or next to the binary).
 std::filesystem::path DefaultVocabularyPath();
 
+// How a caller stops and follows a run (every member optional).
+struct RunControl {
+  // Polled between frames (set by a signal handler or another thread): the run stops and
+  // still writes its outputs for the frames processed.
+  const std::atomic<bool>* interrupt = nullptr;
+  // Called once, just before the first frame, when the input has been read and checked: from
+  // then on `interrupt` is polled (before, reading a dataset may take a while and a caller
+  // should let a signal end the process).
+  std::function<void()> frames_starting;
+  // Called once trajectory.txt holds every frame processed, before the shutdown of local
+  // mapping and loop closing and the other outputs (apps/cmd_run.cc lets a second Ctrl-C end
+  // the process from then on).
+  std::function<void()> trajectory_written;
+};
+
 // Throws InputError / OptionError on bad input, OutputError when an output cannot be written.
-// `interrupt` (may be null) stops the run early; outputs are still written for the frames
-// processed so far. `trajectory_written` (may be empty) is called once trajectory.txt holds
-// every frame processed, before the shutdown of local mapping and loop closing and the other
-// outputs (apps/cmd_run.cc lets a second Ctrl-C end the process from then on).
-RunSummary RunDataset(const RunOptions& options, const std::atomic<bool>* interrupt = nullptr,
-                      const std::function<void()>& trajectory_written = {});
+RunSummary RunDataset(const RunOptions& options, const RunControl& control = {});
 
 }  // namespace pkslam
