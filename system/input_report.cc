@@ -92,4 +92,55 @@ void CheckImuUnits(const std::vector<ImuSample>& samples, const std::filesystem:
   }
 }
 
+std::vector<TimestampJump> ReportTimestampJumps(const std::vector<std::int64_t>& frame_t_ns,
+                                                const std::string& source, InputReport* report) {
+  std::vector<TimestampJump> jumps = FindTimestampJumps(frame_t_ns);
+  report->timestamp_jumps = static_cast<int>(jumps.size());
+  if (jumps.empty()) return jumps;
+  constexpr std::size_t kListed = 5;
+  std::string list;
+  for (std::size_t i = 0; i < std::min(jumps.size(), kListed); ++i) {
+    const TimestampJump& j = jumps[i];
+    list += fmt::format("{}{:.3f} s after frame {} (t = {} ns)", i ? ", " : "",
+                        1e-9 * static_cast<double>(j.dt_ns), j.frame - 1, frame_t_ns[j.frame - 1]);
+  }
+  report->Warn(fmt::format("{}: {} timestamp jump(s) beyond {} frame periods: {}{}", source,
+                           jumps.size(), kJumpPeriods, list,
+                           jumps.size() > kListed ? ", ..." : ""));
+  return jumps;
+}
+
+void CheckImuForFrames(const std::vector<ImuSample>& imu, std::size_t imu_gaps,
+                       const std::filesystem::path& imu_file,
+                       const std::vector<std::int64_t>& frame_t_ns, std::int64_t lookahead_ns,
+                       bool allow_gaps, InputReport* report) {
+  if (imu.size() < 2) {
+    throw InputError(imu_file,
+                     "a single IMU sample: an inertial run needs IMU data over its frames");
+  }
+  CheckImuUnits(imu, imu_file);
+  report->imu_gaps = static_cast<int>(imu_gaps);
+  std::vector<std::int64_t> imu_t_ns;
+  imu_t_ns.reserve(imu.size());
+  for (const ImuSample& s : imu) imu_t_ns.push_back(s.t_ns);
+  // An "inertial" run over frames the IMU does not cover is silently visual-only there.
+  const std::vector<std::size_t> uncovered = FramesWithoutImu(frame_t_ns, imu_t_ns, lookahead_ns);
+  report->frames_without_imu = static_cast<int>(uncovered.size());
+  if (uncovered.empty()) return;
+  const std::int64_t t0 = frame_t_ns.front();
+  const std::string what = fmt::format(
+      "{} of {} frames have no IMU sample since the previous frame (frames {}; the IMU covers "
+      "{:.3f}..{:.3f} s of frames spanning 0..{:.3f} s)",
+      uncovered.size(), frame_t_ns.size(), FormatIndexRanges(uncovered),
+      1e-9 * static_cast<double>(imu.front().t_ns - t0),
+      1e-9 * static_cast<double>(imu.back().t_ns - t0),
+      1e-9 * static_cast<double>(frame_t_ns.back() - t0));
+  if (!allow_gaps) {
+    throw InputError(imu_file, what +
+                                   ": an inertial run would track them without IMU; "
+                                   "--allow-imu-gaps runs anyway");
+  }
+  report->Warn(fmt::format("{}: {}: tracked without IMU", imu_file.string(), what));
+}
+
 }  // namespace pkslam

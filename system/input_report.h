@@ -46,6 +46,18 @@ std::vector<std::size_t> FramesWithoutImu(const std::vector<std::int64_t>& frame
 // "frames 3-7, 12, 40-41" for a sorted index list, at most `max_ranges` ranges then "...".
 std::string FormatIndexRanges(const std::vector<std::size_t>& indices, std::size_t max_ranges = 5);
 
+// FindTimestampJumps, reported to `report` in one warning naming `source`; returns the jumps.
+std::vector<TimestampJump> ReportTimestampJumps(const std::vector<std::int64_t>& frame_t_ns,
+                                                const std::string& source, InputReport* report);
+
+// The IMU checks of an inertial run over frames `frame_t_ns`: at least two samples, units
+// (CheckImuUnits), and every frame covered (FramesWithoutImu): throws InputError naming
+// `imu_file`, or with `allow_gaps` records the uncovered frames as a warning.
+void CheckImuForFrames(const std::vector<ImuSample>& imu, std::size_t imu_gaps,
+                       const std::filesystem::path& imu_file,
+                       const std::vector<std::int64_t>& frame_t_ns, std::int64_t lookahead_ns,
+                       bool allow_gaps, InputReport* report);
+
 // Throws InputError naming `file` when the samples look like another unit than rad/s and
 // m/s^2: the median |accel| of a body in gravity is near 9.81 m/s^2 (near 1 when in g); a
 // 90th percentile of |gyro| above 5 rad/s (290 deg/s) is a spin no MAV or hand-held

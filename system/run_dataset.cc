@@ -155,20 +155,8 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   for (const FrameSource& s : sources) frame_t_ns.push_back(s.t_ns);
   // Jumps of more than a few frame periods: a recording pause, a dropped stretch, a broken
   // stamp. Listed, and --realtime restarts its pacing after those over kMaxFrameGapNs.
-  const std::vector<TimestampJump> jumps = FindTimestampJumps(frame_t_ns);
-  report.timestamp_jumps = static_cast<int>(jumps.size());
-  if (!jumps.empty()) {
-    std::string list;
-    for (std::size_t i = 0; i < std::min<std::size_t>(jumps.size(), 5); ++i) {
-      const TimestampJump& j = jumps[i];
-      list +=
-          fmt::format("{}{:.3f} s after frame {} (t = {} ns)", i ? ", " : "",
-                      1e-9 * static_cast<double>(j.dt_ns), j.frame - 1, frame_t_ns[j.frame - 1]);
-    }
-    report.Warn(fmt::format("{}: {} timestamp jump(s) beyond {} frame periods: {}{}",
-                            options.dataset.string(), jumps.size(), kJumpPeriods, list,
-                            jumps.size() > 5 ? ", ..." : ""));
-  }
+  const std::vector<TimestampJump> jumps =
+      ReportTimestampJumps(frame_t_ns, options.dataset.string(), &report);
 
   const fs::path vocabulary_path = options.vocabulary.value_or(DefaultVocabularyPath());
   if (!fs::exists(vocabulary_path)) {
@@ -211,7 +199,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   // Inertial sensors: IMU samples are fed up to a little past each frame (the preintegration
   // needs one at or after the frame's time).
   constexpr std::int64_t kImuLookaheadNs = 20'000'000;
-  // Frames further apart than this (or not increasing) are reported as a timestamp jump.
+  // --realtime restarts its pacing after frame intervals longer than this (or not increasing).
   constexpr std::int64_t kMaxFrameGapNs = 1'000'000'000;
   std::int64_t imu_fed_ns = t0 - kImuLookaheadNs;
   if (IsInertial(sensor) && (!euroc || !euroc->has_imu() || euroc->imu().empty())) {
@@ -219,37 +207,8 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
                      fmt::format("sensor {} needs IMU data (mav0/imu0)", SensorName(sensor)));
   }
   if (IsInertial(sensor)) {
-    // An "inertial" run over frames the IMU does not cover is silently visual-only there.
-    const auto& imu = euroc->imu();
-    const fs::path imu_csv = euroc->mav0() / "imu0/data.csv";
-    if (imu.size() < 2) {
-      throw InputError(imu_csv,
-                       "a single IMU sample: an inertial run needs IMU data over its "
-                       "frames");
-    }
-    CheckImuUnits(imu, imu_csv);
-    report.imu_gaps = static_cast<int>(euroc->imu_gaps().size());
-    std::vector<std::int64_t> imu_t_ns;
-    imu_t_ns.reserve(imu.size());
-    for (const ImuSample& s : imu) imu_t_ns.push_back(s.t_ns);
-    const std::vector<std::size_t> uncovered =
-        FramesWithoutImu(frame_t_ns, imu_t_ns, kImuLookaheadNs);
-    report.frames_without_imu = static_cast<int>(uncovered.size());
-    if (!uncovered.empty()) {
-      const std::string what = fmt::format(
-          "{} of {} frames have no IMU sample since the previous frame (frames {}; the IMU "
-          "covers {:.3f}..{:.3f} s of frames spanning 0..{:.3f} s)",
-          uncovered.size(), sources.size(), FormatIndexRanges(uncovered),
-          1e-9 * static_cast<double>(imu.front().t_ns - t0),
-          1e-9 * static_cast<double>(imu.back().t_ns - t0),
-          1e-9 * static_cast<double>(sources.back().t_ns - t0));
-      if (!options.allow_imu_gaps) {
-        throw InputError(imu_csv, what +
-                                      ": an inertial run would track them without IMU; "
-                                      "--allow-imu-gaps runs anyway");
-      }
-      report.Warn(fmt::format("{}: {}: tracked without IMU", imu_csv.string(), what));
-    }
+    CheckImuForFrames(euroc->imu(), euroc->imu_gaps().size(), euroc->mav0() / "imu0/data.csv",
+                      frame_t_ns, kImuLookaheadNs, options.allow_imu_gaps, &report);
   }
   // Images are decoded in a thread of their own, a couple of frames ahead of tracking; a pair's
   // second image (right / depth) concurrently with its first: decoding a 640x480 colour PNG
