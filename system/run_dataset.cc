@@ -301,6 +301,9 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
     }
     ++summary.frames;
     if (r.state == TrackingState::kOk) ++summary.tracked;
+    if (r.new_keyframe) {
+      ++summary.keyframe_reasons[r.keyframe_reason.empty() ? "unnamed" : r.keyframe_reason];
+    }
     if (r.camera_from_world) {
       partial.Append(FormatTumLine({s.t_ns, r.camera_from_world->Inverse()}));
       if (!partial.ok() && !partial_warned) {

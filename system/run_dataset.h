@@ -19,7 +19,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
+#include <string>
 
 #include "io/euroc_dataset.h"
 #include "system/input_report.h"
@@ -65,6 +67,8 @@ struct RunSummary {
   double median_tracking_ms = 0;
   bool interrupted = false;
   std::string dataset_fingerprint;  // io/dataset_fingerprint.h
+  // Keyframes created, per reason: the selector rule that fired, or "initialisation".
+  std::map<std::string, int> keyframe_reasons;
   // What was wrong with the input without stopping the run (degraded() when anything was).
   InputReport input;
 };

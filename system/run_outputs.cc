@@ -237,6 +237,11 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
               static_cast<int>(std::count_if(records.begin(), records.end(),
                                              [](const FrameRecord& r) { return r.keyframe; })));
   json.Member("keyframes_culled", mapping.keyframes_culled);
+  // Which rule of the selector created how many keyframes ("initialisation": a map's first
+  // keyframe(s), not a selector decision).
+  json.Key("keyframe_reasons").BeginObject();
+  for (const auto& [reason, count] : summary->keyframe_reasons) json.Member(reason, count);
+  json.EndObject();
   json.Member("map_points", summary->map_points);
   json.Member("maps", summary->maps);
   json.Key("tracking_states").BeginObject();

@@ -121,6 +121,9 @@ TEST(RunCli, ImuCoverageIsChecked) {
   const std::string stats = testing::ReadFileBytes(dir / "out/stats.json");
   EXPECT_THAT(stats, HasSubstr("\"degraded\": true"));
   EXPECT_THAT(stats, HasSubstr("\"frames_without_imu\": 40"));
+  // Keyframes per creating rule: the map's first is the initialisation's.
+  EXPECT_THAT(stats, HasSubstr("\"keyframe_reasons\": {"));
+  EXPECT_THAT(stats, HasSubstr("\"initialisation\": 1"));
   // A finished run keeps no crash copy of its trajectory.
   EXPECT_FALSE(std::filesystem::exists(dir / "out/trajectory.txt.partial"));
   EXPECT_EQ(RunPkslam(run + " --allow-imu-gaps --strict").exit_code, 3);

@@ -127,6 +127,7 @@ TrackResult Tracker::Track(Frame frame) {
       StereoInitialization();
     }
     new_keyframe = state_ == TrackingState::kOk;
+    if (new_keyframe) result.keyframe_reason = "initialisation";
   } else {
     bool ok = false;
     SelectorInput selector_input;
