@@ -40,31 +40,29 @@ class Fnv1a64 {
 
 }  // namespace
 
+std::string DatasetFingerprint(const ImageStream& frames) {
+  Fnv1a64 hash;
+  hash.AddFile(frames.list_file);
+  const auto& images = frames.images;
+  if (!images.empty()) {
+    for (const std::size_t i : {std::size_t{0}, images.size() / 2, images.size() - 1}) {
+      hash.AddFile(images[i].path);
+    }
+  }
+  return fmt::format("{:016x}", hash.value());
+}
+
 std::string DatasetFingerprint(const fs::path& dataset) {
-  fs::path list;
-  std::vector<fs::path> images;
   if (EurocDataset::LooksLikeEuroc(dataset)) {
     EurocOptions options;
     options.read_imu = false;
     options.read_ground_truth = false;
-    const EurocDataset euroc = EurocDataset::Open(dataset, options);
-    list = euroc.cam0().list_file;
-    for (const ImageEntry& e : euroc.cam0().images) images.push_back(e.path);
-  } else if (TumRgbdDataset::LooksLikeTumRgbd(dataset)) {
-    const TumRgbdDataset tum = TumRgbdDataset::Open(dataset);
-    list = tum.rgb().list_file;
-    for (const ImageEntry& e : tum.rgb().images) images.push_back(e.path);
-  } else {
-    throw InputError(dataset, "not a EuRoC or TUM RGB-D dataset");
+    return DatasetFingerprint(EurocDataset::Open(dataset, options).cam0());
   }
-  Fnv1a64 hash;
-  hash.AddFile(list);
-  if (!images.empty()) {
-    for (const std::size_t i : {std::size_t{0}, images.size() / 2, images.size() - 1}) {
-      hash.AddFile(images[i]);
-    }
+  if (TumRgbdDataset::LooksLikeTumRgbd(dataset)) {
+    return DatasetFingerprint(TumRgbdDataset::Open(dataset).rgb());
   }
-  return fmt::format("{:016x}", hash.value());
+  throw InputError(dataset, "not a EuRoC or TUM RGB-D dataset");
 }
 
 void RequireRunOfDataset(const fs::path& run_dir, const fs::path& dataset) {

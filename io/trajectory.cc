@@ -165,10 +165,6 @@ TrajectoryFormat DetectFormat(const std::vector<TextLine>& lines,
   throw InputError(file, "empty trajectory file (no pose lines)");
 }
 
-void WriteFileOrThrow(const std::filesystem::path& file, const std::string& text) {
-  WriteFileAtomically(file, text);
-}
-
 // Seconds with exactly 9 decimals from integer nanoseconds (exact; handles negative times).
 std::string FormatSeconds(std::int64_t t_ns) {
   const bool negative = t_ns < 0;
@@ -318,7 +314,7 @@ std::string FormatTumLine(const StampedPose& p) {
 void WriteTrajectoryTum(const Trajectory& trajectory, const std::filesystem::path& file) {
   std::string text = kTumHeader;
   for (const StampedPose& p : trajectory.poses) text += FormatTumLine(p);
-  WriteFileOrThrow(file, text);
+  WriteFileAtomically(file, text);
 }
 
 void WriteTrajectoryEuroc(const Trajectory& trajectory, const std::filesystem::path& file) {
@@ -347,7 +343,7 @@ void WriteTrajectoryEuroc(const Trajectory& trajectory, const std::filesystem::p
     }
     text += '\n';
   }
-  WriteFileOrThrow(file, text);
+  WriteFileAtomically(file, text);
 }
 
 void WriteTrajectory(const Trajectory& trajectory, const std::filesystem::path& file,
@@ -365,7 +361,7 @@ void WriteTrajectory(const Trajectory& trajectory, const std::filesystem::path& 
         text += fmt::format("{} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n", p.t_ns, t.x(),
                             t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
       }
-      return WriteFileOrThrow(file, text);
+      return WriteFileAtomically(file, text);
     }
     case TrajectoryFormat::kAuto:
       break;

@@ -31,8 +31,6 @@ void WriteStageTimes(JsonWriter& json, const StageTimesMs& t) {
   json.EndObject();
 }
 
-void WriteFile(const fs::path& file, const std::string& text) { WriteFileAtomically(file, text); }
-
 }  // namespace
 
 void OdometryRunOptions::Check() const {
@@ -135,7 +133,7 @@ OdometryRunResult RunRgbdOdometry(const OdometryRunOptions& options) {
   result.map_points = map.size();
 
   WriteTrajectoryTum(trajectory, options.out / "trajectory.txt");
-  WriteFile(options.out / "frames.csv", frames_csv);
+  WriteFileAtomically(options.out / "frames.csv", frames_csv);
   if (options.write_map) map.WritePly(options.out / "map.ply");
   if (sequence.ground_truth && trajectory.size() >= 3) {
     EvaluationOptions eval;
@@ -188,7 +186,7 @@ OdometryRunResult RunRgbdOdometry(const OdometryRunOptions& options) {
     json.Null();
   }
   json.EndObject();
-  WriteFile(options.out / "stats.json", json.str());
+  WriteFileAtomically(options.out / "stats.json", json.str());
   return result;
 }
 

@@ -27,8 +27,6 @@ using Clock = std::chrono::steady_clock;
 
 double MsSince(double start_cpu_ms) { return ProcessCpuMs() - start_cpu_ms; }
 
-void WriteFile(const fs::path& file, const std::string& text) { WriteFileAtomically(file, text); }
-
 cv::Mat GateDepth(const cv::Mat& depth_m, double min_m, double max_m) {
   if (min_m <= 0 && max_m <= 0) return depth_m;
   cv::Mat gated = depth_m.clone();
@@ -351,7 +349,7 @@ void WriteStats(const PlanarRunOptions& options, const RgbdSequence& sequence,
   json.EndArray();
   json.Member("wall_s", result.wall_s);
   json.EndObject();
-  WriteFile(options.out / "stats.json", json.str());
+  WriteFileAtomically(options.out / "stats.json", json.str());
 }
 
 }  // namespace
@@ -375,7 +373,7 @@ PlanarRunResult RunPlanar(const PlanarRunOptions& options) {
         RunGap(sequence, lifter, options, options.gaps[i], i == 0, &progress, &pairs_csv));
   }
   progress.Finish();
-  WriteFile(options.out / "pairs.csv", pairs_csv);
+  WriteFileAtomically(options.out / "pairs.csv", pairs_csv);
   result.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
   WriteStats(options, sequence, result);
   return result;

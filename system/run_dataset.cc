@@ -146,7 +146,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
                      "not a EuRoC (mav0/cam0/data.csv) or TUM RGB-D (rgb.txt, depth.txt) dataset");
   }
   if (sources.empty()) throw InputError(options.dataset, "no frames to process");
-  summary.dataset_fingerprint = DatasetFingerprint(options.dataset);
+  summary.dataset_fingerprint = DatasetFingerprint(euroc ? euroc->cam0() : tum->rgb());
   if (options.max_frames > 0 && static_cast<int>(sources.size()) > options.max_frames) {
     sources.resize(options.max_frames);
   }
@@ -215,8 +215,9 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   // takes about 8 ms and its depth PNG 3 ms, so one loader thread in series capped 30 Hz RGB-D
   // at 2.8x real time.
   struct LoadedImages {
-    cv::Mat a;  // left / rgb
-    cv::Mat b;  // right / depth (empty for monocular)
+    cv::Mat a;              // left / rgb
+    cv::Mat b;              // right / depth (empty for monocular)
+    bool no_depth = false;  // RGB-D: not one valid depth pixel (counted off the tracking thread)
   };
   Prefetcher<LoadedImages> images(
       sources.size(),
@@ -231,6 +232,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
         LoadedImages loaded;
         loaded.a = euroc ? euroc->LoadCam0(s.a) : tum->LoadRgbGrey(s.a);
         if (second.valid()) loaded.b = second.get();
+        loaded.no_depth = tum && IsRgbd(sensor) && cv::countNonZero(loaded.b) == 0;
         // Images of another size than the calibration's were tracked with wrong intrinsics
         // (monocular) or failed deep in the rectification (stereo, RGB-D), naming no image.
         const auto require_size = [&](const cv::Mat& image, const CameraModel& camera,
@@ -291,7 +293,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
       imu_fed_ns = s.t_ns + kImuLookaheadNs;
     }
     const LoadedImages loaded = *images.Next();
-    if (IsRgbd(sensor) && cv::countNonZero(loaded.b) == 0) ++report.frames_without_depth;
+    if (loaded.no_depth) ++report.frames_without_depth;
     if (IsStereo(sensor)) {
       r = system.TrackStereo(loaded.a, loaded.b, s.t_ns);
     } else if (IsRgbd(sensor)) {
