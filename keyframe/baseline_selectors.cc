@@ -16,8 +16,6 @@ void BaselineOptions::Check() const {
   PKSLAM_CHECK_OPTION(ptam_min_frames >= 0 && ptam_min_distance_ratio >= 0, "Keyframe.ptam",
                       "{} / {}", ptam_min_frames, ptam_min_distance_ratio);
   PKSLAM_CHECK_OPTION(match_count_min > 0, "Keyframe.min_matches", "{}", match_count_min);
-  PKSLAM_CHECK_OPTION(vins_parallax_px > 0 && vins_min_tracked >= 0, "Keyframe.parallax", "{} / {}",
-                      vins_parallax_px, vins_min_tracked);
 }
 
 BaselineSelector::BaselineSelector(BaselineKind kind, BaselineOptions options)
@@ -33,16 +31,8 @@ std::string_view BaselineSelector::name() const {
       return "ptam";
     case BaselineKind::kMatchCount:
       return "match-count";
-    case BaselineKind::kVinsParallax:
-      return "vins-parallax";
   }
   return "?";
-}
-
-void BaselineSelector::OnKeyFrameInserted(const SelectorInput& input) {
-  keyframe_uv_.clear();
-  if (kind_ != BaselineKind::kVinsParallax) return;
-  for (const auto& p : input.points) keyframe_uv_[p.id] = p.uv;
 }
 
 SelectorDecision BaselineSelector::Decide(const SelectorInput& in) {
@@ -84,22 +74,6 @@ SelectorDecision BaselineSelector::Decide(const SelectorInput& in) {
       trace["M_c"] = static_cast<double>(matched);
       want = matched < options_.match_count_min;
       reason = "matches";
-      break;
-    }
-    case BaselineKind::kVinsParallax: {
-      double sum = 0;
-      int n = 0;
-      for (const auto& p : in.points) {
-        if (auto it = keyframe_uv_.find(p.id); it != keyframe_uv_.end()) {
-          sum += (p.uv - it->second).norm();
-          ++n;
-        }
-      }
-      const double parallax = n > 0 ? sum / n : 0.0;
-      trace["parallax_px"] = parallax;
-      const bool few = static_cast<int>(in.points.size()) < options_.vins_min_tracked;
-      want = parallax > options_.vins_parallax_px || few;
-      reason = few ? "few-tracked" : "parallax";
       break;
     }
   }

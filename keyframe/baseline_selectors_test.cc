@@ -58,19 +58,6 @@ TEST(MatchCountSelector, FewerThanFourHundredMatches) {
   EXPECT_TRUE(s.Decide(Input(3, 399)).insert);
 }
 
-TEST(VinsParallaxSelector, ParallaxOrFewTracked) {
-  BaselineSelector s(BaselineKind::kVinsParallax, {});
-  s.OnKeyFrameInserted(Input(0, 100));
-  SelectorInput in = Input(3, 100);
-  for (auto& p : in.points) p.uv.x() += 9.0;
-  EXPECT_FALSE(s.Decide(in).insert);
-  for (auto& p : in.points) p.uv.x() += 2.0;  // 11 px mean parallax
-  const auto d = s.Decide(in);
-  EXPECT_TRUE(d.insert);
-  EXPECT_NEAR(d.trace.at("parallax_px"), 11.0, 1e-9);
-  EXPECT_TRUE(s.Decide(Input(3, 49)).insert);  // few tracked points
-}
-
 TEST(BaselineSelectors, InertialBeforeImuInitUsesTheQuarterSecondRule) {
   BaselineSelector s(BaselineKind::kMatchCount, {});
   SelectorInput in = Input(4, 10);

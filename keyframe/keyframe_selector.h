@@ -14,20 +14,25 @@
 #include <vector>
 
 #include "core/features/descriptor.h"
+#include "core/frame/camera_rig.h"
 #include "core/frame/sensor.h"
 #include "core/geometry/se3.h"
 #include "core/map/ids.h"
 
 namespace pkslam {
 
-// One map point tracked (inlier) in the current frame.
+// One map point tracked in the current frame: an inlier of the pose optimisation, or an
+// outlier when the selector NeedsOutliers().
 struct SelectorPoint {
   MapPointId id = kInvalidId;
   Eigen::Vector3d position_world = Eigen::Vector3d::Zero();
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // undistorted pixel in the current frame
   int keypoint_index = -1;
-  bool in_last_keyframe = false;           // the point is observed by the last keyframe
-  const Descriptor* descriptor = nullptr;  // valid during Decide / OnKeyFrameInserted only
+  bool in_last_keyframe = false;  // the point is observed by the last keyframe
+  bool outlier = false;           // rejected by the pose optimisation
+  const Descriptor* descriptor =
+      nullptr;                      // the keypoint's; valid during Decide / OnKeyFrameInserted
+  Descriptor map_point_descriptor;  // the map point's distinctive descriptor
 };
 
 // IMU summary over an interval (from preintegration; body frame at the interval start).
@@ -46,6 +51,10 @@ struct SelectorInput {
   double fps = 20.0;
   int image_width = 0;
   int image_height = 0;
+  // Pinhole of the undistorted keypoint coordinates and the undistorted image's bounds
+  // (selectors that project map points into the frame).
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  ImageBounds bounds;
   SE3d camera_from_world;
 
   // Tracking results of the current frame.
@@ -72,6 +81,9 @@ struct SelectorInput {
   // then.
   bool trace_wanted = false;
   bool local_mapping_initializing = false;  // IMU initialisation running
+  // Local mapping saw the body barely move between its last keyframes while the inertial
+  // refinement is pending (ORB-SLAM3 v0.3's mbBadImu2; consumed by this frame's decision).
+  bool slow_motion_before_refinement = false;
   int local_mapping_queue = 0;
   bool imu_initialized = false;
 
@@ -115,6 +127,11 @@ class KeyframeSelector {
   virtual std::string_view name() const = 0;
   // Whether Decide needs SelectorInput::points (building them costs a little per frame).
   virtual bool NeedsTrackedPoints() const { return false; }
+  // Whether SelectorInput::points also holds the pose optimisation's outliers (flagged).
+  virtual bool NeedsOutliers() const { return false; }
+  // Whether OnKeyFrameInserted wants the frame as it is after keyframe creation (with the new
+  // stereo/RGB-D points) rather than the input its decision saw.
+  virtual bool SnapshotAfterCreation() const { return false; }
   virtual SelectorDecision Decide(const SelectorInput& input) = 0;
   // Called after a keyframe was created from `input`'s frame (the selector may snapshot it).
   virtual void OnKeyFrameInserted(const SelectorInput& input) { (void)input; }

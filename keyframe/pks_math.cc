@@ -156,4 +156,49 @@ int GridCell(double u, double v, int width, int height, int n) {
   return row * n + col;
 }
 
+std::optional<int> StrictGridCell(double u, double v, double min_x, double max_x, double min_y,
+                                  double max_y, int n) {
+  const double step_x = (max_x - min_x) / n;
+  const double step_y = (max_y - min_y) / n;
+  auto strict = [n](double x, double lo, double step) -> std::optional<int> {
+    for (int c = 0; c < n; ++c) {
+      if (x > lo + c * step && x < lo + (c + 1) * step) return c;
+    }
+    return std::nullopt;
+  };
+  const auto col = strict(u, min_x, step_x);
+  const auto row = strict(v, min_y, step_y);
+  if (!col || !row) return std::nullopt;
+  return *row * n + *col;
+}
+
+double ParallaxDeg(const Eigen::Vector3d& point, const Eigen::Vector3d& center_a,
+                   const Eigen::Vector3d& center_b) {
+  const Eigen::Vector3d a = center_a - point;
+  const Eigen::Vector3d b = center_b - point;
+  if (a.isZero() || b.isZero()) return 0.0;
+  // atan2 of |a x b| and a.b stays accurate for the small angles between nearby cameras.
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
+}
+
+void ViewChangeDiagnostics::Add(double view_change, const Eigen::Vector3d& point,
+                                const Eigen::Vector3d& keyframe_center,
+                                const Eigen::Vector3d& center) {
+  view_change_deg.push_back(view_change);
+  parallax_deg.push_back(ParallaxDeg(point, keyframe_center, center));
+}
+
+void ViewChangeDiagnostics::Fill(std::map<std::string, double>* trace) const {
+  auto quantiles = [trace](std::vector<double> v, const std::string& name) {
+    if (v.empty()) return;
+    std::sort(v.begin(), v.end());
+    auto at = [&v](double q) { return v[static_cast<std::size_t>(q * (v.size() - 1) + 0.5)]; };
+    (*trace)[name + "_p50"] = at(0.5);
+    (*trace)[name + "_p90"] = at(0.9);
+    (*trace)[name + "_max"] = v.back();
+  };
+  quantiles(view_change_deg, "view_change");
+  quantiles(parallax_deg, "parallax");
+}
+
 }  // namespace pkslam::pks

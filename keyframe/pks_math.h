@@ -3,7 +3,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <map>
+#include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace pkslam::pks {
@@ -63,5 +66,27 @@ Ecog ComputeEcog(const std::vector<int>& grid, int n, bool late_denominator);
 
 // Grid cell (row-major index) of an image point on an n x n grid over width x height.
 int GridCell(double u, double v, int width, int height, int n);
+
+// The released code's binning over the undistorted image bounds [min, max]: column c when
+// min_x + c * step < u < min_x + (c + 1) * step (strictly), rows alike; a point on a cell
+// border or outside the bounds falls in no cell (nullopt).
+std::optional<int> StrictGridCell(double u, double v, double min_x, double max_x, double min_y,
+                                  double max_y, int n);
+
+// Why delta is (un)reachable: for a normal fixed at the keyframe, a point's viewing-angle change
+// between the keyframe and the frame is at most the parallax angle between the two rays to it
+// (triangle inequality on the sphere). Collects both per matched point of one frame; Fill
+// writes their 50th/90th percentiles and maxima (degrees) into a trace row.
+struct ViewChangeDiagnostics {
+  std::vector<double> view_change_deg;
+  std::vector<double> parallax_deg;
+  void Add(double view_change, const Eigen::Vector3d& point, const Eigen::Vector3d& keyframe_center,
+           const Eigen::Vector3d& center);
+  void Fill(std::map<std::string, double>* trace) const;
+};
+
+// Angle (degrees) between the rays from `point` to two camera centres.
+double ParallaxDeg(const Eigen::Vector3d& point, const Eigen::Vector3d& center_a,
+                   const Eigen::Vector3d& center_b);
 
 }  // namespace pkslam::pks

@@ -29,7 +29,7 @@ TEST(PksAdaptiveThreshold, ReleasedGammaWhenMatchesHalve) {
   // M_c = 100 < M_r / 2: gamma = (300 - 200) / (300 + 200) = 0.2 is subtracted too.
   const auto paper = ComputeAdaptiveThreshold(400, 100, 60, 500, 300, 30, false);
   const auto released = ComputeAdaptiveThreshold(400, 100, 60, 500, 300, 30, true);
-  EXPECT_DOUBLE_EQ(paper.th_initial, 17.0);  // (10 + 24) / 2
+  EXPECT_DOUBLE_EQ(paper.th_initial, 17.0);                                   // (10 + 24) / 2
   EXPECT_NEAR(paper.th_adaptive, 17.0 * (1 + 2.0 / 3.0 - 0.5 - 0.1), 1e-12);  // 18.133
   EXPECT_NEAR(released.gamma, 0.2, 1e-15);
   EXPECT_NEAR(released.th_adaptive, 17.0 * (1 + 2.0 / 3.0 - 0.5 - 0.1 - 0.2), 1e-12);  // 14.733
@@ -42,7 +42,7 @@ TEST(PksAdaptiveThreshold, ReleasedThetaClampChangesTheDecision) {
   // M_c 290 of M_r 300: theta = 1/30 < 0.1, so the released code uses 1.1 * Th_initial.
   const auto paper = ComputeAdaptiveThreshold(400, 290, 30, 500, 300, 30, false);
   const auto released = ComputeAdaptiveThreshold(400, 290, 30, 500, 300, 30, true);
-  EXPECT_DOUBLE_EQ(paper.th_initial, 26.5);  // (29 + 24) / 2
+  EXPECT_DOUBLE_EQ(paper.th_initial, 26.5);              // (29 + 24) / 2
   EXPECT_NEAR(released.th_adaptive, 1.1 * 26.5, 1e-12);  // 29.15
   const double beta = 30.0 / 290 - 0.1;
   const double alpha = 30.0 / 290 - 0.5;
@@ -52,9 +52,9 @@ TEST(PksAdaptiveThreshold, ReleasedThetaClampChangesTheDecision) {
 }
 
 TEST(PksAdaptiveThreshold, DegenerateCounts) {
-  EXPECT_FALSE(ComputeAdaptiveThreshold(400, 200, 60, 500, 0, 0, false).valid);    // M_r = 0
-  EXPECT_FALSE(ComputeAdaptiveThreshold(400, 200, 60, 0, 300, 30, false).valid);   // A_r = 0
-  EXPECT_FALSE(ComputeAdaptiveThreshold(400, 0, 0, 500, 300, 30, false).valid);    // M_c = 0
+  EXPECT_FALSE(ComputeAdaptiveThreshold(400, 200, 60, 500, 0, 0, false).valid);   // M_r = 0
+  EXPECT_FALSE(ComputeAdaptiveThreshold(400, 200, 60, 0, 300, 30, false).valid);  // A_r = 0
+  EXPECT_FALSE(ComputeAdaptiveThreshold(400, 0, 0, 500, 300, 30, false).valid);   // M_c = 0
   // D_r = 0: the threshold is 0, so any changed region passes.
   const auto t = ComputeAdaptiveThreshold(400, 200, 1, 500, 300, 0, false);
   EXPECT_TRUE(t.valid);
@@ -163,8 +163,8 @@ TEST(PksNormals, PlaneGivesItsNormalAndTooFewPointsGiveNone) {
 TEST(PksNormals, ReleasedRawSumCancelsOnSymmetricNeighbourhoods) {
   // Neighbours at +x, -x, +y, -y (and one far point): the pairwise cross products cancel in
   // the released formula; the sign-aligned sum gives the plane's normal.
-  const std::vector<Eigen::Vector3d> pts = {
-      {0, 0, 0}, {0.1, 0, 0}, {-0.1, 0, 0}, {0, 0.1, 0}, {0, -0.1, 0}, {0.3, 0.3, 0}};
+  const std::vector<Eigen::Vector3d> pts = {{0, 0, 0},   {0.1, 0, 0},  {-0.1, 0, 0},
+                                            {0, 0.1, 0}, {0, -0.1, 0}, {0.3, 0.3, 0}};
   EXPECT_TRUE(EstimateNormals(pts, 4, false)[0].isZero());
   EXPECT_NEAR(std::abs(EstimateNormals(pts, 4, true)[0].z()), 1.0, 1e-12);
 }
@@ -190,6 +190,38 @@ TEST(PksGrid, CellsSplitTheImageInThirds) {
   EXPECT_EQ(GridCell(376, 240, 752, 480, 3), 4);
   EXPECT_EQ(GridCell(0, 479, 752, 480, 3), 6);
   EXPECT_EQ(GridCell(-5, 900, 752, 480, 3), 6);  // clamped
+}
+
+TEST(PksGrid, ReleasedStrictBinningDropsBorders) {
+  // 752 x 480 bounds: columns split at 250.67 and 501.33, rows at 160 and 320.
+  EXPECT_EQ(StrictGridCell(136, 80, 0, 752, 0, 480, 3), 0);
+  EXPECT_EQ(StrictGridCell(616, 400, 0, 752, 0, 480, 3), 8);
+  EXPECT_EQ(StrictGridCell(300, 200, 0, 752, 0, 480, 3), 4);
+  EXPECT_FALSE(StrictGridCell(300, 160, 0, 752, 0, 480, 3));  // on a row border
+  EXPECT_FALSE(StrictGridCell(0, 200, 0, 752, 0, 480, 3));    // on the image edge
+  EXPECT_FALSE(StrictGridCell(-3, 200, 0, 752, 0, 480, 3));   // outside (GridCell clamps)
+  EXPECT_EQ(StrictGridCell(10, 200, 5, 755, 0, 480, 3), 3);   // bounds need not start at 0
+}
+
+TEST(PksViewChange, ViewAngleChangeNeverExceedsTheParallax) {
+  // A fixed normal: the change of the angle to it between two cameras is at most the angle
+  // between the two rays (why delta = 30 deg needs 30 deg of parallax).
+  const Eigen::Vector3d point(0, 0, 4);
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.3, -0.2, -1).normalized();
+  const Eigen::Vector3d a(0, 0, 0);
+  for (const Eigen::Vector3d& b :
+       {Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d(2, 1, 0.5), Eigen::Vector3d(-3, 0.2, 1)}) {
+    const double change =
+        std::abs(ViewAngleDeg(normal, point, a, false) - ViewAngleDeg(normal, point, b, false));
+    EXPECT_LE(change, ParallaxDeg(point, a, b) + 1e-9);
+  }
+  EXPECT_NEAR(ParallaxDeg(point, Eigen::Vector3d(-4, 0, 4), Eigen::Vector3d(0, 0, 0)), 90.0, 1e-9);
+  ViewChangeDiagnostics d;
+  d.Add(3.0, point, a, Eigen::Vector3d(4, 0, 4));
+  std::map<std::string, double> trace;
+  d.Fill(&trace);
+  EXPECT_DOUBLE_EQ(trace.at("view_change_max"), 3.0);
+  EXPECT_NEAR(trace.at("parallax_p90"), 90.0, 1e-9);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "keyframe/pks_selector.h"
 
 #include <cmath>
+#include <numeric>
 
 #include "core/util/error.h"
 #include "keyframe/orbslam3_selector.h"
@@ -26,33 +27,30 @@ void PksOptions::Check() const {
   PKSLAM_CHECK_OPTION(forced_interval >= 0 && late_denominator_after >= 0,
                       "Keyframe.forced_interval", "{} / {}", forced_interval,
                       late_denominator_after);
+  PKSLAM_CHECK_OPTION(
+      pairing_radius_px > 0 && pairing_max_hamming > 0 && pairing_max_hamming <= 257,
+      "Keyframe.pairing", "radius {} px / Hamming {}", pairing_radius_px, pairing_max_hamming);
 }
 
-PksSelector::PksSelector(PksOptions options, bool released)
-    : options_(options), released_(released) {
-  options_.Check();
-}
+PksSelector::PksSelector(PksOptions options) : options_(options) { options_.Check(); }
 
 void PksSelector::Reset() {
   snapshot_.clear();
   has_snapshot_ = false;
   keyframe_accel_.reset();
-  previous_accel_.reset();
   reference_.reset();
 }
 
 void PksSelector::OnKeyFrameInserted(const SelectorInput& input) {
   snapshot_.clear();
-  // The released code keeps the previous reference values until a frame with frames == 1
-  // is evaluated; the paper takes a fresh reference after every keyframe.
-  if (!released_) reference_.reset();
+  reference_.reset();  // the paper takes a fresh reference after every keyframe
   std::vector<Eigen::Vector3d> positions;
   positions.reserve(input.points.size());
   for (const auto& p : input.points) positions.push_back(p.position_world);
-  const auto normals = pks::EstimateNormals(positions, options_.normal_neighbours, !released_);
+  const auto normals = pks::EstimateNormals(positions, options_.normal_neighbours, true);
   const Eigen::Vector3d center = input.camera_from_world.Inverse().translation();
   for (std::size_t i = 0; i < input.points.size(); ++i) {
-    const double angle = pks::ViewAngleDeg(normals[i], positions[i], center, released_);
+    const double angle = pks::ViewAngleDeg(normals[i], positions[i], center, false);
     snapshot_[input.points[i].id] = {
         normals[i], angle, pks::ConeRegion(angle, options_.region_width_deg, options_.regions)};
   }
@@ -84,35 +82,27 @@ void PksSelector::ExtendSnapshot(const SelectorInput& input) {
   has_snapshot_ = true;
 }
 
-PksSelector::Counts PksSelector::Measure(const SelectorInput& input) const {
+PksSelector::Counts PksSelector::Measure(const SelectorInput& input,
+                                         pks::ViewChangeDiagnostics* diagnostics) const {
   Counts c;
   const int n = options_.grid;
   c.grid.assign(n * n, 0);
   c.a = static_cast<int>(input.points.size());
   const Eigen::Vector3d center = input.camera_from_world.Inverse().translation();
-  // The released code re-estimates every normal from the current frame's tracked points.
-  std::vector<Eigen::Vector3d> current_normals;
-  if (released_) {
-    std::vector<Eigen::Vector3d> positions;
-    positions.reserve(input.points.size());
-    for (const auto& p : input.points) positions.push_back(p.position_world);
-    current_normals = pks::EstimateNormals(positions, options_.normal_neighbours, false);
-  }
-  for (std::size_t i = 0; i < input.points.size(); ++i) {
-    const SelectorPoint& p = input.points[i];
+  const Eigen::Vector3d kf_center = input.last_keyframe_camera_from_world.Inverse().translation();
+  for (const SelectorPoint& p : input.points) {
     const auto it = snapshot_.find(p.id);
     if (it == snapshot_.end()) continue;
     ++c.m;
     const SnapshotPoint& s = it->second;
-    const Eigen::Vector3d& normal = released_ ? current_normals[i] : s.normal;
-    if (normal.isZero() || s.normal.isZero()) continue;  // no surface estimate: no region
-    const double angle = pks::ViewAngleDeg(normal, p.position_world, center, released_);
+    if (s.normal.isZero()) continue;  // no surface estimate: no region
+    const double angle = pks::ViewAngleDeg(s.normal, p.position_world, center, false);
     const bool region_changed =
         pks::ConeRegion(angle, options_.region_width_deg, options_.regions) != s.region;
     if (region_changed) ++c.d;
-    const bool angle_changed = std::abs(angle - s.angle_deg) > options_.delta_deg;
-    const bool effective = released_ ? (region_changed && angle_changed) : angle_changed;
-    if (effective) {
+    const double change = std::abs(angle - s.angle_deg);
+    if (diagnostics) diagnostics->Add(change, p.position_world, kf_center, center);
+    if (change > options_.delta_deg) {
       ++c.grid[pks::GridCell(p.uv.x(), p.uv.y(), input.image_width, input.image_height, n)];
     }
   }
@@ -120,63 +110,55 @@ PksSelector::Counts PksSelector::Measure(const SelectorInput& input) const {
 }
 
 bool PksSelector::CameraCriterion(const SelectorInput& input, SelectorTrace* trace) {
-  const int frames = input.FramesSinceLastKeyFrame();
   // The paper's M counts every point matched between the keyframe and the current frame; the
   // snapshot taken at insertion only holds the points tracked then (the released code's
-  // reading), so the paper variant completes it with points the keyframe gained since.
-  if (!released_ && input.points.size() > static_cast<std::size_t>(options_.normal_neighbours)) {
+  // reading), so it is completed with points the keyframe gained since.
+  if (input.points.size() > static_cast<std::size_t>(options_.normal_neighbours)) {
     ExtendSnapshot(input);
   }
   if (!has_snapshot_ ||
       input.points.size() < static_cast<std::size_t>(options_.normal_neighbours) + 1) {
     return false;  // too few points for a surface normal: no camera decision
   }
-  const Counts c = Measure(input);
-  // The reference frame: the first frame after the keyframe (released code: exactly the
-  // frame with frames == 1; values from an earlier interval are reused if it was skipped).
-  if (!reference_ || (released_ && frames == 1)) {
-    if (!released_ || frames == 1) reference_ = c;
-  }
+  pks::ViewChangeDiagnostics diagnostics;
+  const Counts c = Measure(input, input.trace_wanted ? &diagnostics : nullptr);
+  if (!reference_) reference_ = c;  // the first frame after the keyframe
   auto& t = *trace;
   t["A_c"] = c.a;
   t["M_c"] = c.m;
   t["D_c"] = c.d;
-  if (!reference_) return false;
+  t["E_c"] = std::accumulate(c.grid.begin(), c.grid.end(), 0);
+  diagnostics.Fill(&t);
   const Counts& r = *reference_;
   t["A_r"] = r.a;
   t["M_r"] = r.m;
   t["D_r"] = r.d;
 
   const pks::AdaptiveThreshold th =
-      pks::ComputeAdaptiveThreshold(c.a, c.m, c.d, r.a, r.m, r.d, released_);
+      pks::ComputeAdaptiveThreshold(c.a, c.m, c.d, r.a, r.m, r.d, false);
   bool criterion1 = false;
   if (th.valid) {
     t["theta"] = th.theta;
     t["beta"] = th.beta;
     t["alpha"] = th.alpha;
-    if (released_) t["gamma"] = th.gamma;
     t["Th_initial"] = th.th_initial;
     t["Th_adaptive"] = th.th_adaptive;
     criterion1 = c.d > th.th_adaptive;
-    if (released_ && (frames <= 1 || c.d == 0)) criterion1 = false;
   }
-  const bool late = released_ && frames > options_.late_denominator_after;
-  const pks::Ecog ecog = pks::ComputeEcog(c.grid, options_.grid, late);
+  const pks::Ecog ecog = pks::ComputeEcog(c.grid, options_.grid, false);
   bool criterion2 = false;
   if (ecog.valid) {
     t["ECOG"] = ecog.ecog;
     t["COG"] = ecog.cog;
     criterion2 = ecog.ecog > ecog.cog;
   }
+  t["criterion1"] = criterion1;
+  t["criterion2"] = criterion2;
   return criterion1 && criterion2;
 }
 
 std::optional<double> PksSelector::AccelerationChange(const SelectorInput& input) const {
   if (!input.imu_since_last_frame) return std::nullopt;
-  if (released_) {
-    if (!previous_accel_ || input.FramesSinceLastKeyFrame() <= 1) return std::nullopt;
-    return (input.imu_since_last_frame->mean_accel - *previous_accel_).norm();
-  }
   const auto& now = input.imu_since_last_frame->mean_accel_world_no_gravity;
   if (!now || !keyframe_accel_) return std::nullopt;
   return (*now - *keyframe_accel_).norm();
@@ -184,15 +166,6 @@ std::optional<double> PksSelector::AccelerationChange(const SelectorInput& input
 
 SelectorDecision PksSelector::Decide(const SelectorInput& in) {
   SelectorDecision decision;
-  // The released code compares consecutive frame intervals: remember this one for the next.
-  struct RememberAccel {
-    PksSelector* self;
-    const SelectorInput& in;
-    ~RememberAccel() {
-      if (in.imu_since_last_frame) self->previous_accel_ = in.imu_since_last_frame->mean_accel;
-    }
-  } remember{this, in};
-
   if (auto exit = CommonSafetyExits(in, options_.imu_uninitialised_interval_s)) return *exit;
   const Eigen::Vector3d center = in.camera_from_world.Inverse().translation();
   const Eigen::Vector3d kf_center = in.last_keyframe_camera_from_world.Inverse().translation();
@@ -202,9 +175,6 @@ SelectorDecision PksSelector::Decide(const SelectorInput& in) {
 
   SelectorTrace trace;
   const bool camera = CameraCriterion(in, &trace);
-  const int frames = in.FramesSinceLastKeyFrame();
-  const bool forced =
-      released_ && options_.forced_interval > 0 && frames == options_.forced_interval;
   const auto accel_change = AccelerationChange(in);
   if (accel_change) trace["delta_a"] = *accel_change;
   const bool imu =
@@ -228,7 +198,6 @@ SelectorDecision PksSelector::Decide(const SelectorInput& in) {
     reason += name;
   };
   add(camera, "camera");
-  add(forced, "forced");
   add(imu, "imu");
   add(c3, "close");
   add(c1, "time");

@@ -1,26 +1,20 @@
 // PKS, the photogrammetric keyframe selector (../shared/docs/PKS.md): camera criterion =
 // cone-region changes above an adaptive threshold (Eq. 1-9) AND a balanced distribution of
 // effective points (ECOG > |COG|, Eq. 10-12); an IMU criterion on sharp acceleration changes;
-// combined with ORB-SLAM3's safety exits. Two variants:
-//  - "pks": the paper. Deliberate readings (documented in docs/keyframe_selectors.md):
-//    each point's surface normal is estimated once, when the keyframe is taken, from its 5
-//    nearest tracked points, and reused for the current frame, so a region change measures
-//    the change of viewing direction and not the noise of a re-estimated normal; the normal
-//    is an unoriented axis (angles in [0, 90]); effective points changed their viewing angle
-//    by more than delta; the IMU trigger compares the gravity-compensated mean specific force
-//    (world frame) of the current frame interval with that of the keyframe's interval.
-//  - "pks-released": the authors' released code (gamma term, theta < 0.1 clamp, forced
-//    keyframe at exactly 6 frames, ECOG denominator switch after 4 frames, normals recomputed
-//    every frame and reflected to world z >= 0, effective = region changed AND angle changed
-//    by more than delta, IMU delta between consecutive frame intervals with gravity, criteria
-//    only after more than one frame).
+// combined with ORB-SLAM3's safety exits. This file is "pks", the paper. Deliberate readings
+// (docs/keyframe_selectors.md): each point's surface normal is estimated once, when the
+// keyframe is taken, from its 5 nearest tracked points, and reused for the current frame, so a
+// region change measures the change of viewing direction and not the noise of a re-estimated
+// normal; the normal is an unoriented axis (angles in [0, 90]); effective points changed their
+// viewing angle by more than delta; the IMU trigger compares the gravity-compensated mean
+// specific force (world frame) of the current frame interval with that of the keyframe's
+// interval. The authors' released code is "pks-released" (pks_released_selector.h).
 #pragma once
 
+#include <Eigen/Core>
 #include <optional>
 #include <unordered_map>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "keyframe/keyframe_selector.h"
 #include "keyframe/pks_math.h"
@@ -40,28 +34,32 @@ struct PksOptions {
   // IMU trigger: |delta a| above this (m/s^2); <= 0 disables it.
   double imu_threshold = 1.0;
   // Safety exits and extra triggers kept from ORB-SLAM3 (PKS.md "How it combines").
-  double min_translation_m = 0.02;          // no keyframe if the camera moved less (> 2 KFs)
+  double min_translation_m = 0.02;  // no keyframe if the camera moved less (> 2 KFs)
   double imu_uninitialised_interval_s = 0.25;
-  double inertial_interval_s = 0.5;         // c1
+  double inertial_interval_s = 0.5;  // c1
   // Visual-only sensors (not evaluated in the paper): ORB-SLAM3's c1a, a keyframe at least
   // every this many seconds (its maxFrames = fps), so monocular maps are not starved.
   double visual_interval_s = 1.0;
-  int close_tracked_max = 100;              // c3: stereo close-point rule
+  int close_tracked_max = 100;  // c3: stereo close-point rule
   int close_untracked_min = 70;
   // Visual-only sensors (not evaluated by the paper): also insert when inliers fall below this
   // share of the reference keyframe's tracked points (ORB-SLAM3's c1c); 0 disables.
   double weak_tracking_ratio = 0.25;
-  // Released-code constants.
-  int forced_interval = 6;          // forced keyframe at exactly this many frames
+  // pks-released only (pks_released_selector.h); the ablations switch its parts off.
+  int forced_interval = 6;          // forced keyframe at exactly this many frames (0: never)
   int late_denominator_after = 4;   // ECOG denominator switch after this many frames
+  double pairing_radius_px = 10.0;  // reprojection pairing: search window half-width
+  int pairing_max_hamming = 30;     // reprojection pairing: descriptor distance below this
+  bool identity_pairing = false;    // ablation: pair by map-point identity instead
+  bool frozen_normals = false;      // ablation: keep the keyframe's normals for the frame
 
   void Check() const;
 };
 
 class PksSelector : public KeyframeSelector {
  public:
-  PksSelector(PksOptions options, bool released);
-  std::string_view name() const override { return released_ ? "pks-released" : "pks"; }
+  explicit PksSelector(PksOptions options);
+  std::string_view name() const override { return "pks"; }
   bool NeedsTrackedPoints() const override { return true; }
   SelectorDecision Decide(const SelectorInput& input) override;
   void OnKeyFrameInserted(const SelectorInput& input) override;
@@ -74,12 +72,13 @@ class PksSelector : public KeyframeSelector {
     int region;
   };
   struct Counts {
-    int a = 0;  // tracked points
-    int m = 0;  // matched to the last keyframe
-    int d = 0;  // matched with a changed cone region
+    int a = 0;              // tracked points
+    int m = 0;              // matched to the last keyframe
+    int d = 0;              // matched with a changed cone region
     std::vector<int> grid;  // effective points per cell
   };
-  Counts Measure(const SelectorInput& input) const;
+  // `diagnostics` (optional) collects each matched point's view change and parallax.
+  Counts Measure(const SelectorInput& input, pks::ViewChangeDiagnostics* diagnostics) const;
   // Adds the last keyframe's points that the snapshot does not hold yet (created with the
   // keyframe or triangulated from it afterwards): their normals from the current tracked
   // points, their angle and region as seen from the keyframe.
@@ -88,12 +87,10 @@ class PksSelector : public KeyframeSelector {
   std::optional<double> AccelerationChange(const SelectorInput& input) const;
 
   PksOptions options_;
-  bool released_;
   // Snapshot of the last keyframe (map point id -> normal/angle/region).
   std::unordered_map<MapPointId, SnapshotPoint> snapshot_;
   bool has_snapshot_ = false;
-  std::optional<Eigen::Vector3d> keyframe_accel_;  // pks: world, gravity removed
-  std::optional<Eigen::Vector3d> previous_accel_;  // released: previous frame interval
+  std::optional<Eigen::Vector3d> keyframe_accel_;  // world, gravity removed
   std::optional<Counts> reference_;
 };
 

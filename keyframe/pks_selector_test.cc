@@ -67,7 +67,8 @@ SelectorInput MakeInput(const std::vector<std::pair<MapPointId, Eigen::Vector3d>
     SelectorPoint sp;
     sp.id = id;
     sp.position_world = p;
-    sp.uv = Eigen::Vector2d(kFx * c.x() / c.z() + kWidth / 2.0, kFx * c.y() / c.z() + kHeight / 2.0);
+    sp.uv =
+        Eigen::Vector2d(kFx * c.x() / c.z() + kWidth / 2.0, kFx * c.y() / c.z() + kHeight / 2.0);
     sp.in_last_keyframe = true;
     in.points.push_back(sp);
   }
@@ -95,11 +96,11 @@ class PksScenario : public ::testing::Test {
 TEST_F(PksScenario, BalancedViewChangeTriggersTheCameraCriterion) {
   // TL and BR change region and viewing angle by > 30 deg (60.8 and 36.9 deg of parallax);
   // TR and BL do not.
-  const auto points = PatchPoints({Facing(centers_[0]), Grazing(centers_[1]),
-                                   Grazing(centers_[2]), Facing(centers_[3])});
+  const auto points = PatchPoints(
+      {Facing(centers_[0]), Grazing(centers_[1]), Grazing(centers_[2]), Facing(centers_[3])});
   PksOptions o;
   o.weak_tracking_ratio = 0;
-  PksSelector s(o, false);
+  PksSelector s(o);
   s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
   // Frame 1 (the reference): barely moved.
   const auto r = s.Decide(MakeInput(points, LookAt(c0_ + Eigen::Vector3d(0.03, 0, 0), target_), 1));
@@ -116,24 +117,24 @@ TEST_F(PksScenario, BalancedViewChangeTriggersTheCameraCriterion) {
 
 TEST_F(PksScenario, OneSidedViewChangeFailsTheBalanceCriterion) {
   // Only the TL patch changes: all effective points in one cell, ECOG = 0.
-  const auto points = PatchPoints({Facing(centers_[0]), Grazing(centers_[1]),
-                                   Grazing(centers_[2]), Grazing(centers_[3])});
+  const auto points = PatchPoints(
+      {Facing(centers_[0]), Grazing(centers_[1]), Grazing(centers_[2]), Grazing(centers_[3])});
   PksOptions o;
   o.weak_tracking_ratio = 0;
-  PksSelector s(o, false);
+  PksSelector s(o);
   s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
   s.Decide(MakeInput(points, LookAt(c0_ + Eigen::Vector3d(0.03, 0, 0), target_), 1));
   const auto d = s.Decide(MakeInput(points, LookAt(c1_, target_), 2));
   EXPECT_EQ(d.trace.at("D_c"), 9);
   EXPECT_GT(d.trace.at("D_c"), d.trace.at("Th_adaptive"));  // criterion 1 holds...
-  EXPECT_DOUBLE_EQ(d.trace.at("ECOG"), 0.0);                 // ...criterion 2 does not
+  EXPECT_DOUBLE_EQ(d.trace.at("ECOG"), 0.0);                // ...criterion 2 does not
   EXPECT_FALSE(d.insert);
 }
 
 TEST_F(PksScenario, FewerThanSixPointsGiveNoCameraDecision) {
   auto points = PatchPoints({Facing(centers_[0])});
   points.resize(5);
-  PksSelector s(PksOptions{}, false);
+  PksSelector s(PksOptions{});
   s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
   const auto d = s.Decide(MakeInput(points, LookAt(c1_, target_), 2));
   EXPECT_EQ(d.trace.count("D_c"), 0u);
@@ -141,11 +142,11 @@ TEST_F(PksScenario, FewerThanSixPointsGiveNoCameraDecision) {
 }
 
 TEST_F(PksScenario, NoKeyframeSnapshotNoCameraDecisionAndResetForgets) {
-  const auto points = PatchPoints({Facing(centers_[0]), Grazing(centers_[1]),
-                                   Grazing(centers_[2]), Facing(centers_[3])});
+  const auto points = PatchPoints(
+      {Facing(centers_[0]), Grazing(centers_[1]), Grazing(centers_[2]), Facing(centers_[3])});
   PksOptions o;
   o.weak_tracking_ratio = 0;
-  PksSelector s(o, false);
+  PksSelector s(o);
   EXPECT_FALSE(s.Decide(MakeInput(points, LookAt(c1_, target_), 2)).insert);
   s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
   s.Reset();
@@ -154,7 +155,7 @@ TEST_F(PksScenario, NoKeyframeSnapshotNoCameraDecisionAndResetForgets) {
 
 TEST_F(PksScenario, CameraThatDidNotMoveTakesNoKeyframe) {
   const auto points = PatchPoints({Facing(centers_[0]), Facing(centers_[3])});
-  PksSelector s(PksOptions{}, false);
+  PksSelector s(PksOptions{});
   s.OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
   auto in = MakeInput(points, LookAt(c0_ + Eigen::Vector3d(0.01, 0, 0), target_), 30);
   in.tracked_close = 0;
@@ -162,19 +163,7 @@ TEST_F(PksScenario, CameraThatDidNotMoveTakesNoKeyframe) {
   EXPECT_EQ(s.Decide(in).reason, "still");
 }
 
-TEST(PksReleased, ForcedKeyframeAtExactlySixFrames) {
-  const std::vector<std::pair<MapPointId, Eigen::Vector3d>> none;
-  PksSelector released(PksOptions{}, true);
-  PksSelector paper(PksOptions{}, false);
-  for (FrameId f : {5, 6, 7}) {
-    SelectorInput in = MakeInput(none, SE3d(), f);
-    in.last_keyframe_camera_from_world = SE3d(SO3d(), Eigen::Vector3d(1, 0, 0));
-    EXPECT_EQ(released.Decide(in).insert, f == 6) << f;
-    EXPECT_FALSE(paper.Decide(in).insert) << f;
-  }
-}
-
-TEST(PksImu, AccelerationTriggerPaperVersusReleased) {
+TEST(PksImu, AccelerationTriggerAgainstTheKeyframeInterval) {
   const std::vector<std::pair<MapPointId, Eigen::Vector3d>> none;
   auto input = [&](FrameId f, const Eigen::Vector3d& body, const Eigen::Vector3d& world) {
     SelectorInput in = MakeInput(none, SE3d(), f);
@@ -190,25 +179,17 @@ TEST(PksImu, AccelerationTriggerPaperVersusReleased) {
     return in;
   };
   const Eigen::Vector3d g(0, 0, 9.81);
-  PksSelector paper(PksOptions{}, false);
+  PksSelector paper(PksOptions{});
   paper.OnKeyFrameInserted(input(0, g, Eigen::Vector3d::Zero()));
   EXPECT_FALSE(paper.Decide(input(1, g, {0.5, 0, 0})).insert);  // |da| 0.5
-  const auto fire = paper.Decide(input(2, g, {1.2, 0, 0}));       // |da| 1.2 > 1
+  const auto fire = paper.Decide(input(2, g, {1.2, 0, 0}));     // |da| 1.2 > 1
   EXPECT_TRUE(fire.insert);
   EXPECT_NEAR(fire.trace.at("delta_a"), 1.2, 1e-12);
-
-  // Released: consecutive frame intervals, gravity included, only after frame 1.
-  PksSelector released(PksOptions{}, true);
-  EXPECT_FALSE(released.Decide(input(1, g, Eigen::Vector3d::Zero())).insert);
-  EXPECT_FALSE(released.Decide(input(2, g + Eigen::Vector3d(0.8, 0, 0), Eigen::Vector3d::Zero())).insert);
-  const auto r = released.Decide(input(3, g + Eigen::Vector3d(-0.8, 0, 0), Eigen::Vector3d::Zero()));
-  EXPECT_NEAR(r.trace.at("delta_a"), 1.6, 1e-12);
-  EXPECT_TRUE(r.insert);
 }
 
 TEST(PksImu, NoImuMeansNoImuCriterion) {
   const std::vector<std::pair<MapPointId, Eigen::Vector3d>> none;
-  PksSelector s(PksOptions{}, false);
+  PksSelector s(PksOptions{});
   SelectorInput in = MakeInput(none, SE3d(), 3);
   in.last_keyframe_camera_from_world = SE3d(SO3d(), Eigen::Vector3d(1, 0, 0));
   const auto d = s.Decide(in);

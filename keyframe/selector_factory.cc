@@ -6,7 +6,9 @@
 #include "core/util/error.h"
 #include "keyframe/baseline_selectors.h"
 #include "keyframe/orbslam3_selector.h"
+#include "keyframe/pks_released_selector.h"
 #include "keyframe/pks_selector.h"
+#include "keyframe/vins_parallax_selector.h"
 
 namespace pkslam {
 namespace {
@@ -26,11 +28,20 @@ class ParameterReader {
     Read(name, &v);
     *value = static_cast<int>(v);
   }
+  void Read(const std::string& name, bool* value) {
+    double v = *value ? 1.0 : 0.0;
+    Read(name, &v);
+    if (v != 0.0 && v != 1.0) {
+      throw OptionError(fmt::format("selector '{}': parameter '{}' is a switch (0 or 1), not {}",
+                                    selector_, name, v));
+    }
+    *value = v == 1.0;
+  }
   void RejectUnknown() const {
     for (const auto& [name, value] : parameters_) {
       if (std::find(known_.begin(), known_.end(), name) == known_.end()) {
-        throw OptionError(fmt::format("selector '{}' has no parameter '{}' (known: {})",
-                                      selector_, name, fmt::join(known_, ", ")));
+        throw OptionError(fmt::format("selector '{}' has no parameter '{}' (known: {})", selector_,
+                                      name, fmt::join(known_, ", ")));
       }
     }
   }
@@ -76,16 +87,33 @@ std::unique_ptr<KeyframeSelector> MakeKeyframeSelector(
     reader.Read("close_tracked_max", &o.close_tracked_max);
     reader.Read("close_untracked_min", &o.close_untracked_min);
     reader.Read("weak_tracking_ratio", &o.weak_tracking_ratio);
+    if (name == "pks") {
+      reader.RejectUnknown();
+      return std::make_unique<PksSelector>(o);
+    }
     reader.Read("forced_interval", &o.forced_interval);
     reader.Read("late_denominator_after", &o.late_denominator_after);
+    reader.Read("pairing_radius", &o.pairing_radius_px);
+    reader.Read("pairing_max_hamming", &o.pairing_max_hamming);
+    reader.Read("identity_pairing", &o.identity_pairing);
+    reader.Read("frozen_normals", &o.frozen_normals);
     reader.RejectUnknown();
-    return std::make_unique<PksSelector>(o, name == "pks-released");
+    return std::make_unique<PksReleasedSelector>(o);
+  }
+  if (name == "vins-parallax") {
+    VinsParallaxOptions o;
+    reader.Read("parallax", &o.parallax_px);
+    reader.Read("focal", &o.focal_px);
+    reader.Read("min_tracked", &o.min_tracked);
+    reader.Read("rotation_compensation", &o.rotation_compensation);
+    reader.Read("imu_uninitialised_interval", &o.imu_uninitialised_interval_s);
+    reader.RejectUnknown();
+    return std::make_unique<VinsParallaxSelector>(o);
   }
   const std::map<std::string, BaselineKind> baselines = {
       {"interval", BaselineKind::kInterval},
       {"ptam", BaselineKind::kPtam},
-      {"match-count", BaselineKind::kMatchCount},
-      {"vins-parallax", BaselineKind::kVinsParallax}};
+      {"match-count", BaselineKind::kMatchCount}};
   if (auto it = baselines.find(name); it != baselines.end()) {
     BaselineOptions o;
     switch (it->second) {
@@ -99,10 +127,6 @@ std::unique_ptr<KeyframeSelector> MakeKeyframeSelector(
         break;
       case BaselineKind::kMatchCount:
         reader.Read("min_matches", &o.match_count_min);
-        break;
-      case BaselineKind::kVinsParallax:
-        reader.Read("parallax", &o.vins_parallax_px);
-        reader.Read("min_tracked", &o.vins_min_tracked);
         break;
     }
     reader.Read("imu_uninitialised_interval", &o.imu_uninitialised_interval_s);

@@ -108,6 +108,7 @@ class LocalMapper : public MappingBackend {
   bool AcceptsKeyFrames() const override { return accept_keyframes_.load(); }
   bool IsStoppedOrStopRequested() const override;
   bool IsInitializingImu() const override { return initializing_imu_.load(); }
+  bool TakeSlowMotionFlag() override { return slow_motion_.exchange(false); }
   int QueueSize() const override;
   void InterruptBundleAdjustment() override { abort_ba_.store(true); }
   void WaitUntilIdle() override;
@@ -181,6 +182,8 @@ class LocalMapper : public MappingBackend {
   std::atomic<bool> accept_keyframes_{true};
   std::atomic<bool> abort_ba_{false};
   std::atomic<bool> initializing_imu_{false};
+  // Raised by InertialStep, taken by tracking (MappingBackend::TakeSlowMotionFlag).
+  std::atomic<bool> slow_motion_{false};
 
   // Owned by the mapping thread: points created recently, checked by CullRecentPoints.
   std::vector<MapPointPtr> recent_points_;
@@ -188,6 +191,9 @@ class LocalMapper : public MappingBackend {
   // (the clock of the VIBA refinements, mapping/inertial_mapping.h).
   const Map* moving_map_ = nullptr;
   double moving_s_ = 0;
+  // Owned by the mapping thread: ORB-SLAM3 v0.3's mTinit, the keyframe intervals since the IMU
+  // initialisation of moving_map_ over which the body travelled more than 5 cm in two steps.
+  double two_step_motion_s_ = 0;
 
   std::thread thread_;
 };

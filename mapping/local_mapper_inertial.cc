@@ -76,6 +76,7 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
     if (map != moving_map_) {
       moving_map_ = map;
       moving_s_ = 0;
+      two_step_motion_s_ = 0;
     }
     if (const KeyFrame* previous = kf->imu.previous; previous != nullptr && !previous->IsBad()) {
       const SE3d previous_from_kf = previous->world_from_body().Inverse() * kf->world_from_body();
@@ -83,6 +84,13 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
           previous_from_kf.so3().Log().norm() > o.moving_angle_rad) {
         step_s = std::min(o.moving_max_interval_s,
                           static_cast<double>(kf->t_ns() - previous->t_ns()) * 1e-9);
+      }
+      const KeyFrame* before = previous->imu.previous;
+      if (initialized && !ba2 && before != nullptr && !before->IsBad()) {
+        const double two_steps = (kf->CameraCenter() - previous->CameraCenter()).norm() +
+                                 (previous->CameraCenter() - before->CameraCenter()).norm();
+        if (two_steps > 0.05) two_step_motion_s_ += (kf->t_ns() - previous->t_ns()) * 1e-9;
+        if (two_step_motion_s_ < 10.0 && two_steps < 0.1) slow_motion_.store(true);
       }
     }
   }
@@ -92,6 +100,7 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
     if (InitializeImu(kf, o.init_gyro_prior,
                       mono ? o.init_accel_prior_mono : o.init_accel_prior_stereo, 0)) {
       moving_s_ = 0;
+      two_step_motion_s_ = 0;
     }
     initializing_imu_.store(false);
     return;

@@ -14,7 +14,7 @@
 
 namespace pkslam {
 
-SelectorInput Tracker::BuildSelectorInput(bool mapping_idle) const {
+SelectorInput Tracker::BuildSelectorInput(bool mapping_idle, bool for_decision) const {
   SelectorInput in;
   const CameraRig& rig = *rig_;
   const Map* map = atlas_->current_map();
@@ -24,6 +24,11 @@ SelectorInput Tracker::BuildSelectorInput(bool mapping_idle) const {
   in.fps = rig.fps;
   in.image_width = rig.camera.width();
   in.image_height = rig.camera.height();
+  in.fx = rig.fx;
+  in.fy = rig.fy;
+  in.cx = rig.cx;
+  in.cy = rig.cy;
+  in.bounds = rig.bounds;
   in.camera_from_world = current_.camera_from_world();
   in.inliers = inliers_;
   in.recently_lost = state_ == TrackingState::kRecentlyLost;
@@ -45,6 +50,8 @@ SelectorInput Tracker::BuildSelectorInput(bool mapping_idle) const {
   in.trace_wanted = trace_enabled_;
   in.local_mapping_initializing = mapping_->IsInitializingImu();
   in.local_mapping_queue = mapping_->QueueSize();
+  // Taken once per decision; a keyframe's second input (SnapshotAfterCreation) never sees it.
+  in.slow_motion_before_refinement = for_decision && mapping_->TakeSlowMotionFlag();
 
   if (!IsMonocular(rig.sensor)) {
     for (int i = 0; i < current_.size(); ++i) {
@@ -58,17 +65,20 @@ SelectorInput Tracker::BuildSelectorInput(bool mapping_idle) const {
     }
   }
   if (selector_->NeedsTrackedPoints()) {
+    const bool outliers = selector_->NeedsOutliers();
     const auto& kps = current_.keypoints_undistorted();
     for (int i = 0; i < current_.size(); ++i) {
       const auto& mp = current_.map_points[i];
-      if (!mp || current_.outliers[i] || mp->IsBad()) continue;
+      if (!mp || (current_.outliers[i] && !outliers) || mp->IsBad()) continue;
       SelectorPoint p;
       p.id = mp->id();
       p.position_world = mp->position();
       p.uv = Eigen::Vector2d(kps[i].pt.x, kps[i].pt.y);
       p.keypoint_index = i;
       p.in_last_keyframe = last_kf_ && !last_kf_->IsBad() && mp->IsInKeyFrame(last_kf_.get());
+      p.outlier = current_.outliers[i] != 0;
       p.descriptor = &current_.descriptors()[i];
+      p.map_point_descriptor = mp->descriptor();
       in.points.push_back(p);
     }
   }
@@ -115,7 +125,17 @@ void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
   reference_kf_ = kf;
   current_.reference_kf = kf;
   last_kf_ = kf;
-  selector_->OnKeyFrameInserted(input);
+  if (selector_->SnapshotAfterCreation()) {
+    // The frame as the keyframe holds it: the new close points in, outliers still in.
+    SelectorInput created;
+    {
+      std::shared_lock lock(atlas_->mutex());
+      created = BuildSelectorInput(input.local_mapping_idle, /*for_decision=*/false);
+    }
+    selector_->OnKeyFrameInserted(created);
+  } else {
+    selector_->OnKeyFrameInserted(input);
+  }
   mapping_->InsertKeyFrame(kf);
   if (options_.lockstep) mapping_->WaitUntilIdle();
 }

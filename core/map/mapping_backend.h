@@ -20,6 +20,10 @@ class MappingBackend {
   // Running IMU initialisation.
   virtual bool IsInitializingImu() const = 0;
   virtual int QueueSize() const = 0;
+  // Returns and clears the flag local mapping raises when, before the second inertial
+  // refinement and within its first 10 s of motion, the body moved less than 10 cm over its
+  // last two keyframe steps (ORB-SLAM3 v0.3's mbBadImu2, which pks-released obeys).
+  virtual bool TakeSlowMotionFlag() { return false; }
   // Asks a running local bundle adjustment to stop early.
   virtual void InterruptBundleAdjustment() = 0;
   // Deterministic mode: blocks until every queued keyframe is processed (and handed on).
