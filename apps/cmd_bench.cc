@@ -40,6 +40,7 @@ struct BenchArgs {
   int jobs = 1;
   bool retry_failed = false;
   bool reevaluate = false;
+  bool prune_cache = false;
   bool no_plots = false;
   bool list = false;
   bool quiet = false;
@@ -103,6 +104,7 @@ void Run(const BenchArgs& a) {
   h.quiet = a.quiet;
   h.retry_failed = a.retry_failed;
   h.reevaluate = a.reevaluate;
+  h.prune_cache = a.prune_cache;
   h.simulator_id = bench::ExecutableId(h.pkslam);
   if (!a.emit_jobs.empty()) {
     const auto e = bench::EmitJobs(suite, runs, h);
@@ -165,6 +167,9 @@ void RegisterBenchCommand(CLI::App& app) {
                   "Execute only these runs (ids as --list prints); no report is written: `pkslam "
                   "bench --collect OUT` makes it");
   cmd->add_flag("--retry-failed", args->retry_failed, "Run failed runs again");
+  cmd->add_flag("--prune-cache", args->prune_cache,
+                "Render each simulated dataset just before its runs and delete it after them "
+                "(disk holds ~--jobs renderings; for suites with seed_per_run)");
   cmd->add_flag("--reevaluate", args->reevaluate,
                 "Measure finished runs again against ground truth (no SLAM re-run)");
   cmd->add_flag("--list", args->list, "Print the run ids of the matrix and exit");

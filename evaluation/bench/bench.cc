@@ -113,6 +113,22 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
   c.skipped = c.total - static_cast<int>(pending.size());
   if (c.skipped > 0) PKSLAM_LOG_INFO("{} of {} runs already finished: skipped", c.skipped, c.total);
 
+  // With prune_cache the runs of one recipe run together (matrix order within) and each
+  // rendering is made by its first run and deleted after its last.
+  std::map<std::string, int> runs_per_render;
+  if (options.prune_cache) {
+    std::map<std::string, std::size_t> first;
+    for (const RunSpec* r : pending) {
+      if (r->sim) first.emplace(SimKey(options, *r), first.size());
+    }
+    auto rank = [&](const RunSpec* r) { return r->sim ? first[SimKey(options, *r)] : 0; };
+    std::stable_sort(pending.begin(), pending.end(),
+                     [&](const RunSpec* a, const RunSpec* b) { return rank(a) < rank(b); });
+    for (const RunSpec* r : pending) {
+      if (r->sim) ++runs_per_render[SimKey(options, *r)];
+    }
+  }
+
   // 1. Simulator recipes, each rendered once (a failure fails only the runs that need it).
   std::vector<const RunSpec*> recipes;
   std::set<std::string> seen;
@@ -123,7 +139,7 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
   }
   std::map<std::string, std::string> sim_errors;
   std::mutex sim_errors_mutex;
-  if (!recipes.empty()) {
+  if (!recipes.empty() && !options.prune_cache) {
     Progress progress("simulate", recipes.size(), options.quiet);
     ParallelFor(
         static_cast<int>(recipes.size()), options.jobs, cancel,
@@ -162,6 +178,14 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
         },
         [&](int i) {
           progress.Add();
+          if (options.prune_cache && pending[i]->sim) {
+            const std::string key = SimKey(options, *pending[i]);
+            if (--runs_per_render[key] == 0 && !(cancel != nullptr && cancel->load())) {
+              std::error_code ec;
+              fs::remove_all(key, ec);
+              if (ec) PKSLAM_LOG_WARN("cannot delete rendering {}: {}", key, ec.message());
+            }
+          }
           if (!done[i]) return;
           ++c.executed;
           const RunResult& r = *done[i];

@@ -221,6 +221,32 @@ std::optional<RunResult> ReadFinished(const fs::path& run_dir) {
   return std::nullopt;  // unreadable: run again
 }
 
+namespace {
+
+// A run with --prune-cache keeps a copy of its ground truth (its rendering is deleted), so it
+// can be evaluated again.
+std::optional<fs::path> KeptGroundTruth(const fs::path& run_dir) {
+  for (const char* name : {"ground_truth.csv", "ground_truth.txt"}) {
+    if (fs::exists(run_dir / name)) return run_dir / name;
+  }
+  return std::nullopt;
+}
+
+fs::path KeepGroundTruth(const fs::path& run_dir, const fs::path& dataset,
+                         const std::optional<fs::path>& ground_truth) {
+  const fs::path source = ground_truth ? *ground_truth : FindGroundTruth(dataset);
+  const fs::path copy =
+      run_dir / (source.extension() == ".csv" ? "ground_truth.csv" : "ground_truth.txt");
+  std::error_code ec;
+  fs::copy_file(source, copy, fs::copy_options::overwrite_existing, ec);
+  if (ec)
+    throw Error(
+        fmt::format("cannot copy {} to {}: {}", source.string(), copy.string(), ec.message()));
+  return copy;
+}
+
+}  // namespace
+
 std::optional<RunResult> ReevaluateRun(const Suite& suite, const RunSpec& run,
                                        const HarnessOptions& options) {
   const fs::path run_dir = RunDir(options.out, run);
@@ -229,9 +255,13 @@ std::optional<RunResult> ReevaluateRun(const Suite& suite, const RunSpec& run,
   RunResult result = ResultSkeleton(run, suite);
   result.dense_points = done->dense_points;
   try {
-    const fs::path dataset = PrepareDataset(suite, run, options);
-    const DatasetSpec& d = DatasetOf(suite, run);
-    EvaluateRun({run_dir, dataset, d.ground_truth, suite.rpe_delta_m}, &result);
+    if (const auto kept = KeptGroundTruth(run_dir)) {
+      EvaluateRun({run_dir, run_dir, kept, suite.rpe_delta_m}, &result);
+    } else {
+      const fs::path dataset = PrepareDataset(suite, run, options);
+      const DatasetSpec& d = DatasetOf(suite, run);
+      EvaluateRun({run_dir, dataset, d.ground_truth, suite.rpe_delta_m}, &result);
+    }
   } catch (const Error& e) {
     result.ok = false;
     result.error = std::string("evaluation: ") + e.what();
@@ -299,7 +329,10 @@ std::optional<RunResult> ExecuteRun(const Suite& suite, const RunSpec& run,
   try {
     if (peer) ImportPeerRun(run_dir, dataset, run.sensor);
     const DatasetSpec& d = DatasetOf(suite, run);
-    EvaluateRun({run_dir, dataset, d.ground_truth, suite.rpe_delta_m}, &result);
+    std::optional<fs::path> ground_truth = d.ground_truth;
+    if (options.prune_cache && run.sim)
+      ground_truth = KeepGroundTruth(run_dir, dataset, ground_truth);
+    EvaluateRun({run_dir, dataset, ground_truth, suite.rpe_delta_m}, &result);
   } catch (const Error& e) {
     result.ok = false;
     result.error = std::string("evaluation: ") + e.what();

@@ -25,6 +25,11 @@ struct HarnessOptions {
   bool quiet = false;            // no progress bars
   bool retry_failed = false;     // re-execute runs whose result.csv says failed
   bool reevaluate = false;       // measure finished runs again (new evaluation code or truth)
+  // Render each simulator recipe just before its first pending run, execute the runs of one
+  // recipe together, and delete the rendering when its last pending run finished: disk holds
+  // about `jobs` renderings at a time (a study with per-run render seeds of full EuRoC replays
+  // would otherwise need ~2 GB per run).
+  bool prune_cache = false;
   // Part of every cache key (ExecutableId of `pkslam`): a rebuilt simulator may render the same
   // command line differently, so its renders are never mistaken for an older build's.
   std::string simulator_id;

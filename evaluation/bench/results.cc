@@ -97,7 +97,11 @@ std::vector<std::string> ResultColumns() {
           "p95_tracking_ms",
           "mapping_ms_per_kf",
           "cpu_s",
-          "peak_memory_mib"};
+          "peak_memory_mib",
+          "sequence_s",
+          "mapping_cpu_s",
+          "degraded",
+          "keyframe_reasons"};
 }
 
 std::string CsvField(const std::string& text) {
@@ -179,7 +183,11 @@ std::string ResultCsvRow(const RunResult& r) {
                                       Num(r.p95_tracking_ms),
                                       Num(r.mapping_ms_per_kf),
                                       Num(r.cpu_s),
-                                      Num(r.peak_memory_mib)};
+                                      Num(r.peak_memory_mib),
+                                      Num(r.sequence_s),
+                                      Num(r.mapping_cpu_s),
+                                      Num(r.degraded),
+                                      CsvField(r.keyframe_reasons)};
   std::string out;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (i > 0) out.push_back(',');
@@ -260,11 +268,14 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
     // In the order of ResultColumns(); a file holds a prefix of them.
     double* optional[] = {&r.dense_points,    &r.gyro_bias_err_pct, &r.accel_bias_err_pct,
                           &r.realtime_factor, &r.p95_tracking_ms,   &r.mapping_ms_per_kf,
-                          &r.cpu_s,           &r.peak_memory_mib};
-    PKSLAM_CHECK(required + std::size(optional) == columns.size(), "optional columns");
-    for (std::size_t k = 0; required + k < header.size(); ++k) {
+                          &r.cpu_s,           &r.peak_memory_mib,   &r.sequence_s,
+                          &r.mapping_cpu_s,   &r.degraded};
+    // The last column (keyframe_reasons) is text.
+    PKSLAM_CHECK(required + std::size(optional) + 1 == columns.size(), "optional columns");
+    for (std::size_t k = 0; k < std::size(optional) && required + k < header.size(); ++k) {
       *optional[k] = ParseDouble(next(), file, n, header[required + k]);
     }
+    if (header.size() == columns.size()) r.keyframe_reasons = next();
     out.push_back(std::move(r));
   }
   return out;

@@ -55,6 +55,12 @@ struct RunResult {
   double mapping_ms_per_kf = kNaN;  // median local mapping time per keyframe
   double cpu_s = kNaN;              // CPU time of the whole process (every thread)
   double peak_memory_mib = kNaN;    // peak resident memory
+  double sequence_s = kNaN;         // duration of the sequence the run processed
+  double mapping_cpu_s = kNaN;      // CPU time of local mapping (equal-budget comparisons)
+  double degraded = kNaN;           // 1: the run warned about degraded input (stats.json)
+  // Keyframes per creating rule, "reason=count" separated by spaces (stats.json
+  // keyframe_reasons; empty for peers and older runs).
+  std::string keyframe_reasons;
 };
 
 // The headline alignment of a run: `suite_choice` when "se3"/"sim3"; for "auto" "sim3" for

@@ -31,6 +31,10 @@ struct StatsJson {
   double mapping_ms_per_kf = kNaN;
   double cpu_s = kNaN;
   double peak_memory_mib = kNaN;
+  double sequence_s = kNaN;
+  double mapping_cpu_s = kNaN;
+  double degraded = kNaN;
+  std::string keyframe_reasons;  // "reason=count ..."
 };
 
 // realtime_factor from stats.json, else sequence_duration_s / wall time. A factor <= 0 is
@@ -76,6 +80,15 @@ StatsJson ReadStats(const fs::path& file) {
   s.mapping_ms_per_kf = optional("median_local_mapping_ms");
   s.cpu_s = optional("process_cpu_s");
   s.peak_memory_mib = optional("peak_memory_mib");
+  s.sequence_s = optional("sequence_duration_s");
+  s.mapping_cpu_s = optional("local_mapping_cpu_s");
+  if (root["degraded"]) s.degraded = get("degraded", false) ? 1.0 : 0.0;
+  if (const YAML::Node reasons = root["keyframe_reasons"]; reasons && reasons.IsMap()) {
+    for (const auto& kv : reasons) {
+      if (!s.keyframe_reasons.empty()) s.keyframe_reasons += ' ';
+      s.keyframe_reasons += kv.first.as<std::string>() + "=" + kv.second.as<std::string>();
+    }
+  }
   return s;
 }
 
@@ -133,8 +146,13 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   result->mapping_ms_per_kf = stats.mapping_ms_per_kf;
   result->cpu_s = stats.cpu_s;
   result->peak_memory_mib = stats.peak_memory_mib;
+  result->sequence_s = stats.sequence_s;
+  result->mapping_cpu_s = stats.mapping_cpu_s;
+  result->degraded = stats.degraded;
+  result->keyframe_reasons = stats.keyframe_reasons;
 
-  const fs::path gt_file = files.ground_truth.value_or(FindGroundTruth(files.dataset));
+  const fs::path gt_file =
+      files.ground_truth ? *files.ground_truth : FindGroundTruth(files.dataset);
   // Visual-only monocular maps have no metric scale: their camera poses are compared with the
   // ground truth moved into the camera (io/rigid_transform_file.h).
   const RunAndGroundTruth pair =
