@@ -45,11 +45,12 @@ void RunEval(const EvalArgs& args) {
   const TrajectoryFormat gt_format = ParseTrajectoryFormat(args.gt_format);
   const TrajectoryFormat est_format = ParseTrajectoryFormat(args.est_format);
 
-  Trajectory gt = ReadTrajectory(args.gt_file, gt_format);
+  // Repeated stamps stay (with a warning), as evo keeps them.
+  Trajectory gt = ReadTrajectory(args.gt_file, gt_format, DuplicateTimestamps::kKeepAll);
   if (!args.body_from_camera_file.empty()) {
     gt = ChangeSensorFrame(gt, ReadRigidTransform(args.body_from_camera_file));
   }
-  const Trajectory est = ReadTrajectory(args.est_file, est_format);
+  const Trajectory est = ReadTrajectory(args.est_file, est_format, DuplicateTimestamps::kKeepAll);
   const EvaluationResult result = EvaluateTrajectories(gt, est, options);
 
   std::cout << fmt::format("ground truth  {} ({} poses, {:.1f} s, {:.2f} m)\n", args.gt_file,

@@ -11,8 +11,8 @@ namespace {
 
 std::int64_t SecondsToNs(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 
-bool StrictlyIncreasing(std::span<const std::int64_t> t) {
-  return std::adjacent_find(t.begin(), t.end(), std::greater_equal<>()) == t.end();
+bool NonDecreasing(std::span<const std::int64_t> t) {
+  return std::adjacent_find(t.begin(), t.end(), std::greater<>()) == t.end();
 }
 
 // The double nearest to t_ns * 1e-9, i.e. what numpy parses from the decimal text of the same
@@ -40,8 +40,8 @@ std::vector<IndexPair> AssociateTimestamps(std::span<const std::int64_t> ref_t_n
                                            std::span<const std::int64_t> est_t_ns,
                                            const AssociationOptions& options) {
   options.Check();
-  PKSLAM_CHECK(StrictlyIncreasing(ref_t_ns) && StrictlyIncreasing(est_t_ns),
-               "association needs strictly increasing timestamps");
+  PKSLAM_CHECK(NonDecreasing(ref_t_ns) && NonDecreasing(est_t_ns),
+               "association needs timestamps sorted by time");
 
   // evo: the shorter trajectory drives; the estimate drives when both are equally long.
   const bool est_drives = est_t_ns.size() <= ref_t_ns.size();
@@ -90,11 +90,14 @@ std::vector<IndexPair> AssociateTimestamps(std::span<const std::int64_t> ref_t_n
 
   if (options.one_to_one) {
     // Matches of one `other` pose are adjacent (nearest-neighbour matching of sorted stamps is
-    // monotone); keep the closest of each run, the earliest on a tie.
+    // monotone); keep the closest of each run, the earliest on a tie. Repeats of one stamp in
+    // the driving trajectory all stay, as in evo (they are the same instant, not a second
+    // pose competing for the pair).
     std::vector<Match> unique;
     unique.reserve(matches.size());
     for (const Match& m : matches) {
-      if (!unique.empty() && unique.back().other == m.other) {
+      const bool repeat = !unique.empty() && driver[unique.back().driver] == driver[m.driver];
+      if (!unique.empty() && unique.back().other == m.other && !repeat) {
         if (m.diff_s < unique.back().diff_s) unique.back() = m;
       } else {
         unique.push_back(m);

@@ -9,7 +9,8 @@
 // evo's rule can pair one pose of the longer trajectory with several poses of the shorter one
 // (only when the shorter trajectory has stamps less than 2 * max_diff apart). With
 // one_to_one (the default) each such group keeps only its closest pair (the earliest on a tie),
-// so every pose appears in at most one pair; whenever evo's pairs are already one-to-one,
+// so every pose appears in at most one pair (repeats of one stamp aside, see below); whenever
+// evo's pairs are already one-to-one,
 // which is the usual case (e.g. a 20-30 Hz estimate against ground truth with max_diff 10 ms),
 // both modes give evo's pairs exactly.
 //
@@ -44,8 +45,9 @@ struct IndexPair {
   bool operator==(const IndexPair&) const = default;
 };
 
-// Pairs sorted by time (both indices non-decreasing; strictly increasing when one_to_one).
-// Both stamp lists must be strictly increasing (trajectory readers guarantee it).
+// Pairs sorted by time (both indices non-decreasing). Both stamp lists must be sorted; repeated
+// stamps are evaluated as evo does: in the driving trajectory each repeat is its own pair (also
+// with one_to_one), in the other one the nearest-time search takes the first of them.
 std::vector<IndexPair> AssociateTimestamps(std::span<const std::int64_t> ref_t_ns,
                                            std::span<const std::int64_t> est_t_ns,
                                            const AssociationOptions& options);

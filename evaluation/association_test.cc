@@ -16,6 +16,7 @@ void PrintTo(const IndexPair& pair, std::ostream* os) {
 namespace {
 
 constexpr std::int64_t kMs = 1000000;
+constexpr std::int64_t kSecond = 1000 * kMs;
 
 std::vector<IndexPair> Associate(const std::vector<std::int64_t>& ref,
                                  const std::vector<std::int64_t>& est,
@@ -108,7 +109,23 @@ TEST(AssociateTimestamps, RejectsBadOptionsAndUnsortedInput) {
   bad.offset_s = std::nan("");
   EXPECT_THROW(Associate({0}, {0}, bad), OptionError);
   EXPECT_THROW(Associate({0, 2, 1}, {0}), Error);
-  EXPECT_THROW(Associate({0}, {3, 3}), Error);
+  EXPECT_THROW(Associate({0}, {3, 1}), Error);
+}
+
+TEST(AssociateTimestamps, RepeatedEstimateStampsEachPairAsInEvo) {
+  // The estimate (3 poses) drives: both poses at 1 s pair with the reference pose at 1 s, also
+  // with one_to_one (evo keeps both). Reference 0..9 s.
+  std::vector<std::int64_t> ref;
+  for (int i = 0; i < 10; ++i) ref.push_back(i * kSecond);
+  const std::vector<std::int64_t> est = {kSecond, kSecond, 2 * kSecond};
+  const std::vector<IndexPair> expected = {{1, 0}, {1, 1}, {2, 2}};
+  EXPECT_EQ(Associate(ref, est), expected);
+  AssociationOptions evo;
+  evo.one_to_one = false;
+  EXPECT_EQ(Associate(ref, est, evo), expected);
+  // A repeated stamp in the longer trajectory: the nearest-time search takes the first.
+  EXPECT_EQ(Associate({0, kSecond, kSecond, 2 * kSecond}, {kSecond}),
+            (std::vector<IndexPair>{{1, 0}}));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <string>
 
 #include "core/util/error.h"
@@ -45,6 +46,43 @@ TEST(EvaluateTrajectories, ReproducesEvoOnFr2DeskOrb) {
   // evo's own association (with its repeated matches) gives the same pairs here.
   options.association.one_to_one = false;
   EXPECT_EQ(EvaluateTrajectories(gt, est, options).pairs, r.pairs);
+}
+
+// An estimate that repeats a stamp with two poses (ORB-SLAM3 does this now and then): evo pairs
+// both with the nearest reference pose and both count in the ATE.
+TEST(EvaluateTrajectories, RepeatedEstimateStampsCountAsInEvo) {
+  const auto dir = testing::MakeTempDir("eval_repeats");
+  {
+    std::ofstream gt(dir / "gt.txt");
+    for (int i = 0; i < 10; ++i) gt << i << ".0 " << i << " 0 0 0 0 0 1\n";
+    std::ofstream est(dir / "est.txt");
+    est << "1.0 1 0 0 0 0 0 1\n1.0 1.3 0 0 0 0 0 1\n2.0 2 0 0 0 0 0 1\n";
+  }
+  const Trajectory gt = ReadTrajectory(dir / "gt.txt");
+  const Trajectory est =
+      ReadTrajectory(dir / "est.txt", TrajectoryFormat::kAuto, DuplicateTimestamps::kKeepAll);
+  ASSERT_EQ(est.size(), 3u);
+  EvaluationOptions options;
+  options.alignment = AlignmentMethod::kNone;
+  const EvaluationResult r = EvaluateTrajectories(gt, est, options);
+  ASSERT_EQ(r.pairs.size(), 3u);
+  // Errors 0, 0.3 and 0 m: rmse = sqrt(0.09 / 3).
+  EXPECT_NEAR(r.ate_translation_m.rmse, std::sqrt(0.03), 1e-9);
+  EXPECT_NEAR(r.ate_translation_m.max, 0.3, 1e-9);
+  // Dropping the repeat (the older reading) would have hidden the 0.3 m error.
+  EXPECT_EQ(ReadTrajectory(dir / "est.txt").size(), 2u);
+}
+
+TEST(EvaluateTrajectories, RepeatedReferenceStampsKeptGiveEvoResultsToo) {
+  PKSLAM_REQUIRE_SHARED_DATA(shared);
+  // fr2_desk ground truth repeats 1311868229.5760: kept or dropped, the nearest-time search
+  // takes the first pose of the two, as evo's argmin does.
+  const Trajectory gt = ReadTrajectory(shared / "evo" / "fr2_desk_groundtruth.txt",
+                                       TrajectoryFormat::kAuto, DuplicateTimestamps::kKeepAll);
+  const Trajectory est = ReadTrajectory(shared / "evo" / "fr2_desk_ORB.txt");
+  EvaluationOptions options;
+  options.alignment = AlignmentMethod::kSE3;
+  ExpectClose(EvaluateTrajectories(gt, est, options).ate_translation_m.rmse, 0.008119, "rmse");
 }
 
 TEST(EvaluateTrajectories, ReproducesEvoOnFr1XyzRgbdslam) {

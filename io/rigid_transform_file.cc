@@ -75,7 +75,9 @@ RunAndGroundTruth ReadRunAndGroundTruth(const std::filesystem::path& run_dir,
   if (body_gt && camera_poses && fs::exists(extrinsic)) {
     r.ground_truth = ChangeSensorFrame(r.ground_truth, ReadRigidTransform(extrinsic));
   }
-  r.estimate = ReadTrajectory(r.estimate_file, TrajectoryFormat::kTum);
+  // Peers (ORB-SLAM3) can repeat a stamp; evo evaluates every such pose, so does pkslam.
+  r.estimate =
+      ReadTrajectory(r.estimate_file, TrajectoryFormat::kTum, DuplicateTimestamps::kKeepAll);
   return r;
 }
 

@@ -268,16 +268,17 @@ Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
 
     if (!trajectory.poses.empty() && stamped.t_ns <= trajectory.poses.back().t_ns) {
       const bool repeat = stamped.t_ns == trajectory.poses.back().t_ns;
-      if (repeat && duplicates == DuplicateTimestamps::kKeepFirst) {
+      if (repeat && duplicates != DuplicateTimestamps::kError) {
         if (duplicates_dropped++ == 0) first_duplicate_line = line.number;
-        continue;
+        if (duplicates == DuplicateTimestamps::kKeepFirst) continue;
+      } else {
+        throw InputError(
+            file, line.number,
+            fmt::format("timestamp {} s {} the previous one ({} s): poses must be sorted by time{}",
+                        FormatSeconds(stamped.t_ns), repeat ? "repeats" : "is before",
+                        FormatSeconds(trajectory.poses.back().t_ns),
+                        repeat ? " without duplicates" : ""));
       }
-      throw InputError(
-          file, line.number,
-          fmt::format("timestamp {} s {} the previous one ({} s): poses must be sorted by time{}",
-                      FormatSeconds(stamped.t_ns), repeat ? "repeats" : "is before",
-                      FormatSeconds(trajectory.poses.back().t_ns),
-                      repeat ? " without duplicates" : ""));
     }
     trajectory.poses.push_back(stamped);
     if (fields.size() == 17) {
@@ -290,8 +291,9 @@ Trajectory ReadTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
   }
   if (trajectory.poses.empty()) throw InputError(file, "empty trajectory file (no pose lines)");
   if (duplicates_dropped > 0) {
-    PKSLAM_LOG_WARN("{}: dropped {} line(s) repeating the previous timestamp (first at line {})",
-                    file.string(), duplicates_dropped, first_duplicate_line);
+    PKSLAM_LOG_WARN("{}: {} {} line(s) repeating the previous timestamp (first at line {})",
+                    file.string(), duplicates == DuplicateTimestamps::kKeepAll ? "kept" : "dropped",
+                    duplicates_dropped, first_duplicate_line);
   }
   if (far_from_unit > 0) {
     PKSLAM_LOG_WARN(

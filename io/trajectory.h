@@ -82,6 +82,8 @@ TrajectoryFormat DetectTrajectoryFormat(const std::filesystem::path& file);
 // What to do with a line whose timestamp equals the previous line's.
 enum class DuplicateTimestamps {
   kKeepFirst,  // drop the later line, warn once per file with the count and the first line
+  kKeepAll,    // keep every line (stamps then only non-decreasing), warn once likewise: evo
+               // evaluates each pose of an estimate, repeated stamps included
   kError,      // throw InputError naming the line
 };
 
