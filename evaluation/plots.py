@@ -39,6 +39,12 @@ def read_results(path):
         r["ok"] = r["status"] == "ok"
         for k in ("ate_m", "keyframes", "median_tracking_ms", "wall_s", "sweep_value"):
             r[k] = number(r[k])
+        # Absent in results.csv files written before the PKS study columns.
+        for k in ("sequence_s", "mapping_cpu_s", "realtime_factor", "coverage"):
+            r[k] = number(r.get(k))
+        if not math.isfinite(r["sequence_s"]):
+            r["sequence_s"] = r["realtime_factor"] * r["wall_s"]
+        r["keyframe_reasons"] = r.get("keyframe_reasons") or ""
         # Absent in results.csv files written before dense clouds were part of a bench.
         r["dense_points"] = number(r.get("dense_points"))
         r["index"] = int(r["index"])
@@ -248,6 +254,171 @@ def sweeps(index, rows):
                    + (", and the Eq. 13 score from the dense clouds" if dense else ""))
 
 
+def equal_budget(index, rows):
+    """ATE against keyframes per second and against local-mapping CPU time: every configuration
+    (sweep values included) as one point per dataset, a selector's sweep joined by a line, so a
+    better selection is not confused with more keyframes."""
+    if not any(r["sweep_param"] for r in rows):
+        return
+    for sensor in unique(r["sensor"] for r in rows):
+        sub = [r for r in rows if r["sensor"] == sensor and r["ok"]]
+        datasets = unique(r["dataset"] for r in sub)
+        if not datasets:
+            continue
+        fig, axes = plt.subplots(len(datasets), 2, figsize=(11, 3.6 * len(datasets)),
+                                 squeeze=False)
+        colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+        for row, dataset in zip(axes, datasets):
+            pts = [r for r in sub if r["dataset"] == dataset]
+            bases = unique(r["config"].split("@")[0] for r in pts)
+            for i, base in enumerate(bases):
+                color = colors[i % len(colors)]
+                group = [r for r in pts if r["config"].split("@")[0] == base]
+                configs = unique(r["config"] for r in group)
+                xs_kf, xs_cpu, ys = [], [], []
+                for config in configs:
+                    runs = [r for r in group if r["config"] == config]
+                    kfps = [r["keyframes"] / r["sequence_s"] for r in runs
+                            if math.isfinite(r["sequence_s"]) and r["sequence_s"] > 0]
+                    cpu = [r["mapping_cpu_s"] for r in runs]
+                    xs_kf.append(mean_std(kfps)[0])
+                    xs_cpu.append(mean_std(cpu)[0])
+                    ys.append(mean_std([r["ate_m"] for r in runs])[0])
+                for ax, xs in ((row[0], xs_kf), (row[1], xs_cpu)):
+                    order = sorted((x, y) for x, y in zip(xs, ys)
+                                   if math.isfinite(x) and math.isfinite(y))
+                    if not order:
+                        continue
+                    ax.plot([x for x, _ in order], [y for _, y in order], "-o", color=color,
+                            ms=4, label=base)
+            row[0].set_xlabel("keyframes per second (final map)")
+            row[1].set_xlabel("local-mapping CPU time [s]")
+            for ax in row:
+                ax.set_ylabel("ATE RMSE [m] (mean)")
+                ax.set_title(f"{dataset} / {sensor}", fontsize=9)
+                ax.grid(alpha=0.3)
+                ax.legend(fontsize=7)
+        index.save(fig, f"equal_budget_{safe(sensor)}.png", "budget",
+                   f"{sensor}: mean ATE against keyframes per second and against local-mapping CPU "
+                   "time; each selector's sweep is one line (compare selectors at equal x)")
+
+
+def per_sequence_cdf(index, rows):
+    """The PKS paper's per-sequence plot: each configuration's runs sorted by ATE."""
+    for sensor in unique(r["sensor"] for r in rows):
+        sub = [r for r in rows if r["sensor"] == sensor]
+        datasets = unique(r["dataset"] for r in sub)
+        cols = min(3, len(datasets))
+        rows_n = math.ceil(len(datasets) / cols)
+        fig, axes = plt.subplots(rows_n, cols, figsize=(4.6 * cols, 3.4 * rows_n), squeeze=False)
+        for ax, dataset in zip(axes.flat, datasets):
+            for config in unique(r["config"] for r in sub if r["dataset"] == dataset):
+                runs = [r for r in sub if r["dataset"] == dataset and r["config"] == config]
+                v = np.sort([r["ate_m"] for r in runs if r["ok"] and math.isfinite(r["ate_m"])])
+                if v.size == 0:
+                    continue
+                ax.plot(np.arange(1, v.size + 1), np.cumsum(v), "-o", ms=3,
+                        label=f"{config} ({v.size}/{len(runs)})")
+            ax.set_title(dataset, fontsize=9)
+            ax.set_xlabel("runs (sorted by ATE)")
+            ax.set_ylabel("cumulative ATE [m]")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7)
+        for ax in list(axes.flat)[len(datasets):]:
+            ax.axis("off")
+        index.save(fig, f"ate_cumulative_{safe(sensor)}.png", "accuracy",
+                   f"{sensor}: cumulative ATE over each configuration's runs sorted by ATE, per "
+                   "sequence, as the PKS paper plots it (failed runs are left out; n/N in the "
+                   "legend)")
+
+
+def keyframe_views(index, rows, roots):
+    """Top views with the keyframes of each configuration's median-ATE run, one panel each."""
+    for dataset in unique(r["dataset"] for r in rows):
+        for sensor in unique(r["sensor"] for r in rows if r["dataset"] == dataset):
+            sub = [r for r in rows if r["dataset"] == dataset and r["sensor"] == sensor
+                   and r["ok"] and not r["sweep_param"]]
+            configs = unique(r["config"] for r in sub)
+            if not configs:
+                continue
+            fig, axes = plt.subplots(1, len(configs), figsize=(3.6 * len(configs), 3.8),
+                                     squeeze=False)
+            drawn = 0
+            for ax, config in zip(axes[0], configs):
+                runs = sorted((r for r in sub if r["config"] == config), key=lambda r: r["ate_m"])
+                median = runs[(len(runs) - 1) // 2]
+                d = find_run(roots, median["run_id"])
+                traj = read_xyz(os.path.join(d, "plot_trajectory.csv"),
+                                ["gt_x", "gt_y"]) if d else None
+                kf = read_xyz(os.path.join(d, "plot_keyframes.csv"), ["x", "y"]) if d else None
+                if traj is None:
+                    ax.axis("off")
+                    continue
+                ax.plot(traj[:, 0], traj[:, 1], "-", color="0.6", lw=1)
+                if kf is not None:
+                    ax.plot(kf[:, 0], kf[:, 1], "o", ms=2.5, color="C3")
+                ax.set_aspect("equal", adjustable="datalim")
+                ax.set_title(f"{config}: {0 if kf is None else len(kf)} KFs", fontsize=9)
+                ax.tick_params(labelsize=7)
+                drawn += 1
+            if not drawn:
+                plt.close(fig)
+                continue
+            index.save(fig, f"keyframes_{safe(dataset)}_{safe(sensor)}.png", "trajectories",
+                       f"{dataset}, {sensor}: keyframe positions (red) of each configuration's "
+                       "median-ATE run over the ground-truth path (grey)")
+
+
+def reason_shares(index, rows):
+    """Which rule created the keyframes: share per configuration (a keyframe counts for every
+    rule its reason names, e.g. forced+imu)."""
+    rows = [r for r in rows if r["keyframe_reasons"] and not r["sweep_param"]]
+    if not rows:
+        return
+    sensors = unique(r["sensor"] for r in rows)
+    fig, axes = plt.subplots(1, len(sensors), figsize=(6 * len(sensors), 4), squeeze=False)
+    for ax, sensor in zip(axes[0], sensors):
+        sub = [r for r in rows if r["sensor"] == sensor]
+        configs = unique(r["config"] for r in sub)
+        counts = {c: {} for c in configs}
+        for r in sub:
+            for item in r["keyframe_reasons"].split():
+                reason, _, n = item.rpartition("=")
+                for rule in reason.split(";")[0].split("+"):
+                    counts[r["config"]][rule] = counts[r["config"]].get(rule, 0) + number(n)
+        rules = unique(rule for c in configs for rule in counts[c])
+        bottom = np.zeros(len(configs))
+        for rule in rules:
+            share = np.array([counts[c].get(rule, 0) / max(1, sum(counts[c].values()))
+                              for c in configs])
+            ax.bar(range(len(configs)), share, bottom=bottom, label=rule)
+            bottom += share
+        ax.set_xticks(range(len(configs)))
+        ax.set_xticklabels(configs, rotation=25, ha="right", fontsize=8)
+        ax.set_ylabel("share of rule mentions")
+        ax.set_title(sensor)
+        ax.legend(fontsize=7, ncol=2)
+    index.save(fig, "keyframe_reasons.png", "keyframes",
+               "Which rule created the keyframes, per configuration (all runs)")
+
+
+def statistics_fragments(out, results_path):
+    """The Statistics section (bench_statistics.py) as Markdown and HTML fragments."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import bench_statistics  # noqa: E402 (scipy: only needed here)
+    rows = bench_statistics.read_rows(results_path)
+    if not rows:
+        return
+    result = bench_statistics.analyse(rows)
+    with open(os.path.join(out, "statistics.md"), "w") as f:
+        f.write(bench_statistics.markdown(result))
+    with open(os.path.join(out, "statistics.html"), "w") as f:
+        f.write(bench_statistics.html_fragment(result))
+    with open(os.path.join(out, "statistics.json"), "w") as f:
+        import json
+        json.dump(result, f, indent=1, default=float)
+
+
 def equation13(axis, values, ate, dense, label):
     """Plots min-max normalised density minus normalised ATE; marks the argmax."""
     pts = [(v, a, d) for v, a, d in zip(values, ate, dense)
@@ -283,13 +454,18 @@ def main():
         per_sensor_bars(index, main_rows, "ate_m", "ATE RMSE [m]", "ate_bars.png", "accuracy",
                         "ATE per sequence: mean over runs, error bars one standard deviation")
         ate_cdf(index, main_rows)
+        per_sequence_cdf(index, main_rows)
         trajectories(index, rows, a.runs)
+        keyframe_views(index, rows, a.runs)
+        reason_shares(index, rows)
         per_sensor_bars(index, main_rows, "keyframes", "keyframes in the final map",
                         "keyframes.png", "keyframes", "Keyframes per sequence (mean ± std)")
         per_sensor_bars(index, main_rows, "median_tracking_ms", "median tracking time [ms]",
                         "tracking_time.png", "keyframes",
                         "Median per-frame tracking time (mean ± std over runs)")
         sweeps(index, rows)
+        equal_budget(index, rows)
+        statistics_fragments(a.out, a.results)
     index.write()
     print(f"plots: {len(index.lines)} PNGs in {a.out}")
     return 0

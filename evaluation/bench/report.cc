@@ -146,6 +146,22 @@ void AddSpeed(Document* doc, const std::vector<GroupSummary>& groups) {
   doc->AddTable(speed);
 }
 
+// The Statistics section plots.py wrote with bench_statistics.py (tests, intervals, power).
+void AddStatistics(Document* doc, const fs::path& plots_dir) {
+  const fs::path md = plots_dir / "statistics.md";
+  const fs::path html = plots_dir / "statistics.html";
+  if (!fs::exists(md) || !fs::exists(html)) return;
+  auto slurp = [](const fs::path& file) {
+    std::ifstream in(file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  doc->Heading(2, "Statistics");
+  doc->md += slurp(md) + "\n";
+  doc->html += slurp(html);
+}
+
 std::string Now() {
   const std::time_t t = std::time(nullptr);
   std::tm tm{};
@@ -229,6 +245,16 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
   doc.Heading(2, "Accuracy");
   for (const auto& t : HeadlineTables(groups)) doc.AddTable(t);
   doc.Images(plots, "accuracy");
+  AddStatistics(&doc, options.out / "plots");
+  if (std::any_of(plots.begin(), plots.end(),
+                  [](const Plot& p) { return p.section == "budget"; })) {
+    doc.Heading(2, "Equal keyframe budget");
+    doc.Paragraph(
+        "A selector that takes more keyframes may be more accurate for that reason alone: each "
+        "selector's swept parameter moves it along a line of ATE against keyframe rate and "
+        "mapping cost; compare selectors where their lines overlap in x.");
+    doc.Images(plots, "budget");
+  }
   doc.Heading(2, "Trajectories");
   doc.Paragraph(
       "Top view (x-y) of ground truth and the median-ATE run of each configuration, "
@@ -236,6 +262,7 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
   doc.Images(plots, "trajectories");
   doc.Heading(2, "Keyframes, maps and run time");
   doc.AddTable(DetailTable(groups));
+  if (const Table reasons = ReasonTable(results); !reasons.rows.empty()) doc.AddTable(reasons);
   doc.Images(plots, "keyframes");
   AddSpeed(&doc, groups);
   const Table biases = BiasTable(groups);

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <tuple>
 
 #include "core/util/error.h"
@@ -441,6 +443,64 @@ Table FailureTable(const std::vector<RunResult>& results) {
   t.header = {"run", "error"};
   for (const auto& r : results) {
     if (!r.ok) t.rows.push_back({r.run_id, r.error});
+  }
+  return t;
+}
+
+Table ReasonTable(const std::vector<RunResult>& results) {
+  struct Counts {
+    std::string sensor;
+    std::string config;
+    int runs = 0;
+    std::map<std::string, double> per_rule;
+    double mentions = 0;
+  };
+  std::vector<Counts> groups;  // in matrix order
+  std::vector<std::string> rules;
+  for (const auto& r : results) {
+    if (!r.ok || r.keyframe_reasons.empty() || !r.sweep_param.empty()) continue;
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const Counts& c) {
+      return c.sensor == r.sensor && c.config == r.config;
+    });
+    if (it == groups.end()) {
+      Counts fresh;
+      fresh.sensor = r.sensor;
+      fresh.config = r.config;
+      it = groups.insert(groups.end(), std::move(fresh));
+    }
+    ++it->runs;
+    std::stringstream items(r.keyframe_reasons);
+    std::string item;
+    while (items >> item) {
+      const auto eq = item.rfind('=');
+      if (eq == std::string::npos) continue;
+      const double n = std::atof(item.c_str() + eq + 1);
+      std::string reason = item.substr(0, eq);
+      reason = reason.substr(0, reason.find(';'));
+      std::stringstream parts(reason);
+      std::string rule;
+      while (std::getline(parts, rule, '+')) {
+        if (rule.empty()) continue;
+        if (std::find(rules.begin(), rules.end(), rule) == rules.end()) rules.push_back(rule);
+        it->per_rule[rule] += n;
+        it->mentions += n;
+      }
+    }
+  }
+  Table t;
+  t.title = "Keyframes per run by the rule that created them (share of rule mentions)";
+  t.header = {"sensor", "configuration", "runs"};
+  t.header.insert(t.header.end(), rules.begin(), rules.end());
+  for (const auto& g : groups) {
+    std::vector<std::string> row = {g.sensor, g.config, std::to_string(g.runs)};
+    for (const auto& rule : rules) {
+      const auto it = g.per_rule.find(rule);
+      row.push_back(it == g.per_rule.end()
+                        ? "—"
+                        : fmt::format("{:.1f} ({:.0f}%)", it->second / g.runs,
+                                      100.0 * it->second / std::max(1.0, g.mentions)));
+    }
+    t.rows.push_back(std::move(row));
   }
   return t;
 }

@@ -99,6 +99,11 @@ Table BiasTable(const std::vector<GroupSummary>& groups);
 Table SpeedTable(const std::vector<GroupSummary>& groups);
 // Failed runs with their error (empty table when none).
 Table FailureTable(const std::vector<RunResult>& results);
+// Which rule created the keyframes (results.csv keyframe_reasons): one row per sensor and
+// configuration (sweeps left out), one column per rule, cells = keyframes per run naming that
+// rule (a "forced+imu" keyframe counts for both; suffixes such as ";busy" are dropped) and its
+// share of all rule mentions. No rows when no run recorded its reasons (peers, older runs).
+Table ReasonTable(const std::vector<RunResult>& results);
 
 std::string MarkdownTable(const Table& table);
 

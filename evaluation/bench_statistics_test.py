@@ -1,0 +1,113 @@
+"""Tests of bench_statistics.py on runs with a known effect, none, and failures.
+
+  /usr/bin/python3 -m unittest evaluation/bench_statistics_test.py   (CTest: bench_statistics)
+"""
+
+import math
+import os
+import sys
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_statistics as bs  # noqa: E402
+
+
+def rows_for(ate_by_config, sensor="stereo-inertial", datasets=("A", "B", "C", "D", "E"),
+             failures=None):
+    """ate_by_config: config -> function(dataset index, run) -> ATE. First config = baseline."""
+    rows = []
+    baseline = next(iter(ate_by_config))
+    index = 0
+    for d, dataset in enumerate(datasets):
+        for config, ate in ate_by_config.items():
+            for run in range(10):
+                failed = failures is not None and failures(config, d, run)
+                rows.append({"dataset": dataset, "sensor": sensor, "config": config,
+                             "baseline": baseline, "ok": not failed,
+                             "ate": math.inf if failed else ate(d, run),
+                             "coverage": 0.2 if failed else 1.0, "index": index})
+                index += 1
+    return rows
+
+
+class BenchStatisticsTest(unittest.TestCase):
+    def setUp(self):
+        bs.PERMUTATIONS = 4000  # enough for the margins below, and a quick test
+        bs.BOOTSTRAP = 1000
+
+    def test_holm_by_hand(self):
+        # Sorted 0.01 x 3 = 0.03; 0.03 x 2 = 0.06; 0.04 x 1 = 0.04 -> monotone 0.06.
+        self.assertEqual([round(p, 12) for p in bs.holm([0.01, 0.04, 0.03])], [0.03, 0.06, 0.06])
+
+    def test_exact_permutation_of_complete_separation(self):
+        a = np.array([1.0, 2, 3, 4, 5])
+        b = np.array([6.0, 7, 8, 9, 10])
+        effect, p, exact = bs.stratified_permutation([(a, b)], np.random.default_rng(1))
+        self.assertTrue(exact)
+        self.assertAlmostEqual(effect, 0.5)
+        self.assertAlmostEqual(p, 2 / 252)  # the two fully separated arrangements of C(10, 5)
+
+    def test_a_twenty_percent_gain_is_found_and_matches_the_paper(self):
+        rng = np.random.default_rng(3)
+        base = {d: 0.03 + 0.01 * d for d in range(5)}
+        noise = rng.normal(0, 0.03, size=(2, 5, 10))
+        rows = rows_for({"orbslam3": lambda d, r: base[d] * math.exp(noise[0, d, r]),
+                         "pks": lambda d, r: 0.819 * base[d] * math.exp(noise[1, d, r])})
+        result = bs.analyse(rows)
+        pooled = result["pooled"][0]
+        self.assertLess(pooled["p"], 0.001)
+        self.assertGreater(pooled["improvement_pct"], 15)
+        self.assertLess(pooled["ci_low"], 18.1)
+        self.assertGreater(pooled["ci_high"], 18.1)
+        self.assertIn("significantly more accurate", pooled["sentence"])
+        self.assertIn("inside", pooled["sentence"])
+
+    def test_no_effect_with_noisy_runs_is_not_decidable(self):
+        rng = np.random.default_rng(4)
+        noise = rng.normal(0, 0.6, size=(2, 5, 10))
+        rows = rows_for({"orbslam3": lambda d, r: 0.05 * math.exp(noise[0, d, r]),
+                         "pks": lambda d, r: 0.05 * math.exp(noise[1, d, r])})
+        pooled = bs.analyse(rows)["pooled"][0]
+        self.assertGreater(pooled["p_holm"], 0.05)
+        self.assertLess(pooled["power_for_paper"], 0.8)
+        self.assertGreater(pooled["runs_for_80pct_power"], 10)
+        self.assertIn("not decidable", pooled["sentence"])
+
+    def test_no_effect_with_tight_runs_refutes_the_paper(self):
+        rng = np.random.default_rng(5)
+        noise = rng.normal(0, 0.02, size=(2, 5, 10))
+        rows = rows_for({"orbslam3": lambda d, r: 0.05 * math.exp(noise[0, d, r]),
+                         "pks": lambda d, r: 0.05 * math.exp(noise[1, d, r])})
+        pooled = bs.analyse(rows)["pooled"][0]
+        self.assertGreater(pooled["power_for_paper"], 0.99)
+        self.assertIn("not reproduced", pooled["sentence"])
+
+    def test_failures_count_against_a_configuration(self):
+        # Equal ATE where both succeed, but pks fails half its runs on every sequence.
+        rows = rows_for({"orbslam3": lambda d, r: 0.05 + 0.001 * r,
+                         "pks": lambda d, r: 0.05 + 0.001 * r},
+                        failures=lambda c, d, r: c == "pks" and r % 2 == 0)
+        result = bs.analyse(rows)
+        outcome = [o for o in result["outcomes"] if o["config"] == "pks"][0]
+        self.assertEqual(outcome["failures"], 5)
+        self.assertAlmostEqual(outcome["failure_rate"], 0.5)
+        pooled = result["pooled"][0]
+        self.assertLess(pooled["effect"], 0)  # worse, although the successful ATEs are equal
+        self.assertLess(pooled["p"], 0.05)
+        self.assertIn("significantly less accurate", pooled["sentence"])
+
+    def test_markdown_names_the_rules_and_every_comparison(self):
+        rows = rows_for({"orbslam3": lambda d, r: 0.05 + 0.001 * r,
+                         "pks": lambda d, r: 0.05 + 0.001 * r,
+                         "pks-released": lambda d, r: 0.05 + 0.001 * r})
+        md = bs.markdown(bs.analyse(rows))
+        self.assertIn("covers less than 50%", md)
+        self.assertIn("pks vs orbslam3", md)
+        self.assertIn("pks-released vs orbslam3", md)
+        self.assertIn("Holm", md)
+
+
+if __name__ == "__main__":
+    unittest.main()
