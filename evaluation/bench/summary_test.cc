@@ -157,5 +157,21 @@ TEST(Summary, SweepScoreFollowsEquation13) {
   EXPECT_EQ(SweepTables(plain)[0].header.back(), "ok/runs");
 }
 
+TEST(Summary, ReasonTableCountsEveryRuleAKeyframeNames) {
+  RunResult a = Result(0, "d", "pks-released", 0.01, 20);
+  a.keyframe_reasons = "forced=10 forced+imu=2 camera;busy=1";
+  RunResult b = Result(1, "d", "pks-released", 0.01, 20);
+  b.keyframe_reasons = "forced=6 imu=2";
+  RunResult peer = Result(2, "d", "orbslam3-peer", 0.01, 20);  // no reasons: no row
+  const Table t = ReasonTable({a, b, peer});
+  ASSERT_EQ(t.rows.size(), 1u);
+  EXPECT_EQ(t.header, (std::vector<std::string>{"sensor", "configuration", "runs", "forced", "imu",
+                                                "camera"}));
+  // forced: (12 + 6) / 2 runs = 9 per run, 18 of 23 mentions; imu (2 + 2) / 2; camera 1 / 2.
+  EXPECT_EQ(t.rows[0][3], "9.0 (78%)");
+  EXPECT_EQ(t.rows[0][4], "2.0 (17%)");
+  EXPECT_EQ(t.rows[0][5], "0.5 (4%)");
+}
+
 }  // namespace
 }  // namespace pkslam::bench
