@@ -37,7 +37,7 @@ PksSelector::PksSelector(PksOptions options) : options_(options) { options_.Chec
 void PksSelector::Reset() {
   snapshot_.clear();
   has_snapshot_ = false;
-  keyframe_accel_.reset();
+  keyframe_accel_camera_.reset();
   reference_.reset();
 }
 
@@ -48,16 +48,15 @@ void PksSelector::OnKeyFrameInserted(const SelectorInput& input) {
   positions.reserve(input.points.size());
   for (const auto& p : input.points) positions.push_back(p.position_world);
   const auto normals = pks::EstimateNormals(positions, options_.normal_neighbours, true);
-  const Eigen::Vector3d center = input.camera_from_world.Inverse().translation();
+  const SO3d camera_from_world = input.camera_from_world.so3();
   for (std::size_t i = 0; i < input.points.size(); ++i) {
-    const double angle = pks::ViewAngleDeg(normals[i], positions[i], center, false);
-    snapshot_[input.points[i].id] = {
-        normals[i], angle, pks::ConeRegion(angle, options_.region_width_deg, options_.regions)};
+    snapshot_[input.points[i].id] = {camera_from_world * normals[i]};
   }
   has_snapshot_ = true;
-  keyframe_accel_.reset();
+  keyframe_accel_camera_.reset();
   if (input.imu_since_last_frame && input.imu_since_last_frame->mean_accel_world_no_gravity) {
-    keyframe_accel_ = *input.imu_since_last_frame->mean_accel_world_no_gravity;
+    keyframe_accel_camera_ =
+        camera_from_world * *input.imu_since_last_frame->mean_accel_world_no_gravity;
   }
 }
 
@@ -73,12 +72,9 @@ void PksSelector::ExtendSnapshot(const SelectorInput& input) {
   for (const auto& p : input.points) positions.push_back(p.position_world);
   // Per-frame path: normals only for the newcomers (usually a handful), not every tracked point.
   const auto normals = pks::EstimateNormals(positions, options_.normal_neighbours, true, missing);
-  const Eigen::Vector3d kf_center = input.last_keyframe_camera_from_world.Inverse().translation();
-  for (const std::size_t i : missing) {
-    const double angle = pks::ViewAngleDeg(normals[i], positions[i], kf_center, false);
-    snapshot_[input.points[i].id] = {
-        normals[i], angle, pks::ConeRegion(angle, options_.region_width_deg, options_.regions)};
-  }
+  const SO3d keyframe_from_world = input.last_keyframe_camera_from_world.so3();
+  for (const std::size_t i : missing)
+    snapshot_[input.points[i].id] = {keyframe_from_world * normals[i]};
   has_snapshot_ = true;
 }
 
@@ -89,18 +85,23 @@ PksSelector::Counts PksSelector::Measure(const SelectorInput& input,
   c.grid.assign(n * n, 0);
   c.a = static_cast<int>(input.points.size());
   const Eigen::Vector3d center = input.camera_from_world.Inverse().translation();
-  const Eigen::Vector3d kf_center = input.last_keyframe_camera_from_world.Inverse().translation();
+  const SE3d world_from_keyframe = input.last_keyframe_camera_from_world.Inverse();
+  const Eigen::Vector3d kf_center = world_from_keyframe.translation();
   for (const SelectorPoint& p : input.points) {
     const auto it = snapshot_.find(p.id);
     if (it == snapshot_.end()) continue;
     ++c.m;
     const SnapshotPoint& s = it->second;
-    if (s.normal.isZero()) continue;  // no surface estimate: no region
-    const double angle = pks::ViewAngleDeg(s.normal, p.position_world, center, false);
+    if (s.normal_keyframe.isZero()) continue;  // no surface estimate: no region
+    // One normal and one point estimate, seen from the keyframe and from the frame.
+    const Eigen::Vector3d normal = world_from_keyframe.so3() * s.normal_keyframe;
+    const double kf_angle = pks::ViewAngleDeg(normal, p.position_world, kf_center, false);
+    const double angle = pks::ViewAngleDeg(normal, p.position_world, center, false);
     const bool region_changed =
-        pks::ConeRegion(angle, options_.region_width_deg, options_.regions) != s.region;
+        pks::ConeRegion(angle, options_.region_width_deg, options_.regions) !=
+        pks::ConeRegion(kf_angle, options_.region_width_deg, options_.regions);
     if (region_changed) ++c.d;
-    const double change = std::abs(angle - s.angle_deg);
+    const double change = std::abs(angle - kf_angle);
     if (diagnostics) diagnostics->Add(change, p.position_world, kf_center, center);
     if (change > options_.delta_deg) {
       ++c.grid[pks::GridCell(p.uv.x(), p.uv.y(), input.image_width, input.image_height, n)];
@@ -160,8 +161,10 @@ bool PksSelector::CameraCriterion(const SelectorInput& input, SelectorTrace* tra
 std::optional<double> PksSelector::AccelerationChange(const SelectorInput& input) const {
   if (!input.imu_since_last_frame) return std::nullopt;
   const auto& now = input.imu_since_last_frame->mean_accel_world_no_gravity;
-  if (!now || !keyframe_accel_) return std::nullopt;
-  return (*now - *keyframe_accel_).norm();
+  if (!now || !keyframe_accel_camera_) return std::nullopt;
+  const Eigen::Vector3d keyframe_accel =
+      input.last_keyframe_camera_from_world.so3().Inverse() * *keyframe_accel_camera_;
+  return (*now - keyframe_accel).norm();
 }
 
 SelectorDecision PksSelector::Decide(const SelectorInput& in) {

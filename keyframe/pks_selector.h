@@ -66,10 +66,12 @@ class PksSelector : public KeyframeSelector {
   void Reset() override;
 
  private:
+  // A point's surface normal in the keyframe's camera frame: a world change (IMU
+  // initialisation, scale and gravity refinement, loop correction) moves the keyframe and the
+  // point together, so the normal follows them; the keyframe's viewing angle is evaluated at
+  // measurement time from the current estimates.
   struct SnapshotPoint {
-    Eigen::Vector3d normal;
-    double angle_deg;
-    int region;
+    Eigen::Vector3d normal_keyframe;
   };
   struct Counts {
     int a = 0;              // tracked points
@@ -81,16 +83,18 @@ class PksSelector : public KeyframeSelector {
   Counts Measure(const SelectorInput& input, pks::ViewChangeDiagnostics* diagnostics) const;
   // Adds the last keyframe's points that the snapshot does not hold yet (created with the
   // keyframe or triangulated from it afterwards): their normals from the current tracked
-  // points, their angle and region as seen from the keyframe.
+  // points.
   void ExtendSnapshot(const SelectorInput& input);
   bool CameraCriterion(const SelectorInput& input, SelectorTrace* trace);
   std::optional<double> AccelerationChange(const SelectorInput& input) const;
 
   PksOptions options_;
-  // Snapshot of the last keyframe (map point id -> normal/angle/region).
+  // Snapshot of the last keyframe (map point id -> normal).
   std::unordered_map<MapPointId, SnapshotPoint> snapshot_;
   bool has_snapshot_ = false;
-  std::optional<Eigen::Vector3d> keyframe_accel_;  // world, gravity removed
+  // The keyframe interval's gravity-free specific force, in the keyframe's camera frame (so
+  // that a world change rotates it along).
+  std::optional<Eigen::Vector3d> keyframe_accel_camera_;
   std::optional<Counts> reference_;
 };
 

@@ -49,7 +49,8 @@ std::vector<std::pair<MapPointId, Eigen::Vector3d>> PatchPoints(const std::vecto
 SelectorInput MakeInput(const std::vector<std::pair<MapPointId, Eigen::Vector3d>>& points,
                         const SE3d& camera_from_world, FrameId frame) {
   SelectorInput in;
-  in.last_keyframe_camera_from_world = SE3d(SO3d(), Eigen::Vector3d(2.5, 0, 0));  // at -2.5 x
+  // The scenario keyframe: at -2.5 x, aimed at (0, 0, 2) (PksScenario::c0_, target_).
+  in.last_keyframe_camera_from_world = LookAt({-2.5, 0, 0}, {0, 0, 2});
   in.sensor = Sensor::kStereo;
   in.fps = 20;
   in.image_width = kWidth;
@@ -113,6 +114,38 @@ TEST_F(PksScenario, BalancedViewChangeTriggersTheCameraCriterion) {
   EXPECT_GT(d.trace.at("ECOG"), d.trace.at("COG"));
   EXPECT_TRUE(d.insert);
   EXPECT_NE(d.reason.find("camera"), std::string::npos) << d.reason;
+}
+
+TEST_F(PksScenario, AWorldChangeAfterTheKeyframeChangesNothing) {
+  // IMU initialisation rotates (and shifts) the whole map after the keyframe was taken: the
+  // keyframe, its points and the frame move together, so D, E and the decision must not change
+  // (before, the snapshot's world-frame normals stayed in the old world: spurious view changes).
+  const auto points = PatchPoints(
+      {Facing(centers_[0]), Grazing(centers_[1]), Grazing(centers_[2]), Facing(centers_[3])});
+  const SE3d new_from_old(SO3d::Exp(Eigen::Vector3d(0.3, -1.1, 0.7)), Eigen::Vector3d(1, -2, 3));
+  auto moved = [&](SelectorInput in) {
+    in.camera_from_world = in.camera_from_world * new_from_old.Inverse();
+    in.last_keyframe_camera_from_world =
+        in.last_keyframe_camera_from_world * new_from_old.Inverse();
+    for (auto& p : in.points) p.position_world = new_from_old * p.position_world;
+    return in;
+  };
+  PksOptions o;
+  o.weak_tracking_ratio = 0;
+  PksSelector plain(o);
+  PksSelector changed(o);
+  for (auto* s : {&plain, &changed})
+    s->OnKeyFrameInserted(MakeInput(points, LookAt(c0_, target_), 0));
+  const auto reference = MakeInput(points, LookAt(c0_ + Eigen::Vector3d(0.03, 0, 0), target_), 1);
+  plain.Decide(reference);
+  changed.Decide(moved(reference));
+  const auto frame = MakeInput(points, LookAt(c1_, target_), 2);
+  const auto a = plain.Decide(frame);
+  const auto b = changed.Decide(moved(frame));
+  EXPECT_EQ(a.trace.at("D_c"), b.trace.at("D_c"));
+  EXPECT_EQ(a.trace.at("E_c"), b.trace.at("E_c"));
+  EXPECT_EQ(a.insert, b.insert);
+  EXPECT_TRUE(b.insert);
 }
 
 TEST_F(PksScenario, OneSidedViewChangeFailsTheBalanceCriterion) {
@@ -185,6 +218,30 @@ TEST(PksImu, AccelerationTriggerAgainstTheKeyframeInterval) {
   const auto fire = paper.Decide(input(2, g, {1.2, 0, 0}));     // |da| 1.2 > 1
   EXPECT_TRUE(fire.insert);
   EXPECT_NEAR(fire.trace.at("delta_a"), 1.2, 1e-12);
+}
+
+TEST(PksImu, AccelerationOfTheKeyframeIntervalFollowsAWorldRotation) {
+  const std::vector<std::pair<MapPointId, Eigen::Vector3d>> none;
+  const SO3d new_from_old = SO3d::Exp(Eigen::Vector3d(0, 0, 1.2));
+  auto input = [&](FrameId f, const SO3d& world_change, const Eigen::Vector3d& accel_world) {
+    SelectorInput in = MakeInput(none, SE3d(), f);
+    in.sensor = Sensor::kStereoInertial;
+    in.imu_initialized = true;
+    in.t_ns = in.last_keyframe_t_ns + 100'000'000;
+    in.camera_from_world = SE3d(world_change.Inverse(), Eigen::Vector3d(-1, 0, 0));
+    in.last_keyframe_camera_from_world = SE3d(world_change.Inverse(), Eigen::Vector3d(1, 0, 0));
+    SelectorImuInterval imu;
+    imu.dt = 0.05;
+    imu.mean_accel_world_no_gravity = accel_world;
+    in.imu_since_last_frame = imu;
+    return in;
+  };
+  PksSelector s(PksOptions{});
+  s.OnKeyFrameInserted(input(0, SO3d(), {2, 0, 0}));
+  // The same specific force, expressed in the rotated world: no change.
+  const auto d = s.Decide(input(1, new_from_old, new_from_old * Eigen::Vector3d(2, 0, 0)));
+  EXPECT_NEAR(d.trace.at("delta_a"), 0.0, 1e-12);
+  EXPECT_FALSE(d.insert);
 }
 
 TEST(PksImu, NoImuMeansNoImuCriterion) {
