@@ -306,6 +306,8 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
     if (r.new_keyframe) {
       ++summary.keyframe_reasons[r.keyframe_reason.empty() ? "unnamed" : r.keyframe_reason];
     }
+    if (r.selector_decided) ++summary.selector_decisions;
+    for (const auto& criterion : r.criteria_held) ++summary.criteria_held[criterion];
     if (r.camera_from_world) {
       partial.Append(FormatTumLine({s.t_ns, r.camera_from_world->Inverse()}));
       if (!partial.ok() && !partial_warned) {

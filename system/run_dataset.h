@@ -69,6 +69,10 @@ struct RunSummary {
   std::string dataset_fingerprint;  // io/dataset_fingerprint.h
   // Keyframes created, per reason: the selector rule that fired, or "initialisation".
   std::map<std::string, int> keyframe_reasons;
+  // Frames the selector decided on, and on how many of them each criterion held
+  // (TrackResult::criteria_held).
+  int selector_decisions = 0;
+  std::map<std::string, int> criteria_held;
   // What was wrong with the input without stopping the run (degraded() when anything was).
   InputReport input;
 };

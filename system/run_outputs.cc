@@ -242,6 +242,12 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   json.Key("keyframe_reasons").BeginObject();
   for (const auto& [reason, count] : summary->keyframe_reasons) json.Member(reason, count);
   json.EndObject();
+  // On how many of the frames the selector decided on each of its criteria held (pks and
+  // pks-released: criterion1 = D_c > Th_adaptive, criterion2 = ECOG > |COG|).
+  json.Key("selector_criteria").BeginObject();
+  json.Member("decisions", summary->selector_decisions);
+  for (const auto& [criterion, count] : summary->criteria_held) json.Member(criterion, count);
+  json.EndObject();
   json.Member("map_points", summary->map_points);
   json.Member("maps", summary->maps);
   json.Key("tracking_states").BeginObject();

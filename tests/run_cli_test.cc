@@ -123,6 +123,7 @@ TEST(RunCli, ImuCoverageIsChecked) {
   EXPECT_THAT(stats, HasSubstr("\"frames_without_imu\": 40"));
   // Keyframes per creating rule: the map's first is the initialisation's.
   EXPECT_THAT(stats, HasSubstr("\"keyframe_reasons\": {"));
+  EXPECT_THAT(stats, HasSubstr("\"selector_criteria\": {"));
   EXPECT_THAT(stats, HasSubstr("\"initialisation\": 1"));
   // A finished run keeps no crash copy of its trajectory.
   EXPECT_FALSE(std::filesystem::exists(dir / "out/trajectory.txt.partial"));

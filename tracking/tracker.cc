@@ -211,6 +211,10 @@ TrackResult Tracker::Track(Frame frame) {
         if (current_.map_points[i] && current_.outliers[i]) current_.map_points[i].reset();
       }
       result.keyframe_reason = last_decision_.reason;
+      result.selector_decided = true;
+      for (const auto& [key, value] : last_decision_.trace) {
+        if (key.starts_with("criterion") && value != 0) result.criteria_held.push_back(key);
+      }
     } else {
       velocity_.reset();
     }

@@ -54,6 +54,10 @@ struct TrackResult {
   bool new_keyframe = false;
   int inliers = 0;
   std::string keyframe_reason;
+  // The selector decided on this frame (it was tracked); the trace's criterion* entries that
+  // held (PKS: criterion1 = D_c > Th, criterion2 = ECOG > |COG|).
+  bool selector_decided = false;
+  std::vector<std::string> criteria_held;
 };
 
 class Tracker {
