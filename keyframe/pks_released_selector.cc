@@ -221,7 +221,9 @@ SelectorDecision PksReleasedSelector::Decide(const SelectorInput& in) {
   } remember{this, in};
 
   if (auto exit = CommonSafetyExits(in, options_.imu_uninitialised_interval_s)) return *exit;
-  if (in.local_mapping_initializing) return SelectorDecision::No("imu-initialising");
+  if (in.local_mapping_initializing && options_.no_keyframe_while_imu_initialises) {
+    return SelectorDecision::No("imu-initialising");
+  }
   if (in.slow_motion_before_refinement) return SelectorDecision::No("slow-motion");
   const Eigen::Vector3d center = in.camera_from_world.Inverse().translation();
   const Eigen::Vector3d kf_center = in.last_keyframe_camera_from_world.Inverse().translation();

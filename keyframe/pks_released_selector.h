@@ -22,7 +22,9 @@
 //    needs local mapping idle; the IMU rule compares consecutive frame intervals' mean
 //    body-frame acceleration with gravity, after frame 1.
 // Ablations (PksOptions): identity_pairing, frozen_normals, forced_interval = 0 (no forced
-// keyframe), imu_threshold = 0 (no IMU rule).
+// keyframe), imu_threshold = 0 (no IMU rule); no_keyframe_while_imu_initialises = false takes
+// ORB-SLAM3 v1.0's reading of that exit (in threaded pkslam runs the v0.3 exit starves tracking
+// through a slow inertial refinement and loses it: docs/keyframe_selectors.md).
 // Remaining differences, documented in docs/keyframe_selectors.md: the released code keeps its
 // snapshot and reference in function statics that no map reset clears (here: Reset()); it
 // removes duplicate points by equal position (here: by map-point id); equal descriptor

@@ -275,6 +275,16 @@ TEST(PksReleased, ExitsOfTheReleasedCode) {
   auto in = Input(scene, kKeyframe + Eigen::Vector3d(0, 0, -0.5), 6);  // forced otherwise
   in.local_mapping_initializing = true;
   EXPECT_EQ(s.Decide(in).reason, "imu-initialising");
+  // ORB-SLAM3 v1.0's reading: the keyframe is taken and waits for local mapping.
+  PksOptions v1 = Options();
+  v1.no_keyframe_while_imu_initialises = false;
+  PksReleasedSelector t(v1);
+  t.OnKeyFrameInserted(Input(scene, kKeyframe, 0));
+  in.local_mapping_idle = false;
+  const auto taken = t.Decide(in);
+  EXPECT_TRUE(taken.insert);
+  EXPECT_EQ(taken.reason, "forced");
+  in.local_mapping_idle = true;
   in.local_mapping_initializing = false;
   in.slow_motion_before_refinement = true;
   EXPECT_EQ(s.Decide(in).reason, "slow-motion");

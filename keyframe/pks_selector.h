@@ -52,6 +52,9 @@ struct PksOptions {
   int pairing_max_hamming = 30;     // reprojection pairing: descriptor distance below this
   bool identity_pairing = false;    // ablation: pair by map-point identity instead
   bool frozen_normals = false;      // ablation: keep the keyframe's normals for the frame
+  // The released code takes no keyframe while local mapping initialises the IMU (as ORB-SLAM3
+  // v0.3); false: such a keyframe waits in the queue as with ORB-SLAM3 v1.0's rule.
+  bool no_keyframe_while_imu_initialises = true;
 
   void Check() const;
 };

@@ -97,6 +97,7 @@ std::unique_ptr<KeyframeSelector> MakeKeyframeSelector(
     reader.Read("pairing_max_hamming", &o.pairing_max_hamming);
     reader.Read("identity_pairing", &o.identity_pairing);
     reader.Read("frozen_normals", &o.frozen_normals);
+    reader.Read("no_keyframe_while_imu_initialises", &o.no_keyframe_while_imu_initialises);
     reader.RejectUnknown();
     return std::make_unique<PksReleasedSelector>(o);
   }
