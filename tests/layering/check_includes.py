@@ -1,0 +1,171 @@
+#!/usr/bin/python3
+"""Dependencies point one way: every `#include "folder/..."` of a library's sources must name a
+file of the library itself or of a library it links (DEPS, transitively), and the DEPS graph has
+no cycle. Tests and benchmarks may also use their TEST_DEPS. Reads the pkslam_library() calls of
+the CMakeLists.txt files; prints each violation as FILE:LINE and exits 1.
+
+  /usr/bin/python3 tests/layering/check_includes.py [REPO]      (CTest: layering.includes)
+"""
+
+import os
+import re
+import sys
+
+# Targets outside pkslam_library(): the test-support libraries and the executable at the top.
+EXTRA = {
+    "pkslam_core_testing": {"folder": "core/testing", "deps": ["pkslam_core"]},
+    "pkslam_testsupport": {"folder": "tests/support", "deps": []},
+}
+SKIP_FOLDERS = {"build", "build-address", "build-fuzz", "build-thread", ".git", "third_party"}
+TOP_FOLDERS = {"apps", "tests", "fuzz", "examples"}  # may include anything
+
+
+def parse_libraries(repo):
+    libs = {}
+    for root, dirs, files in os.walk(repo):
+        dirs[:] = [d for d in dirs if d not in SKIP_FOLDERS and not d.startswith("build")]
+        if "CMakeLists.txt" not in files:
+            continue
+        text = open(os.path.join(root, "CMakeLists.txt")).read()
+        text = re.sub(r"#[^\n]*", "", text)
+        for m in re.finditer(r"pkslam_library\(\s*(\w+)(.*?)\)", text, re.S):
+            name, body = m.group(1), m.group(2)
+            sections, current = {}, None
+            for word in body.split():
+                if word in ("SOURCES", "DEPS", "TESTS", "TEST_DEPS", "BENCHMARKS", "LABEL"):
+                    current = word
+                    sections.setdefault(word, [])
+                elif current:
+                    sections[current].append(word)
+            folder = os.path.relpath(root, repo)
+            libs[name] = {
+                "folder": folder,
+                "deps": [d for d in sections.get("DEPS", []) if d.startswith("pkslam_")],
+                "test_deps": [d for d in sections.get("TEST_DEPS", []) if d.startswith("pkslam_")],
+                "tests": {os.path.normpath(os.path.join(folder, f))
+                          for f in sections.get("TESTS", []) + sections.get("BENCHMARKS", [])},
+            }
+    for name, extra in EXTRA.items():
+        libs.setdefault(name, {"folder": extra["folder"], "deps": extra["deps"], "test_deps": [],
+                               "tests": set()})
+    return libs
+
+
+def find_cycle(libs):
+    state = {}
+
+    def visit(n, path):
+        state[n] = 1
+        for d in libs.get(n, {}).get("deps", []):
+            if d not in libs:
+                continue
+            if state.get(d) == 1:
+                return path + [n, d]
+            if d not in state:
+                cycle = visit(d, path + [n])
+                if cycle:
+                    return cycle
+        state[n] = 2
+        return None
+
+    for n in libs:
+        if n not in state:
+            cycle = visit(n, [])
+            if cycle:
+                return cycle
+    return None
+
+
+def closure(libs, names):
+    seen, stack = set(), list(names)
+    while stack:
+        n = stack.pop()
+        if n in seen or n not in libs:
+            continue
+        seen.add(n)
+        stack.extend(libs[n]["deps"])
+    return seen
+
+
+def owner(libs, path):
+    """The library whose folder is the longest prefix of `path` (None: top-level code)."""
+    best, best_len = None, -1
+    for name, lib in libs.items():
+        folder = lib["folder"]
+        if (path == folder or path.startswith(folder + "/")) and len(folder) > best_len:
+            best, best_len = name, len(folder)
+    return best
+
+
+def main():
+    repo = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else
+                           os.path.join(os.path.dirname(__file__), "..", ".."))
+    libs = parse_libraries(repo)
+    problems = []
+    cycle = find_cycle(libs)
+    if cycle:
+        problems.append("CMake: dependency cycle " + " -> ".join(cycle))
+    include = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+    # Test-support headers beside the sources (scenario builders, test data): headers that
+    # only tests, benchmarks or other such headers include.
+    includers = {}
+    tests = set()
+    for name, lib in libs.items():
+        for root, dirs, files in os.walk(os.path.join(repo, lib["folder"])):
+            dirs[:] = [d for d in dirs if d not in SKIP_FOLDERS]
+            for f in files:
+                if not f.endswith((".cc", ".h")):
+                    continue
+                rel = os.path.relpath(os.path.join(root, f), repo)
+                if rel in lib["tests"] or f.endswith(("_test.cc", "_benchmark.cc")):
+                    tests.add(rel)
+                with open(os.path.join(repo, rel), errors="replace") as fh:
+                    for line in fh:
+                        m = include.match(line)
+                        if m:
+                            includers.setdefault(m.group(1), set()).add(rel)
+    changed = True
+    while changed:
+        changed = False
+        for header, by in includers.items():
+            if header not in tests and header.endswith(".h") and by and by <= tests:
+                tests.add(header)
+                changed = True
+    checked = 0
+    for name, lib in sorted(libs.items()):
+        base = os.path.join(repo, lib["folder"])
+        allowed = closure(libs, [name])
+        allowed_tests = allowed | closure(libs, lib["test_deps"]) | {"pkslam_testsupport",
+                                                                     "pkslam_core_testing"}
+        for root, dirs, files in os.walk(base):
+            dirs[:] = [d for d in dirs if d not in SKIP_FOLDERS]
+            for f in files:
+                if not f.endswith((".cc", ".h")):
+                    continue
+                rel = os.path.relpath(os.path.join(root, f), repo)
+                if owner(libs, rel) != name or rel.split("/")[0] in TOP_FOLDERS:
+                    continue
+                is_test = rel in tests or "/testing/" in rel
+                ok = allowed_tests if is_test else allowed
+                checked += 1
+                with open(os.path.join(repo, rel), errors="replace") as fh:
+                    for number, line in enumerate(fh, 1):
+                        m = include.match(line)
+                        if not m:
+                            continue
+                        target = m.group(1)
+                        if not os.path.exists(os.path.join(repo, target)):
+                            continue  # a generated or third-party header
+                        to = owner(libs, target)
+                        if to is not None and to not in ok:
+                            problems.append(f"{rel}:{number}: includes {target} of {to}, which "
+                                            f"{name} does not link"
+                                            + (" (test)" if is_test else ""))
+    for p in problems:
+        print(p)
+    print(f"layering: {checked} files of {len(libs)} libraries checked, {len(problems)} problem(s)")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
