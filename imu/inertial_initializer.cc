@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "core/optim/ceres_setup.h"
 #include "core/util/error.h"
 #include "imu/imu_factors.h"
 #include "imu/imu_manifolds.h"
@@ -108,11 +109,8 @@ InertialInitResult InitializeInertial(const std::vector<InertialInitKeyFrame>& k
   problem.SetManifold(gravity_block, &gravity_manifold);
   if (!options.estimate_scale) problem.SetParameterBlockConstant(&log_scale);
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.num_threads = 1;
-  solver_options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options solver_options =
+      SolverOptions(ceres::DENSE_QR, options.max_iterations, /*num_threads=*/1);
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
 

@@ -11,6 +11,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/optim/ceres_setup.h"
 #include "core/util/log.h"
 #include "imu/body_reprojection_error.h"
 #include "imu/imu_factors.h"
@@ -20,26 +21,6 @@
 
 namespace pkslam {
 namespace {
-
-// Stops the solver once *abort is set, keeping the best iterate (see core/optim/bundle_solve.cc).
-class AbortCallback final : public ceres::IterationCallback {
- public:
-  explicit AbortCallback(const std::atomic<bool>* abort) : abort_(abort) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override {
-    if (abort_ == nullptr || !abort_->load(std::memory_order_relaxed)) {
-      return ceres::SOLVER_CONTINUE;
-    }
-    fired_ = true;
-    return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
-  }
-  bool fired() const { return fired_; }
-
- private:
-  const std::atomic<bool>* abort_;
-  bool fired_ = false;
-};
-
-constexpr int kMaxFreePosesForDenseSchur = 40;
 
 // Every block in one buffer (poses, velocities, gyro biases, accel biases, points): Ceres orders
 // the blocks of an elimination group by address, so separate vectors made the order of the
@@ -184,10 +165,7 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
     return result;
   }
 
-  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
-  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
-  ceres::LossFunctionWrapper loss_mono(&huber_mono, ceres::DO_NOT_TAKE_OWNERSHIP);
-  ceres::LossFunctionWrapper loss_stereo(&huber_stereo, ceres::DO_NOT_TAKE_OWNERSHIP);
+  ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/true);
   BodyPoseManifold pose_manifold;
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -285,20 +263,17 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
       blocks[i] = ceres_problem.AddResidualBlock(
           new BodyStereoReprojectionError(camera, Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right),
                                           o.inv_sigma2),
-          &loss_stereo, pose, point);
+          losses.stereo(), pose, point);
     } else {
       blocks[i] = ceres_problem.AddResidualBlock(
-          new BodyMonoReprojectionError(camera, o.uv, o.inv_sigma2), &loss_mono, pose, point);
+          new BodyMonoReprojectionError(camera, o.uv, o.inv_sigma2), losses.mono(), pose, point);
     }
   }
 
-  ceres::Solver::Options solver_options;
   int free_poses = 0;
   for (int i = 0; i < num_kf; ++i) free_poses += pose_added[i] && !visual.keyframes[i].fixed;
-  solver_options.linear_solver_type =
-      free_poses <= kMaxFreePosesForDenseSchur ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Options solver_options =
+      SolverOptions(SchurSolverFor(free_poses), 0, options.num_threads);
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (int i = 0; i < num_points; ++i) {
     if (point_added[i]) ordering->AddElementToGroup(s.point(i), 0);
@@ -346,8 +321,7 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
     }
   }
   if (!result.visual.aborted && options.iterations_second > 0) {
-    loss_mono.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
-    loss_stereo.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+    losses.SetRobust(false);
     solve(options.iterations_second);
   }
   if (marginalize && marg_edge && !result.visual.aborted) {

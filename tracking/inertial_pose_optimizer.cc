@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/map/map_point.h"
+#include "core/optim/ceres_setup.h"
 #include "core/util/error.h"
 #include "imu/body_reprojection_error.h"
 #include "imu/imu_factors.h"
@@ -106,10 +107,7 @@ InertialPoseOutput OptimizeInertialPose(Frame* frame, const InertialPoseInput& i
     c.inv_sigma2 = inv_sigma2[kp.octave];
   }
 
-  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
-  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
-  ceres::LossFunctionWrapper loss_mono(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
-  ceres::LossFunctionWrapper loss_stereo(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+  ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/false);
   BodyPoseManifold pose_manifold;
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -160,32 +158,28 @@ InertialPoseOutput OptimizeInertialPose(Frame* frame, const InertialPoseInput& i
                                                          c.inv_sigma2);
       }
     }
-    c.block =
-        problem.AddResidualBlock(c.cost.get(), c.stereo ? &loss_stereo : &loss_mono, cur.pose);
+    c.block = problem.AddResidualBlock(c.cost.get(), c.stereo ? losses.stereo() : losses.mono(),
+                                       cur.pose);
   };
   for (Correspondence& c : corrs) {
     if (std::isfinite(Chi2(camera, cur.State().world_from_body, c))) add(c);
   }
 
-  ceres::Solver::Options solver_options;
   // The (many) reprojection rows touch only the frame's pose: Schur-eliminating the pose folds
   // them into a 6 x 6 block, instead of a dense rows x 30 Jacobian (measured 2x faster tracking).
-  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  ceres::Solver::Options solver_options =
+      SolverOptions(ceres::DENSE_SCHUR, options.iterations_per_round, options.num_threads);
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   ordering->AddElementToGroup(cur.pose, 0);
   for (double* b : {cur.v, cur.bg, cur.ba, prev.pose, prev.v, prev.bg, prev.ba}) {
     ordering->AddElementToGroup(b, 1);
   }
   solver_options.linear_solver_ordering = ordering;
-  solver_options.max_num_iterations = options.iterations_per_round;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
 
   int inliers = 0;
   for (int round = 0; round < options.rounds; ++round) {
     const bool robust = round < options.robust_rounds;
-    loss_mono.Reset(robust ? &huber_mono : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
-    loss_stereo.Reset(robust ? &huber_stereo : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+    losses.SetRobust(robust);
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     const SE3d world_from_body = cur.State().world_from_body;
@@ -201,8 +195,7 @@ InertialPoseOutput OptimizeInertialPose(Frame* frame, const InertialPoseInput& i
       inliers += inlier ? 1 : 0;
     }
   }
-  loss_mono.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
-  loss_stereo.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+  losses.SetRobust(false);
 
   InertialPoseOutput out;
   out.inliers = inliers;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/map/map_point.h"
+#include "core/optim/ceres_setup.h"
 #include "core/optim/reprojection_error.h"
 #include "core/optim/se3_manifold.h"
 #include "core/util/error.h"
@@ -79,10 +80,7 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
   // One problem for all rounds: outliers are removed from / re-inliers re-added to it, and the
   // Huber losses sit in wrappers that are switched to plain least squares after robust_rounds.
   // Declared before the wrappers and the problem that point at them (destroyed after them).
-  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
-  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
-  ceres::LossFunctionWrapper loss_mono(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
-  ceres::LossFunctionWrapper loss_stereo(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+  ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/false);
   SE3LeftManifold manifold;
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -104,7 +102,8 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
         c.cost = std::make_unique<MonoPoseOnlyError>(k, c.p_world, c.obs.head<2>(), c.inv_sigma2);
       }
     }
-    c.block = problem.AddResidualBlock(c.cost.get(), c.stereo ? &loss_stereo : &loss_mono, pose);
+    c.block =
+        problem.AddResidualBlock(c.cost.get(), c.stereo ? losses.stereo() : losses.mono(), pose);
   };
 
   // Start with every correspondence in front of the camera as an inlier (the residuals cannot
@@ -117,20 +116,16 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
     }
   }
 
-  ceres::Solver::Options solver_options;
   // A 6x6 system: normal equations beat DENSE_QR on the (2-3 N) x 6 Jacobian by ~8% of the
   // total (callgrind, 800 stereo correspondences); LM damping keeps them well conditioned.
-  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  solver_options.max_num_iterations = options.iterations_per_round;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options solver_options = SolverOptions(
+      ceres::DENSE_NORMAL_CHOLESKY, options.iterations_per_round, options.num_threads);
 
   SE3d camera_from_world = frame->camera_from_world();
   for (int round = 0; round < options.rounds; ++round) {
     if (num_active == 0) break;
     const bool robust = round < options.robust_rounds;
-    loss_mono.Reset(robust ? &huber_mono : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
-    loss_stereo.Reset(robust ? &huber_stereo : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+    losses.SetRobust(robust);
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     camera_from_world = PoseFromBlock(pose);

@@ -11,38 +11,13 @@
 
 #include "core/optim/bundle_adjustment.h"
 #include "core/optim/bundle_adjustment_internal.h"
+#include "core/optim/ceres_setup.h"
 #include "core/optim/reprojection_error.h"
 #include "core/optim/se3_manifold.h"
 #include "core/util/log.h"
 
 namespace pkslam {
 namespace {
-
-// Stops the solver once *abort is set. It returns SOLVER_TERMINATE_SUCCESSFULLY, not
-// SOLVER_ABORT: Ceres then writes the best iterate so far back to the parameter blocks, so an
-// interrupted BA still delivers its progress (as g2o's force-stop does in ORB-SLAM).
-// SOLVER_ABORT leaves the blocks unchanged, and combined with update_state_every_iteration
-// it was measured to leave a state worse than the initial one (Ceres 2.1).
-class AbortCallback final : public ceres::IterationCallback {
- public:
-  explicit AbortCallback(const std::atomic<bool>* abort) : abort_(abort) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override {
-    if (!abort_->load(std::memory_order_relaxed)) return ceres::SOLVER_CONTINUE;
-    fired_ = true;
-    return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
-  }
-  bool fired() const { return fired_; }
-
- private:
-  const std::atomic<bool>* abort_;
-  bool fired_ = false;
-};
-
-// Reduced camera systems up to this many free poses are solved densely. Measured with
-// bundle_adjustment_benchmark.cc: DENSE_SCHUR executes 2-3% fewer instructions (callgrind)
-// than SPARSE_SCHUR at 10-20 free keyframes; CPU time is about equal at 40 and DENSE_SCHUR is
-// ~14% slower at 80 (global BA).
-constexpr int kMaxFreePosesForDenseSchur = 40;
 
 // The solver's working copy of the problem state.
 struct State {
@@ -113,10 +88,7 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
   }
 
   const PinholeIntrinsics k{problem.fx, problem.fy, problem.cx, problem.cy, problem.bf};
-  ceres::HuberLoss huber_mono(std::sqrt(options.chi2_mono));
-  ceres::HuberLoss huber_stereo(std::sqrt(options.chi2_stereo));
-  ceres::LossFunctionWrapper loss_mono(&huber_mono, ceres::DO_NOT_TAKE_OWNERSHIP);
-  ceres::LossFunctionWrapper loss_stereo(&huber_stereo, ceres::DO_NOT_TAKE_OWNERSHIP);
+  ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/true);
   SE3LeftManifold manifold;
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -146,22 +118,19 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
       blocks[i] = ceres_problem.AddResidualBlock(
           new StereoReprojectionError(k, Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right),
                                       o.inv_sigma2, o.disparity_inv_sigma2),
-          &loss_stereo, pose, point);
+          losses.stereo(), pose, point);
     } else {
       blocks[i] = ceres_problem.AddResidualBlock(new MonoReprojectionError(k, o.uv, o.inv_sigma2),
-                                                 &loss_mono, pose, point);
+                                                 losses.mono(), pose, point);
     }
   }
 
-  ceres::Solver::Options solver_options;
   int free_poses = 0;
   for (int i = 0; i < num_keyframes; ++i) {
     free_poses += pose_added[i] && !problem.keyframes[i].fixed ? 1 : 0;
   }
-  solver_options.linear_solver_type = overrides.linear_solver.value_or(
-      free_poses <= kMaxFreePosesForDenseSchur ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR);
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Options solver_options = SolverOptions(
+      overrides.linear_solver.value_or(SchurSolverFor(free_poses)), 0, options.num_threads);
   // Schur complement: eliminate the points (group 0), then solve for the poses.
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (int i = 0; i < num_points; ++i) {
@@ -209,8 +178,7 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
         blocks[i] = nullptr;
       }
     }
-    loss_mono.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
-    loss_stereo.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+    losses.SetRobust(false);
     solve(options.iterations_second);
     for (int i = 0; i < num_obs; ++i) {
       if (!outlier[i]) outlier[i] = IsOutlier(k, problem.observations[i], state, options);

@@ -11,6 +11,7 @@
 #include "core/map/keyframe.h"
 #include "core/map/map.h"
 #include "core/map/map_point.h"
+#include "core/optim/ceres_setup.h"
 #include "core/optim/yaw_manifold.h"
 #include "core/util/error.h"
 
@@ -282,11 +283,8 @@ EssentialGraphResult SolveEssentialGraph(const EssentialGraphProblem& problem,
                                    pj + kS);
   }
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  solver_options.max_num_iterations = options.iterations;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options solver_options =
+      SolverOptions(ceres::SPARSE_NORMAL_CHOLESKY, options.iterations, options.num_threads);
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &ceres_problem, &summary);
   result.iterations = static_cast<int>(summary.iterations.size());

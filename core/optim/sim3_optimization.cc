@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 
+#include "core/optim/ceres_setup.h"
 #include "core/util/error.h"
 
 namespace pkslam {
@@ -123,11 +124,8 @@ Sim3OptimizationResult OptimizeSim3(const std::vector<Sim3Match>& matches,
                                                  state.t.data(), &state.log_s));
   }
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.max_num_iterations = options.iterations_first;
+  ceres::Solver::Options solver_options =
+      SolverOptions(ceres::DENSE_QR, options.iterations_first, options.num_threads);
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
   result.initial_cost = summary.initial_cost;

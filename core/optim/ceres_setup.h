@@ -1,0 +1,65 @@
+// One Ceres setup for every optimiser of pkslam (bundle adjustments visual and inertial, pose
+// optimisations, Sim(3), essential graph, inertial initialisation): quiet solver options with a
+// fixed thread count, the dense/sparse Schur choice, the abort callback a running local BA
+// obeys, and the robust kernels of the reprojection residuals.
+#pragma once
+
+#include <ceres/iteration_callback.h>
+#include <ceres/loss_function.h>
+#include <ceres/solver.h>
+#include <ceres/types.h>
+
+#include <atomic>
+
+namespace pkslam {
+
+// Stops the solver once *abort is set (never with a null flag). It returns
+// SOLVER_TERMINATE_SUCCESSFULLY, not SOLVER_ABORT: Ceres then writes the best iterate so far back
+// to the parameter blocks, so an interrupted BA still delivers its progress (as g2o's force-stop
+// does in ORB-SLAM). SOLVER_ABORT leaves the blocks unchanged, and combined with
+// update_state_every_iteration it was measured to leave a state worse than the initial one
+// (Ceres 2.1).
+class AbortCallback final : public ceres::IterationCallback {
+ public:
+  explicit AbortCallback(const std::atomic<bool>* abort) : abort_(abort) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override;
+  bool fired() const { return fired_; }
+
+ private:
+  const std::atomic<bool>* abort_;
+  bool fired_ = false;
+};
+
+// Reduced camera systems up to this many free poses are solved densely. Measured with
+// bundle_adjustment_benchmark.cc: DENSE_SCHUR executes 2-3% fewer instructions (callgrind)
+// than SPARSE_SCHUR at 10-20 free keyframes; CPU time is about equal at 40 and DENSE_SCHUR is
+// ~14% slower at 80 (global BA).
+inline constexpr int kMaxFreePosesForDenseSchur = 40;
+ceres::LinearSolverType SchurSolverFor(int free_poses);
+
+// Silent options with `linear_solver`, `max_iterations` and `num_threads`. Ceres's result for a
+// given problem and thread count is deterministic (--deterministic runs fix the counts).
+ceres::Solver::Options SolverOptions(ceres::LinearSolverType linear_solver, int max_iterations,
+                                     int num_threads);
+
+// Huber kernels at the mono and stereo chi-square thresholds (pixels: sqrt(chi2)), behind
+// wrappers the residual blocks keep, so the kernels can be switched off between passes (the
+// outlier-free refinement) without rebuilding the problem. Not movable: blocks hold the
+// wrappers' addresses.
+class ReprojectionLosses {
+ public:
+  ReprojectionLosses(double chi2_mono, double chi2_stereo, bool robust);
+  ReprojectionLosses(const ReprojectionLosses&) = delete;
+  ReprojectionLosses& operator=(const ReprojectionLosses&) = delete;
+  void SetRobust(bool robust);
+  ceres::LossFunction* mono() { return &mono_; }
+  ceres::LossFunction* stereo() { return &stereo_; }
+
+ private:
+  ceres::HuberLoss huber_mono_;
+  ceres::HuberLoss huber_stereo_;
+  ceres::LossFunctionWrapper mono_;
+  ceres::LossFunctionWrapper stereo_;
+};
+
+}  // namespace pkslam
