@@ -71,22 +71,15 @@ SelectorDecision OrbSlam3Selector::Decide(const SelectorInput& in) {
     no.trace = trace;
   }
   if (!(((c1a || c1b || c1c) && c2) || c3 || c4)) return no;
-  std::string reason;
-  auto add = [&reason](bool c, const char* name) {
-    if (!c) return;
-    if (!reason.empty()) reason += '+';
-    reason += name;
-  };
-  add(c1a, "c1a");
-  add(c1b, "c1b");
-  add(c1c, "c1c");
-  add(c2, "c2");
-  add(c3, "c3");
-  add(c4, "c4");
-  add(need_close, "close");
-  SelectorDecision d = AcceptIfMappingCanTakeIt(in, reason);
-  d.trace = std::move(trace);
-  return d;
+  ReasonList reasons;
+  reasons.Add(c1a, "c1a");
+  reasons.Add(c1b, "c1b");
+  reasons.Add(c1c, "c1c");
+  reasons.Add(c2, "c2");
+  reasons.Add(c3, "c3");
+  reasons.Add(c4, "c4");
+  reasons.Add(need_close, "close");
+  return DecideFromReasons(in, reasons, std::move(trace));
 }
 
 }  // namespace pkslam

@@ -49,7 +49,7 @@ TEST(OrbSlam3Selector, BusyMappingNeedsMaxFramesOrWeakTracking) {
   EXPECT_FALSE(s.Decide(in).insert);
   in.frame_id = 120;  // c1a
   const auto d = s.Decide(in);
-  EXPECT_TRUE(d.insert);           // stereo, queue 0 < 3
+  EXPECT_TRUE(d.insert);  // stereo, queue 0 < 3
   EXPECT_TRUE(d.interrupt_local_ba);
   in.local_mapping_queue = 3;
   EXPECT_FALSE(s.Decide(in).insert);

@@ -244,40 +244,19 @@ SelectorDecision PksReleasedSelector::Decide(const SelectorInput& in) {
   const bool imu =
       options_.imu_threshold > 0 && accel_change && *accel_change > options_.imu_threshold;
 
-  const Sensor s = in.sensor;
-  const bool need_close = !IsMonocular(s) && in.tracked_close < options_.close_tracked_max &&
-                          in.untracked_close > options_.close_untracked_min;
-  const bool c3 = need_close && in.inliers > 15 && in.local_mapping_idle;
-  // c1 is the released code's inertial rule; visual-only sensors (which it never ran) get the
-  // paper selector's interval and weak-tracking rules, pkslam's additions.
-  const bool c1 = IsInertial(s) ? in.SecondsSinceLastKeyFrame() >= options_.inertial_interval_s
-                                : in.SecondsSinceLastKeyFrame() >= options_.visual_interval_s;
-  const bool c2 =
-      s == Sensor::kMonocularInertial && ((in.inliers > 15 && in.inliers < 75) || in.recently_lost);
-  const bool weak = !IsInertial(s) && options_.weak_tracking_ratio > 0 &&
-                    in.inliers < options_.weak_tracking_ratio * in.reference_tracked_points;
-
-  std::string reason;
-  auto add = [&reason](bool c, const char* name) {
-    if (!c) return;
-    if (!reason.empty()) reason += '+';
-    reason += name;
-  };
-  add(camera, "camera");
-  add(forced, "forced");
-  add(imu, "imu");
-  add(c3, "close");
-  add(c1, "time");
-  add(c2, "weak-mono-inertial");
-  add(weak, "weak");
-  SelectorDecision decision;
-  if (reason.empty()) {
-    decision.reason = "no";
-  } else {
-    decision = AcceptIfMappingCanTakeIt(in, reason);
-  }
-  decision.trace = std::move(trace);
-  return decision;
+  // The close-point rule needs local mapping idle; c1 is the released code's inertial timer;
+  // visual-only sensors (which it never ran) get the paper selector's interval and
+  // weak-tracking rules, pkslam's additions.
+  const PksCompanionRules rules = EvaluatePksCompanionRules(in, options_, true);
+  ReasonList reasons;
+  reasons.Add(camera, "camera");
+  reasons.Add(forced, "forced");
+  reasons.Add(imu, "imu");
+  reasons.Add(rules.close, "close");
+  reasons.Add(rules.time, "time");
+  reasons.Add(rules.weak_mono_inertial, "weak-mono-inertial");
+  reasons.Add(rules.weak, "weak");
+  return DecideFromReasons(in, reasons, std::move(trace));
 }
 
 }  // namespace pkslam

@@ -32,6 +32,22 @@ void PksOptions::Check() const {
       "Keyframe.pairing", "radius {} px / Hamming {}", pairing_radius_px, pairing_max_hamming);
 }
 
+PksCompanionRules EvaluatePksCompanionRules(const SelectorInput& in, const PksOptions& o,
+                                            bool close_needs_idle_mapping) {
+  const Sensor s = in.sensor;
+  PksCompanionRules r;
+  const bool need_close = !IsMonocular(s) && in.tracked_close < o.close_tracked_max &&
+                          in.untracked_close > o.close_untracked_min;
+  r.close = need_close && in.inliers > 15 && (in.local_mapping_idle || !close_needs_idle_mapping);
+  r.time = in.SecondsSinceLastKeyFrame() >=
+           (IsInertial(s) ? o.inertial_interval_s : o.visual_interval_s);
+  r.weak_mono_inertial =
+      s == Sensor::kMonocularInertial && ((in.inliers > 15 && in.inliers < 75) || in.recently_lost);
+  r.weak = !IsInertial(s) && o.weak_tracking_ratio > 0 &&
+           in.inliers < o.weak_tracking_ratio * in.reference_tracked_points;
+  return r;
+}
+
 PksSelector::PksSelector(PksOptions options) : options_(options) { options_.Check(); }
 
 void PksSelector::Reset() {
@@ -168,7 +184,6 @@ std::optional<double> PksSelector::AccelerationChange(const SelectorInput& input
 }
 
 SelectorDecision PksSelector::Decide(const SelectorInput& in) {
-  SelectorDecision decision;
   if (auto exit = CommonSafetyExits(in, options_.imu_uninitialised_interval_s)) return *exit;
   const Eigen::Vector3d center = in.camera_from_world.Inverse().translation();
   const Eigen::Vector3d kf_center = in.last_keyframe_camera_from_world.Inverse().translation();
@@ -183,37 +198,15 @@ SelectorDecision PksSelector::Decide(const SelectorInput& in) {
   const bool imu =
       options_.imu_threshold > 0 && accel_change && *accel_change > options_.imu_threshold;
 
-  const Sensor s = in.sensor;
-  const bool need_close = !IsMonocular(s) && in.tracked_close < options_.close_tracked_max &&
-                          in.untracked_close > options_.close_untracked_min;
-  const bool c3 = need_close && in.inliers > 15;
-  const bool c1 = IsInertial(s) ? in.SecondsSinceLastKeyFrame() >= options_.inertial_interval_s
-                                : in.SecondsSinceLastKeyFrame() >= options_.visual_interval_s;
-  const bool c2 =
-      s == Sensor::kMonocularInertial && ((in.inliers > 15 && in.inliers < 75) || in.recently_lost);
-  const bool weak = !IsInertial(s) && options_.weak_tracking_ratio > 0 &&
-                    in.inliers < options_.weak_tracking_ratio * in.reference_tracked_points;
-
-  std::string reason;
-  auto add = [&reason](bool c, const char* name) {
-    if (!c) return;
-    if (!reason.empty()) reason += '+';
-    reason += name;
-  };
-  add(camera, "camera");
-  add(imu, "imu");
-  add(c3, "close");
-  add(c1, "time");
-  add(c2, "weak-mono-inertial");
-  add(weak, "weak");
-  if (reason.empty()) {
-    decision.reason = "no";
-    decision.trace = std::move(trace);
-    return decision;
-  }
-  decision = AcceptIfMappingCanTakeIt(in, reason);
-  decision.trace = std::move(trace);
-  return decision;
+  const PksCompanionRules rules = EvaluatePksCompanionRules(in, options_, false);
+  ReasonList reasons;
+  reasons.Add(camera, "camera");
+  reasons.Add(imu, "imu");
+  reasons.Add(rules.close, "close");
+  reasons.Add(rules.time, "time");
+  reasons.Add(rules.weak_mono_inertial, "weak-mono-inertial");
+  reasons.Add(rules.weak, "weak");
+  return DecideFromReasons(in, reasons, std::move(trace));
 }
 
 }  // namespace pkslam

@@ -59,6 +59,20 @@ struct PksOptions {
   void Check() const;
 };
 
+// The rules PKS combines with its camera and IMU criteria (PKS.md "How it combines"): the
+// stereo close-point rule (the released code: only with local mapping idle), the keyframe
+// timer (inertial: inertial_interval; visual-only sensors, which the paper did not evaluate:
+// visual_interval), weak mono-inertial tracking and, for visual-only sensors, ORB-SLAM3's
+// weak-tracking rule.
+struct PksCompanionRules {
+  bool close = false;
+  bool time = false;
+  bool weak_mono_inertial = false;
+  bool weak = false;
+};
+PksCompanionRules EvaluatePksCompanionRules(const SelectorInput& input, const PksOptions& options,
+                                            bool close_needs_idle_mapping);
+
 class PksSelector : public KeyframeSelector {
  public:
   explicit PksSelector(PksOptions options);

@@ -1,5 +1,7 @@
 #include "keyframe/selector_common.h"
 
+#include "keyframe/orbslam3_selector.h"
+
 namespace pkslam {
 
 std::optional<SelectorDecision> CommonSafetyExits(const SelectorInput& in,
@@ -18,6 +20,14 @@ std::optional<SelectorDecision> CommonSafetyExits(const SelectorInput& in,
     return SelectorDecision::No("after-reloc");
   }
   return std::nullopt;
+}
+
+SelectorDecision DecideFromReasons(const SelectorInput& input, const ReasonList& reasons,
+                                   SelectorTrace trace) {
+  SelectorDecision d =
+      reasons.empty() ? SelectorDecision::No("no") : AcceptIfMappingCanTakeIt(input, reasons.str());
+  d.trace = std::move(trace);
+  return d;
 }
 
 }  // namespace pkslam

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 
 #include "keyframe/keyframe_selector.h"
 
@@ -12,5 +13,24 @@ namespace pkslam {
 // A decision when an exit applies, nullopt when the selector's own rule decides.
 std::optional<SelectorDecision> CommonSafetyExits(const SelectorInput& input,
                                                   double imu_uninitialised_interval_s);
+
+// The names of the rules that fired, joined by '+' in the order they are added ("camera+imu").
+class ReasonList {
+ public:
+  void Add(bool fired, const char* name) {
+    if (!fired) return;
+    if (!text_.empty()) text_ += '+';
+    text_ += name;
+  }
+  bool empty() const { return text_.empty(); }
+  const std::string& str() const { return text_; }
+
+ private:
+  std::string text_;
+};
+
+// "no" when no rule fired, else the decision AcceptIfMappingCanTakeIt makes; with `trace`.
+SelectorDecision DecideFromReasons(const SelectorInput& input, const ReasonList& reasons,
+                                   SelectorTrace trace);
 
 }  // namespace pkslam
