@@ -162,6 +162,13 @@ def find_run(roots, run_id):
     return None
 
 
+def median_run(rows, config, roots):
+    """The median-ATE run of a configuration and its folder (None when not found)."""
+    runs = sorted((r for r in rows if r["config"] == config), key=lambda r: r["ate_m"])
+    median = runs[(len(runs) - 1) // 2]
+    return median, find_run(roots, median["run_id"])
+
+
 def trajectories(index, rows, roots):
     for dataset in unique(r["dataset"] for r in rows):
         for sensor in unique(r["sensor"] for r in rows if r["dataset"] == dataset):
@@ -174,9 +181,7 @@ def trajectories(index, rows, roots):
             gt_drawn = False
             colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
             for i, config in enumerate(configs):
-                runs = sorted((r for r in sub if r["config"] == config), key=lambda r: r["ate_m"])
-                median = runs[(len(runs) - 1) // 2]
-                d = find_run(roots, median["run_id"])
+                median, d = median_run(sub, config, roots)
                 if d is None:
                     continue
                 traj = read_xyz(os.path.join(d, "plot_trajectory.csv"),
@@ -345,9 +350,7 @@ def keyframe_views(index, rows, roots):
                                      squeeze=False)
             drawn = 0
             for ax, config in zip(axes[0], configs):
-                runs = sorted((r for r in sub if r["config"] == config), key=lambda r: r["ate_m"])
-                median = runs[(len(runs) - 1) // 2]
-                d = find_run(roots, median["run_id"])
+                _, d = median_run(sub, config, roots)
                 traj = read_xyz(os.path.join(d, "plot_trajectory.csv"),
                                 ["gt_x", "gt_y"]) if d else None
                 kf = read_xyz(os.path.join(d, "plot_keyframes.csv"), ["x", "y"]) if d else None

@@ -4,7 +4,6 @@
 #include <vector>
 
 #include "core/util/error.h"
-#include "keyframe/orbslam3_selector.h"
 #include "keyframe/selector_common.h"
 
 namespace pkslam {
@@ -78,15 +77,9 @@ SelectorDecision BaselineSelector::Decide(const SelectorInput& in) {
     }
   }
   trace["A_c"] = static_cast<double>(in.points.size());
-  if (!want) {
-    SelectorDecision no;
-    no.reason = "no";
-    no.trace = std::move(trace);
-    return no;
-  }
-  SelectorDecision d = AcceptIfMappingCanTakeIt(in, reason);
-  d.trace = std::move(trace);
-  return d;
+  ReasonList reasons;
+  reasons.Add(want, reason.c_str());
+  return DecideFromReasons(in, reasons, std::move(trace));
 }
 
 }  // namespace pkslam

@@ -4,7 +4,6 @@
 #include <numeric>
 #include <unordered_map>
 
-#include "keyframe/orbslam3_selector.h"
 #include "keyframe/selector_common.h"
 
 namespace pkslam {
@@ -248,15 +247,7 @@ SelectorDecision PksReleasedSelector::Decide(const SelectorInput& in) {
   // visual-only sensors (which it never ran) get the paper selector's interval and
   // weak-tracking rules, pkslam's additions.
   const PksCompanionRules rules = EvaluatePksCompanionRules(in, options_, true);
-  ReasonList reasons;
-  reasons.Add(camera, "camera");
-  reasons.Add(forced, "forced");
-  reasons.Add(imu, "imu");
-  reasons.Add(rules.close, "close");
-  reasons.Add(rules.time, "time");
-  reasons.Add(rules.weak_mono_inertial, "weak-mono-inertial");
-  reasons.Add(rules.weak, "weak");
-  return DecideFromReasons(in, reasons, std::move(trace));
+  return DecideFromReasons(in, PksReasons(camera, forced, imu, rules), std::move(trace));
 }
 
 }  // namespace pkslam

@@ -4,7 +4,6 @@
 #include <numeric>
 
 #include "core/util/error.h"
-#include "keyframe/orbslam3_selector.h"
 #include "keyframe/selector_common.h"
 
 namespace pkslam {
@@ -46,6 +45,18 @@ PksCompanionRules EvaluatePksCompanionRules(const SelectorInput& in, const PksOp
   r.weak = !IsInertial(s) && o.weak_tracking_ratio > 0 &&
            in.inliers < o.weak_tracking_ratio * in.reference_tracked_points;
   return r;
+}
+
+ReasonList PksReasons(bool camera, bool forced, bool imu, const PksCompanionRules& rules) {
+  ReasonList reasons;
+  reasons.Add(camera, "camera");
+  reasons.Add(forced, "forced");
+  reasons.Add(imu, "imu");
+  reasons.Add(rules.close, "close");
+  reasons.Add(rules.time, "time");
+  reasons.Add(rules.weak_mono_inertial, "weak-mono-inertial");
+  reasons.Add(rules.weak, "weak");
+  return reasons;
 }
 
 PksSelector::PksSelector(PksOptions options) : options_(options) { options_.Check(); }
@@ -199,14 +210,7 @@ SelectorDecision PksSelector::Decide(const SelectorInput& in) {
       options_.imu_threshold > 0 && accel_change && *accel_change > options_.imu_threshold;
 
   const PksCompanionRules rules = EvaluatePksCompanionRules(in, options_, false);
-  ReasonList reasons;
-  reasons.Add(camera, "camera");
-  reasons.Add(imu, "imu");
-  reasons.Add(rules.close, "close");
-  reasons.Add(rules.time, "time");
-  reasons.Add(rules.weak_mono_inertial, "weak-mono-inertial");
-  reasons.Add(rules.weak, "weak");
-  return DecideFromReasons(in, reasons, std::move(trace));
+  return DecideFromReasons(in, PksReasons(camera, false, imu, rules), std::move(trace));
 }
 
 }  // namespace pkslam

@@ -18,6 +18,7 @@
 
 #include "keyframe/keyframe_selector.h"
 #include "keyframe/pks_math.h"
+#include "keyframe/selector_common.h"
 
 namespace pkslam {
 
@@ -72,6 +73,8 @@ struct PksCompanionRules {
 };
 PksCompanionRules EvaluatePksCompanionRules(const SelectorInput& input, const PksOptions& options,
                                             bool close_needs_idle_mapping);
+// The rules that fired, in PKS's order: camera, forced (pks-released), imu, then the companions.
+ReasonList PksReasons(bool camera, bool forced, bool imu, const PksCompanionRules& rules);
 
 class PksSelector : public KeyframeSelector {
  public:

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "core/util/error.h"
-#include "keyframe/orbslam3_selector.h"
 #include "keyframe/selector_common.h"
 
 namespace pkslam {
@@ -88,18 +87,10 @@ SelectorDecision VinsParallaxSelector::Decide(const SelectorInput& in) {
       parallax_rule = mean >= options_.parallax_px / options_.focal_px;
     }
   }
-  std::string reason;
-  if (parallax_rule) reason = "parallax";
-  if (few) reason += reason.empty() ? "few-tracked" : "+few-tracked";
-  if (reason.empty()) {
-    SelectorDecision no;
-    no.reason = "no";
-    no.trace = std::move(trace);
-    return no;
-  }
-  SelectorDecision d = AcceptIfMappingCanTakeIt(in, reason);
-  d.trace = std::move(trace);
-  return d;
+  ReasonList reasons;
+  reasons.Add(parallax_rule, "parallax");
+  reasons.Add(few, "few-tracked");
+  return DecideFromReasons(in, reasons, std::move(trace));
 }
 
 }  // namespace pkslam
