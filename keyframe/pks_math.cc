@@ -172,6 +172,34 @@ std::optional<int> StrictGridCell(double u, double v, double min_x, double max_x
   return *row * n + *col;
 }
 
+int Counts::Effective() const { return std::accumulate(grid.begin(), grid.end(), 0); }
+
+void TraceCounts(const Counts& counts, const std::string& suffix,
+                 std::map<std::string, double>* trace) {
+  (*trace)["A_" + suffix] = counts.a;
+  (*trace)["M_" + suffix] = counts.m;
+  (*trace)["D_" + suffix] = counts.d;
+  if (suffix == "c") (*trace)["E_c"] = counts.Effective();
+}
+
+void TraceThreshold(const AdaptiveThreshold& threshold, bool released,
+                    std::map<std::string, double>* trace) {
+  if (!threshold.valid) return;
+  auto& t = *trace;
+  t["theta"] = threshold.theta;
+  t["beta"] = threshold.beta;
+  t["alpha"] = threshold.alpha;
+  if (released) t["gamma"] = threshold.gamma;
+  t["Th_initial"] = threshold.th_initial;
+  t["Th_adaptive"] = threshold.th_adaptive;
+}
+
+void TraceEcog(const Ecog& ecog, std::map<std::string, double>* trace) {
+  if (!ecog.valid) return;
+  (*trace)["ECOG"] = ecog.ecog;
+  (*trace)["COG"] = ecog.cog;
+}
+
 double ParallaxDeg(const Eigen::Vector3d& point, const Eigen::Vector3d& center_a,
                    const Eigen::Vector3d& center_b) {
   const Eigen::Vector3d a = center_a - point;

@@ -73,6 +73,24 @@ int GridCell(double u, double v, int width, int height, int n);
 std::optional<int> StrictGridCell(double u, double v, double min_x, double max_x, double min_y,
                                   double max_y, int n);
 
+// One frame's counts: A tracked points, M matched to the last keyframe, D matched with a
+// changed cone region, and the effective points per grid cell (row-major).
+struct Counts {
+  int a = 0;
+  int m = 0;
+  int d = 0;
+  std::vector<int> grid;
+  int Effective() const;
+};
+
+// Trace rows (keyframe_trace.csv columns): A_/M_/D_ with `suffix` ("c" or "r") and E_c; the
+// threshold's terms (gamma only for the released code); ECOG and |COG| when valid.
+void TraceCounts(const Counts& counts, const std::string& suffix,
+                 std::map<std::string, double>* trace);
+void TraceThreshold(const AdaptiveThreshold& threshold, bool released,
+                    std::map<std::string, double>* trace);
+void TraceEcog(const Ecog& ecog, std::map<std::string, double>* trace);
+
 // Why delta is (un)reachable: for a normal fixed at the keyframe, a point's viewing-angle change
 // between the keyframe and the frame is at most the parallax angle between the two rays to it
 // (triangle inequality on the sphere). Collects both per matched point of one frame; Fill

@@ -1,7 +1,6 @@
 #include "keyframe/pks_released_selector.h"
 
 #include <cmath>
-#include <numeric>
 #include <unordered_map>
 
 #include "keyframe/selector_common.h"
@@ -170,40 +169,23 @@ bool PksReleasedSelector::CameraCriterion(const SelectorInput& input, SelectorTr
   }
   pks::ViewChangeDiagnostics diagnostics;
   const Counts c = Measure(input, input.trace_wanted ? &diagnostics : nullptr);
-  auto& t = *trace;
-  t["A_c"] = c.a;
-  t["M_c"] = c.m;
-  t["D_c"] = c.d;
-  t["E_c"] = std::accumulate(c.grid.begin(), c.grid.end(), 0);
-  diagnostics.Fill(&t);
+  pks::TraceCounts(c, "c", trace);
+  diagnostics.Fill(trace);
   // Early return before the reference is taken: an earlier interval's reference survives.
   if (c.d == 0 || c.m == 0) return false;
   if (frames == 1) reference_ = c;
   if (!reference_) return false;  // the released code's zero statics give NaN: no keyframe
   const Counts& r = *reference_;
-  t["A_r"] = r.a;
-  t["M_r"] = r.m;
-  t["D_r"] = r.d;
+  pks::TraceCounts(r, "r", trace);
   const pks::AdaptiveThreshold th =
       pks::ComputeAdaptiveThreshold(c.a, c.m, c.d, r.a, r.m, r.d, true);
-  bool criterion1 = false;
-  if (th.valid) {
-    t["theta"] = th.theta;
-    t["beta"] = th.beta;
-    t["alpha"] = th.alpha;
-    t["gamma"] = th.gamma;
-    t["Th_initial"] = th.th_initial;
-    t["Th_adaptive"] = th.th_adaptive;
-    criterion1 = c.d > th.th_adaptive && frames > 1;
-  }
+  pks::TraceThreshold(th, true, trace);
+  const bool criterion1 = th.valid && c.d > th.th_adaptive && frames > 1;
   const bool late = frames > options_.late_denominator_after;
   const pks::Ecog ecog = pks::ComputeEcog(c.grid, options_.grid, late);
-  bool criterion2 = false;
-  if (ecog.valid) {
-    t["ECOG"] = ecog.ecog;
-    t["COG"] = ecog.cog;
-    criterion2 = ecog.ecog > ecog.cog;
-  }
+  pks::TraceEcog(ecog, trace);
+  const bool criterion2 = ecog.valid && ecog.ecog > ecog.cog;
+  auto& t = *trace;
   t["criterion1"] = criterion1;
   t["criterion2"] = criterion2;
   return criterion1 && criterion2;

@@ -71,12 +71,7 @@ class PksReleasedSelector : public KeyframeSelector {
     double angle_deg;
     int region;
   };
-  struct Counts {
-    int a = 0;
-    int m = 0;
-    int d = 0;
-    std::vector<int> grid;
-  };
+  using Counts = pks::Counts;
   View MakeView(const SelectorInput& input, bool with_normals) const;
   // Pairs the snapshot with the frame and counts A, M, D and the effective-point grid.
   Counts Measure(const SelectorInput& input, pks::ViewChangeDiagnostics* diagnostics) const;

@@ -1,7 +1,6 @@
 #include "keyframe/pks_selector.h"
 
 #include <cmath>
-#include <numeric>
 
 #include "core/util/error.h"
 #include "keyframe/selector_common.h"
@@ -151,35 +150,18 @@ bool PksSelector::CameraCriterion(const SelectorInput& input, SelectorTrace* tra
   pks::ViewChangeDiagnostics diagnostics;
   const Counts c = Measure(input, input.trace_wanted ? &diagnostics : nullptr);
   if (!reference_) reference_ = c;  // the first frame after the keyframe
-  auto& t = *trace;
-  t["A_c"] = c.a;
-  t["M_c"] = c.m;
-  t["D_c"] = c.d;
-  t["E_c"] = std::accumulate(c.grid.begin(), c.grid.end(), 0);
-  diagnostics.Fill(&t);
+  pks::TraceCounts(c, "c", trace);
+  diagnostics.Fill(trace);
   const Counts& r = *reference_;
-  t["A_r"] = r.a;
-  t["M_r"] = r.m;
-  t["D_r"] = r.d;
-
+  pks::TraceCounts(r, "r", trace);
   const pks::AdaptiveThreshold th =
       pks::ComputeAdaptiveThreshold(c.a, c.m, c.d, r.a, r.m, r.d, false);
-  bool criterion1 = false;
-  if (th.valid) {
-    t["theta"] = th.theta;
-    t["beta"] = th.beta;
-    t["alpha"] = th.alpha;
-    t["Th_initial"] = th.th_initial;
-    t["Th_adaptive"] = th.th_adaptive;
-    criterion1 = c.d > th.th_adaptive;
-  }
+  pks::TraceThreshold(th, false, trace);
+  const bool criterion1 = th.valid && c.d > th.th_adaptive;
   const pks::Ecog ecog = pks::ComputeEcog(c.grid, options_.grid, false);
-  bool criterion2 = false;
-  if (ecog.valid) {
-    t["ECOG"] = ecog.ecog;
-    t["COG"] = ecog.cog;
-    criterion2 = ecog.ecog > ecog.cog;
-  }
+  pks::TraceEcog(ecog, trace);
+  const bool criterion2 = ecog.valid && ecog.ecog > ecog.cog;
+  auto& t = *trace;
   t["criterion1"] = criterion1;
   t["criterion2"] = criterion2;
   return criterion1 && criterion2;

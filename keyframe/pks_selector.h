@@ -93,12 +93,7 @@ class PksSelector : public KeyframeSelector {
   struct SnapshotPoint {
     Eigen::Vector3d normal_keyframe;
   };
-  struct Counts {
-    int a = 0;              // tracked points
-    int m = 0;              // matched to the last keyframe
-    int d = 0;              // matched with a changed cone region
-    std::vector<int> grid;  // effective points per cell
-  };
+  using Counts = pks::Counts;
   // `diagnostics` (optional) collects each matched point's view change and parallax.
   Counts Measure(const SelectorInput& input, pks::ViewChangeDiagnostics* diagnostics) const;
   // Adds the last keyframe's points that the snapshot does not hold yet (created with the
