@@ -105,7 +105,7 @@ TEST_F(InertialLoopTest, CorrectsYawAndTranslationKeepingGravity) {
     EXPECT_NEAR(ClosestYawAngle(turn), -0.03, 2e-3);
     EXPECT_LT((kf.imu.state.velocity_world - turn * before.velocity.at(kf.id())).norm(), 1e-9);
   }
-  EXPECT_GT(atlas_.current_map()->imu_change_index, 0);  // tracking re-anchors on its keyframe
+  EXPECT_GT(atlas_.current_map()->NumWorldChanges(), 0);  // tracking re-anchors on its keyframe
 }
 
 TEST_F(InertialLoopTest, TwoInertialMapsMergeByYawAndTranslation) {

@@ -345,7 +345,7 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
         }
         applied = true;
         if (IsInertial(sensor_) && map->imu_initialized) {
-          ++map->imu_change_index;
+          map->RecordWorldChange({});
           PKSLAM_LOG_INFO("global BA of map {}: largest keyframe tilt change {:.2e} rad", map->id(),
                           MaxTiltChange(*map, gravity_before));
         }

@@ -215,7 +215,7 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
     query->AddLoopEdge(region.matched.get());
     region.matched->AddLoopEdge(query);
     // Tracking predicts from its last keyframe (corrected pose and velocity) next time.
-    if (four_dof) ++map->imu_change_index;
+    if (four_dof) map->RecordWorldChange({});
     PKSLAM_LOG_INFO(
         "loop correction of map {} ({}): yaw {:.4f} rad, largest keyframe tilt change "
         "{:.2e} rad",
@@ -321,7 +321,7 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     region.matched->AddLoopEdge(query);
 
     merged->imu_initialized = merged->imu_initialized && current->imu_initialized;
-    ++merged->imu_change_index;
+    merged->RecordWorldChange({});
     atlas_->SetCurrentMap(merged);
     atlas_->RemoveMap(current);
     merged->IncreaseChangeIndex();

@@ -67,12 +67,12 @@ InertialStatePrior MakeInertialStatePrior(const NavState& state, const ImuBias& 
 void StampPrior(const Map& map, InertialStatePrior* prior) {
   prior->map_id = map.id();
   prior->map_change_index = map.change_index();
-  prior->world_change_index = map.world_change_index;
+  prior->world_transforms = map.NumWorldTransforms();
 }
 
 bool PriorIsValid(const InertialStatePrior& prior, const Map& map) {
   return prior.map_id == map.id() && prior.map_change_index == map.change_index() &&
-         prior.world_change_index == map.world_change_index;
+         prior.world_transforms == map.NumWorldTransforms();
 }
 
 }  // namespace pkslam

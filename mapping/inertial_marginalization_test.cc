@@ -221,7 +221,7 @@ TEST_F(MarginalizationMapTest, ValidPriorFreesTheAnchorStalePriorIsIgnored) {
   // An IMU initialisation / refinement rotated the map: stale too.
   GiveAnchorPrior(1e4);
   EXPECT_TRUE(PriorIsValid(*anchor()->imu.prior, *map()));
-  ++map()->world_change_index;
+  map()->RecordWorldChange({WorldChange::Kind::kTransform, SO3d(), 1.0});
   EXPECT_FALSE(PriorIsValid(*anchor()->imu.prior, *map()));
   // Another map.
   GiveAnchorPrior(1e4);

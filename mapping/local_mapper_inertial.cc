@@ -197,7 +197,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
       if (other->id() > kf->id() && !other->IsBad()) other->imu.state.bias = kf->imu.state.bias;
     }
     map->gravity_refinement_observability = stat.observability;
-    ++map->imu_change_index;
+    map->RecordWorldChange({});
     accel_bias = kf->imu.state.bias.accel;
   }
   stat.ms =
@@ -287,13 +287,9 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
       }
     }
     ApplyScaledRotation(map, new_from_old, r.scale);
-    ++map->world_change_index;
-    map->last_world_rotation = new_from_old;
-    map->last_world_scale = r.scale;
     map->imu_initialized = true;
     if (!refinement) map->imu_init_t_ns = kf->t_ns();
-    map->applied_scale *= r.scale;
-    ++map->imu_change_index;
+    map->RecordWorldChange({WorldChange::Kind::kTransform, new_from_old, r.scale});
   }
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -346,7 +342,7 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
       if (other->id() > kf->id()) other->imu.state.bias = result.biases.front();
     }
   }
-  ++kf->map()->imu_change_index;
+  kf->map()->RecordWorldChange({});
   // Every state moved: marginalisation priors of the local inertial BA are stale.
   kf->map()->IncreaseChangeIndex();
 }
@@ -380,7 +376,7 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
   std::unique_lock lock(atlas_->mutex());
   if (kf->map() == nullptr) return true;
   ApplyInertialBundle(problem, result);
-  ++kf->map()->imu_change_index;
+  kf->map()->RecordWorldChange({});
   lock.unlock();
   PKSLAM_LOG_DEBUG(
       "local inertial BA at kf {}: {} iterations, cost {:.1f} -> {:.1f}, anchor {}, next prior "

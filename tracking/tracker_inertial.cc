@@ -97,38 +97,42 @@ void Tracker::SyncWithInertialMap() {
 
 void Tracker::SyncWithInertialMapLocked(bool correct_current) {
   const Map* map = atlas_->current_map();
+  const int changes = map->NumWorldChanges();
   if (map != imu_->map) {
     imu_->map = map;
-    imu_->seen_change_index = map->imu_change_index;
-    imu_->seen_scale = map->applied_scale;
-    imu_->seen_world_change_index = map->world_change_index;
+    imu_->seen_world_changes = changes;
+    imu_->seen_scale = map->applied_scale();
     imu_->from_keyframe = true;
     imu_->last_frame_information.reset();
     return;
   }
-  if (map->imu_change_index != imu_->seen_change_index) {
-    imu_->seen_change_index = map->imu_change_index;
-    imu_->from_keyframe = true;
-    imu_->last_frame_information.reset();
-  }
-  if (map->world_change_index != imu_->seen_world_change_index) {
-    // Local mapping rotated / rescaled the map after the current frame was tracked: its pose is
-    // in the old world. One change is carried across exactly; more cannot be (not observed).
-    if (correct_current && current_.HasPose() &&
-        map->world_change_index == imu_->seen_world_change_index + 1) {
-      const SE3d& tcw = current_.camera_from_world();
-      current_.SetPose(SE3d(tcw.so3() * map->last_world_rotation.Inverse(),
-                            map->last_world_scale * tcw.translation()));
-      current_.imu.state.velocity_world =
-          map->last_world_scale * (map->last_world_rotation * current_.imu.state.velocity_world);
+  if (changes == imu_->seen_world_changes) return;
+  // Every change re-estimated the keyframes' states: predict from the last keyframe.
+  imu_->from_keyframe = true;
+  imu_->last_frame_information.reset();
+  int transforms = 0;
+  const WorldChange* transform = nullptr;
+  for (int i = imu_->seen_world_changes; i < changes; ++i) {
+    if (map->world_change(i).kind == WorldChange::Kind::kTransform) {
+      ++transforms;
+      transform = &map->world_change(i);
     }
-    imu_->seen_world_change_index = map->world_change_index;
   }
-  if (map->applied_scale != imu_->seen_scale) {
+  imu_->seen_world_changes = changes;
+  // Local mapping rotated / rescaled the map after the current frame was tracked: its pose is
+  // in the old world. One transform is carried across exactly; more cannot be (not observed).
+  if (correct_current && current_.HasPose() && transforms == 1) {
+    const SE3d& tcw = current_.camera_from_world();
+    current_.SetPose(
+        SE3d(tcw.so3() * transform->rotation.Inverse(), transform->scale * tcw.translation()));
+    current_.imu.state.velocity_world =
+        transform->scale * (transform->rotation * current_.imu.state.velocity_world);
+  }
+  if (map->applied_scale() != imu_->seen_scale) {
     // Monocular-inertial initialisation rescaled the map: what tracking keeps relative to its
     // keyframes scales with it.
-    const double ratio = map->applied_scale / imu_->seen_scale;
-    imu_->seen_scale = map->applied_scale;
+    const double ratio = map->applied_scale() / imu_->seen_scale;
+    imu_->seen_scale = map->applied_scale();
     for (FrameRecord& r : records_) {
       if (r.reference && r.reference->map() == map) r.camera_from_reference.translation() *= ratio;
     }

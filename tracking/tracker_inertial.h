@@ -19,9 +19,8 @@ struct InertialTrackingState {
   std::int64_t last_frame_t_ns = -1;
   // The map the fields below refer to and what was last seen of its inertial changes.
   const Map* map = nullptr;
-  int seen_change_index = 0;
+  int seen_world_changes = 0;  // cursor into the map's world-change log
   double seen_scale = 1.0;
-  int seen_world_change_index = 0;
   // Predict and optimise against the last keyframe (true after the map changed under us)
   // instead of the last frame.
   bool from_keyframe = true;

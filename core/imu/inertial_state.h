@@ -34,7 +34,8 @@ struct FrameImu {
 // (the local inertial BA's marginalisation prior, mapping/inertial_marginalization.h). Written
 // and read by local mapping under the Atlas mutex. Valid only while the map it was computed in
 // has not moved map-wide: `map_id`, `map_change_index` (Map::change_index: loop corrections,
-// merges, global and full inertial BA) and `world_change_index` must still match.
+// merges, global and full inertial BA) and `world_transforms` (Map::NumWorldTransforms) must
+// still match.
 struct InertialStatePrior {
   NavState mean;  // world_from_body and velocity at the prior's mean
   ImuBias bias_mean;
@@ -46,7 +47,7 @@ struct InertialStatePrior {
   std::optional<Eigen::Matrix<double, 15, 15>> sqrt_information;
   MapId map_id = -1;
   int map_change_index = 0;
-  int world_change_index = 0;
+  int world_transforms = 0;
 };
 
 // A keyframe's IMU data: the preintegration from the previous keyframe of the chain and the

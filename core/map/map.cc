@@ -68,6 +68,14 @@ MapPointPtr Map::Share(const MapPoint* point) const {
   return it != map_points_.end() && it->second.get() == point ? it->second : nullptr;
 }
 
+void Map::RecordWorldChange(const WorldChange& change) {
+  world_changes_.push_back(change);
+  if (change.kind == WorldChange::Kind::kTransform) {
+    applied_scale_ *= change.scale;
+    ++world_transforms_;
+  }
+}
+
 void Map::Clear() {
   if (database_ != nullptr) database_->Clear(this);
   // Keyframes hold points and points point back at keyframes: unlink before releasing so

@@ -10,6 +10,7 @@
 
 #include "core/geometry/so3.h"
 #include "core/map/ids.h"
+#include "core/map/world_change.h"
 
 namespace pkslam {
 
@@ -65,18 +66,17 @@ class Map {
   double gravity_refinement_observability = 0;
   // Time of the first keyframe of the IMU initialisation and of the initialisation [ns].
   std::int64_t imu_init_t_ns = 0;
-  // Bumped whenever local mapping rotates / rescales the map or re-estimates keyframe
-  // velocities and biases (IMU initialisation, inertial BA): tracking then predicts from the
-  // last keyframe instead of the last frame.
-  int imu_change_index = 0;
+  // World changes (world_change.h): recorded by whoever changed the map (holding the Atlas
+  // lock exclusively), read by tracking past its cursor. A transform also multiplies the
+  // applied scale.
+  void RecordWorldChange(const WorldChange& change);
+  int NumWorldChanges() const { return static_cast<int>(world_changes_.size()); }
+  const WorldChange& world_change(int index) const { return world_changes_.at(index); }
   // Product of the scale factors applied to the map (monocular-inertial initialisation), so
   // tracking can rescale what it stores relative to keyframes.
-  double applied_scale = 1.0;
-  // Bumped when local mapping rotates / rescales the whole map (x' = scale * rotation * x);
-  // the last such change, so tracking can carry a frame tracked just before it across.
-  int world_change_index = 0;
-  SO3d last_world_rotation;
-  double last_world_scale = 1.0;
+  double applied_scale() const { return applied_scale_; }
+  // How many transforms the map underwent (marginalisation priors expire with each).
+  int NumWorldTransforms() const { return world_transforms_; }
 
   // Drops everything (used on reset). Breaks every keyframe<->point link first.
   void Clear();
@@ -94,6 +94,9 @@ class Map {
   KeyFrameId max_kf_id_ = kInvalidId;
   int change_index_ = 0;
   KeyFrameDatabase* database_ = nullptr;
+  std::vector<WorldChange> world_changes_;
+  double applied_scale_ = 1.0;
+  int world_transforms_ = 0;
 };
 
 }  // namespace pkslam
