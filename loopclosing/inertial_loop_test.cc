@@ -41,9 +41,9 @@ class InertialLoopTest : public testing::RevisitTest {
     Finish(second_);
     std::unique_lock lock(atlas_.mutex());
     for (Map* map : atlas_.maps()) {
-      map->imu_initialized = true;
-      map->inertial_ba1_done = true;
-      map->inertial_ba2_done = true;
+      map->mutable_imu_status().imu_initialized = true;
+      map->mutable_imu_status().inertial_ba1_done = true;
+      map->mutable_imu_status().inertial_ba2_done = true;
       KeyFrame* previous = nullptr;
       for (const auto& kf : map->keyframes()) {
         kf.second->imu.previous = previous;
@@ -156,8 +156,8 @@ class DriftBoundTest : public InertialLoopTest {
     Finish(second_);
     if (IsInertial(sensor)) {
       std::unique_lock lock(atlas_.mutex());
-      atlas_.current_map()->imu_initialized = true;
-      atlas_.current_map()->inertial_ba2_done = true;
+      atlas_.current_map()->mutable_imu_status().imu_initialized = true;
+      atlas_.current_map()->mutable_imu_status().inertial_ba2_done = true;
     }
     const Snapshot before = Take();
     const LoopClosingStats stats = Close(sensor);

@@ -191,7 +191,7 @@ std::optional<CommonRegion> LoopClosing::Detect(const KeyFramePtr& kf, double* v
   Map* map = kf->map();
   if (database == nullptr || map == nullptr || kf->IsBad()) return std::nullopt;
   // Inertial maps wait for their second inertial BA (ORB-SLAM3); small maps are not searched.
-  if (IsInertial(sensor_) && !map->inertial_ba2_done) return std::nullopt;
+  if (IsInertial(sensor_) && !map->imu_status().inertial_ba2_done) return std::nullopt;
   const int min_keyframes =
       IsMonocular(sensor_) ? options_.min_keyframes_mono : options_.min_keyframes_stereo;
   if (map->NumKeyFrames() < min_keyframes) return std::nullopt;
@@ -305,7 +305,7 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
   BundleProblem problem;
   {
     std::shared_lock lock(atlas_->mutex());
-    if (IsInertial(sensor_) && map->imu_initialized &&
+    if (IsInertial(sensor_) && map->imu_status().imu_initialized &&
         map->NumKeyFrames() <= options_.inertial_global_ba_max_keyframes) {
       KeyFrame* newest = nullptr;
       for (auto it = map->keyframes().rbegin(); it != map->keyframes().rend() && !newest; ++it) {
@@ -344,7 +344,7 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
           MergeGlobalBundle(map, problem, result);
         }
         applied = true;
-        if (IsInertial(sensor_) && map->imu_initialized) {
+        if (IsInertial(sensor_) && map->imu_status().imu_initialized) {
           map->RecordWorldChange({});
           PKSLAM_LOG_INFO("global BA of map {}: largest keyframe tilt change {:.2e} rad", map->id(),
                           MaxTiltChange(*map, gravity_before));

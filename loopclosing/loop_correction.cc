@@ -40,7 +40,7 @@ std::vector<KeyFrame*> Neighbourhood(KeyFrame* query) {
 }  // namespace
 
 bool LoopClosing::UsesFourDof(const Map& map) const {
-  return IsInertial(sensor_) && map.imu_initialized;
+  return IsInertial(sensor_) && map.imu_status().imu_initialized;
 }
 
 PoseGraphDof LoopClosing::GraphDof(const Map& map) const {
@@ -320,7 +320,8 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     query->AddLoopEdge(region.matched.get());
     region.matched->AddLoopEdge(query);
 
-    merged->imu_initialized = merged->imu_initialized && current->imu_initialized;
+    merged->mutable_imu_status().imu_initialized =
+        merged->imu_status().imu_initialized && current->imu_status().imu_initialized;
     merged->RecordWorldChange({});
     atlas_->SetCurrentMap(merged);
     atlas_->RemoveMap(current);

@@ -35,8 +35,8 @@ InertialCullingContext MakeInertialCullingContext(const KeyFrame& current,
   c.window_start_id = k->id();
   if (const Map* map = current.map()) {
     c.map_keyframes = map->NumKeyFrames();
-    c.imu_initialized = map->imu_initialized;
-    c.refined = map->inertial_ba2_done;
+    c.imu_initialized = map->imu_status().imu_initialized;
+    c.refined = map->imu_status().inertial_ba2_done;
   }
   return c;
 }

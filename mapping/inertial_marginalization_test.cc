@@ -157,7 +157,7 @@ class MarginalizationMapTest : public ::testing::Test {
       kf->imu.state.valid = true;
     }
     testing::LinkWithImu(map_.keyframes, samples, bias_, noise_);
-    map()->imu_initialized = true;
+    map()->mutable_imu_status().imu_initialized = true;
     options_.window = 5;
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }

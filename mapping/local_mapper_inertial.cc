@@ -69,10 +69,10 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
     std::shared_lock lock(atlas_->mutex());
     if (kf->IsBad() || kf->map() == nullptr) return;
     const Map* map = kf->map();
-    initialized = map->imu_initialized;
-    ba1 = map->inertial_ba1_done;
-    ba2 = map->inertial_ba2_done;
-    init_t_ns = map->imu_init_t_ns;
+    initialized = map->imu_status().imu_initialized;
+    ba1 = map->imu_status().inertial_ba1_done;
+    ba2 = map->imu_status().inertial_ba2_done;
+    init_t_ns = map->imu_status().imu_init_t_ns;
     if (map != moving_map_) {
       moving_map_ = map;
       moving_s_ = 0;
@@ -113,7 +113,8 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
   auto mark = [&](bool second) {
     std::unique_lock lock(atlas_->mutex());
     if (kf->map() == nullptr) return;
-    (second ? kf->map()->inertial_ba2_done : kf->map()->inertial_ba1_done) = true;
+    MapImuStatus& status = kf->map()->mutable_imu_status();
+    (second ? status.inertial_ba2_done : status.inertial_ba1_done) = true;
   };
   if (!ba1 && since > o.viba1_s) {
     initializing_imu_.store(true);
@@ -152,8 +153,9 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
     orientations.reserve(chain.size());
     for (const KeyFrame* k : chain) orientations.push_back(k->world_from_body().so3());
     stat.observability = TiltObservability(orientations);
-    const double due = std::max(o.gravity_refinement_min,
-                                map->gravity_refinement_observability + o.gravity_refinement_step);
+    const double due =
+        std::max(o.gravity_refinement_min,
+                 map->imu_status().gravity_refinement_observability + o.gravity_refinement_step);
     if (stat.observability < due) return;
     problem = CollectFullInertialBundle(kf.get(), ba, /*free_tilt=*/true);
     change_index = map->change_index();
@@ -196,7 +198,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
     for (const auto& [id, other] : map->keyframes()) {
       if (other->id() > kf->id() && !other->IsBad()) other->imu.state.bias = kf->imu.state.bias;
     }
-    map->gravity_refinement_observability = stat.observability;
+    map->mutable_imu_status().gravity_refinement_observability = stat.observability;
     map->RecordWorldChange({});
     accel_bias = kf->imu.state.bias.accel;
   }
@@ -287,8 +289,8 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
       }
     }
     ApplyScaledRotation(map, new_from_old, r.scale);
-    map->imu_initialized = true;
-    if (!refinement) map->imu_init_t_ns = kf->t_ns();
+    map->mutable_imu_status().imu_initialized = true;
+    if (!refinement) map->mutable_imu_status().imu_init_t_ns = kf->t_ns();
     map->RecordWorldChange({WorldChange::Kind::kTransform, new_from_old, r.scale});
   }
   const double ms =
@@ -353,7 +355,8 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
   ba.num_threads = options_.ba.num_threads;
   {
     std::unique_lock lock(atlas_->mutex());
-    if (kf->IsBad() || kf->map() == nullptr || !kf->map()->imu_initialized) return false;
+    if (kf->IsBad() || kf->map() == nullptr || !kf->map()->imu_status().imu_initialized)
+      return false;
     // Keyframes created from frames tracked before the initialisation reached tracking have
     // no estimated state yet: start them at their predecessor's.
     std::vector<KeyFrame*> missing;

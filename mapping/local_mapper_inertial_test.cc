@@ -74,7 +74,7 @@ InitialisedStates RunInitialisationWithQueuedKeyFrames(int num_keyframes,
   InitialisedStates out;
   mapper.SetKeyFrameConsumer([&](const KeyFramePtr& kf) {
     std::shared_lock lock(atlas.mutex());
-    if (out.initialized || !kf->map()->imu_initialized) return;
+    if (out.initialized || !kf->map()->imu_status().imu_initialized) return;
     out.initialized = true;
     out.trigger = kf->id();
     for (const KeyFramePtr& k : map.keyframes) {

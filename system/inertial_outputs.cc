@@ -51,7 +51,7 @@ void WriteInertialOutputs(const SlamSystem& system, const std::filesystem::path&
           "{:.9f},{:.6f},{:.6f},{:.6f},{:.7f},{:.7f},{:.7f},{:.6f},{:.6f},{:.6f},{},{}\n",
           kf->t_s(), s.velocity_world.x(), s.velocity_world.y(), s.velocity_world.z(),
           s.bias.gyro.x(), s.bias.gyro.y(), s.bias.gyro.z(), s.bias.accel.x(), s.bias.accel.y(),
-          s.bias.accel.z(), s.valid ? 1 : 0, best->imu_initialized ? 1 : 0);
+          s.bias.accel.z(), s.valid ? 1 : 0, best->imu_status().imu_initialized ? 1 : 0);
     }
   }
   lock.unlock();

@@ -44,7 +44,9 @@ void Tracker::AddImu(const std::vector<ImuMeasurement>& samples) {
   }
 }
 
-bool Tracker::ImuReady() const { return imu_ != nullptr && atlas_->current_map()->imu_initialized; }
+bool Tracker::ImuReady() const {
+  return imu_ != nullptr && atlas_->current_map()->imu_status().imu_initialized;
+}
 
 std::optional<PreintegratedImu> Tracker::PreintegrateBetween(std::int64_t t0_ns, std::int64_t t1_ns,
                                                              const ImuBias& bias) const {

@@ -33,7 +33,7 @@ SelectorInput Tracker::BuildSelectorInput(bool mapping_idle, bool for_decision) 
   in.inliers = inliers_;
   in.recently_lost = state_ == TrackingState::kRecentlyLost;
   in.keyframes_in_map = map->NumKeyFrames();
-  in.imu_initialized = map->imu_initialized;
+  in.imu_initialized = map->imu_status().imu_initialized;
   if (reference_kf_) {
     in.reference_tracked_points = reference_kf_->TrackedMapPoints(in.keyframes_in_map <= 2 ? 2 : 3);
   }

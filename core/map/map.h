@@ -16,6 +16,18 @@ namespace pkslam {
 
 class KeyFrameDatabase;
 
+// How far a map's IMU initialisation has come.
+struct MapImuStatus {
+  bool imu_initialized = false;
+  bool inertial_ba1_done = false;
+  bool inertial_ba2_done = false;
+  // Tilt observability (mapping/gravity_refinement.h) of the chain at the last gravity
+  // refinement (0: none yet).
+  double gravity_refinement_observability = 0;
+  // Time of the first keyframe of the IMU initialisation [ns].
+  std::int64_t imu_init_t_ns = 0;
+};
+
 class Map {
  public:
   explicit Map(MapId id) : id_(id) {}
@@ -57,15 +69,11 @@ class Map {
   int change_index() const { return change_index_; }
   void IncreaseChangeIndex() { ++change_index_; }
 
-  // Inertial state of the map.
-  bool imu_initialized = false;
-  bool inertial_ba1_done = false;
-  bool inertial_ba2_done = false;
-  // Tilt observability (mapping/gravity_refinement.h) of the chain at the last gravity
-  // refinement (0: none yet).
-  double gravity_refinement_observability = 0;
-  // Time of the first keyframe of the IMU initialisation and of the initialisation [ns].
-  std::int64_t imu_init_t_ns = 0;
+  // Inertial state of the map: read by every thread under the Atlas lock, written by local
+  // mapping (IMU initialisation and refinements) and loop closing (merges) under it.
+  const MapImuStatus& imu_status() const { return imu_status_; }
+  MapImuStatus& mutable_imu_status() { return imu_status_; }
+
   // World changes (world_change.h): recorded by whoever changed the map (holding the Atlas
   // lock exclusively), read by tracking past its cursor. A transform also multiplies the
   // applied scale.
@@ -94,6 +102,7 @@ class Map {
   KeyFrameId max_kf_id_ = kInvalidId;
   int change_index_ = 0;
   KeyFrameDatabase* database_ = nullptr;
+  MapImuStatus imu_status_;
   std::vector<WorldChange> world_changes_;
   double applied_scale_ = 1.0;
   int world_transforms_ = 0;
