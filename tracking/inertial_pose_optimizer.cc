@@ -16,19 +16,12 @@
 #include "imu/body_reprojection_error.h"
 #include "imu/imu_factors.h"
 #include "imu/imu_manifolds.h"
+#include "tracking/pose_correspondences.h"
 
 namespace pkslam {
 namespace {
 
-struct Correspondence {
-  int keypoint = -1;
-  bool stereo = false;
-  Eigen::Vector3d p_world;
-  Eigen::Vector3d obs;  // u, v, u_right
-  double inv_sigma2 = 1.0;
-  std::unique_ptr<ceres::CostFunction> cost;
-  ceres::ResidualBlockId block = nullptr;  // null while an outlier
-};
+using Correspondence = PoseCorrespondence;
 
 double Chi2(const BodyCamera& camera, const SE3d& world_from_body, const Correspondence& c) {
   return c.stereo ? BodyStereoChi2(camera, world_from_body, c.p_world, c.obs, c.inv_sigma2)
@@ -88,24 +81,8 @@ InertialPoseOutput OptimizeInertialPose(Frame* frame, const InertialPoseInput& i
   camera.cy = rig.cy;
   camera.bf = rig.bf;
   camera.camera_from_body = rig.body_from_camera.Inverse();
-  const int n = frame->size();
-  const auto& keypoints = frame->keypoints_undistorted();
-  const auto& right_u = frame->right_u();
-  const auto& inv_sigma2 = rig.pyramid.inv_sigma2;
-
-  std::vector<Correspondence> corrs;
-  corrs.reserve(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    const MapPointPtr& point = frame->map_points[i];
-    if (!point) continue;
-    const cv::KeyPoint& kp = keypoints[i];
-    Correspondence& c = corrs.emplace_back();
-    c.keypoint = i;
-    c.stereo = !right_u.empty() && right_u[i] >= 0;
-    c.p_world = point->position();
-    c.obs = Eigen::Vector3d(kp.pt.x, kp.pt.y, c.stereo ? right_u[i] : -1.0);
-    c.inv_sigma2 = inv_sigma2[kp.octave];
-  }
+  std::vector<Correspondence> corrs =
+      CollectPoseCorrespondences(*frame, /*depth_information=*/false);
 
   ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/false);
   BodyPoseManifold pose_manifold;
@@ -183,17 +160,9 @@ InertialPoseOutput OptimizeInertialPose(Frame* frame, const InertialPoseInput& i
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     const SE3d world_from_body = cur.State().world_from_body;
-    inliers = 0;
-    for (Correspondence& c : corrs) {
-      const double chi2 = Chi2(camera, world_from_body, c);
-      const bool inlier = chi2 <= (c.stereo ? options.chi2_stereo : options.chi2_mono);
-      if (inlier && c.block == nullptr) add(c);
-      if (!inlier && c.block != nullptr) {
-        problem.RemoveResidualBlock(c.block);
-        c.block = nullptr;
-      }
-      inliers += inlier ? 1 : 0;
-    }
+    inliers = ReclassifyCorrespondences(
+        &corrs, &problem, options.chi2_mono, options.chi2_stereo,
+        [&](const Correspondence& c) { return Chi2(camera, world_from_body, c); }, add);
   }
   losses.SetRobust(false);
 
@@ -218,8 +187,7 @@ InertialPoseOutput OptimizeInertialPose(Frame* frame, const InertialPoseInput& i
   }
   out.information = 0.5 * (out.information + out.information.transpose()).eval();
 
-  frame->outliers.assign(static_cast<std::size_t>(n), 0);
-  for (const Correspondence& c : corrs) frame->outliers[c.keypoint] = c.block == nullptr ? 1 : 0;
+  WriteOutlierFlags(corrs, frame);
   frame->SetPose((out.state.world_from_body * camera.camera_from_body.Inverse()).Inverse());
   frame->imu.state.velocity_world = out.state.velocity_world;
   frame->imu.state.bias = out.bias;

@@ -13,20 +13,12 @@
 #include "core/optim/reprojection_error.h"
 #include "core/optim/se3_manifold.h"
 #include "core/util/error.h"
+#include "tracking/pose_correspondences.h"
 
 namespace pkslam {
 namespace {
 
-struct Correspondence {
-  int keypoint = -1;
-  bool stereo = false;
-  Eigen::Vector3d p_world;
-  Eigen::Vector3d obs;  // u, v, u_right (u_right unused for monocular)
-  double inv_sigma2 = 1.0;
-  double disparity_inv_sigma2 = 0.0;  // RGB-D depth reading's information (0: stereo form)
-  std::unique_ptr<ceres::CostFunction> cost;
-  ceres::ResidualBlockId block = nullptr;  // null while classified as outlier
-};
+using Correspondence = PoseCorrespondence;
 
 double Chi2(const PinholeIntrinsics& k, const SE3d& camera_from_world, const Correspondence& c) {
   return c.stereo ? StereoChi2(k, camera_from_world, c.p_world, c.obs, c.inv_sigma2,
@@ -51,29 +43,8 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
   PKSLAM_CHECK(frame->HasPose(), "frame {} has no initial pose", frame->id());
   const CameraRig& rig = frame->rig();
   const PinholeIntrinsics k{rig.fx, rig.fy, rig.cx, rig.cy, rig.bf};
-  const int n = frame->size();
-  PKSLAM_CHECK(static_cast<int>(frame->map_points.size()) == n,
-               "{} map-point slots for {} keypoints", frame->map_points.size(), n);
-  const auto& keypoints = frame->keypoints_undistorted();
-  const auto& right_u = frame->right_u();
-  const auto& inv_sigma2 = rig.pyramid.inv_sigma2;
-
-  std::vector<Correspondence> corrs;
-  corrs.reserve(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    const MapPointPtr& point = frame->map_points[i];
-    if (!point) continue;
-    const cv::KeyPoint& kp = keypoints[i];
-    PKSLAM_CHECK(kp.octave >= 0 && kp.octave < static_cast<int>(inv_sigma2.size()),
-                 "keypoint {} has octave {}", i, kp.octave);
-    Correspondence& c = corrs.emplace_back();
-    c.keypoint = i;
-    c.stereo = !right_u.empty() && right_u[i] >= 0;
-    c.p_world = point->position();
-    c.obs = Eigen::Vector3d(kp.pt.x, kp.pt.y, c.stereo ? right_u[i] : -1.0);
-    c.inv_sigma2 = inv_sigma2[kp.octave];
-    if (c.stereo) c.disparity_inv_sigma2 = frame->DisparityInformation(i);
-  }
+  std::vector<Correspondence> corrs =
+      CollectPoseCorrespondences(*frame, /*depth_information=*/true);
   const int num_correspondences = static_cast<int>(corrs.size());
   if (num_correspondences < 3) return 0;
 
@@ -130,28 +101,12 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
     ceres::Solve(solver_options, &problem, &summary);
     camera_from_world = PoseFromBlock(pose);
 
-    // Re-classify every correspondence (outliers too) at the new pose.
-    num_active = 0;
-    for (Correspondence& c : corrs) {
-      const double chi2 = Chi2(k, camera_from_world, c);
-      const bool inlier = chi2 <= (c.stereo ? options.chi2_stereo : options.chi2_mono);
-      if (inlier && c.block == nullptr) add(c);
-      if (!inlier && c.block != nullptr) {
-        problem.RemoveResidualBlock(c.block);
-        c.block = nullptr;
-      }
-      num_active += inlier ? 1 : 0;
-    }
+    num_active = ReclassifyCorrespondences(
+        &corrs, &problem, options.chi2_mono, options.chi2_stereo,
+        [&](const Correspondence& c) { return Chi2(k, camera_from_world, c); }, add);
   }
 
-  // Every slot is rewritten: no stale flag survives on a slot matched later.
-  frame->outliers.assign(static_cast<std::size_t>(n), 0);
-  int num_outliers = 0;
-  for (const Correspondence& c : corrs) {
-    const bool outlier = c.block == nullptr;
-    frame->outliers[c.keypoint] = outlier ? 1 : 0;
-    num_outliers += outlier ? 1 : 0;
-  }
+  const int num_outliers = WriteOutlierFlags(corrs, frame);
   frame->SetPose(camera_from_world);
   return num_correspondences - num_outliers;
 }
