@@ -249,7 +249,8 @@ def analyse(rows, seed=1):
 
 
 def sentence(e):
-    head = (f"{e['config']} vs {e['baseline']} ({e['sensor']}, {e['sequences']} sequences, "
+    seqs = f"{e['sequences']} sequence" + ("s" if e["sequences"] != 1 else "")
+    head = (f"{e['config']} vs {e['baseline']} ({e['sensor']}, {seqs}, "
             f"~{e['runs_per_sequence']:.0f} runs each): ATE {fmt_pct(-e['improvement_pct'])} "
             f"[95% CI {fmt_pct(-e['ci_high'])}, {fmt_pct(-e['ci_low'])}], "
             f"permutation p = {e['p']:.3g}, Holm p = {e['p_holm']:.3g}")
