@@ -143,10 +143,10 @@ TEST(ResultsCsv, ReadsFilesWithoutTheSpeedColumns) {
 TEST(ResultsCsv, SpeedColumnsTrailTheOlderOptionalOnes) {
   const auto columns = ResultColumns();
   const std::vector<std::string> tail(columns.end() - 10, columns.end());
-  EXPECT_EQ(tail, (std::vector<std::string>{"accel_bias_err_pct", "realtime_factor",
-                                            "p95_tracking_ms", "mapping_ms_per_kf", "cpu_s",
-                                            "peak_memory_mib", "sequence_s", "mapping_cpu_s",
-                                            "degraded", "keyframe_reasons"}));
+  EXPECT_EQ(tail,
+            (std::vector<std::string>{"accel_bias_err_pct", "realtime_factor", "p95_tracking_ms",
+                                      "mapping_ms_per_kf", "cpu_s", "peak_memory_mib", "sequence_s",
+                                      "mapping_cpu_s", "degraded", "keyframe_reasons"}));
 }
 
 TEST(ResultsCsv, StudyColumnsRoundTripAndOlderFilesLackThem) {
