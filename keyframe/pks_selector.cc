@@ -191,7 +191,9 @@ SelectorDecision PksSelector::Decide(const SelectorInput& in) {
   const bool imu =
       options_.imu_threshold > 0 && accel_change && *accel_change > options_.imu_threshold;
 
-  const PksCompanionRules rules = EvaluatePksCompanionRules(in, options_, false);
+  // The close-point rule needs local mapping idle, as the code PKS combines with (its c3): without
+  // that, realistic MH_01 stereo-inertial took 600 close keyframes (3.3/s) and lost tracking.
+  const PksCompanionRules rules = EvaluatePksCompanionRules(in, options_, true);
   return DecideFromReasons(in, PksReasons(camera, false, imu, rules), std::move(trace));
 }
 

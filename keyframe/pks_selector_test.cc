@@ -196,6 +196,18 @@ TEST_F(PksScenario, CameraThatDidNotMoveTakesNoKeyframe) {
   EXPECT_EQ(s.Decide(in).reason, "still");
 }
 
+TEST(PksCombination, CloseRuleNeedsLocalMappingIdle) {
+  const std::vector<std::pair<MapPointId, Eigen::Vector3d>> none;
+  PksSelector s(PksOptions{});
+  SelectorInput in = MakeInput(none, SE3d(), 3);
+  in.inliers = 200;
+  in.tracked_close = 10;
+  in.untracked_close = 200;
+  EXPECT_EQ(s.Decide(in).reason, "close");
+  in.local_mapping_idle = false;  // busy: the released code's c3 waits (ORB-SLAM3 gates it too)
+  EXPECT_EQ(s.Decide(in).reason, "no");
+}
+
 TEST(PksImu, AccelerationTriggerAgainstTheKeyframeInterval) {
   const std::vector<std::pair<MapPointId, Eigen::Vector3d>> none;
   auto input = [&](FrameId f, const Eigen::Vector3d& body, const Eigen::Vector3d& world) {
