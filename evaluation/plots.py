@@ -169,48 +169,53 @@ def median_run(rows, config, roots):
     return median, find_run(roots, median["run_id"])
 
 
-def trajectories(index, rows, roots):
+def run_groups(rows):
+    """(dataset, sensor, successful non-sweep runs, their configurations) per dataset and sensor."""
     for dataset in unique(r["dataset"] for r in rows):
         for sensor in unique(r["sensor"] for r in rows if r["dataset"] == dataset):
             sub = [r for r in rows if r["dataset"] == dataset and r["sensor"] == sensor
                    and r["ok"] and not r["sweep_param"]]
             configs = unique(r["config"] for r in sub)
-            if not configs:
+            if configs:
+                yield dataset, sensor, sub, configs
+
+
+def trajectories(index, rows, roots):
+    for dataset, sensor, sub, configs in run_groups(rows):
+        fig, ax = plt.subplots(figsize=(6.5, 6))
+        gt_drawn = False
+        colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+        for i, config in enumerate(configs):
+            median, d = median_run(sub, config, roots)
+            if d is None:
                 continue
-            fig, ax = plt.subplots(figsize=(6.5, 6))
-            gt_drawn = False
-            colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-            for i, config in enumerate(configs):
-                median, d = median_run(sub, config, roots)
-                if d is None:
-                    continue
-                traj = read_xyz(os.path.join(d, "plot_trajectory.csv"),
-                                ["gt_x", "gt_y", "est_x", "est_y"])
-                if traj is None:
-                    continue
-                if not gt_drawn:
-                    ax.plot(traj[:, 0], traj[:, 1], "k-", lw=2.0, alpha=0.6, label="ground truth")
-                    ax.plot(traj[0, 0], traj[0, 1], "ko", ms=6)
-                    gt_drawn = True
-                color = colors[i % len(colors)]
-                ax.plot(traj[:, 2], traj[:, 3], "-", color=color, lw=1.0,
-                        label=f"{config} (ATE {median['ate_m']:.3f} m, "
-                              f"{int(median['keyframes'])} KFs)")
-                kf = read_xyz(os.path.join(d, "plot_keyframes.csv"), ["x", "y"])
-                if kf is not None:
-                    ax.plot(kf[:, 0], kf[:, 1], "o", color=color, ms=3.5, mfc="none")
+            traj = read_xyz(os.path.join(d, "plot_trajectory.csv"),
+                            ["gt_x", "gt_y", "est_x", "est_y"])
+            if traj is None:
+                continue
             if not gt_drawn:
-                plt.close(fig)
-                continue
-            ax.set_aspect("equal", adjustable="datalim")
-            ax.set_xlabel("x [m]")
-            ax.set_ylabel("y [m]")
-            ax.set_title(f"{dataset} / {sensor}: top view (median-ATE run each)")
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=8, loc="best")
-            index.save(fig, f"traj_{safe(dataset)}_{safe(sensor)}.png", "trajectories",
-                       f"{dataset}, {sensor}: ground truth (black) and estimates; circles are "
-                       "keyframe positions")
+                ax.plot(traj[:, 0], traj[:, 1], "k-", lw=2.0, alpha=0.6, label="ground truth")
+                ax.plot(traj[0, 0], traj[0, 1], "ko", ms=6)
+                gt_drawn = True
+            color = colors[i % len(colors)]
+            ax.plot(traj[:, 2], traj[:, 3], "-", color=color, lw=1.0,
+                    label=f"{config} (ATE {median['ate_m']:.3f} m, "
+                          f"{int(median['keyframes'])} KFs)")
+            kf = read_xyz(os.path.join(d, "plot_keyframes.csv"), ["x", "y"])
+            if kf is not None:
+                ax.plot(kf[:, 0], kf[:, 1], "o", color=color, ms=3.5, mfc="none")
+        if not gt_drawn:
+            plt.close(fig)
+            continue
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_title(f"{dataset} / {sensor}: top view (median-ATE run each)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="best")
+        index.save(fig, f"traj_{safe(dataset)}_{safe(sensor)}.png", "trajectories",
+                   f"{dataset}, {sensor}: ground truth (black) and estimates; circles are "
+                   "keyframe positions")
 
 
 def sweeps(index, rows):
@@ -344,37 +349,31 @@ def per_sequence_cdf(index, rows):
 
 def keyframe_views(index, rows, roots):
     """Top views with the keyframes of each configuration's median-ATE run, one panel each."""
-    for dataset in unique(r["dataset"] for r in rows):
-        for sensor in unique(r["sensor"] for r in rows if r["dataset"] == dataset):
-            sub = [r for r in rows if r["dataset"] == dataset and r["sensor"] == sensor
-                   and r["ok"] and not r["sweep_param"]]
-            configs = unique(r["config"] for r in sub)
-            if not configs:
+    for dataset, sensor, sub, configs in run_groups(rows):
+        fig, axes = plt.subplots(1, len(configs), figsize=(3.6 * len(configs), 3.8),
+                                 squeeze=False)
+        drawn = 0
+        for ax, config in zip(axes[0], configs):
+            _, d = median_run(sub, config, roots)
+            traj = read_xyz(os.path.join(d, "plot_trajectory.csv"),
+                            ["gt_x", "gt_y"]) if d else None
+            kf = read_xyz(os.path.join(d, "plot_keyframes.csv"), ["x", "y"]) if d else None
+            if traj is None:
+                ax.axis("off")
                 continue
-            fig, axes = plt.subplots(1, len(configs), figsize=(3.6 * len(configs), 3.8),
-                                     squeeze=False)
-            drawn = 0
-            for ax, config in zip(axes[0], configs):
-                _, d = median_run(sub, config, roots)
-                traj = read_xyz(os.path.join(d, "plot_trajectory.csv"),
-                                ["gt_x", "gt_y"]) if d else None
-                kf = read_xyz(os.path.join(d, "plot_keyframes.csv"), ["x", "y"]) if d else None
-                if traj is None:
-                    ax.axis("off")
-                    continue
-                ax.plot(traj[:, 0], traj[:, 1], "-", color="0.6", lw=1)
-                if kf is not None:
-                    ax.plot(kf[:, 0], kf[:, 1], "o", ms=2.5, color="C3")
-                ax.set_aspect("equal", adjustable="datalim")
-                ax.set_title(f"{config}: {0 if kf is None else len(kf)} KFs", fontsize=9)
-                ax.tick_params(labelsize=7)
-                drawn += 1
-            if not drawn:
-                plt.close(fig)
-                continue
-            index.save(fig, f"keyframes_{safe(dataset)}_{safe(sensor)}.png", "trajectories",
-                       f"{dataset}, {sensor}: keyframe positions (red) of each configuration's "
-                       "median-ATE run over the ground-truth path (grey)")
+            ax.plot(traj[:, 0], traj[:, 1], "-", color="0.6", lw=1)
+            if kf is not None:
+                ax.plot(kf[:, 0], kf[:, 1], "o", ms=2.5, color="C3")
+            ax.set_aspect("equal", adjustable="datalim")
+            ax.set_title(f"{config}: {0 if kf is None else len(kf)} KFs", fontsize=9)
+            ax.tick_params(labelsize=7)
+            drawn += 1
+        if not drawn:
+            plt.close(fig)
+            continue
+        index.save(fig, f"keyframes_{safe(dataset)}_{safe(sensor)}.png", "trajectories",
+                   f"{dataset}, {sensor}: keyframe positions (red) of each configuration's "
+                   "median-ATE run over the ground-truth path (grey)")
 
 
 def reason_shares(index, rows):

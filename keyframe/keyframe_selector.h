@@ -30,9 +30,10 @@ struct SelectorPoint {
   int keypoint_index = -1;
   bool in_last_keyframe = false;  // the point is observed by the last keyframe
   bool outlier = false;           // rejected by the pose optimisation
-  const Descriptor* descriptor =
-      nullptr;                      // the keypoint's; valid during Decide / OnKeyFrameInserted
-  Descriptor map_point_descriptor;  // the map point's distinctive descriptor
+  // Valid during Decide / OnKeyFrameInserted only: the keypoint's descriptor and the map
+  // point's distinctive one.
+  const Descriptor* descriptor = nullptr;
+  const Descriptor* map_point_descriptor = nullptr;
 };
 
 // IMU summary over an interval (from preintegration; body frame at the interval start).

@@ -10,6 +10,8 @@
 namespace pkslam {
 namespace {
 
+const Descriptor kDescriptor{};
+
 // ~1200 features of which ~800 are tracked map points on a bumpy wall 3-6 m away.
 SelectorInput MakeInput(std::mt19937& rng, FrameId frame, const Eigen::Vector3d& center) {
   std::uniform_real_distribution<double> u(-3, 3), v(-2, 2), w(3, 6);
@@ -38,6 +40,7 @@ SelectorInput MakeInput(std::mt19937& rng, FrameId frame, const Eigen::Vector3d&
     p.uv = Eigen::Vector2d(435 * c.x() / c.z() + 376, 435 * c.y() / c.z() + 240);
     p.in_last_keyframe = true;
     p.keypoint_index = i;
+    p.map_point_descriptor = &kDescriptor;
     in.points.push_back(p);
   }
   (void)rng;

@@ -200,6 +200,21 @@ void TraceEcog(const Ecog& ecog, std::map<std::string, double>* trace) {
   (*trace)["COG"] = ecog.cog;
 }
 
+bool CameraCriterion(const Counts& c, const Counts& r, const CameraRule& rule,
+                     std::map<std::string, double>* trace) {
+  TraceCounts(r, "r", trace);
+  const AdaptiveThreshold th =
+      ComputeAdaptiveThreshold(c.a, c.m, c.d, r.a, r.m, r.d, rule.released);
+  TraceThreshold(th, rule.released, trace);
+  const bool criterion1 = rule.criterion1_allowed && th.valid && c.d > th.th_adaptive;
+  const Ecog ecog = ComputeEcog(c.grid, rule.grid, rule.late_denominator);
+  TraceEcog(ecog, trace);
+  const bool criterion2 = ecog.valid && ecog.ecog > ecog.cog;
+  (*trace)["criterion1"] = criterion1;
+  (*trace)["criterion2"] = criterion2;
+  return criterion1 && criterion2;
+}
+
 double ParallaxDeg(const Eigen::Vector3d& point, const Eigen::Vector3d& center_a,
                    const Eigen::Vector3d& center_b) {
   const Eigen::Vector3d a = center_a - point;

@@ -91,6 +91,20 @@ void TraceThreshold(const AdaptiveThreshold& threshold, bool released,
                     std::map<std::string, double>* trace);
 void TraceEcog(const Ecog& ecog, std::map<std::string, double>* trace);
 
+// The camera decision from the frame's (c) and the reference's (r) counts: criterion 1
+// (D_c > Th_adaptive, Eq. 1-9; the released code's form with `released`) AND criterion 2
+// (ECOG > |COG|, Eq. 10-12, with the late denominator when asked). `criterion1_allowed` false
+// vetoes criterion 1 (the released code's frames > 1). Traces r's counts, the terms and both
+// criteria.
+struct CameraRule {
+  bool released = false;
+  bool late_denominator = false;
+  bool criterion1_allowed = true;
+  int grid = 3;
+};
+bool CameraCriterion(const Counts& c, const Counts& r, const CameraRule& rule,
+                     std::map<std::string, double>* trace);
+
 // Why delta is (un)reachable: for a normal fixed at the keyframe, a point's viewing-angle change
 // between the keyframe and the frame is at most the parallax angle between the two rays to it
 // (triangle inequality on the sphere). Collects both per matched point of one frame; Fill

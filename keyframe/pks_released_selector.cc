@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "keyframe/selector_common.h"
 
@@ -63,9 +64,9 @@ void PksReleasedSelector::Reset() {
 PksReleasedSelector::View PksReleasedSelector::MakeView(const SelectorInput& input,
                                                         bool with_normals) const {
   View v;
-  std::unordered_map<MapPointId, bool> seen;
+  std::unordered_set<MapPointId> seen;
   for (std::size_t i = 0; i < input.points.size(); ++i) {
-    if (seen.emplace(input.points[i].id, true).second) v.point.push_back(i);
+    if (seen.insert(input.points[i].id).second) v.point.push_back(i);
   }
   if (!with_normals) return v;
   std::vector<Eigen::Vector3d> positions;
@@ -87,8 +88,8 @@ void PksReleasedSelector::OnKeyFrameInserted(const SelectorInput& input) {
   const View v = MakeView(input, true);
   for (std::size_t e = 0; e < v.point.size(); ++e) {
     const SelectorPoint& p = input.points[v.point[e]];
-    snapshot_.push_back(
-        {p.id, p.position_world, p.map_point_descriptor, v.normal[e], v.angle_deg[e], v.region[e]});
+    snapshot_.push_back({p.id, p.position_world, *p.map_point_descriptor, v.normal[e],
+                         v.angle_deg[e], v.region[e]});
   }
 }
 
@@ -126,7 +127,7 @@ PksReleasedSelector::Counts PksReleasedSelector::Measure(
       }
       int best = 257;
       for (const std::size_t e : buckets.Near(input, v.point, *uv, options_.pairing_radius_px)) {
-        const int d = HammingDistance(input.points[v.point[e]].map_point_descriptor, s.descriptor);
+        const int d = HammingDistance(*input.points[v.point[e]].map_point_descriptor, s.descriptor);
         if (d < best) {
           best = d;
           paired = e;
@@ -176,19 +177,12 @@ bool PksReleasedSelector::CameraCriterion(const SelectorInput& input, SelectorTr
   if (frames == 1) reference_ = c;
   if (!reference_) return false;  // the released code's zero statics give NaN: no keyframe
   const Counts& r = *reference_;
-  pks::TraceCounts(r, "r", trace);
-  const pks::AdaptiveThreshold th =
-      pks::ComputeAdaptiveThreshold(c.a, c.m, c.d, r.a, r.m, r.d, true);
-  pks::TraceThreshold(th, true, trace);
-  const bool criterion1 = th.valid && c.d > th.th_adaptive && frames > 1;
-  const bool late = frames > options_.late_denominator_after;
-  const pks::Ecog ecog = pks::ComputeEcog(c.grid, options_.grid, late);
-  pks::TraceEcog(ecog, trace);
-  const bool criterion2 = ecog.valid && ecog.ecog > ecog.cog;
-  auto& t = *trace;
-  t["criterion1"] = criterion1;
-  t["criterion2"] = criterion2;
-  return criterion1 && criterion2;
+  pks::CameraRule rule;
+  rule.released = true;
+  rule.late_denominator = frames > options_.late_denominator_after;
+  rule.criterion1_allowed = frames > 1;
+  rule.grid = options_.grid;
+  return pks::CameraCriterion(c, r, rule, trace);
 }
 
 SelectorDecision PksReleasedSelector::Decide(const SelectorInput& in) {

@@ -94,7 +94,7 @@ SelectorInput Input(const std::vector<ScenePoint>& points, const Eigen::Vector3d
     p.uv = Eigen::Vector2d(kF * c.x() / c.z() + kCx, kF * c.y() / c.z() + kCy);
     p.keypoint_index = k++;
     p.in_last_keyframe = true;
-    p.map_point_descriptor = s.descriptor;
+    p.map_point_descriptor = &s.descriptor;
     in.points.push_back(p);
   }
   return in;
@@ -181,7 +181,9 @@ TEST(PksReleased, PairsByReprojectionAndDescriptorNotByIdentity) {
   EXPECT_EQ(identity.Decide(frame).trace.at("M_c"), 0);
   // The same ids pair by identity whatever their descriptor.
   auto same = Input(scene, kReference, 1);
-  for (auto& p : same.points) p.map_point_descriptor = Flipped(p.map_point_descriptor, 100);
+  std::vector<Descriptor> far;
+  for (const auto& p : same.points) far.push_back(Flipped(*p.map_point_descriptor, 100));
+  for (std::size_t i = 0; i < far.size(); ++i) same.points[i].map_point_descriptor = &far[i];
   EXPECT_EQ(identity.Decide(same).trace.at("M_c"), 36);
 }
 

@@ -153,18 +153,9 @@ bool PksSelector::CameraCriterion(const SelectorInput& input, SelectorTrace* tra
   pks::TraceCounts(c, "c", trace);
   diagnostics.Fill(trace);
   const Counts& r = *reference_;
-  pks::TraceCounts(r, "r", trace);
-  const pks::AdaptiveThreshold th =
-      pks::ComputeAdaptiveThreshold(c.a, c.m, c.d, r.a, r.m, r.d, false);
-  pks::TraceThreshold(th, false, trace);
-  const bool criterion1 = th.valid && c.d > th.th_adaptive;
-  const pks::Ecog ecog = pks::ComputeEcog(c.grid, options_.grid, false);
-  pks::TraceEcog(ecog, trace);
-  const bool criterion2 = ecog.valid && ecog.ecog > ecog.cog;
-  auto& t = *trace;
-  t["criterion1"] = criterion1;
-  t["criterion2"] = criterion2;
-  return criterion1 && criterion2;
+  pks::CameraRule rule;
+  rule.grid = options_.grid;
+  return pks::CameraCriterion(c, r, rule, trace);
 }
 
 std::optional<double> PksSelector::AccelerationChange(const SelectorInput& input) const {

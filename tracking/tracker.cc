@@ -187,6 +187,8 @@ TrackResult Tracker::Track(Frame frame) {
         }
         selector_input =
             BuildSelectorInput(emulated ? idle_at_frame : mapping_->AcceptsKeyFrames());
+        // Taken once per decision (a keyframe's second input, SnapshotAfterCreation, has none).
+        selector_input.slow_motion_before_refinement = mapping_->TakeSlowMotionFlag();
         last_decision_ = selector_->Decide(selector_input);
         if (MapStarving(selector_input)) {
           last_decision_.insert = true;

@@ -110,9 +110,8 @@ class Tracker {
   void UpdateLocalPoints();
   int SearchLocalPoints();
   // `mapping_idle`: whether local mapping takes keyframes at this frame's time.
-  // The selector's view of the current frame (caller holds the Atlas lock, shared). A decision's
-  // input takes local mapping's slow-motion flag; a keyframe's second input does not.
-  SelectorInput BuildSelectorInput(bool mapping_idle, bool for_decision = true) const;
+  // The selector's view of the current frame (caller holds the Atlas lock, shared).
+  SelectorInput BuildSelectorInput(bool mapping_idle) const;
   void CreateNewKeyFrame(const SelectorInput& input);
   // Finds the frame's pose in the current map from BoW candidates (tracking/relocalization.cc).
   bool Relocalize();

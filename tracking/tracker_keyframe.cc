@@ -14,7 +14,7 @@
 
 namespace pkslam {
 
-SelectorInput Tracker::BuildSelectorInput(bool mapping_idle, bool for_decision) const {
+SelectorInput Tracker::BuildSelectorInput(bool mapping_idle) const {
   SelectorInput in;
   const CameraRig& rig = *rig_;
   const Map* map = atlas_->current_map();
@@ -50,8 +50,6 @@ SelectorInput Tracker::BuildSelectorInput(bool mapping_idle, bool for_decision) 
   in.trace_wanted = trace_enabled_;
   in.local_mapping_initializing = mapping_->IsInitializingImu();
   in.local_mapping_queue = mapping_->QueueSize();
-  // Taken once per decision; a keyframe's second input (SnapshotAfterCreation) never sees it.
-  in.slow_motion_before_refinement = for_decision && mapping_->TakeSlowMotionFlag();
 
   if (!IsMonocular(rig.sensor)) {
     for (int i = 0; i < current_.size(); ++i) {
@@ -78,7 +76,7 @@ SelectorInput Tracker::BuildSelectorInput(bool mapping_idle, bool for_decision) 
       p.in_last_keyframe = last_kf_ && !last_kf_->IsBad() && mp->IsInKeyFrame(last_kf_.get());
       p.outlier = current_.outliers[i] != 0;
       p.descriptor = &current_.descriptors()[i];
-      p.map_point_descriptor = mp->descriptor();
+      p.map_point_descriptor = &mp->descriptor();
       in.points.push_back(p);
     }
   }
@@ -130,7 +128,7 @@ void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
     SelectorInput created;
     {
       std::shared_lock lock(atlas_->mutex());
-      created = BuildSelectorInput(input.local_mapping_idle, /*for_decision=*/false);
+      created = BuildSelectorInput(input.local_mapping_idle);
     }
     selector_->OnKeyFrameInserted(created);
   } else {
