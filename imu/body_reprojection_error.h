@@ -2,8 +2,8 @@
 // perturbation, [I6; 0] Jacobian convention) with a fixed body_from_camera, for inertial bundle
 // adjustment and visual-inertial tracking, where the states are body (IMU) poses:
 //   p_camera = camera_from_body * world_from_body^-1 * p_world.
-// Residual definitions, whitening and the depth rule match core/optim/reprojection_error.h (the
-// camera_from_world variants): r = sqrt(inv_sigma2) * (projection - observation),
+// Residual definitions, whitening and the depth rule match estimators/optim/reprojection_error.h
+// (the camera_from_world variants): r = sqrt(inv_sigma2) * (projection - observation),
 //   mono:   (u, v)          = (fx x/z + cx, fy y/z + cy)
 //   stereo: (u, v, u_right) with u_right = u - bf / z,
 // and Evaluate returns false when the point is at depth <= kMinBodyReprojectionDepth (Ceres

@@ -1,12 +1,12 @@
 // Ceres parameter blocks of inertial problems and their manifolds (Ceres 2.1 Manifold API).
 //
 // Body pose block: 7 doubles (qx, qy, qz, qw, tx, ty, tz) of world_from_body (T_wb), the same
-// memory layout as the camera_from_world blocks of core/optim, updated by a RIGHT perturbation
-// in the body frame (as ORB-SLAM3's VertexPose for the IMU body):
+// memory layout as the camera_from_world blocks of estimators/optim, updated by a RIGHT
+// perturbation in the body frame (as ORB-SLAM3's VertexPose for the IMU body):
 //   Plus(T_wb, delta) = T_wb * Exp(delta),   delta = [rho; phi]  (core/geometry/se3.h order),
 // so to first order R_wb <- R_wb Exp(phi) and p_wb <- p_wb + R_wb rho. Equivalently
 // body_from_world <- Exp(-delta) * body_from_world: a left perturbation of the inverse pose,
-// which is what core/optim's SE3LeftManifold applies to camera_from_world blocks.
+// which is what estimators/optim's SE3LeftManifold applies to camera_from_world blocks.
 //
 // Like SE3LeftManifold these manifolds use the "[I; 0] Jacobian trick": PlusJacobian returns a
 // constant [I; 0] instead of d Plus / d delta in ambient (quaternion) coordinates, and every cost

@@ -15,7 +15,7 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Block = Eigen::Matrix<double, 7, 1>;
 
 TEST(BodyPoseManifold, BlockLayoutMatchesCoreOptim) {
-  // (qx, qy, qz, qw, tx, ty, tz): the layout of core/optim's pose blocks.
+  // (qx, qy, qz, qw, tx, ty, tz): the layout of estimators/optim's pose blocks.
   const SE3d pose(SO3d::Exp(Vec3(0.1, 0.2, 0.3)), Vec3(1, 2, 3));
   Block x;
   BodyPoseToBlock(pose, x.data());

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <memory>
 
-#include "core/optim/ceres_setup.h"
 #include "core/util/error.h"
+#include "estimators/optim/ceres_setup.h"
 #include "imu/imu_factors.h"
 #include "imu/imu_manifolds.h"
 #include "imu/preintegration.h"

@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "core/camera/camera_model.h"
-#include "core/frame/camera_rig.h"
 #include "core/geometry/se3.h"
+#include "core/sensor/camera_rig.h"
 
 namespace pkslam {
 
@@ -69,7 +69,7 @@ struct Settings {
   // RGBD.DepthMapFactor: depth image value per metre (TUM: 5000). Optional.
   std::optional<double> depth_map_factor;
   // RGBD.DepthNoise (pkslam): k of the depth noise sigma_z = k z^2 [1/m]; optional, default
-  // Kinect v1 (core/frame/camera_rig.h).
+  // Kinect v1 (core/sensor/camera_rig.h).
   std::optional<double> depth_noise_k;
   OrbExtractorSettings orb;                // ORBextractor.*: optional, defaults above
   std::map<std::string, double> keyframe;  // Keyframe.<name>: selector parameters, free-form

@@ -1,4 +1,4 @@
-// RGBD.DepthNoise (pkslam's key for the RGB-D depth noise model, core/frame/camera_rig.h).
+// RGBD.DepthNoise (pkslam's key for the RGB-D depth noise model, core/sensor/camera_rig.h).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 

@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "core/features/descriptor.h"
-#include "core/frame/camera_rig.h"
-#include "core/frame/sensor.h"
 #include "core/geometry/se3.h"
-#include "core/map/ids.h"
+#include "core/sensor/camera_rig.h"
+#include "core/sensor/sensor.h"
+#include "core/util/ids.h"
 
 namespace pkslam {
 

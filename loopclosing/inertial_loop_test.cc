@@ -8,7 +8,7 @@
 #include <mutex>
 #include <shared_mutex>
 
-#include "core/optim/yaw_manifold.h"
+#include "estimators/optim/yaw_manifold.h"
 #include "loopclosing/loop_closing.h"
 #include "loopclosing/revisit_fixture.h"
 #include "mapping/global_bundle.h"

@@ -5,11 +5,11 @@
 #include <mutex>
 #include <shared_mutex>
 
-#include "core/map/keyframe.h"
-#include "core/map/keyframe_database.h"
-#include "core/map/map.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "map_model/keyframe.h"
+#include "map_model/keyframe_database.h"
+#include "map_model/map.h"
 #include "mapping/global_bundle.h"
 #include "mapping/inertial_bundle.h"
 
@@ -339,7 +339,8 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
         const auto gravity_before = GravityInCameras(*map);
         if (use_inertial) {
           MergeGlobalBundle(
-              map, inertial.visual, [&] { ApplyInertialBundle(inertial, inertial_result); }, true);
+              map, inertial.visual, [&] { ApplyInertialBundle(map, inertial, inertial_result); },
+              true);
         } else {
           MergeGlobalBundle(map, problem, result);
         }

@@ -34,11 +34,11 @@
 #include <thread>
 #include <vector>
 
-#include "core/frame/camera_rig.h"
-#include "core/map/atlas.h"
-#include "core/optim/bundle_adjustment.h"
-#include "core/optim/essential_graph.h"
+#include "core/sensor/camera_rig.h"
 #include "loopclosing/place_verifier.h"
+#include "map_model/atlas.h"
+#include "map_model/estimation/bundle_collect.h"
+#include "map_model/estimation/essential_graph_collect.h"
 
 namespace pkslam {
 

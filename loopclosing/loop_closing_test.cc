@@ -4,8 +4,8 @@
 
 #include <atomic>
 
-#include "core/testing/synthetic_map.h"
 #include "core/util/error.h"
+#include "map_model/testing/synthetic_map.h"
 
 namespace pkslam {
 namespace {

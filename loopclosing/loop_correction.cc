@@ -12,14 +12,14 @@
 #include <set>
 #include <shared_mutex>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/map/map_point.h"
-#include "core/matching/orb_matcher.h"
-#include "core/optim/essential_graph.h"
-#include "core/optim/yaw_manifold.h"
 #include "core/util/log.h"
+#include "estimators/optim/yaw_manifold.h"
 #include "loopclosing/loop_closing.h"
+#include "map_model/estimation/essential_graph_collect.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/map_point.h"
+#include "map_model/matching/orb_matcher.h"
 #include "mapping/global_bundle.h"
 
 namespace pkslam {
@@ -211,7 +211,7 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
     graph.dof = GraphDof(*map);
     graph.num_threads = options_.num_threads;
     const EssentialGraphProblem problem = CollectEssentialGraph(map, correction, graph);
-    ApplyEssentialGraph(problem, SolveEssentialGraph(problem, graph));
+    ApplyEssentialGraph(map, problem, SolveEssentialGraph(problem, graph));
     query->AddLoopEdge(region.matched.get());
     region.matched->AddLoopEdge(query);
     // Tracking predicts from its last keyframe (corrected pose and velocity) next time.
@@ -316,7 +316,7 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
                          : (options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3);
     graph.num_threads = options_.num_threads;
     const EssentialGraphProblem problem = CollectEssentialGraph(merged, correction, graph);
-    ApplyEssentialGraph(problem, SolveEssentialGraph(problem, graph));
+    ApplyEssentialGraph(merged, problem, SolveEssentialGraph(problem, graph));
     query->AddLoopEdge(region.matched.get());
     region.matched->AddLoopEdge(query);
 

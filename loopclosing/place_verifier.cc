@@ -2,13 +2,13 @@
 
 #include <set>
 
-#include "core/geometry/sim3_solver.h"
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/map/map_point.h"
-#include "core/matching/orb_matcher.h"
-#include "core/optim/sim3_optimization.h"
 #include "core/util/error.h"
+#include "estimators/optim/sim3_optimization.h"
+#include "map_model/estimation/ransac_inputs.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/map_point.h"
+#include "map_model/matching/orb_matcher.h"
 
 namespace pkslam {
 

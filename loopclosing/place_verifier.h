@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "core/geometry/sim3.h"
-#include "core/map/ids.h"
+#include "map_model/ids.h"
 
 namespace pkslam {
 

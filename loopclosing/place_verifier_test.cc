@@ -12,10 +12,10 @@
 #include <tuple>
 
 #include "core/bow/bow_test_utils.h"
-#include "core/map/keyframe_database.h"
-#include "core/map/keyframe_database_test_utils.h"
 #include "loopclosing/loop_closing.h"
 #include "loopclosing/revisit_fixture.h"
+#include "map_model/keyframe_database.h"
+#include "map_model/keyframe_database_test_utils.h"
 
 namespace pkslam {
 namespace {

@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "core/bow/bow_test_utils.h"
-#include "core/map/atlas.h"
-#include "core/map/keyframe.h"
-#include "core/map/keyframe_database.h"
-#include "core/map/keyframe_database_test_utils.h"
-#include "core/map/map_point.h"
+#include "map_model/atlas.h"
+#include "map_model/keyframe.h"
+#include "map_model/keyframe_database.h"
+#include "map_model/keyframe_database_test_utils.h"
+#include "map_model/map_point.h"
 
 namespace pkslam::testing {
 

@@ -6,15 +6,15 @@
 #include <map>
 #include <set>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/map/map_point.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/map_point.h"
 
 namespace pkslam {
 
 void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResult& result) {
   MergeGlobalBundle(
-      map, problem, [&] { ApplyBundle(problem, result); }, false);
+      map, problem, [&] { ApplyBundle(map, problem, result); }, false);
 }
 
 void MergeGlobalBundle(Map* map, const BundleProblem& problem, const std::function<void()>& apply,
@@ -24,11 +24,10 @@ void MergeGlobalBundle(Map* map, const BundleProblem& problem, const std::functi
   std::map<KeyFrameId, SE3d> before;
   for (const auto& [id, kf] : map->keyframes()) before[id] = kf->camera_from_world();
   std::set<KeyFrameId> in_problem;
-  for (const auto& k : problem.keyframes) {
-    if (k.keyframe->map() == map) in_problem.insert(k.keyframe->id());
-  }
+  // (A keyframe that left the map meanwhile is skipped below by its map() test.)
+  for (const auto& k : problem.keyframes) in_problem.insert(k.keyframe_id);
   std::set<MapPointId> points_in_problem;
-  for (const auto& p : problem.points) points_in_problem.insert(p.point->id());
+  for (const auto& p : problem.points) points_in_problem.insert(p.point_id);
 
   apply();
 

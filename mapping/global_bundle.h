@@ -9,8 +9,8 @@
 #include <functional>
 #include <map>
 
-#include "core/map/ids.h"
-#include "core/optim/bundle_adjustment.h"
+#include "map_model/estimation/bundle_collect.h"
+#include "map_model/ids.h"
 
 namespace pkslam {
 

@@ -5,10 +5,10 @@
 #include <mutex>
 #include <shared_mutex>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/map/map_point.h"
-#include "core/testing/synthetic_map.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/map_point.h"
+#include "map_model/testing/synthetic_map.h"
 
 namespace pkslam {
 namespace {
@@ -70,14 +70,18 @@ TEST_F(MergeGlobalBundleTest, ProblemKeyframesAndPointsTakeTheOptimisedValues) {
   const int change_index = atlas_.current_map()->change_index();
   MergeGlobalBundle(atlas_.current_map(), problem_, result);
   for (std::size_t k = 0; k < problem_.keyframes.size(); ++k) {
-    const SE3d& got = problem_.keyframes[k].keyframe->camera_from_world();
+    const SE3d& got =
+        atlas_.current_map()->KeyFrameById(problem_.keyframes[k].keyframe_id)->camera_from_world();
     // The fixed gauge keyframe keeps its pose.
     const SE3d& expected = problem_.keyframes[k].fixed ? problem_.keyframes[k].camera_from_world
                                                        : result.camera_from_world[k];
     EXPECT_LT((got.translation() - expected.translation()).norm(), 1e-9);
   }
   for (std::size_t p = 0; p < problem_.points.size(); ++p) {
-    EXPECT_LT((problem_.points[p].point->position() - result.points_world[p]).norm(), 1e-9);
+    EXPECT_LT((atlas_.current_map()->MapPointById(problem_.points[p].point_id)->position() -
+               result.points_world[p])
+                  .norm(),
+              1e-9);
   }
   EXPECT_EQ(atlas_.current_map()->change_index(), change_index + 1);
 }

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "core/geometry/so3.h"
-#include "core/imu/inertial_state.h"
+#include "map_model/inertial_state.h"
 
 namespace pkslam {
 

@@ -3,8 +3,8 @@
 
 #include <vector>
 
-#include "core/map/keyframe.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
 
 namespace pkslam::testing {
 

@@ -6,18 +6,16 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/map/map_point.h"
 #include "core/util/error.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/map_point.h"
 #include "mapping/gravity_refinement.h"
 #include "mapping/inertial_marginalization.h"
 
 namespace pkslam {
 namespace {
-
-using KeyFrameIndex = std::unordered_map<const KeyFrame*, int>;
 
 // Inertial role of a problem keyframe (InertialBundleProblem::inertial).
 constexpr std::uint8_t kNoInertial = 0;
@@ -32,31 +30,14 @@ PreintegratedImu WithoutSteps(const PreintegratedImu& pim) {
 }
 
 void AddKeyFrame(KeyFrame* kf, bool fixed, std::uint8_t inertial, InertialBundleProblem* problem,
-                 KeyFrameIndex* index) {
-  const KeyFramePtr shared = kf->map()->Share(kf);
-  PKSLAM_CHECK(shared != nullptr, "keyframe {} is not live in its map", kf->id());
+                 BundleKeyFrameIndex* index) {
+  PKSLAM_CHECK(kf->map() != nullptr && kf->map()->Share(kf) != nullptr,
+               "keyframe {} is not live in its map", kf->id());
   (*index)[kf] = static_cast<int>(problem->visual.keyframes.size());
-  problem->visual.keyframes.push_back({shared, kf->camera_from_world(), fixed});
+  problem->visual.keyframes.push_back({kf->id(), kf->camera_from_world(), fixed});
   problem->inertial.push_back(inertial);
   problem->velocities.push_back(kf->imu.state.velocity_world);
   problem->biases.push_back(kf->imu.state.bias);
-}
-
-void AddPoint(const MapPointPtr& point, const KeyFrameIndex& index, BundleProblem* problem) {
-  const int point_index = static_cast<int>(problem->points.size());
-  bool any = false;
-  for (const auto& [id, obs] : point->observations()) {
-    const auto it = index.find(obs.keyframe);
-    if (it == index.end()) continue;
-    const KeyFrame& kf = *obs.keyframe;
-    const cv::KeyPoint& kp = kf.keypoints_undistorted()[obs.index];
-    const double u_right = kf.right_u().empty() ? -1.0 : kf.right_u()[obs.index];
-    problem->observations.push_back(
-        {it->second, point_index, obs.index, Eigen::Vector2d(kp.pt.x, kp.pt.y),
-         u_right >= 0 ? u_right : -1.0, kf.rig().pyramid.inv_sigma2[kp.octave]});
-    any = true;
-  }
-  if (any) problem->points.push_back({point, point->position()});
 }
 
 void SetCommon(const KeyFrame& kf, const InertialBundleOptions& options,
@@ -67,11 +48,12 @@ void SetCommon(const KeyFrame& kf, const InertialBundleOptions& options,
   problem->visual.cx = rig.cx;
   problem->visual.cy = rig.cy;
   problem->visual.bf = rig.bf;
+  problem->visual.map_id = kf.map() != nullptr ? kf.map()->id() : kInvalidId;
   problem->camera_from_body = rig.body_from_camera.Inverse();
   problem->gravity_world = Eigen::Vector3d(0, 0, -options.gravity_magnitude);
 }
 
-void AddEdges(const std::vector<KeyFrame*>& chain, const KeyFrameIndex& index,
+void AddEdges(const std::vector<KeyFrame*>& chain, const BundleKeyFrameIndex& index,
               InertialBundleProblem* problem) {
   for (std::size_t i = 1; i < chain.size(); ++i) {
     problem->edges.push_back(
@@ -145,7 +127,7 @@ InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
   if (chain.size() < 2) return problem;
   const Map* map = keyframe->map();
   SetCommon(*keyframe, options, &problem);
-  KeyFrameIndex index;
+  BundleKeyFrameIndex index;
   // The oldest is the anchor, joined by its inertial edge: free with its marginalisation prior
   // when it has a valid one, otherwise fixed.
   const KeyFrame* anchor = chain.front();
@@ -183,7 +165,7 @@ InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
     ranked.resize(static_cast<std::size_t>(options.max_fixed_keyframes));
   }
   for (const auto& [count, kf] : ranked) AddKeyFrame(kf, true, kNoInertial, &problem, &index);
-  for (const MapPointPtr& point : points) AddPoint(point, index, &problem.visual);
+  for (const MapPointPtr& point : points) AddBundlePoint(point, index, &problem.visual);
   return problem;
 }
 
@@ -196,7 +178,7 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
   if (chain.size() < 2) return problem;
   const Map* map = newest->map();
   SetCommon(*newest, options, &problem);
-  KeyFrameIndex index;
+  BundleKeyFrameIndex index;
   // The first pose anchors position and yaw (fixed, or with free_tilt by a prior on just those);
   // its velocity and biases stay free.
   for (std::size_t i = 0; i < chain.size(); ++i) {
@@ -217,25 +199,33 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
   }
   // Fixed keyframes would hold the world's tilt.
   for (KeyFrame* kf : others) AddKeyFrame(kf, !free_tilt, kNoInertial, &problem, &index);
-  for (const MapPointPtr& point : PointsOf(chain, map)) AddPoint(point, index, &problem.visual);
+  for (const MapPointPtr& point : PointsOf(chain, map))
+    AddBundlePoint(point, index, &problem.visual);
   return problem;
 }
 
-void ApplyInertialBundle(const InertialBundleProblem& problem, const InertialBundleResult& result) {
+void ApplyInertialBundle(Map* map, const InertialBundleProblem& problem,
+                         const InertialBundleResult& result) {
   PKSLAM_CHECK(result.velocities.size() == problem.visual.keyframes.size() &&
                    result.biases.size() == problem.visual.keyframes.size(),
                "inertial result does not match the problem");
-  ApplyBundle(problem.visual, result.visual);
+  ApplyBundle(map, problem.visual, result.visual);
+  // The problem's keyframes as they are in the map now (null: moved to another map).
+  auto keyframe = [&](int i) {
+    return map->KeyFrameById(problem.visual.keyframes[static_cast<std::size_t>(i)].keyframe_id)
+        .get();
+  };
   for (std::size_t i = 0; i < problem.visual.keyframes.size(); ++i) {
-    KeyFrame* kf = problem.visual.keyframes[i].keyframe.get();
-    if (problem.inertial[i] != kFreeInertial || kf->IsBad()) continue;
+    KeyFrame* kf = keyframe(static_cast<int>(i));
+    if (problem.inertial[i] != kFreeInertial || kf == nullptr || kf->IsBad()) continue;
     kf->imu.state.velocity_world = result.velocities[i];
     kf->imu.state.bias = result.biases[i];
     kf->imu.state.valid = true;
   }
   if (result.next_prior && problem.marginalize_to >= 0) {
-    KeyFrame* next = problem.visual.keyframes[problem.marginalize_to].keyframe.get();
-    if (!next->IsBad() && next->map() != nullptr && PriorIsValid(problem.stamps, *next->map())) {
+    KeyFrame* next = keyframe(problem.marginalize_to);
+    if (next != nullptr && !next->IsBad() && next->map() != nullptr &&
+        PriorIsValid(problem.stamps, *next->map())) {
       next->imu.prior = *result.next_prior;
       StampPrior(*next->map(), &*next->imu.prior);
     }
@@ -243,9 +233,10 @@ void ApplyInertialBundle(const InertialBundleProblem& problem, const InertialBun
   // Preintegrations follow their start keyframe's bias (re-integrated when it moved far).
   const PreintegrationOptions reintegration;
   for (const auto& edge : problem.edges) {
-    KeyFrame* from = problem.visual.keyframes[edge.from].keyframe.get();
-    KeyFrame* to = problem.visual.keyframes[edge.to].keyframe.get();
-    if (from->IsBad() || to->IsBad() || !to->imu.from_previous || to->imu.previous != from)
+    KeyFrame* from = keyframe(edge.from);
+    KeyFrame* to = keyframe(edge.to);
+    if (from == nullptr || to == nullptr || from->IsBad() || to->IsBad() ||
+        !to->imu.from_previous || to->imu.previous != from)
       continue;
     UpdateBias(from->imu.state.bias, reintegration, &*to->imu.from_previous);
   }

@@ -1,5 +1,5 @@
 // Visual-inertial bundle adjustment (ORB-SLAM3's LocalInertialBA and FullInertialBA) in Ceres,
-// in the three phases of core/optim/bundle_adjustment.h so the solver runs without the Atlas
+// in the three phases of estimators/optim/bundle_adjustment.h so the solver runs without the Atlas
 // lock: Collect (shared lock) -> Solve (no lock, abortable) -> Apply (exclusive lock).
 //
 // States are body poses world_from_body (BodyPoseManifold), velocities and biases; the visual
@@ -29,8 +29,8 @@
 #include <vector>
 
 #include "core/imu/imu_types.h"
-#include "core/imu/inertial_state.h"
-#include "core/optim/bundle_adjustment.h"
+#include "map_model/estimation/bundle_collect.h"
+#include "map_model/inertial_state.h"
 
 namespace pkslam {
 
@@ -119,7 +119,9 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
 // Requires the Atlas mutex (exclusive): ApplyBundle for the visual part, then velocities and
 // biases of free inertial keyframes, and re-linearises the preintegrations whose bias moved;
 // stores result.next_prior on its keyframe if the map did not move map-wide since Collect.
-void ApplyInertialBundle(const InertialBundleProblem& problem, const InertialBundleResult& result);
+// `map` is the map the problem was collected from.
+void ApplyInertialBundle(Map* map, const InertialBundleProblem& problem,
+                         const InertialBundleResult& result);
 
 // The temporal chain ending at `newest` (oldest first), at most `max_length` keyframes (0: all),
 // stopping at a retired keyframe or one without a preintegration to its predecessor.

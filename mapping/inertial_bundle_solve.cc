@@ -11,8 +11,8 @@
 #include <memory>
 #include <vector>
 
-#include "core/optim/ceres_setup.h"
 #include "core/util/log.h"
+#include "estimators/optim/ceres_setup.h"
 #include "imu/body_reprojection_error.h"
 #include "imu/imu_factors.h"
 #include "imu/imu_manifolds.h"

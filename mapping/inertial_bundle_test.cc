@@ -57,7 +57,7 @@ Scene MakeScene(bool shared_bias) {
                                  0.03 * n01(rng), 0.01 * n01(rng), 0.01 * n01(rng), 0.01 * n01(rng))
                                     .finished());
     }
-    p.visual.keyframes.push_back({nullptr, start.Inverse(), k == 0});
+    p.visual.keyframes.push_back({k, start.Inverse(), k == 0});
     p.inertial.push_back(1);
     p.velocities.push_back(Eigen::Vector3d::Zero());
     p.biases.emplace_back();
@@ -83,8 +83,7 @@ Scene MakeScene(bool shared_bias) {
       seen = true;
     }
     if (seen)
-      p.visual.points.push_back(
-          {nullptr, x + 0.05 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng))});
+      p.visual.points.push_back({i, x + 0.05 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng))});
   }
   return s;
 }

@@ -1,9 +1,9 @@
 #include "mapping/inertial_culling.h"
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
 #include "core/util/error.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
 
 namespace pkslam {
 namespace {

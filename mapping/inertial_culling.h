@@ -14,7 +14,7 @@
 // queries, exclusive for the splicing).
 #pragma once
 
-#include "core/map/ids.h"
+#include "map_model/ids.h"
 
 namespace pkslam {
 

@@ -6,10 +6,10 @@
 
 #include <mutex>
 
-#include "core/map/keyframe.h"
-#include "core/testing/synthetic_map.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
+#include "map_model/testing/synthetic_map.h"
 
 namespace pkslam {
 namespace {

@@ -1,7 +1,7 @@
 #include "mapping/inertial_init_chain.h"
 
-#include "core/map/keyframe.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
 #include "mapping/inertial_bundle.h"
 
 namespace pkslam {

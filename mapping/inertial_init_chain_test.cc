@@ -5,10 +5,10 @@
 #include <mutex>
 #include <vector>
 
-#include "core/map/keyframe.h"
-#include "core/testing/synthetic_map.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
+#include "map_model/testing/synthetic_map.h"
 #include "mapping/imu_chain_testing.h"
 
 namespace pkslam {

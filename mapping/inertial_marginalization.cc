@@ -2,8 +2,8 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "core/map/map.h"
 #include "core/util/error.h"
+#include "map_model/map.h"
 
 namespace pkslam {
 namespace {

@@ -10,7 +10,7 @@
 // and the Schur complement onto the next keyframe,
 //   H' = H_nn - H_na H_aa^+ H_an,   b' = b_n - H_na H_aa^+ b_a,
 // symmetrised and clamped to positive semi-definite, is the next keyframe's prior
-// (core/imu/inertial_state.h InertialStatePrior), stored as a mean x_lin [+] (-H'^+ b') and the
+// (map_model/inertial_state.h InertialStatePrior), stored as a mean x_lin [+] (-H'^+ b') and the
 // information H' for InertialStatePriorError (imu/imu_factors.h).
 //
 // Approximations: the prior is linearised once (at the solve that made it) and never
@@ -26,7 +26,7 @@
 
 #include <Eigen/Core>
 
-#include "core/imu/inertial_state.h"
+#include "map_model/inertial_state.h"
 
 namespace pkslam {
 

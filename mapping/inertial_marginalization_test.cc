@@ -10,14 +10,14 @@
 #include <mutex>
 #include <random>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/testing/synthetic_map.h"
 #include "core/util/error.h"
 #include "imu/imu_factors.h"
 #include "imu/imu_manifolds.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/testing/synthetic_map.h"
 #include "mapping/imu_chain_testing.h"
 #include "mapping/inertial_bundle.h"
 #include "mapping/inertial_culling.h"
@@ -189,7 +189,7 @@ TEST_F(MarginalizationMapTest, ValidPriorFreesTheAnchorStalePriorIsIgnored) {
   {
     const InertialBundleProblem p = CollectLocalInertialBundle(newest(), options_);
     ASSERT_FALSE(p.empty());
-    EXPECT_EQ(p.visual.keyframes[0].keyframe.get(), anchor());
+    EXPECT_EQ(p.visual.keyframes[0].keyframe_id, anchor()->id());
     EXPECT_TRUE(p.visual.keyframes[0].fixed);  // no prior yet: fixed (ORB-SLAM3)
     EXPECT_FALSE(p.anchor_prior.has_value());
     EXPECT_EQ(p.marginalize_from, 0);
@@ -254,7 +254,7 @@ TEST_F(MarginalizationMapTest, SolveMarginalisesTheAnchorOntoTheNextKeyFrame) {
   KeyFrame* next = kf(kNumKeyFrames - options_.window);
   {
     std::unique_lock lock(atlas_.mutex());
-    ApplyInertialBundle(p, r);
+    ApplyInertialBundle(map(), p, r);
     ASSERT_TRUE(next->imu.prior.has_value());
     EXPECT_TRUE(PriorIsValid(*next->imu.prior, *map()));
     EXPECT_EQ(next->imu.prior->bias_mean.gyro, r.next_prior->bias_mean.gyro);
@@ -262,7 +262,7 @@ TEST_F(MarginalizationMapTest, SolveMarginalisesTheAnchorOntoTheNextKeyFrame) {
     // Applying a result collected before a map-wide change stores nothing.
     next->imu.prior.reset();
     map()->IncreaseChangeIndex();
-    ApplyInertialBundle(p, r);
+    ApplyInertialBundle(map(), p, r);
     EXPECT_FALSE(next->imu.prior.has_value());
   }
 }

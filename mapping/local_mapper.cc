@@ -3,8 +3,8 @@
 
 #include <algorithm>
 
-#include "core/map/keyframe.h"
 #include "core/util/error.h"
+#include "map_model/keyframe.h"
 
 namespace pkslam {
 

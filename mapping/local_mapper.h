@@ -21,11 +21,11 @@
 #include <utility>
 #include <vector>
 
-#include "core/frame/camera_rig.h"
 #include "core/imu/imu_types.h"
-#include "core/map/atlas.h"
-#include "core/map/mapping_backend.h"
-#include "core/optim/bundle_adjustment.h"
+#include "core/sensor/camera_rig.h"
+#include "map_model/atlas.h"
+#include "map_model/estimation/bundle_collect.h"
+#include "map_model/mapping_backend.h"
 #include "mapping/inertial_mapping.h"
 
 namespace pkslam {

@@ -5,13 +5,13 @@
 #include <mutex>
 #include <shared_mutex>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/map/map_point.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "imu/inertial_initializer.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/map_point.h"
 #include "mapping/global_bundle.h"
 #include "mapping/gravity_refinement.h"
 #include "mapping/inertial_init_chain.h"
@@ -187,10 +187,14 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
       ++stats_.gravity_refinements_dropped;
       return;
     }
-    const KeyFrame& first = *problem.visual.keyframes.front().keyframe;
+    // Live or retired: the problem's first keyframe measures the tilt change either way.
+    const KeyFramePtr first_kf = map->FindKeyFrame(problem.visual.keyframes.front().keyframe_id);
+    PKSLAM_CHECK(first_kf != nullptr, "gravity refinement: keyframe {} left map {}",
+                 problem.visual.keyframes.front().keyframe_id, map->id());
+    const KeyFrame& first = *first_kf;
     const Eigen::Vector3d up_before = first.camera_from_world().so3() * Eigen::Vector3d::UnitZ();
     MergeGlobalBundle(
-        map, problem.visual, [&] { ApplyInertialBundle(problem, result); },
+        map, problem.visual, [&] { ApplyInertialBundle(map, problem, result); },
         /*apply_sets_velocities=*/true);
     const Eigen::Vector3d up_after = first.camera_from_world().so3() * Eigen::Vector3d::UnitZ();
     stat.tilt_change_rad = std::atan2(up_after.cross(up_before).norm(), up_after.dot(up_before));
@@ -336,8 +340,9 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
   problem.accel_prior_information = accel_prior;
   const InertialBundleResult result = SolveInertialBundle(problem, ba);
   std::unique_lock lock(atlas_->mutex());
-  if (kf->map() == nullptr) return;
-  ApplyInertialBundle(problem, result);
+  Map* map = atlas_->FindMap(problem.visual.map_id);
+  if (kf->map() == nullptr || map == nullptr) return;
+  ApplyInertialBundle(map, problem, result);
   // Keyframes newer than the problem take the estimated biases too.
   if (!result.biases.empty()) {
     for (const auto& [id, other] : kf->map()->keyframes()) {
@@ -377,8 +382,9 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
   if (problem.empty() || problem.edges.empty()) return false;
   const InertialBundleResult result = SolveInertialBundle(problem, ba, &abort_ba_);
   std::unique_lock lock(atlas_->mutex());
-  if (kf->map() == nullptr) return true;
-  ApplyInertialBundle(problem, result);
+  Map* map = atlas_->FindMap(problem.visual.map_id);
+  if (kf->map() == nullptr || map == nullptr) return true;
+  ApplyInertialBundle(map, problem, result);
   kf->map()->RecordWorldChange({});
   lock.unlock();
   PKSLAM_LOG_DEBUG(

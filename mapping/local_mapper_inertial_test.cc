@@ -9,11 +9,11 @@
 #include <shared_mutex>
 #include <vector>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/testing/synthetic_map.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/testing/synthetic_map.h"
 #include "mapping/imu_chain_testing.h"
 #include "mapping/local_mapper.h"
 

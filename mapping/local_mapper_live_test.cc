@@ -8,8 +8,8 @@
 #include <thread>
 #include <vector>
 
-#include "core/map/keyframe.h"
-#include "core/testing/synthetic_map.h"
+#include "map_model/keyframe.h"
+#include "map_model/testing/synthetic_map.h"
 #include "mapping/local_mapper.h"
 
 namespace pkslam {

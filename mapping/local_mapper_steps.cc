@@ -6,12 +6,12 @@
 #include <shared_mutex>
 #include <unordered_set>
 
-#include "core/map/keyframe.h"
-#include "core/map/keyframe_database.h"
-#include "core/map/map_point.h"
-#include "core/matching/orb_matcher.h"
 #include "core/util/cpu_time.h"
 #include "core/util/log.h"
+#include "map_model/keyframe.h"
+#include "map_model/keyframe_database.h"
+#include "map_model/map_point.h"
+#include "map_model/matching/orb_matcher.h"
 #include "mapping/inertial_culling.h"
 #include "mapping/local_mapper.h"
 #include "mapping/triangulation.h"
@@ -218,7 +218,8 @@ void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
   if (problem.empty()) return;
   const BundleResult result = SolveBundle(problem, options_.ba, &abort_ba_);
   std::unique_lock lock(atlas_->mutex());
-  ApplyBundle(problem, result);
+  // A map merged away while the solver ran takes its keyframes with it: nothing to write.
+  if (Map* map = atlas_->FindMap(problem.map_id)) ApplyBundle(map, problem, result);
   if (result.aborted) {
     lock.unlock();
     std::lock_guard stats_lock(mutex_);

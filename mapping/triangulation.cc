@@ -3,7 +3,7 @@
 #include <Eigen/SVD>
 #include <cmath>
 
-#include "core/map/keyframe.h"
+#include "map_model/keyframe.h"
 
 namespace pkslam {
 namespace {
@@ -27,7 +27,7 @@ bool ReprojectionOk(const KeyFrame& kf, int index, const Eigen::Vector3d& p_worl
   if (u_right < 0) return ex * ex + ey * ey <= kChi2Mono * sigma2;
   const double disparity_info = kf.DisparityInformation(index);
   if (disparity_info > 0) {
-    // RGB-D: the depth reading has its own sigma (core/optim/reprojection_error.h).
+    // RGB-D: the depth reading has its own sigma (estimators/optim/reprojection_error.h).
     const double ed = rig.bf * inv_z - (kp.pt.x - u_right);
     return (ex * ex + ey * ey) / sigma2 + disparity_info * ed * ed <= kChi2Stereo;
   }

@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <optional>
 
-#include "core/map/ids.h"
+#include "map_model/ids.h"
 
 namespace pkslam {
 

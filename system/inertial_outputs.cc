@@ -6,11 +6,11 @@
 #include <mutex>
 #include <shared_mutex>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
 #include "core/util/error.h"
 #include "core/util/output_file.h"
 #include "io/trajectory.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
 
 namespace pkslam {
 

@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "core/camera/stereo_rectification.h"
-#include "core/frame/camera_rig.h"
+#include "core/sensor/camera_rig.h"
 #include "io/settings.h"
 
 namespace pkslam {

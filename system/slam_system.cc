@@ -5,13 +5,13 @@
 #include <mutex>
 #include <shared_mutex>
 
-#include "core/map/keyframe.h"
-#include "core/map/keyframe_database.h"
-#include "core/map/map_point.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/output_file.h"
 #include "keyframe/selector_factory.h"
+#include "map_model/keyframe.h"
+#include "map_model/keyframe_database.h"
+#include "map_model/map_point.h"
 
 namespace pkslam {
 

@@ -11,10 +11,10 @@
 #include <string>
 
 #include "core/bow/vocabulary.h"
-#include "core/map/atlas.h"
 #include "io/settings.h"
 #include "io/trajectory.h"
 #include "loopclosing/loop_closing.h"
+#include "map_model/atlas.h"
 #include "mapping/local_mapper.h"
 #include "system/rig_factory.h"
 #include "tracking/tracker.h"

@@ -4,9 +4,9 @@
 #include <set>
 #include <shared_mutex>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/map/map_point.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/map_point.h"
 
 namespace pkslam {
 

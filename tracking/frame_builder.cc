@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/frame/depth_uncertainty.h"
+#include "core/sensor/depth_uncertainty.h"
 #include "core/util/error.h"
 
 namespace pkslam {

@@ -4,12 +4,11 @@
 
 #include <cstdint>
 #include <memory>
-
 #include <opencv2/core.hpp>
 
 #include "core/features/orb_extractor.h"
 #include "core/features/stereo_matcher.h"
-#include "core/frame/frame.h"
+#include "map_model/frame.h"
 
 namespace pkslam {
 
@@ -19,8 +18,7 @@ class FrameBuilder {
                StereoMatcherOptions stereo = {});
 
   // Rectified grey pair.
-  Frame BuildStereo(FrameId id, std::int64_t t_ns, const cv::Mat& left,
-                    const cv::Mat& right) const;
+  Frame BuildStereo(FrameId id, std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right) const;
   // Grey image + registered depth (CV_16U scaled by rig.depth_factor, or CV_32F metres).
   Frame BuildRgbd(FrameId id, std::int64_t t_ns, const cv::Mat& grey, const cv::Mat& depth) const;
   // Monocular; `initialisation` doubles the feature count (ORB-SLAM's init extractor).

@@ -21,7 +21,7 @@
 
 #include "core/features/orb_extractor.h"
 #include "core/features/synthetic_texture.h"
-#include "core/frame/camera_rig.h"
+#include "core/sensor/camera_rig.h"
 #include "core/util/quantile.h"
 #include "tracking/frame_builder.h"
 

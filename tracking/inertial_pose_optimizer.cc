@@ -10,12 +10,12 @@
 #include <memory>
 #include <vector>
 
-#include "core/map/map_point.h"
-#include "core/optim/ceres_setup.h"
 #include "core/util/error.h"
+#include "estimators/optim/ceres_setup.h"
 #include "imu/body_reprojection_error.h"
 #include "imu/imu_factors.h"
 #include "imu/imu_manifolds.h"
+#include "map_model/map_point.h"
 #include "tracking/pose_correspondences.h"
 
 namespace pkslam {

@@ -10,8 +10,8 @@
 #include <Eigen/Core>
 #include <optional>
 
-#include "core/frame/frame.h"
 #include "core/imu/imu_types.h"
+#include "map_model/frame.h"
 #include "tracking/pose_optimizer.h"
 
 namespace pkslam {

@@ -1,7 +1,7 @@
 #include "tracking/pose_correspondences.h"
 
-#include "core/map/map_point.h"
 #include "core/util/error.h"
+#include "map_model/map_point.h"
 
 namespace pkslam {
 

@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/frame/frame.h"
+#include "map_model/frame.h"
 
 namespace pkslam {
 

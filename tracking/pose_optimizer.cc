@@ -8,11 +8,11 @@
 #include <memory>
 #include <vector>
 
-#include "core/map/map_point.h"
-#include "core/optim/ceres_setup.h"
-#include "core/optim/reprojection_error.h"
-#include "core/optim/se3_manifold.h"
 #include "core/util/error.h"
+#include "estimators/optim/ceres_setup.h"
+#include "estimators/optim/reprojection_error.h"
+#include "estimators/optim/se3_manifold.h"
+#include "map_model/map_point.h"
 #include "tracking/pose_correspondences.h"
 
 namespace pkslam {

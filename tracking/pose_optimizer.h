@@ -4,7 +4,7 @@
 // Reads map-point positions: caller holds the Atlas mutex (shared).
 #pragma once
 
-#include "core/frame/frame.h"
+#include "map_model/frame.h"
 
 namespace pkslam {
 

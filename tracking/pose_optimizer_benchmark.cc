@@ -6,8 +6,8 @@
 #include <memory>
 #include <vector>
 
-#include "core/map/map_point.h"
-#include "core/testing/synthetic_map.h"
+#include "map_model/map_point.h"
+#include "map_model/testing/synthetic_map.h"
 #include "tracking/pose_optimizer.h"
 
 namespace pkslam {

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "core/map/map_point.h"
-#include "core/testing/synthetic_map.h"
 #include "core/util/error.h"
+#include "map_model/map_point.h"
+#include "map_model/testing/synthetic_map.h"
 
 namespace pkslam {
 namespace {

@@ -5,12 +5,12 @@
 #include <unordered_set>
 
 #include "core/bow/vocabulary.h"
-#include "core/geometry/pnp.h"
-#include "core/map/keyframe.h"
-#include "core/map/keyframe_database.h"
-#include "core/map/map_point.h"
-#include "core/matching/orb_matcher.h"
 #include "core/util/log.h"
+#include "map_model/estimation/ransac_inputs.h"
+#include "map_model/keyframe.h"
+#include "map_model/keyframe_database.h"
+#include "map_model/map_point.h"
+#include "map_model/matching/orb_matcher.h"
 #include "tracking/pose_optimizer.h"
 #include "tracking/tracker.h"
 

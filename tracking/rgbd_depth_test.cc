@@ -1,4 +1,4 @@
-// RGB-D depth in pose optimisation: the depth reading's own noise (core/frame/
+// RGB-D depth in pose optimisation: the depth reading's own noise (core/sensor/
 // depth_uncertainty.h) weights a disparity residual, instead of the keypoint's pixel sigma on
 // a virtual right coordinate (ORB-SLAM's form, kept for stereo).
 #include <gtest/gtest.h>
@@ -8,8 +8,8 @@
 #include <random>
 #include <vector>
 
-#include "core/map/map_point.h"
-#include "core/testing/synthetic_map.h"
+#include "map_model/map_point.h"
+#include "map_model/testing/synthetic_map.h"
 #include "tracking/pose_optimizer.h"
 
 namespace pkslam {

@@ -5,12 +5,12 @@
 #include <shared_mutex>
 
 #include "core/bow/vocabulary.h"
-#include "core/map/keyframe.h"
-#include "core/map/map_point.h"
-#include "core/matching/orb_matcher.h"
 #include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "map_model/keyframe.h"
+#include "map_model/map_point.h"
+#include "map_model/matching/orb_matcher.h"
 #include "tracking/pose_optimizer.h"
 
 namespace pkslam {

@@ -10,10 +10,10 @@
 #include <optional>
 #include <vector>
 
-#include "core/frame/frame.h"
-#include "core/map/atlas.h"
-#include "core/map/mapping_backend.h"
 #include "keyframe/keyframe_selector.h"
+#include "map_model/atlas.h"
+#include "map_model/frame.h"
+#include "map_model/mapping_backend.h"
 #include "tracking/frame_builder.h"
 #include "tracking/tracker_inertial.h"
 #include "tracking/tracking_options.h"

@@ -7,13 +7,13 @@
 #include <mutex>
 #include <shared_mutex>
 
-#include "core/map/keyframe.h"
-#include "core/map/map.h"
-#include "core/map/map_point.h"
-#include "core/matching/orb_matcher.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "imu/preintegration.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/map_point.h"
+#include "map_model/matching/orb_matcher.h"
 #include "tracking/tracker.h"
 
 namespace pkslam {

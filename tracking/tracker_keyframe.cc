@@ -4,11 +4,11 @@
 #include <shared_mutex>
 
 #include "core/bow/vocabulary.h"
-#include "core/map/keyframe.h"
-#include "core/map/map_point.h"
-#include "core/matching/orb_matcher.h"
-#include "core/optim/bundle_adjustment.h"
 #include "core/util/log.h"
+#include "map_model/estimation/bundle_collect.h"
+#include "map_model/keyframe.h"
+#include "map_model/map_point.h"
+#include "map_model/matching/orb_matcher.h"
 #include "tracking/tracker.h"
 #include "tracking/two_view_initializer.h"
 
@@ -215,7 +215,7 @@ void Tracker::CreateInitialMapMonocular(const TwoViewResult& reconstruction) {
     ba.iterations_second = 0;
     const BundleResult result = SolveBundle(problem, ba);
     std::unique_lock lock(atlas_->mutex());
-    ApplyBundle(problem, result);
+    ApplyBundle(atlas_->current_map(), problem, result);
   }
   {
     std::unique_lock lock(atlas_->mutex());

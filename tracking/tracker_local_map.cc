@@ -5,9 +5,9 @@
 #include <unordered_set>
 
 #include "core/bow/vocabulary.h"
-#include "core/map/keyframe.h"
-#include "core/map/map_point.h"
-#include "core/matching/orb_matcher.h"
+#include "map_model/keyframe.h"
+#include "map_model/map_point.h"
+#include "map_model/matching/orb_matcher.h"
 #include "tracking/pose_optimizer.h"
 #include "tracking/tracker.h"
 

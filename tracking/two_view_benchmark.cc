@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "core/testing/synthetic_map.h"
+#include "map_model/testing/synthetic_map.h"
 #include "tracking/two_view_initializer.h"
 #include "tracking/two_view_models.h"
 #include "tracking/two_view_motion.h"

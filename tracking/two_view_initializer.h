@@ -21,8 +21,8 @@
 #include <optional>
 #include <vector>
 
-#include "core/frame/frame.h"
 #include "core/geometry/se3.h"
+#include "map_model/frame.h"
 
 namespace pkslam {
 

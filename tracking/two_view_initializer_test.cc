@@ -1,4 +1,4 @@
-// Monocular two-view initialisation on synthetic scenes (core/testing/synthetic_map.h):
+// Monocular two-view initialisation on synthetic scenes (map_model/testing/synthetic_map.h):
 // general and planar scenes, degenerate motions, outliers and determinism.
 #include "tracking/two_view_initializer.h"
 
@@ -9,8 +9,8 @@
 #include <cmath>
 #include <random>
 
-#include "core/testing/synthetic_map.h"
 #include "core/util/error.h"
+#include "map_model/testing/synthetic_map.h"
 
 namespace pkslam {
 namespace {

@@ -11,7 +11,7 @@
 #include <random>
 #include <string>
 
-#include "core/testing/synthetic_map.h"
+#include "map_model/testing/synthetic_map.h"
 #include "tracking/two_view_initializer.h"
 #include "tracking/two_view_refine.h"
 

@@ -13,7 +13,7 @@ import sys
 
 # Targets outside pkslam_library(): the test-support libraries and the executable at the top.
 EXTRA = {
-    "pkslam_core_testing": {"folder": "core/testing", "deps": ["pkslam_core"]},
+    "pkslam_map_model_testing": {"folder": "map_model/testing", "deps": ["pkslam_map_model"]},
     "pkslam_testsupport": {"folder": "tests/support", "deps": []},
 }
 SKIP_FOLDERS = {"build", "build-address", "build-fuzz", "build-thread", ".git", "third_party"}
@@ -135,8 +135,7 @@ def main():
     for name, lib in sorted(libs.items()):
         base = os.path.join(repo, lib["folder"])
         allowed = closure(libs, [name])
-        allowed_tests = allowed | closure(libs, lib["test_deps"]) | {"pkslam_testsupport",
-                                                                     "pkslam_core_testing"}
+        allowed_tests = allowed | closure(libs, lib["test_deps"]) | {"pkslam_testsupport"}
         for root, dirs, files in os.walk(base):
             dirs[:] = [d for d in dirs if d not in SKIP_FOLDERS]
             for f in files:

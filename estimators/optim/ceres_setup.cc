@@ -1,0 +1,38 @@
+#include "estimators/optim/ceres_setup.h"
+
+#include <cmath>
+
+namespace pkslam {
+
+ceres::CallbackReturnType AbortCallback::operator()(const ceres::IterationSummary& /*summary*/) {
+  if (abort_ == nullptr || !abort_->load(std::memory_order_relaxed)) return ceres::SOLVER_CONTINUE;
+  fired_ = true;
+  return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+}
+
+ceres::LinearSolverType SchurSolverFor(int free_poses) {
+  return free_poses <= kMaxFreePosesForDenseSchur ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
+}
+
+ceres::Solver::Options SolverOptions(ceres::LinearSolverType linear_solver, int max_iterations,
+                                     int num_threads) {
+  ceres::Solver::Options o;
+  o.linear_solver_type = linear_solver;
+  o.max_num_iterations = max_iterations;
+  o.num_threads = num_threads;
+  o.logging_type = ceres::SILENT;
+  return o;
+}
+
+ReprojectionLosses::ReprojectionLosses(double chi2_mono, double chi2_stereo, bool robust)
+    : huber_mono_(std::sqrt(chi2_mono)),
+      huber_stereo_(std::sqrt(chi2_stereo)),
+      mono_(robust ? &huber_mono_ : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP),
+      stereo_(robust ? &huber_stereo_ : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP) {}
+
+void ReprojectionLosses::SetRobust(bool robust) {
+  mono_.Reset(robust ? &huber_mono_ : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+  stereo_.Reset(robust ? &huber_stereo_ : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+}
+
+}  // namespace pkslam

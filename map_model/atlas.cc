@@ -1,0 +1,52 @@
+#include "map_model/atlas.h"
+
+#include <algorithm>
+
+namespace pkslam {
+
+Atlas::Atlas() { CreateNewMap(); }
+
+Atlas::~Atlas() {
+  // Maps erase their keyframes from the database while clearing; the database goes last.
+  for (auto& m : maps_) m->Clear();
+  maps_.clear();
+}
+
+void Atlas::SetDatabase(std::unique_ptr<KeyFrameDatabase> database) {
+  database_ = std::move(database);
+  for (auto& m : maps_) m->set_database(database_.get());
+}
+
+Map* Atlas::CreateNewMap() {
+  maps_.push_back(std::make_unique<Map>(next_map_id_++));
+  current_ = maps_.back().get();
+  current_->set_database(database_.get());
+  return current_;
+}
+
+void Atlas::SetCurrentMap(Map* map) { current_ = map; }
+
+void Atlas::RemoveMap(const Map* map) {
+  std::erase_if(maps_, [map](const std::unique_ptr<Map>& m) { return m.get() == map; });
+  if (current_ == map) current_ = maps_.empty() ? nullptr : maps_.back().get();
+}
+
+void Atlas::ResetCurrentMap() {
+  if (current_ != nullptr) current_->Clear();
+}
+
+std::vector<Map*> Atlas::maps() const {
+  std::vector<Map*> out;
+  out.reserve(maps_.size());
+  for (const auto& m : maps_) out.push_back(m.get());
+  return out;
+}
+
+Map* Atlas::FindMap(MapId id) const {
+  for (const auto& m : maps_) {
+    if (m->id() == id) return m.get();
+  }
+  return nullptr;
+}
+
+}  // namespace pkslam

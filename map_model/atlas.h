@@ -1,0 +1,63 @@
+// The Atlas: all maps of a session, the current (active) map, the id counters and the mutex
+// that guards the whole map model (see docs/architecture.md for the locking rules).
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <vector>
+
+#include "map_model/ids.h"
+#include "map_model/keyframe_database.h"
+#include "map_model/map.h"
+
+namespace pkslam {
+
+class Atlas {
+ public:
+  Atlas();
+  ~Atlas();
+  Atlas(const Atlas&) = delete;
+  Atlas& operator=(const Atlas&) = delete;
+
+  // Shared: read the map model. Exclusive: change it.
+  std::shared_mutex& mutex() const { return mutex_; }
+
+  // Requires the exclusive lock.
+  Map* CreateNewMap();
+  void SetCurrentMap(Map* map);
+  // Removes an (empty or merged) map; requires the exclusive lock.
+  void RemoveMap(const Map* map);
+  // Clears the current map's content (a reset) keeping the map object.
+  void ResetCurrentMap();
+
+  // Requires at least the shared lock.
+  Map* current_map() const { return current_; }
+  std::vector<Map*> maps() const;
+  // The map with this id, or null (removed, e.g. merged into another, or never created).
+  Map* FindMap(MapId id) const;
+  int NumMaps() const { return static_cast<int>(maps_.size()); }
+
+  // The keyframe database over all maps (place recognition); null until set. Guarded by the
+  // Atlas mutex like the rest of the map model. Every map created afterwards uses it.
+  void SetDatabase(std::unique_ptr<KeyFrameDatabase> database);
+  KeyFrameDatabase* database() const { return database_.get(); }
+
+  // Id counters (thread-safe, deterministic: ids increase by one per call).
+  FrameId NextFrameId() { return next_frame_id_.fetch_add(1); }
+  KeyFrameId NextKeyFrameId() { return next_kf_id_.fetch_add(1); }
+  MapPointId NextMapPointId() { return next_point_id_.fetch_add(1); }
+
+ private:
+  mutable std::shared_mutex mutex_;
+  std::unique_ptr<KeyFrameDatabase> database_;  // declared before maps_: outlives them
+  std::vector<std::unique_ptr<Map>> maps_;
+  Map* current_ = nullptr;
+  MapId next_map_id_ = 0;
+  std::atomic<FrameId> next_frame_id_{0};
+  std::atomic<KeyFrameId> next_kf_id_{0};
+  std::atomic<MapPointId> next_point_id_{0};
+};
+
+}  // namespace pkslam

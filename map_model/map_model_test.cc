@@ -1,0 +1,185 @@
+#include <gtest/gtest.h>
+
+#include <mutex>
+
+#include "map_model/keyframe.h"
+#include "map_model/map_point.h"
+#include "map_model/testing/synthetic_map.h"
+
+namespace pkslam {
+namespace {
+
+using testing::MakeForwardPath;
+using testing::MakeMap;
+using testing::MakeScene;
+using testing::MakeStereoRig;
+
+class MapModelTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    rig_ = MakeStereoRig();
+    scene_ = MakeScene(600, 3);
+    poses_ = MakeForwardPath(6, 0.15, 4);
+    map_ = MakeMap(&atlas_, scene_, rig_, poses_, {});
+  }
+  Atlas atlas_;
+  std::shared_ptr<CameraRig> rig_;
+  testing::SyntheticScene scene_;
+  std::vector<SE3d> poses_;
+  testing::SyntheticMap map_;
+};
+
+TEST_F(MapModelTest, CovisibilityWeightsCountSharedPoints) {
+  std::unique_lock lock(atlas_.mutex());
+  KeyFrame* a = map_.keyframes[0].get();
+  KeyFrame* b = map_.keyframes[1].get();
+  int shared = 0;
+  for (const auto& mp : a->map_points()) {
+    if (mp && mp->IsInKeyFrame(b)) ++shared;
+  }
+  ASSERT_GT(shared, 15);
+  EXPECT_EQ(a->Weight(b), shared);
+  EXPECT_EQ(b->Weight(a), shared);
+  // Ordered by decreasing weight.
+  const auto& ordered = a->CovisiblesByWeight();
+  for (std::size_t i = 1; i < ordered.size(); ++i) {
+    EXPECT_GE(a->Weight(ordered[i - 1]), a->Weight(ordered[i]));
+  }
+}
+
+TEST_F(MapModelTest, SpanningTreeLinksEveryKeyFrameButTheOrigin) {
+  std::unique_lock lock(atlas_.mutex());
+  EXPECT_EQ(atlas_.current_map()->origin(), map_.keyframes[0].get());
+  EXPECT_EQ(map_.keyframes[0]->parent(), nullptr);
+  for (std::size_t k = 1; k < map_.keyframes.size(); ++k) {
+    ASSERT_NE(map_.keyframes[k]->parent(), nullptr) << k;
+    EXPECT_TRUE(map_.keyframes[k]->parent()->children().count(map_.keyframes[k]->id()));
+  }
+}
+
+TEST_F(MapModelTest, RetiringAKeyFrameReparentsChildrenAndKeepsItsRelativePose) {
+  std::unique_lock lock(atlas_.mutex());
+  Map* map = atlas_.current_map();
+  KeyFrame* victim = map_.keyframes[2].get();
+  const auto children = victim->children();
+  KeyFrame* parent = victim->parent();
+  const SE3d expected_relative = victim->camera_from_world() * parent->world_from_camera();
+  victim->SetBad();
+  EXPECT_TRUE(victim->IsBad());
+  EXPECT_EQ(map->keyframes().count(victim->id()), 0u);
+  EXPECT_EQ(map->retired_keyframes().count(victim->id()), 1u);
+  EXPECT_LT((victim->camera_from_parent().Matrix() - expected_relative.Matrix()).norm(), 1e-12);
+  for (const auto& [id, child] : children) {
+    ASSERT_NE(child->parent(), nullptr);
+    EXPECT_NE(child->parent(), victim);
+    EXPECT_FALSE(child->parent()->IsBad());
+  }
+  for (const auto& kf : map_.keyframes) {
+    if (kf.get() == victim) continue;
+    EXPECT_EQ(kf->Weight(victim), 0);
+  }
+  for (const auto& [id, mp] : map->map_points()) EXPECT_FALSE(mp->IsInKeyFrame(victim));
+}
+
+TEST_F(MapModelTest, OriginIsNeverRetired) {
+  std::unique_lock lock(atlas_.mutex());
+  map_.keyframes[0]->SetBad();
+  EXPECT_FALSE(map_.keyframes[0]->IsBad());
+}
+
+TEST_F(MapModelTest, NotEraseDefersRetirement) {
+  std::unique_lock lock(atlas_.mutex());
+  KeyFrame* kf = map_.keyframes[3].get();
+  kf->SetNotErase();
+  kf->SetBad();
+  EXPECT_FALSE(kf->IsBad());
+  EXPECT_TRUE(kf->SetErase());
+  EXPECT_TRUE(kf->IsBad());
+}
+
+TEST_F(MapModelTest, ErasingObservationsMakesAPointBadAtTwoUnits) {
+  std::unique_lock lock(atlas_.mutex());
+  Map* map = atlas_.current_map();
+  // A point seen with stereo depth (2 units each) by exactly three keyframes.
+  MapPointPtr target;
+  for (const auto& mp : map_.point_of_scene_index) {
+    if (mp && mp->observations().size() == 3) {
+      target = mp;
+      break;
+    }
+  }
+  ASSERT_TRUE(target);
+  EXPECT_EQ(target->NumObservations(), 6);
+  auto erase_first = [&target]() {
+    KeyFrame* kf = target->observations().begin()->second.keyframe;
+    kf->EraseMapPointMatch(target->IndexInKeyFrame(kf));
+    return std::make_pair(kf, target->EraseObservation(kf));
+  };
+  EXPECT_FALSE(erase_first().second);  // 4 units left
+  EXPECT_EQ(target->NumObservations(), 4);
+  KeyFrame* remaining = std::prev(target->observations().end())->second.keyframe;
+  EXPECT_TRUE(erase_first().second);  // 2 units left: ORB-SLAM drops it
+  EXPECT_TRUE(target->IsBad());
+  EXPECT_EQ(map->map_points().count(target->id()), 0u);
+  for (const auto& mp : remaining->map_points()) EXPECT_NE(mp, target);
+}
+
+TEST_F(MapModelTest, ReplaceMovesObservationsToTheSurvivor) {
+  std::unique_lock lock(atlas_.mutex());
+  Map* map = atlas_.current_map();
+  MapPointPtr a, b;
+  for (const auto& mp : map_.point_of_scene_index) {
+    if (!mp) continue;
+    if (!a) {
+      a = mp;
+    } else {
+      b = mp;
+      break;
+    }
+  }
+  ASSERT_TRUE(a && b);
+  const auto a_obs = a->observations();
+  b->Replace(a);
+  EXPECT_TRUE(b->IsBad());
+  EXPECT_EQ(b->replaced_by(), a);
+  EXPECT_EQ(map->map_points().count(b->id()), 0u);
+  for (const auto& [id, obs] : a_obs) EXPECT_EQ(obs.keyframe->map_point(obs.index), a);
+  for (const auto& kf : map_.keyframes) {
+    for (const auto& mp : kf->map_points()) EXPECT_NE(mp, b);
+  }
+}
+
+TEST_F(MapModelTest, DistinctiveDescriptorIsTheMedoid) {
+  std::unique_lock lock(atlas_.mutex());
+  for (const auto& mp : map_.point_of_scene_index) {
+    if (!mp) continue;
+    // No bit flips in the fixture: every observation has the scene descriptor.
+    const auto& obs = mp->observations().begin()->second;
+    EXPECT_EQ(mp->descriptor(), obs.keyframe->descriptors()[obs.index]);
+  }
+}
+
+TEST_F(MapModelTest, PredictScaleIsMonotoneInDistance) {
+  std::unique_lock lock(atlas_.mutex());
+  const MapPointPtr mp = map_.point_of_scene_index[map_.keypoint_points[0][0]];
+  ASSERT_TRUE(mp);
+  int previous = 100;
+  for (double d = mp->min_distance(); d < mp->max_distance(); d += 0.1) {
+    const int level = mp->PredictScale(d, rig_->pyramid);
+    EXPECT_LE(level, previous);
+    previous = level;
+  }
+}
+
+TEST_F(MapModelTest, ClearBreaksAllLinks) {
+  std::unique_lock lock(atlas_.mutex());
+  std::weak_ptr<KeyFrame> weak_kf = map_.keyframes[1];
+  map_.keyframes.clear();
+  map_.point_of_scene_index.clear();
+  atlas_.ResetCurrentMap();
+  EXPECT_TRUE(weak_kf.expired());
+  EXPECT_EQ(atlas_.current_map()->NumKeyFrames(), 0);
+}
+
+}  // namespace
+}  // namespace pkslam

@@ -1,0 +1,98 @@
+// A 3-D landmark: position, representative descriptor, viewing direction and scale range,
+// and which keyframes observe it.
+//
+// Threading (docs/architecture.md): everything except the visible/found counters is guarded by
+// the Atlas mutex — read under a shared lock, written under an exclusive lock. The counters are
+// atomics because tracking bumps them while holding only a shared lock.
+#pragma once
+
+#include <Eigen/Core>
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <memory>
+
+#include "core/features/descriptor.h"
+#include "core/sensor/scale_pyramid.h"
+#include "map_model/ids.h"
+
+namespace pkslam {
+
+class MapPoint : public std::enable_shared_from_this<MapPoint> {
+ public:
+  MapPoint(MapPointId id, const Eigen::Vector3d& position_world, KeyFrame* reference_kf, Map* map);
+  MapPoint(const MapPoint&) = delete;
+  MapPoint& operator=(const MapPoint&) = delete;
+
+  MapPointId id() const { return id_; }
+  Map* map() const { return map_; }
+  void set_map(Map* map) { map_ = map; }
+  KeyFrameId first_keyframe_id() const { return first_kf_id_; }
+
+  const Eigen::Vector3d& position() const { return position_; }
+  void SetPosition(const Eigen::Vector3d& p) { position_ = p; }
+  // Mean unit direction from the observing cameras to the point.
+  const Eigen::Vector3d& normal() const { return normal_; }
+  const Descriptor& descriptor() const { return descriptor_; }
+  // Scale-invariance distance range: the point can be matched from [min, max] metres.
+  double min_distance() const { return 0.8 * min_distance_; }
+  double max_distance() const { return 1.2 * max_distance_; }
+
+  // --- observations (keyframe id order => deterministic iteration) ---
+  struct Observation {
+    KeyFrame* keyframe = nullptr;  // non-owning; valid while the observation exists
+    int index = -1;                // keypoint index in that keyframe
+  };
+  const std::map<KeyFrameId, Observation>& observations() const { return observations_; }
+  // Stereo/RGB-D observations count twice (as in ORB-SLAM).
+  int NumObservations() const { return num_obs_; }
+  void AddObservation(KeyFrame* kf, int index);
+  // Returns true if the point has become bad (fewer than 3 observation units left).
+  bool EraseObservation(KeyFrame* kf);
+  bool IsInKeyFrame(const KeyFrame* kf) const;
+  int IndexInKeyFrame(const KeyFrame* kf) const;  // -1 if not observed there
+
+  KeyFrame* reference_keyframe() const { return reference_kf_; }
+
+  // Marks the point bad and removes it from all observing keyframes and from its map.
+  // Must be owned by a MapPointPtr (the call keeps itself alive while unlinking).
+  void SetBad();
+  bool IsBad() const { return bad_; }
+  // Fuse: moves all observations to `other` (which survives) and marks this one bad.
+  void Replace(const MapPointPtr& other);
+  // The point this one was fused into (follow the chain), or nullptr.
+  MapPointPtr replaced_by() const { return replaced_by_; }
+
+  // Median-distance descriptor among all observations.
+  void ComputeDistinctiveDescriptor();
+  // Recomputes the normal and the distance range from the observations.
+  void UpdateNormalAndDepth();
+  // Pyramid level at which the point is expected when seen from `distance` metres.
+  int PredictScale(double distance, const ScalePyramid& pyramid) const;
+
+  // --- statistics written by tracking (atomic) ---
+  void IncreaseVisible(int n = 1) { visible_.fetch_add(n, std::memory_order_relaxed); }
+  void IncreaseFound(int n = 1) { found_.fetch_add(n, std::memory_order_relaxed); }
+  int visible() const { return visible_.load(std::memory_order_relaxed); }
+  int found() const { return found_.load(std::memory_order_relaxed); }
+  double FoundRatio() const { return static_cast<double>(found()) / std::max(1, visible()); }
+
+ private:
+  MapPointId id_;
+  KeyFrameId first_kf_id_;
+  Map* map_;
+  Eigen::Vector3d position_;
+  Eigen::Vector3d normal_ = Eigen::Vector3d::Zero();
+  Descriptor descriptor_;
+  double min_distance_ = 0;
+  double max_distance_ = 0;
+  std::map<KeyFrameId, Observation> observations_;
+  int num_obs_ = 0;
+  KeyFrame* reference_kf_;
+  bool bad_ = false;
+  MapPointPtr replaced_by_;
+  std::atomic<int> visible_{1};
+  std::atomic<int> found_{1};
+};
+
+}  // namespace pkslam
