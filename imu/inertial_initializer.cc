@@ -84,10 +84,7 @@ InertialInitResult InitializeInertial(const std::vector<InertialInitKeyFrame>& k
   // The problem borrows the cost functions and the manifold; they live until the solve ends.
   std::vector<std::unique_ptr<ceres::CostFunction>> costs;
   GravityDirectionManifold gravity_manifold;
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
+  ceres::Problem problem(ProblemOptions({.cost_functions = true}));
   for (std::size_t k = 0; k + 1 < n; ++k) {
     costs.push_back(std::make_unique<InertialGravityScaleError>(
         preintegrations[k], keyframes[k].world_from_body, keyframes[k + 1].world_from_body,

@@ -11,6 +11,7 @@
 #include "estimators/optim/yaw_manifold.h"
 #include "loopclosing/loop_closing.h"
 #include "loopclosing/revisit_fixture.h"
+#include "map_model/map_editor.h"
 #include "mapping/global_bundle.h"
 
 namespace pkslam {
@@ -34,12 +35,12 @@ class InertialLoopTest : public testing::RevisitTest {
     drift_ = SE3d(SO3d::Exp(Eigen::Vector3d(roll, 0, yaw)), Eigen::Vector3d(0.12, -0.03, 0.05));
     Map* second_map = atlas_.current_map();
     if (merge) {
-      std::unique_lock lock(atlas_.mutex());
+      auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
       second_map = atlas_.CreateNewMap();
     }
     second_ = Revisit(second_map, scene_);
     Finish(second_);
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (Map* map : atlas_.maps()) {
       map->mutable_imu_status().imu_initialized = true;
       map->mutable_imu_status().inertial_ba1_done = true;
@@ -56,7 +57,7 @@ class InertialLoopTest : public testing::RevisitTest {
   }
 
   Snapshot Take() {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     Snapshot s;
     for (const Map* map : atlas_.maps()) {
       for (const auto& [id, kf] : map->keyframes()) {
@@ -82,7 +83,7 @@ class InertialLoopTest : public testing::RevisitTest {
 
   // Largest change (rad) of a keyframe's view of the world's z axis since `before`.
   double MaxTiltChange(const Snapshot& before) {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     return pkslam::MaxTiltChange(*atlas_.current_map(), before.gravity_in_camera);
   }
 
@@ -96,7 +97,7 @@ TEST_F(InertialLoopTest, CorrectsYawAndTranslationKeepingGravity) {
   ASSERT_EQ(stats.loops.size(), 1u);
   EXPECT_EQ(stats.rejected_inertial, 0);
   EXPECT_LT(MaxTiltChange(before), 1e-9);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   for (int k = 0; k < kKeyFrames; ++k) {
     const KeyFrame& kf = *second_[static_cast<std::size_t>(k)];
     // The yaw and translation drift is gone (what is left: the uncorrected roll over ~1 m).
@@ -113,7 +114,7 @@ TEST_F(InertialLoopTest, TwoInertialMapsMergeByYawAndTranslation) {
   const Snapshot before = Take();
   const LoopClosingStats stats = Close(Sensor::kStereoInertial);
   ASSERT_EQ(stats.merges.size(), 1u);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   EXPECT_EQ(atlas_.NumMaps(), 1);
   EXPECT_LT(MaxTiltChange(before), 1e-9);
   for (int k = 0; k < kKeyFrames; ++k) {
@@ -139,7 +140,7 @@ TEST_F(InertialLoopTest, RefusesALoopThatTiltsGravity) {
   const LoopClosingStats stats = Close(Sensor::kStereoInertial);
   EXPECT_TRUE(stats.loops.empty());
   EXPECT_GE(stats.rejected_inertial, 1);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   for (const auto& [id, kf] : atlas_.current_map()->keyframes()) {
     EXPECT_EQ(kf->camera_from_world().Matrix(), before.camera_from_world.at(id).Matrix());
   }
@@ -155,7 +156,7 @@ class DriftBoundTest : public InertialLoopTest {
     second_ = Revisit(atlas_.current_map(), scene_);
     Finish(second_);
     if (IsInertial(sensor)) {
-      std::unique_lock lock(atlas_.mutex());
+      auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
       atlas_.current_map()->mutable_imu_status().imu_initialized = true;
       atlas_.current_map()->mutable_imu_status().inertial_ba2_done = true;
     }
@@ -163,7 +164,7 @@ class DriftBoundTest : public InertialLoopTest {
     const LoopClosingStats stats = Close(sensor);
     EXPECT_TRUE(stats.loops.empty());
     EXPECT_GE(stats.rejected_implausible, 1);
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     for (const auto& [id, kf] : atlas_.current_map()->keyframes()) {
       EXPECT_EQ(kf->camera_from_world().Matrix(), before.camera_from_world.at(id).Matrix());
     }

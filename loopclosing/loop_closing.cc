@@ -10,6 +10,7 @@
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "mapping/global_bundle.h"
 #include "mapping/inertial_bundle.h"
 
@@ -148,7 +149,7 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
   event.detection_ms = verification_ms;
   bool merge = false;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (region->query->map() == nullptr || region->matched->map() == nullptr) return;
     event.map = region->query->map()->id();
     event.matched_map = region->matched->map()->id();
@@ -186,7 +187,7 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
 }
 
 std::optional<CommonRegion> LoopClosing::Detect(const KeyFramePtr& kf, double* verification_ms) {
-  std::shared_lock lock(atlas_->mutex());
+  auto lock = MapReader(*atlas_).Lock();
   KeyFrameDatabase* database = atlas_->database();
   Map* map = kf->map();
   if (database == nullptr || map == nullptr || kf->IsBad()) return std::nullopt;
@@ -304,7 +305,7 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
   InertialBundleProblem inertial;
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (IsInertial(sensor_) && map->imu_status().imu_initialized &&
         map->NumKeyFrames() <= options_.inertial_global_ba_max_keyframes) {
       KeyFrame* newest = nullptr;
@@ -333,7 +334,7 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
   if (!aborted && !gba_abort_.load()) {
     PauseMapping();
     {
-      std::unique_lock lock(atlas_->mutex());
+      auto lock = MapEditor(atlas_).Write(MapEdit::kGlobalBundle);
       // A newer loop or merge may have aborted us in the meantime (then it owns the map).
       if (!gba_abort_.load()) {
         const auto gravity_before = GravityInCameras(*map);

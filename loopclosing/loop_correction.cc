@@ -18,6 +18,7 @@
 #include "map_model/estimation/essential_graph_collect.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
 #include "mapping/global_bundle.h"
@@ -157,7 +158,7 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
   PauseMapping();
   Map* map = nullptr;
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kLoopCorrection);
     KeyFrame* query = region.query.get();
     map = query->map();
     if (query->IsBad() || map == nullptr || region.matched->IsBad() ||
@@ -231,7 +232,7 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
   PauseMapping();
   Map* merged = nullptr;
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kMergeMaps);
     KeyFrame* query = region.query.get();
     Map* current = query->map();
     merged = region.matched->map();

@@ -16,6 +16,7 @@
 #include "loopclosing/revisit_fixture.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/keyframe_database_test_utils.h"
+#include "map_model/map_editor.h"
 
 namespace pkslam {
 namespace {
@@ -27,7 +28,7 @@ using testing::RevisitTest;
 TEST_F(RevisitTest, VerifiesTheRevisitAndRecoversTheTruePose) {
   const auto second = Revisit(atlas_.current_map(), scene_);
   Finish(second);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const int q = kKeyFrames / 2;
   const auto region = VerifyCandidate(second[q], first_[q].get(), PlaceVerifierOptions{}, 7);
   ASSERT_TRUE(region.has_value());
@@ -49,7 +50,7 @@ TEST_F(RevisitTest, RejectsTheSameLooksInADifferentGeometry) {
   std::shuffle(shuffled.points_world.begin(), shuffled.points_world.end(), rng);
   const auto second = Revisit(atlas_.current_map(), shuffled);
   Finish(second);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   for (int q = 0; q < kKeyFrames; ++q) {
     for (const auto& candidate : first_) {
       EXPECT_FALSE(VerifyCandidate(second[q], candidate.get(), PlaceVerifierOptions{}, 7))
@@ -71,13 +72,13 @@ TEST_P(LoopClosingRevisitTest, ClosesTheLoopOrMergesTheMaps) {
   Map* first_map = atlas_.current_map();
   Map* second_map = first_map;
   if (merge) {
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     second_map = atlas_.CreateNewMap();
   }
   const auto second = Revisit(second_map, scene_);
   Finish(second);
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     EXPECT_GT(CentreError(*second.back(), poses_.back()), 0.1);  // drifted before
   }
   std::atomic<bool> stop_requested{false};
@@ -97,7 +98,7 @@ TEST_P(LoopClosingRevisitTest, ClosesTheLoopOrMergesTheMaps) {
   std::thread reader([&] {
     double sum = 0;
     while (!done.load()) {
-      std::shared_lock lock(atlas_.mutex());
+      auto lock = MapReader(atlas_).Lock();
       for (const Map* map : atlas_.maps()) {
         for (const auto& [id, kf] : map->keyframes()) sum += kf->CameraCenter().x();
         for (const auto& [id, mp] : map->map_points()) sum += mp->position().x();
@@ -116,7 +117,7 @@ TEST_P(LoopClosingRevisitTest, ClosesTheLoopOrMergesTheMaps) {
   // Threaded: local mapping was paused for the correction and for the BA write-back.
   EXPECT_EQ(pauses.load(), synchronous ? 0 : 2);
   EXPECT_FALSE(stop_requested.load());  // and released again
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   EXPECT_EQ(atlas_.NumMaps(), 1);
   EXPECT_EQ(atlas_.current_map(), first_map);
   for (int k = 0; k < kKeyFrames; ++k) {

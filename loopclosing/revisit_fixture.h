@@ -13,6 +13,7 @@
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/keyframe_database_test_utils.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 
 namespace pkslam::testing {
@@ -33,7 +34,7 @@ class RevisitTest : public ::testing::Test {
   // Builds the second visit in `map` (drifted) from `scene`.
   std::vector<KeyFramePtr> Revisit(Map* map, const testing::SyntheticScene& scene) {
     auto kfs = AddKeyFrames(&atlas_, map, scene, rig_, poses_, vocabulary_, 100);
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (const auto& kf : kfs) {
       for (const auto& mp : kf->map_points()) {
         if (mp && mp->first_keyframe_id() == kf->id()) mp->SetPosition(drift_ * mp->position());
@@ -44,7 +45,7 @@ class RevisitTest : public ::testing::Test {
   }
 
   void Finish(const std::vector<KeyFramePtr>& kfs) {
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (const auto& kf : kfs) {
       atlas_.database()->Add(kf.get());
       for (const auto& mp : kf->map_points()) {

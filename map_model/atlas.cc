@@ -42,6 +42,19 @@ std::vector<Map*> Atlas::maps() const {
   return out;
 }
 
+MapEditTable Atlas::EditStats() const {
+  std::lock_guard lock(edit_stats_mutex_);
+  return edit_stats_;
+}
+
+void Atlas::RecordEdit(MapEdit edit, double held_s) const {
+  std::lock_guard lock(edit_stats_mutex_);
+  MapEditStats& s = edit_stats_[static_cast<std::size_t>(edit)];
+  ++s.holds;
+  s.total_s += held_s;
+  s.max_s = std::max(s.max_s, held_s);
+}
+
 Map* Atlas::FindMap(MapId id) const {
   for (const auto& m : maps_) {
     if (m->id() == id) return m.get();

@@ -1,5 +1,7 @@
 // The Atlas: all maps of a session, the current (active) map, the id counters and the mutex
-// that guards the whole map model (see docs/architecture.md for the locking rules).
+// that guards the whole map model. The mutex is private: readers lock it through MapReader,
+// writers through MapEditor (map_editor.h), the only code that takes it exclusively (see
+// docs/architecture.md for the locking rules).
 #pragma once
 
 #include <atomic>
@@ -11,6 +13,7 @@
 #include "map_model/ids.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/map.h"
+#include "map_model/map_edit.h"
 
 namespace pkslam {
 
@@ -20,9 +23,6 @@ class Atlas {
   ~Atlas();
   Atlas(const Atlas&) = delete;
   Atlas& operator=(const Atlas&) = delete;
-
-  // Shared: read the map model. Exclusive: change it.
-  std::shared_mutex& mutex() const { return mutex_; }
 
   // Requires the exclusive lock.
   Map* CreateNewMap();
@@ -49,8 +49,20 @@ class Atlas {
   KeyFrameId NextKeyFrameId() { return next_kf_id_.fetch_add(1); }
   MapPointId NextMapPointId() { return next_point_id_.fetch_add(1); }
 
+  // Exclusive holds of the map lock so far, per kind of change (thread-safe; no lock needed).
+  MapEditTable EditStats() const;
+
  private:
+  friend class MapEditor;
+  friend class MapReader;
+  friend class MapWriteLock;
+  void RecordEdit(MapEdit edit, double held_s) const;
+
+  // Shared: read the map model. Exclusive: change it. Taken only by MapReader / MapEditor.
   mutable std::shared_mutex mutex_;
+  // Guards edit_stats_ (written when a MapWriteLock ends, read by EditStats()).
+  mutable std::mutex edit_stats_mutex_;
+  mutable MapEditTable edit_stats_{};
   std::unique_ptr<KeyFrameDatabase> database_;  // declared before maps_: outlives them
   std::vector<std::unique_ptr<Map>> maps_;
   Map* current_ = nullptr;

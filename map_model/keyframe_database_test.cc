@@ -9,6 +9,7 @@
 #include "core/util/error.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database_test_utils.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/testing/synthetic_map.h"
 
@@ -27,7 +28,7 @@ class KeyFrameDatabaseTest : public ::testing::Test {
       : vocabulary_(testing::MakeRandomVocabulary(10, 4, 5)),
         rig_(MakeStereoRig()),
         scene_(MakeScene(4000, 11, 30.0, 2.5, 4.0, 8.0)) {
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     map_a_ = atlas_.current_map();
     map_b_ = atlas_.CreateNewMap();
     atlas_.SetCurrentMap(map_a_);
@@ -57,7 +58,7 @@ TEST_F(KeyFrameDatabaseTest, RelocalisationFindsTheKeyFramesOfThePlace) {
   const auto poses = Strip(-24.0, 1.2, 20);
   const auto kfs = AddKeyFrames(&atlas_, map_a_, scene_, rig_, poses, vocabulary_, 1);
   KeyFrameDatabase db(vocabulary_);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   for (const auto& kf : kfs) db.Add(kf.get());
   ASSERT_EQ(db.size(), 20u);
 
@@ -90,7 +91,7 @@ TEST_F(KeyFrameDatabaseTest, LoopAndMergeCandidatesExcludeConnectedKeyFrames) {
   const auto other =
       AddKeyFrames(&atlas_, map_b_, scene_, rig_, Strip(-10.5, 1.2, 6, -0.1), vocabulary_, 200);
   KeyFrameDatabase db(vocabulary_);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   for (const auto* list : {&first, &revisit, &other}) {
     for (const auto& kf : *list) db.Add(kf.get());
   }
@@ -123,7 +124,7 @@ TEST_F(KeyFrameDatabaseTest, EraseWorksAfterRetirementAndClearIsPerMap) {
   const auto a = AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 20), vocabulary_, 1);
   const auto b = AddKeyFrames(&atlas_, map_b_, scene_, rig_, Strip(-24.0, 1.2, 5), vocabulary_, 7);
   KeyFrameDatabase db(vocabulary_);
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   for (const auto& kf : a) db.Add(kf.get());
   for (const auto& kf : b) db.Add(kf.get());
   EXPECT_EQ(db.size(), 25u);
@@ -158,7 +159,7 @@ TEST_F(KeyFrameDatabaseTest, ResultsDoNotDependOnInsertionOrder) {
       AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 20), vocabulary_, 1);
   KeyFrameDatabase forward(vocabulary_);
   KeyFrameDatabase backward(vocabulary_);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   for (const auto& kf : kfs) forward.Add(kf.get());
   for (auto it = kfs.rbegin(); it != kfs.rend(); ++it) backward.Add(it->get());
   for (int place : {3, 9, 15}) {
@@ -186,7 +187,7 @@ TEST_F(KeyFrameDatabaseTest, RejectsWordsOutsideTheVocabularyAndBadOptions) {
   const auto kfs =
       AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 2), vocabulary_, 1);
   KeyFrameDatabase db(small);
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   EXPECT_THROW(db.Add(kfs[0].get()), Error);
   KeyFrameDatabaseOptions options;
   options.min_common_words_ratio = 1.5;

@@ -8,6 +8,7 @@
 
 #include "core/bow/vocabulary.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/testing/synthetic_map.h"
 
@@ -20,7 +21,7 @@ inline std::vector<KeyFramePtr> AddKeyFrames(Atlas* atlas, Map* map, const Synth
                                              const std::shared_ptr<const CameraRig>& rig,
                                              const std::vector<SE3d>& poses,
                                              const Vocabulary& vocabulary, std::uint64_t seed) {
-  std::unique_lock lock(atlas->mutex());
+  auto lock = MapEditor(atlas).Write(MapEdit::kFixture);
   std::vector<KeyFramePtr> kfs;
   std::vector<std::vector<int>> keypoint_points;
   std::vector<int> seen(scene.points_world.size(), 0);

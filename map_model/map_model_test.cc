@@ -3,6 +3,7 @@
 #include <mutex>
 
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/testing/synthetic_map.h"
 
@@ -30,7 +31,7 @@ class MapModelTest : public ::testing::Test {
 };
 
 TEST_F(MapModelTest, CovisibilityWeightsCountSharedPoints) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   KeyFrame* a = map_.keyframes[0].get();
   KeyFrame* b = map_.keyframes[1].get();
   int shared = 0;
@@ -48,7 +49,7 @@ TEST_F(MapModelTest, CovisibilityWeightsCountSharedPoints) {
 }
 
 TEST_F(MapModelTest, SpanningTreeLinksEveryKeyFrameButTheOrigin) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   EXPECT_EQ(atlas_.current_map()->origin(), map_.keyframes[0].get());
   EXPECT_EQ(map_.keyframes[0]->parent(), nullptr);
   for (std::size_t k = 1; k < map_.keyframes.size(); ++k) {
@@ -58,7 +59,7 @@ TEST_F(MapModelTest, SpanningTreeLinksEveryKeyFrameButTheOrigin) {
 }
 
 TEST_F(MapModelTest, RetiringAKeyFrameReparentsChildrenAndKeepsItsRelativePose) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Map* map = atlas_.current_map();
   KeyFrame* victim = map_.keyframes[2].get();
   const auto children = victim->children();
@@ -82,13 +83,13 @@ TEST_F(MapModelTest, RetiringAKeyFrameReparentsChildrenAndKeepsItsRelativePose) 
 }
 
 TEST_F(MapModelTest, OriginIsNeverRetired) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   map_.keyframes[0]->SetBad();
   EXPECT_FALSE(map_.keyframes[0]->IsBad());
 }
 
 TEST_F(MapModelTest, NotEraseDefersRetirement) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   KeyFrame* kf = map_.keyframes[3].get();
   kf->SetNotErase();
   kf->SetBad();
@@ -98,7 +99,7 @@ TEST_F(MapModelTest, NotEraseDefersRetirement) {
 }
 
 TEST_F(MapModelTest, ErasingObservationsMakesAPointBadAtTwoUnits) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Map* map = atlas_.current_map();
   // A point seen with stereo depth (2 units each) by exactly three keyframes.
   MapPointPtr target;
@@ -125,7 +126,7 @@ TEST_F(MapModelTest, ErasingObservationsMakesAPointBadAtTwoUnits) {
 }
 
 TEST_F(MapModelTest, ReplaceMovesObservationsToTheSurvivor) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Map* map = atlas_.current_map();
   MapPointPtr a, b;
   for (const auto& mp : map_.point_of_scene_index) {
@@ -150,7 +151,7 @@ TEST_F(MapModelTest, ReplaceMovesObservationsToTheSurvivor) {
 }
 
 TEST_F(MapModelTest, DistinctiveDescriptorIsTheMedoid) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   for (const auto& mp : map_.point_of_scene_index) {
     if (!mp) continue;
     // No bit flips in the fixture: every observation has the scene descriptor.
@@ -160,7 +161,7 @@ TEST_F(MapModelTest, DistinctiveDescriptorIsTheMedoid) {
 }
 
 TEST_F(MapModelTest, PredictScaleIsMonotoneInDistance) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   const MapPointPtr mp = map_.point_of_scene_index[map_.keypoint_points[0][0]];
   ASSERT_TRUE(mp);
   int previous = 100;
@@ -172,7 +173,7 @@ TEST_F(MapModelTest, PredictScaleIsMonotoneInDistance) {
 }
 
 TEST_F(MapModelTest, ClearBreaksAllLinks) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   std::weak_ptr<KeyFrame> weak_kf = map_.keyframes[1];
   map_.keyframes.clear();
   map_.point_of_scene_index.clear();

@@ -7,6 +7,7 @@
 
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/testing/synthetic_map.h"
 
@@ -38,7 +39,7 @@ class MergeGlobalBundleTest : public ::testing::Test {
     scene_ = MakeScene(600, 5);
     poses_ = MakeForwardPath(6, 0.2, 6);
     map_ = MakeMap(&atlas_, scene_, rig_, poses_, FrameOptions{});
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem_ = CollectGlobalBundle(*atlas_.current_map());
   }
 
@@ -66,7 +67,7 @@ class MergeGlobalBundleTest : public ::testing::Test {
 TEST_F(MergeGlobalBundleTest, ProblemKeyframesAndPointsTakeTheOptimisedValues) {
   const SE3d change(SO3d::Exp(Eigen::Vector3d(0.0, 0.05, 0.0)), Eigen::Vector3d(0.3, 0, 0.1));
   const BundleResult result = MoveWorld(problem_, change);
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   const int change_index = atlas_.current_map()->change_index();
   MergeGlobalBundle(atlas_.current_map(), problem_, result);
   for (std::size_t k = 0; k < problem_.keyframes.size(); ++k) {
@@ -94,7 +95,7 @@ TEST_F(MergeGlobalBundleTest, NewKeyframesFollowTheirParentAndNewPointsTheirRefe
   SE3d b_before;
   Eigen::Vector3d point_before;
   {
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     a = AddKeyFrame(map_.keyframes.back().get(), 0.2);
     b = AddKeyFrame(a.get(), 0.2);  // a chain of two new keyframes
     point_before = b->world_from_camera() * Eigen::Vector3d(0.1, -0.2, 4.0);
@@ -106,7 +107,7 @@ TEST_F(MergeGlobalBundleTest, NewKeyframesFollowTheirParentAndNewPointsTheirRefe
   }
   const SE3d change(SO3d::Exp(Eigen::Vector3d(0.02, -0.04, 0.01)), Eigen::Vector3d(-0.2, 0.1, 0));
   const BundleResult result = MoveWorld(problem_, change);
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   MergeGlobalBundle(atlas_.current_map(), problem_, result);
   // The whole world moved by `change`: so must the keyframes and the point the BA never saw.
   const SE3d a_expected = a_before * change.Inverse();
@@ -122,7 +123,7 @@ TEST_F(MergeGlobalBundleTest, KeyframesOfAnotherMapAreLeftAlone) {
   KeyFramePtr moved;
   SE3d before;
   {
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     moved = AddKeyFrame(map_.keyframes.back().get(), 0.2);
     Map* other = atlas_.CreateNewMap();
     atlas_.SetCurrentMap(map_.keyframes.front()->map());
@@ -130,7 +131,7 @@ TEST_F(MergeGlobalBundleTest, KeyframesOfAnotherMapAreLeftAlone) {
     before = moved->camera_from_world();
   }
   const SE3d change(SO3d(), Eigen::Vector3d(1.0, 0, 0));
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   MergeGlobalBundle(map_.keyframes.front()->map(), problem_, MoveWorld(problem_, change));
   EXPECT_LT((moved->camera_from_world().translation() - before.translation()).norm(), 1e-12);
 }

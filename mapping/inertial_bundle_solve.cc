@@ -167,13 +167,10 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
 
   ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/true);
   BodyPoseManifold pose_manifold;
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   // Removing outlier blocks between the passes needs Ceres' removal index; a single pass
   // (ORB-SLAM3's local inertial BA) only classifies them and skips its upkeep.
-  problem_options.enable_fast_removal = options.iterations_second > 0;
-  ceres::Problem ceres_problem(problem_options);
+  ceres::Problem ceres_problem(
+      ProblemOptions({.loss_functions = true, .fast_removal = options.iterations_second > 0}));
 
   std::vector<std::uint8_t> pose_added(static_cast<std::size_t>(num_kf), 0);
   auto add_pose = [&](int i) {

@@ -9,6 +9,7 @@
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/testing/synthetic_map.h"
 
 namespace pkslam {
@@ -25,7 +26,7 @@ class InertialCullingTest : public ::testing::Test {
                             testing::MakeForwardPath(kNumKeyFrames, 0.15, 4), {});
     samples_ = testing::SampleImu(testing::HelixMotion(), 0, kKeyFramePeriodNs * kNumKeyFrames,
                                   5'000'000, bias_, noise_, nullptr);
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (int k = 0; k < kNumKeyFrames; ++k) {
       KeyFrame* kf = map_.keyframes[k].get();
       ASSERT_EQ(kf->t_ns(), k * kKeyFramePeriodNs);
@@ -59,7 +60,7 @@ class InertialCullingTest : public ::testing::Test {
 };
 
 TEST_F(InertialCullingTest, SplicingMergesThePreintegrationIntoTheSuccessor) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   kf(4)->imu.state.bias = ImuBias(Eigen::Vector3d(0.001, 0, 0), Eigen::Vector3d(0.01, 0, 0));
   Retire(5);
   EXPECT_EQ(kf(6)->imu.previous, kf(4));
@@ -80,7 +81,7 @@ TEST_F(InertialCullingTest, SplicingMergesThePreintegrationIntoTheSuccessor) {
 }
 
 TEST_F(InertialCullingTest, ContextFindsTheStartOfTheNewestWindow) {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   InertialCullingOptions options;
   options.window = 21;
   const InertialCullingContext c = MakeInertialCullingContext(*kf(29), options);
@@ -90,7 +91,7 @@ TEST_F(InertialCullingTest, ContextFindsTheStartOfTheNewestWindow) {
 }
 
 TEST_F(InertialCullingTest, TimeSpacingDecidesWhichRedundantKeyFramesMayGo) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   InertialCullingOptions options;
   InertialCullingContext c;
   c.current_id = kf(29)->id();
@@ -127,7 +128,7 @@ TEST_F(InertialCullingTest, TimeSpacingDecidesWhichRedundantKeyFramesMayGo) {
 }
 
 TEST_F(InertialCullingTest, RepairSplicesKeyFramesRetiredWithoutSplicing) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   kf(15)->SetBad();
   kf(16)->SetBad();
   ASSERT_EQ(kf(17)->imu.previous, kf(16));

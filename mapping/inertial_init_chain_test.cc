@@ -8,6 +8,7 @@
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/testing/synthetic_map.h"
 #include "mapping/imu_chain_testing.h"
 
@@ -33,7 +34,7 @@ class InertialInitChainTest : public ::testing::Test {
                             testing::FrameOptions());
     const auto samples =
         SampleImu(motion_, 0, (kNum - 1) * 50'000'000LL, 5'000'000, bias_, *rig_->imu, nullptr);
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     testing::LinkWithImu(map_.keyframes, samples, bias_, *rig_->imu);
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
@@ -48,14 +49,14 @@ class InertialInitChainTest : public ::testing::Test {
 };
 
 TEST_F(InertialInitChainTest, ChainRunsThroughTheKeyFramesLinkedAfter) {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const std::vector<KeyFrame*> chain = InertialChainThrough(kf(3));
   ASSERT_EQ(chain.size(), static_cast<std::size_t>(kNum));
   for (int k = 0; k < kNum; ++k) EXPECT_EQ(chain[k], kf(k));
 }
 
 TEST_F(InertialInitChainTest, ChainStopsWhereTheLinkBreaks) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   kf(6)->imu.from_previous.reset();  // an IMU gap before keyframe 6
   const std::vector<KeyFrame*> chain = InertialChainThrough(kf(3));
   ASSERT_EQ(chain.size(), 6u);
@@ -68,7 +69,7 @@ TEST_F(InertialInitChainTest, ChainStopsWhereTheLinkBreaks) {
 }
 
 TEST_F(InertialInitChainTest, PropagatedVelocitiesFollowTheImu) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   // Metric = 2 * map units: the chain's velocities are in map units, so are the predictions.
   const double scale = 2.0;
   for (int k = 0; k <= 3; ++k) {

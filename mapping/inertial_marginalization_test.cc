@@ -17,6 +17,7 @@
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/testing/synthetic_map.h"
 #include "mapping/imu_chain_testing.h"
 #include "mapping/inertial_bundle.h"
@@ -150,7 +151,7 @@ class MarginalizationMapTest : public ::testing::Test {
     const auto samples =
         testing::SampleImu(testing::HelixMotion(), 0, kKeyFramePeriodNs * kNumKeyFrames, 5'000'000,
                            bias_, noise_, nullptr);
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (int k = 0; k < kNumKeyFrames; ++k) {
       KeyFrame* kf = map_.keyframes[k].get();
       kf->imu.state.bias = bias_;
@@ -185,7 +186,7 @@ class MarginalizationMapTest : public ::testing::Test {
 };
 
 TEST_F(MarginalizationMapTest, ValidPriorFreesTheAnchorStalePriorIsIgnored) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   {
     const InertialBundleProblem p = CollectLocalInertialBundle(newest(), options_);
     ASSERT_FALSE(p.empty());
@@ -231,7 +232,7 @@ TEST_F(MarginalizationMapTest, ValidPriorFreesTheAnchorStalePriorIsIgnored) {
 }
 
 TEST_F(MarginalizationMapTest, CulledKeyFrameDropsItsPrior) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   GiveAnchorPrior(1e4);
   KeyFrame* k = anchor();
   k->SetBad();
@@ -242,7 +243,7 @@ TEST_F(MarginalizationMapTest, CulledKeyFrameDropsItsPrior) {
 TEST_F(MarginalizationMapTest, SolveMarginalisesTheAnchorOntoTheNextKeyFrame) {
   InertialBundleProblem p;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     p = CollectLocalInertialBundle(newest(), options_);
   }
   const InertialBundleResult r = SolveInertialBundle(p, options_);
@@ -253,7 +254,7 @@ TEST_F(MarginalizationMapTest, SolveMarginalisesTheAnchorOntoTheNextKeyFrame) {
   EXPECT_GT((r.next_prior->information.topLeftCorner<6, 6>().trace()), 1.0);
   KeyFrame* next = kf(kNumKeyFrames - options_.window);
   {
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     ApplyInertialBundle(map(), p, r);
     ASSERT_TRUE(next->imu.prior.has_value());
     EXPECT_TRUE(PriorIsValid(*next->imu.prior, *map()));

@@ -11,6 +11,7 @@
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "mapping/global_bundle.h"
 #include "mapping/gravity_refinement.h"
@@ -66,7 +67,7 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
   std::int64_t init_t_ns = 0;
   const InertialMappingOptions& o = options_.inertial;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return;
     const Map* map = kf->map();
     initialized = map->imu_status().imu_initialized;
@@ -111,7 +112,7 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
   const double since =
       o.viba_motion_time ? moving_s_ : static_cast<double>(kf->t_ns() - init_t_ns) * 1e-9;
   auto mark = [&](bool second) {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
     if (kf->map() == nullptr) return;
     MapImuStatus& status = kf->map()->mutable_imu_status();
     (second ? status.inertial_ba2_done : status.inertial_ba1_done) = true;
@@ -142,7 +143,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
   // keyframe tries again.
   if (HasQueued()) return;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return;
     const Map* map = kf->map();
     const std::vector<KeyFrame*> chain = InertialChain(kf.get(), 0);
@@ -176,7 +177,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
   }
   Eigen::Vector3d accel_bias;
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
     Map* map = kf->map();
     if (map == nullptr || kf->IsBad() || map->change_index() != change_index) {
       // A loop correction or merge moved the map meanwhile: the result is stale; the next
@@ -232,7 +233,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
   KeyFramePtr newest;  // the chain's newest keyframe (kf, or one tracking created after it)
   ImuBias initial_bias;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return false;
     chain = InertialChainThrough(kf.get());
     newest = kf->map()->Share(chain.back());
@@ -269,7 +270,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
     return false;
   }
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
     Map* map = kf->map();
     if (map == nullptr || kf->IsBad()) return false;
     const SO3d new_from_old = r.world_from_gravity.Inverse();
@@ -311,7 +312,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
   snapshot.stage = stage;
   snapshot.scale = r.scale;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     snapshot.bias = kf->imu.state.bias;
     for (KeyFrame* k : InertialChain(newest.get(), 0)) {
       snapshot.world_from_body.emplace_back(k->t_ns(), k->world_from_body());
@@ -330,7 +331,7 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
   ba.iterations_second = options_.inertial.full_ba_iterations;
   ba.num_threads = options_.ba.num_threads;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return;
     problem = CollectFullInertialBundle(kf.get(), ba);
   }
@@ -339,7 +340,7 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
   problem.gyro_prior_information = gyro_prior;
   problem.accel_prior_information = accel_prior;
   const InertialBundleResult result = SolveInertialBundle(problem, ba);
-  std::unique_lock lock(atlas_->mutex());
+  auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
   Map* map = atlas_->FindMap(problem.visual.map_id);
   if (kf->map() == nullptr || map == nullptr) return;
   ApplyInertialBundle(map, problem, result);
@@ -359,7 +360,7 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
   InertialBundleOptions ba = options_.inertial.local_ba;
   ba.num_threads = options_.ba.num_threads;
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kApplyInertialBundle);
     if (kf->IsBad() || kf->map() == nullptr || !kf->map()->imu_status().imu_initialized)
       return false;
     // Keyframes created from frames tracked before the initialisation reached tracking have
@@ -375,13 +376,13 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
     }
   }
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return false;
     problem = CollectLocalInertialBundle(kf.get(), ba);
   }
   if (problem.empty() || problem.edges.empty()) return false;
   const InertialBundleResult result = SolveInertialBundle(problem, ba, &abort_ba_);
-  std::unique_lock lock(atlas_->mutex());
+  auto lock = MapEditor(atlas_).Write(MapEdit::kApplyInertialBundle);
   Map* map = atlas_->FindMap(problem.visual.map_id);
   if (kf->map() == nullptr || map == nullptr) return true;
   ApplyInertialBundle(map, problem, result);

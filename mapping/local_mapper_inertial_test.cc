@@ -13,6 +13,7 @@
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/testing/synthetic_map.h"
 #include "mapping/imu_chain_testing.h"
 #include "mapping/local_mapper.h"
@@ -62,7 +63,7 @@ InitialisedStates RunInitialisationWithQueuedKeyFrames(int num_keyframes,
   const std::vector<ImuMeasurement> samples = SampleImu(
       motion, 0, (num_keyframes - 1) * kKeyFramePeriodNs, kImuPeriodNs, bias, *rig->imu, nullptr);
   {
-    std::unique_lock lock(atlas.mutex());
+    auto lock = MapEditor(&atlas).Write(MapEdit::kFixture);
     testing::LinkWithImu(map.keyframes, samples, ImuBias(), *rig->imu);
   }
 
@@ -73,7 +74,7 @@ InitialisedStates RunInitialisationWithQueuedKeyFrames(int num_keyframes,
   LocalMapper mapper(&atlas, rig, options);
   InitialisedStates out;
   mapper.SetKeyFrameConsumer([&](const KeyFramePtr& kf) {
-    std::shared_lock lock(atlas.mutex());
+    auto lock = MapReader(atlas).Lock();
     if (out.initialized || !kf->map()->imu_status().imu_initialized) return;
     out.initialized = true;
     out.trigger = kf->id();

@@ -10,6 +10,7 @@
 #include "core/util/log.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
 #include "mapping/inertial_culling.h"
@@ -47,7 +48,7 @@ void LocalMapper::ProcessNext() {
   if (!HasQueued() && !IsStoppedOrStopRequested()) {
     int keyframes = 0;
     {
-      std::shared_lock lock(atlas_->mutex());
+      auto lock = MapReader(*atlas_).Lock();
       keyframes = kf->map() != nullptr ? kf->map()->NumKeyFrames() : 0;
     }
     if (keyframes > 2) {
@@ -73,7 +74,7 @@ void LocalMapper::ProcessNext() {
 }
 
 void LocalMapper::ProcessNewKeyFrame(const KeyFramePtr& kf) {
-  std::unique_lock lock(atlas_->mutex());
+  auto lock = MapEditor(atlas_).Write(MapEdit::kProcessKeyFrame);
   if (kf->IsBad() || kf->map() == nullptr) return;
   const auto& points = kf->map_points();
   for (int i = 0; i < static_cast<int>(points.size()); ++i) {
@@ -95,7 +96,7 @@ void LocalMapper::ProcessNewKeyFrame(const KeyFramePtr& kf) {
 }
 
 void LocalMapper::CullRecentPoints(const KeyFramePtr& kf) {
-  std::unique_lock lock(atlas_->mutex());
+  auto lock = MapEditor(atlas_).Write(MapEdit::kCullPoints);
   const int min_observations = IsMonocular(rig_->sensor) ? 2 : 3;
   int culled = 0;
   std::erase_if(recent_points_, [&](const MapPointPtr& mp) {
@@ -125,7 +126,7 @@ void LocalMapper::CreateNewMapPoints(const KeyFramePtr& kf) {
   std::vector<TriangulatedPoint> created;
   std::vector<KeyFrame*> neighbours;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return;
     neighbours = kf->BestCovisibles(n_neighbours);
     const OrbMatcher matcher(0.6, false);
@@ -145,7 +146,7 @@ void LocalMapper::CreateNewMapPoints(const KeyFramePtr& kf) {
     }
   }
   if (created.empty()) return;
-  std::unique_lock lock(atlas_->mutex());
+  auto lock = MapEditor(atlas_).Write(MapEdit::kCreatePoints);
   Map* map = kf->map();
   if (kf->IsBad() || map == nullptr) return;
   int added = 0;
@@ -170,7 +171,7 @@ void LocalMapper::CreateNewMapPoints(const KeyFramePtr& kf) {
 }
 
 void LocalMapper::SearchInNeighbours(const KeyFramePtr& kf) {
-  std::unique_lock lock(atlas_->mutex());
+  auto lock = MapEditor(atlas_).Write(MapEdit::kFuse);
   if (kf->IsBad() || kf->map() == nullptr) return;
   const int n = IsMonocular(rig_->sensor) ? 30 : 10;
   std::vector<KeyFrame*> targets;
@@ -211,13 +212,13 @@ void LocalMapper::SearchInNeighbours(const KeyFramePtr& kf) {
 void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return;
     problem = CollectLocalBundle(kf.get(), options_.ba);
   }
   if (problem.empty()) return;
   const BundleResult result = SolveBundle(problem, options_.ba, &abort_ba_);
-  std::unique_lock lock(atlas_->mutex());
+  auto lock = MapEditor(atlas_).Write(MapEdit::kApplyBundle);
   // A map merged away while the solver ran takes its keyframes with it: nothing to write.
   if (Map* map = atlas_->FindMap(problem.map_id)) ApplyBundle(map, problem, result);
   if (result.aborted) {
@@ -228,7 +229,7 @@ void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
 }
 
 void LocalMapper::CullKeyFrames(const KeyFramePtr& kf) {
-  std::unique_lock lock(atlas_->mutex());
+  auto lock = MapEditor(atlas_).Write(MapEdit::kCullKeyFrames);
   if (kf->IsBad() || kf->map() == nullptr) return;
   const bool mono = IsMonocular(rig_->sensor);
   const int observers = options_.culling_observers;

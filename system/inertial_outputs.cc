@@ -11,6 +11,7 @@
 #include "io/trajectory.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 
 namespace pkslam {
 
@@ -39,7 +40,7 @@ void WriteInertialOutputs(const SlamSystem& system, const std::filesystem::path&
   std::ostream& out = output.stream();
   out << "time,vx,vy,vz,bgx,bgy,bgz,bax,bay,baz,valid,map_imu_initialized\n";
   const Atlas& atlas = system.atlas();
-  std::shared_lock lock(atlas.mutex());
+  auto lock = MapReader(atlas).Lock();
   const Map* best = nullptr;
   for (const Map* m : atlas.maps()) {
     if (best == nullptr || m->NumKeyFrames() > best->NumKeyFrames()) best = m;

@@ -14,6 +14,7 @@
 #include "core/util/output_file.h"
 #include "core/util/quantile.h"
 #include "io/rigid_transform_file.h"
+#include "map_model/map_editor.h"
 #include "system/inertial_outputs.h"
 #include "system/sparse_model_builder.h"
 
@@ -290,6 +291,20 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   json.Member("median_local_mapping_cpu_ms", Median(mapping.keyframe_cpu_ms));
   json.Member("median_local_ba_cpu_ms", Median(mapping.ba_cpu_ms));
   json.Member("peak_memory_mib", PeakMemoryMiB());
+  // Exclusive holds of the map lock per kind of change (map_model/map_editor.h): how often and
+  // how long (wall) each kind kept the other threads out of the map.
+  json.Key("map_edits").BeginObject();
+  const MapEditTable edits = system.atlas().EditStats();
+  for (int k = 0; k < kNumMapEdits; ++k) {
+    const MapEditStats& e = edits[static_cast<std::size_t>(k)];
+    if (e.holds == 0) continue;
+    json.Key(std::string(MapEditName(static_cast<MapEdit>(k)))).BeginObject();
+    json.Member("holds", e.holds);
+    json.Member("total_ms", 1e3 * e.total_s);
+    json.Member("max_ms", 1e3 * e.max_s);
+    json.EndObject();
+  }
+  json.EndObject();
   WriteLoopClosing(system, options, &json);
   WriteArray(&json, "tracking_ms", tracking_ms);
   WriteArray(&json, "local_mapping_ms", mapping.keyframe_ms);

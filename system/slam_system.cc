@@ -11,6 +11,7 @@
 #include "keyframe/selector_factory.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 
 namespace pkslam {
@@ -126,7 +127,7 @@ SE3d CameraFromWorld(const KeyFrame* kf) {
 }  // namespace
 
 Trajectory SlamSystem::FrameTrajectory() const {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   Trajectory out;
   const Map* map = LargestMap();
   for (const FrameRecord& r : tracker_->records()) {
@@ -138,7 +139,7 @@ Trajectory SlamSystem::FrameTrajectory() const {
 }
 
 Trajectory SlamSystem::KeyFrameTrajectory() const {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   Trajectory out;
   const Map* map = LargestMap();
   if (map == nullptr) return out;
@@ -151,7 +152,7 @@ Trajectory SlamSystem::KeyFrameTrajectory() const {
 }
 
 void SlamSystem::WriteMapPly(const std::filesystem::path& file) const {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const Map* map = LargestMap();
   OutputFile output(file);
   std::ostream& out = output.stream();
@@ -175,19 +176,19 @@ void SlamSystem::WriteMapPly(const std::filesystem::path& file) const {
 }
 
 int SlamSystem::NumKeyFrames() const {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const Map* map = LargestMap();
   return map != nullptr ? map->NumKeyFrames() : 0;
 }
 
 int SlamSystem::NumMapPoints() const {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const Map* map = LargestMap();
   return map != nullptr ? map->NumMapPoints() : 0;
 }
 
 int SlamSystem::NumMaps() const {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   return atlas_.NumMaps();
 }
 

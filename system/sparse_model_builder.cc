@@ -6,6 +6,7 @@
 
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 
 namespace pkslam {
@@ -16,7 +17,7 @@ SparseModel BuildSparseModel(const SlamSystem& system) {
   model.camera = {rig.camera.width(), rig.camera.height(), rig.camera.fx(), rig.camera.fy(),
                   rig.camera.cx(),    rig.camera.cy(),     rig.bf};
 
-  std::shared_lock lock(system.atlas().mutex());
+  auto lock = MapReader(system.atlas()).Lock();
   const Map* map = system.LargestMap();
   if (map == nullptr) return model;
   // A keypoint refers to a point only when the link is mutual (the point lists that

@@ -86,12 +86,8 @@ InertialPoseOutput OptimizeInertialPose(Frame* frame, const InertialPoseInput& i
 
   ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/false);
   BodyPoseManifold pose_manifold;
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.enable_fast_removal = true;
-  ceres::Problem problem(problem_options);
+  ceres::Problem problem(
+      ProblemOptions({.cost_functions = true, .loss_functions = true, .fast_removal = true}));
 
   StateBlocks cur;
   StateBlocks prev;

@@ -53,12 +53,8 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
   // Declared before the wrappers and the problem that point at them (destroyed after them).
   ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/false);
   SE3LeftManifold manifold;
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.enable_fast_removal = true;
-  ceres::Problem problem(problem_options);
+  ceres::Problem problem(
+      ProblemOptions({.cost_functions = true, .loss_functions = true, .fast_removal = true}));
 
   double pose[kPoseBlockSize];
   PoseToBlock(frame->camera_from_world(), pose);

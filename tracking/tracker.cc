@@ -9,6 +9,7 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
 #include "tracking/pose_optimizer.h"
@@ -140,7 +141,7 @@ TrackResult Tracker::Track(Frame frame) {
     const bool idle_at_frame = emulated && mapping_->AcceptsKeyFramesAt(current_.t_ns());
     frame_wait_ms = MsSince(wait_start);
     {
-      std::shared_lock lock(atlas_->mutex());
+      auto lock = MapReader(*atlas_).Lock();
       if (imu_) SyncWithInertialMapLocked(/*correct_current=*/false);  // the world tracked in
       // Local mapping may have fused points of the last frame into others meanwhile.
       for (auto& mp : last_.map_points) {
@@ -256,7 +257,7 @@ void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
   const bool posed =
       state_ == TrackingState::kOk || (imu_ != nullptr && state_ == TrackingState::kRecentlyLost);
   if (posed && current_.HasPose() && ref) {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (imu_) SyncWithInertialMapLocked(/*correct_current=*/true);
     r.camera_from_world_online = current_.camera_from_world();
     if (keyframe && ref->t_ns() == current_.t_ns() && !ref->IsBad()) {
@@ -291,7 +292,7 @@ void Tracker::StereoInitialization() {
   KeyFramePtr kf;
   int points = 0;
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kInitialise);
     Map* map = atlas_->current_map();
     current_.SetPose(SE3d());
     current_.ComputeBoW(*vocabulary_);
@@ -332,7 +333,7 @@ void Tracker::StereoInitialization() {
 void Tracker::HandleLost() {
   int keyframes = 0;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     keyframes = atlas_->current_map()->NumKeyFrames();
   }
   if (keyframes <= options_.min_keyframes_to_keep_map) {
@@ -344,7 +345,7 @@ void Tracker::HandleLost() {
   PKSLAM_LOG_WARN("tracking lost at t = {:.3f} s: starting a new map", current_.t_s());
   mapping_->ResetQueue();
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kReset);
     atlas_->CreateNewMap();
   }
   StartOver();
@@ -353,7 +354,7 @@ void Tracker::HandleLost() {
 void Tracker::Reset() {
   mapping_->ResetQueue();
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kReset);
     // Records of the dropped map lose their reference (those frames end up without pose).
     Map* map = atlas_->current_map();
     for (auto& r : records_) {

@@ -12,6 +12,7 @@
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
 #include "tracking/tracker.h"
@@ -71,7 +72,7 @@ void Tracker::PreintegrateImu() {
   // The bias tracking integrates with: the last frame's estimate, else the last keyframe's.
   ImuBias bias;
   {
-    std::shared_lock lock(atlas_->mutex());
+    auto lock = MapReader(*atlas_).Lock();
     if (last_.imu.state.valid) {
       bias = last_.imu.state.bias;
     } else if (last_kf_) {
@@ -93,7 +94,7 @@ void Tracker::PreintegrateImu() {
 }
 
 void Tracker::SyncWithInertialMap() {
-  std::shared_lock lock(atlas_->mutex());
+  auto lock = MapReader(*atlas_).Lock();
   SyncWithInertialMapLocked(false);
 }
 

@@ -7,6 +7,7 @@
 #include "core/util/log.h"
 #include "map_model/estimation/bundle_collect.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
 #include "tracking/tracker.h"
@@ -86,7 +87,7 @@ SelectorInput Tracker::BuildSelectorInput(bool mapping_idle) const {
 void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
   KeyFramePtr kf;
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kInsertKeyFrame);
     Map* map = atlas_->current_map();
     current_.ComputeBoW(*vocabulary_);
     kf = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
@@ -127,7 +128,7 @@ void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
     // The frame as the keyframe holds it: the new close points in, outliers still in.
     SelectorInput created;
     {
-      std::shared_lock lock(atlas_->mutex());
+      auto lock = MapReader(*atlas_).Lock();
       created = BuildSelectorInput(input.local_mapping_idle);
     }
     selector_->OnKeyFrameInserted(created);
@@ -173,7 +174,7 @@ void Tracker::CreateInitialMapMonocular(const TwoViewResult& reconstruction) {
   KeyFramePtr kf_init;
   KeyFramePtr kf_current;
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kInitialise);
     Map* map = atlas_->current_map();
     init_frame_->SetPose(SE3d());
     current_.SetPose(reconstruction.camera2_from_camera1);
@@ -207,18 +208,18 @@ void Tracker::CreateInitialMapMonocular(const TwoViewResult& reconstruction) {
   {
     BundleProblem problem;
     {
-      std::shared_lock lock(atlas_->mutex());
+      auto lock = MapReader(*atlas_).Lock();
       problem = CollectGlobalBundle(*atlas_->current_map());
     }
     BundleAdjustmentOptions ba;
     ba.iterations_first = 20;
     ba.iterations_second = 0;
     const BundleResult result = SolveBundle(problem, ba);
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kInitialise);
     ApplyBundle(atlas_->current_map(), problem, result);
   }
   {
-    std::unique_lock lock(atlas_->mutex());
+    auto lock = MapEditor(atlas_).Write(MapEdit::kInitialise);
     const double median_depth = kf_init->SceneDepthQuantile(0.5);
     if (median_depth <= 0 || kf_current->TrackedMapPoints(1) < 50) {
       lock.unlock();

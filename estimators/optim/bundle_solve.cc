@@ -101,11 +101,7 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
   const PinholeIntrinsics k{problem.fx, problem.fy, problem.cx, problem.cy, problem.bf};
   ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/true);
   SE3LeftManifold manifold;
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.enable_fast_removal = true;
-  ceres::Problem ceres_problem(problem_options);
+  ceres::Problem ceres_problem(ProblemOptions({.loss_functions = true, .fast_removal = true}));
 
   // Observations whose point is behind the camera cannot be evaluated: outliers from the
   // start. Parameter blocks enter the problem with their first residual, so every block in

@@ -14,6 +14,15 @@ ceres::LinearSolverType SchurSolverFor(int free_poses) {
   return free_poses <= kMaxFreePosesForDenseSchur ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
 }
 
+ceres::Problem::Options ProblemOptions(const ProblemBorrows& borrows) {
+  ceres::Problem::Options options;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  if (borrows.cost_functions) options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  if (borrows.loss_functions) options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.enable_fast_removal = borrows.fast_removal;
+  return options;
+}
+
 ceres::Solver::Options SolverOptions(ceres::LinearSolverType linear_solver, int max_iterations,
                                      int num_threads) {
   ceres::Solver::Options o;

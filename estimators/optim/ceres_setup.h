@@ -42,6 +42,16 @@ ceres::LinearSolverType SchurSolverFor(int free_poses);
 ceres::Solver::Options SolverOptions(ceres::LinearSolverType linear_solver, int max_iterations,
                                      int num_threads);
 
+// What a ceres::Problem borrows from its caller instead of owning (Ceres deletes what it owns).
+// Manifolds are always borrowed: every optimiser keeps them on its stack, shared by its blocks.
+struct ProblemBorrows {
+  bool cost_functions = false;  // the caller re-adds or reuses them (rounds, several problems)
+  bool loss_functions = false;  // ReprojectionLosses' wrappers and other stack losses
+  // Ceres' removal index: needed when residual blocks are removed between rounds or passes.
+  bool fast_removal = false;
+};
+ceres::Problem::Options ProblemOptions(const ProblemBorrows& borrows);
+
 // Huber kernels at the mono and stereo chi-square thresholds (pixels: sqrt(chi2)), behind
 // wrappers the residual blocks keep, so the kernels can be switched off between passes (the
 // outlier-free refinement) without rebuilding the problem. Not movable: blocks hold the

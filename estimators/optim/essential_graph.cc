@@ -109,13 +109,11 @@ EssentialGraphResult SolveEssentialGraph(const EssentialGraphProblem& problem,
     return result;
   }
 
-  ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   // Shared by all rotation blocks.
   ceres::EigenQuaternionManifold quaternion_manifold;
   YawQuaternionManifold yaw_manifold;
   const bool yaw_only = problem.dof == PoseGraphDof::kYawTranslation;
-  ceres::Problem ceres_problem(problem_options);
+  ceres::Problem ceres_problem(ProblemOptions({}));
   for (std::size_t v = 0; v < n; ++v) {
     double* p = &params[v * kVertexSize];
     ceres_problem.AddParameterBlock(

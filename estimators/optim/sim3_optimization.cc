@@ -98,13 +98,10 @@ Sim3OptimizationResult OptimizeSim3(const std::vector<Sim3Match>& matches,
   if (matches.empty()) return result;
 
   State state{initial.so3().quaternion(), initial.translation(), std::log(initial.scale())};
-  ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   // Declared before the problem so they outlive it.
   ceres::EigenQuaternionManifold quaternion_manifold;
   ceres::HuberLoss huber(std::sqrt(options.chi2));
-  ceres::Problem problem(problem_options);
+  ceres::Problem problem(ProblemOptions({.loss_functions = true}));
   problem.AddParameterBlock(state.q.coeffs().data(), 4, &quaternion_manifold);
   problem.AddParameterBlock(state.t.data(), 3);
   problem.AddParameterBlock(&state.log_s, 1);

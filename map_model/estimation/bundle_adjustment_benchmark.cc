@@ -16,6 +16,7 @@
 #include "estimators/optim/bundle_adjustment_internal.h"
 #include "map_model/estimation/bundle_collect.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/testing/synthetic_map.h"
 
 namespace pkslam {
@@ -62,7 +63,7 @@ BundleProblem Perturbed(BundleProblem problem) {
 }
 
 BundleProblem Collect(LocalMap& m) {
-  std::shared_lock lock(m.atlas.mutex());
+  auto lock = MapReader(m.atlas).Lock();
   return CollectLocalBundle(m.map.keyframes.back().get(), {});
 }
 
@@ -106,7 +107,7 @@ void BM_SolveGlobalBundle(benchmark::State& state) {
   const auto m = BuildMap(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), true);
   BundleProblem problem;
   {
-    std::shared_lock lock(m->atlas.mutex());
+    auto lock = MapReader(m->atlas).Lock();
     problem = Perturbed(CollectGlobalBundle(*m->atlas.current_map()));
   }
   internal::BundleSolverOverrides overrides;
@@ -145,7 +146,7 @@ void BM_ApplyBundle(benchmark::State& state) {
   const BundleProblem problem = Collect(*m);
   const BundleResult result = SolveBundle(Perturbed(problem), {});
   for (auto _ : state) {
-    std::unique_lock lock(m->atlas.mutex());
+    auto lock = MapEditor(&m->atlas).Write(MapEdit::kFixture);
     ApplyBundle(m->atlas.current_map(), problem, result);
   }
   SetCounters(state, problem, result.iterations);

@@ -16,6 +16,7 @@
 #include "estimators/optim/reprojection_error.h"
 #include "map_model/estimation/bundle_collect.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/testing/synthetic_map.h"
 
@@ -120,7 +121,7 @@ TEST_F(BundleAdjustmentTest, LocalBundleHasOrbSlamStructure) {
   Build(true);
   BundleAdjustmentOptions options;
   options.max_local_keyframes = 4;
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   KeyFrame* kf = LastKeyFrame();
   const BundleProblem problem = CollectLocalBundle(kf, options);
   ASSERT_FALSE(problem.empty());
@@ -176,7 +177,7 @@ TEST_F(BundleAdjustmentTest, LocalBundleHasOrbSlamStructure) {
 
 TEST_F(BundleAdjustmentTest, OriginIsFixedEvenWhenLocal) {
   Build(true);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const BundleProblem problem = CollectLocalBundle(map_.keyframes[0].get(), {});
   ASSERT_FALSE(problem.empty());
   EXPECT_EQ(KeyFrameOf(problem.keyframes[0]), map_.keyframes[0].get());
@@ -190,7 +191,7 @@ TEST_F(BundleAdjustmentTest, StereoLocalBundleReturnsToTruth) {
   Build(true);
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectLocalBundle(LastKeyFrame(), {});
   }
   Perturb(&problem, 5);
@@ -219,7 +220,7 @@ TEST_F(BundleAdjustmentTest, MonocularLocalBundleReturnsToTruth) {
   options.iterations_second = 30;
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectLocalBundle(LastKeyFrame(), options);
   }
   int fixed = 0;
@@ -239,7 +240,7 @@ TEST_F(BundleAdjustmentTest, GlobalBundleFixesOnlyTheOrigin) {
   Build(true);
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectGlobalBundle(*atlas_.current_map());
     EXPECT_EQ(problem.keyframes.size(), map_.keyframes.size());
     EXPECT_EQ(static_cast<int>(problem.points.size()), atlas_.current_map()->NumMapPoints());
@@ -258,7 +259,7 @@ TEST_F(BundleAdjustmentTest, OutlierObservationsAreDetectedAndErased) {
   Build(true, 0.5, 0.05);
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectLocalBundle(LastKeyFrame(), {});
   }
   // Ground truth: observations far (> 10 px) from the true projection were moved. Points
@@ -290,7 +291,7 @@ TEST_F(BundleAdjustmentTest, OutlierObservationsAreDetectedAndErased) {
   const Errors e = ErrorsOf(problem, r);
   EXPECT_LT(e.max_translation, 5e-3);  // 0.5 px noise, gauge held by the origin only
 
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   ApplyBundle(atlas_.current_map(), problem, r);
   for (int i : flagged) {
     const auto& o = problem.observations[i];
@@ -315,12 +316,12 @@ TEST_F(BundleAdjustmentTest, ApplyWritesFreeEntitiesAndSkipsBadOnes) {
   Build(true);
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectLocalBundle(LastKeyFrame(), {});
   }
   Perturb(&problem, 9);
   const BundleResult r = SolveBundle(problem, {});
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   // Between Solve and Apply, local mapping culled a point and a keyframe.
   const MapPointPtr culled = PointOf(problem.points[3]);
   const Eigen::Vector3d culled_position = culled->position();
@@ -357,7 +358,7 @@ TEST_F(BundleAdjustmentTest, AbortBeforeStartReturnsTheInput) {
   Build(true);
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectLocalBundle(LastKeyFrame(), {});
   }
   Perturb(&problem, 10);
@@ -388,7 +389,7 @@ TEST_F(BundleAdjustmentTest, AbortMidwayKeepsTheProgress) {
   Build(true);
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectLocalBundle(LastKeyFrame(), {});
   }
   Perturb(&problem, 11);
@@ -408,7 +409,7 @@ TEST_F(BundleAdjustmentTest, SingleThreadedIsBitIdentical) {
   Build(true, 1.0, 0.03);
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectLocalBundle(LastKeyFrame(), {});
   }
   Perturb(&problem, 12);
@@ -443,7 +444,7 @@ TEST_F(BundleAdjustmentTest, DenseAndSparseSchurAgree) {
   Build(true, 1.0);
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectLocalBundle(LastKeyFrame(), {});
   }
   Perturb(&problem, 13);
@@ -462,7 +463,7 @@ TEST_F(BundleAdjustmentTest, PointBehindACameraIsAnOutlierFromTheStart) {
   Build(true);
   BundleProblem problem;
   {
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     problem = CollectLocalBundle(LastKeyFrame(), {});
   }
   // Mirror point 0 through the first observing camera's centre.

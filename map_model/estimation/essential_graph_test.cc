@@ -5,6 +5,7 @@
 
 #include "core/util/error.h"
 #include "map_model/estimation/essential_graph_collect.h"
+#include "map_model/map_editor.h"
 #include "map_model/testing/loop_scenario.h"
 
 namespace pkslam {
@@ -32,12 +33,12 @@ Outcome CloseLoop(LoopScenario* s, const testing::SyntheticScene& scene, PoseGra
   out.kf_rmse_before = KeyFramePositionRmse(*s);
   out.point_rmse_before = PointRmse(*s, scene);
   {
-    std::shared_lock lock(s->atlas.mutex());
+    auto lock = MapReader(s->atlas).Lock();
     out.problem = CollectEssentialGraph(s->map, s->correction, options);
   }
   out.result = SolveEssentialGraph(out.problem, options);
   {
-    std::unique_lock lock(s->atlas.mutex());
+    auto lock = MapEditor(&s->atlas).Write(MapEdit::kFixture);
     ApplyEssentialGraph(s->map, out.problem, out.result);
   }
   out.kf_rmse_after = KeyFramePositionRmse(*s);
@@ -98,7 +99,7 @@ TEST(EssentialGraphTest, KeyFramesAndPointsAddedAfterCollectFollowTheirAncestor)
   eg.dof = PoseGraphDof::kSE3;
   EssentialGraphProblem problem;
   {
-    std::shared_lock lock(s.atlas.mutex());
+    auto lock = MapReader(s.atlas).Lock();
     problem = CollectEssentialGraph(s.map, s.correction, eg);
   }
   // While the solver runs, tracking inserts a keyframe hanging from keyframe 20 and a point.
@@ -107,7 +108,7 @@ TEST(EssentialGraphTest, KeyFramesAndPointsAddedAfterCollectFollowTheirAncestor)
   MapPointPtr late_point;
   const SE3d late_from_anchor(SO3d::Exp(Eigen::Vector3d(0, 0.05, 0)), Eigen::Vector3d(0.1, 0, 0));
   {
-    std::unique_lock lock(s.atlas.mutex());
+    auto lock = MapEditor(&s.atlas).Write(MapEdit::kFixture);
     std::vector<int> unused;
     Frame f = testing::MakeFrame(scene, testing::MakeStereoRig(), anchor->camera_from_world(),
                                  s.atlas.NextFrameId(), 0, {}, &unused);
@@ -121,7 +122,7 @@ TEST(EssentialGraphTest, KeyFramesAndPointsAddedAfterCollectFollowTheirAncestor)
     s.map->AddMapPoint(late_point);
   }
   const auto result = SolveEssentialGraph(problem, eg);
-  std::unique_lock lock(s.atlas.mutex());
+  auto lock = MapEditor(&s.atlas).Write(MapEdit::kFixture);
   ApplyEssentialGraph(s.map, problem, result);
   const SE3d rel = late->camera_from_world() * anchor->world_from_camera();
   EXPECT_LT((rel.translation() - late_from_anchor.translation()).norm(), 1e-9);

@@ -8,6 +8,7 @@
 
 #include "estimators/optim/yaw_manifold.h"
 #include "map_model/estimation/essential_graph_collect.h"
+#include "map_model/map_editor.h"
 #include "map_model/testing/loop_scenario.h"
 
 namespace pkslam {
@@ -105,7 +106,7 @@ void BuildInertialLoop(double loop_tilt, const testing::SyntheticScene& scene, I
   o.drift_scale_per_keyframe = 1.0;
   o.world_from_scenario = SO3d::Exp(Eigen::Vector3d(M_PI / 2, 0, 0));  // y -> z
   BuildLoopScenario(o, scene, &l->s);
-  std::unique_lock lock(l->s.atlas.mutex());
+  auto lock = MapEditor(&l->s.atlas).Write(MapEdit::kFixture);
   auto& kfs = l->s.synthetic.keyframes;
   for (std::size_t k = 0; k < kfs.size(); ++k) {
     KeyFrame* kf = kfs[k].get();
@@ -146,11 +147,11 @@ Solved Close(LoopScenario* s, PoseGraphDof dof) {
   EssentialGraphOptions options;
   options.dof = dof;
   {
-    std::shared_lock lock(s->atlas.mutex());
+    auto lock = MapReader(s->atlas).Lock();
     out.problem = CollectEssentialGraph(s->map, s->correction, options);
   }
   out.result = SolveEssentialGraph(out.problem, options);
-  std::unique_lock lock(s->atlas.mutex());
+  auto lock = MapEditor(&s->atlas).Write(MapEdit::kFixture);
   ApplyEssentialGraph(s->map, out.problem, out.result);
   return out;
 }

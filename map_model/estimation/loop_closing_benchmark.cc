@@ -13,6 +13,7 @@
 #include "map_model/estimation/essential_graph_collect.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/keyframe_database_test_utils.h"
+#include "map_model/map_editor.h"
 #include "map_model/testing/loop_scenario.h"
 
 namespace pkslam {
@@ -30,13 +31,13 @@ void BM_KeyFrameDatabase_Relocalisation(benchmark::State& state) {
   Atlas atlas;
   Map* map = nullptr;
   {
-    std::shared_lock lock(atlas.mutex());
+    auto lock = MapReader(atlas).Lock();
     map = atlas.current_map();
   }
   const auto kfs =
       testing::AddKeyFrames(&atlas, map, scene, rig, testing::Strip(-290, 2.9, 200), vocabulary, 1);
   KeyFrameDatabase db(vocabulary);
-  std::shared_lock lock(atlas.mutex());
+  auto lock = MapReader(atlas).Lock();
   for (const auto& kf : kfs) db.Add(kf.get());
   testing::FrameOptions fo;
   fo.descriptor_bit_flips = 2;
@@ -155,14 +156,14 @@ void TimeEssentialGraph(benchmark::State& state, testing::LoopScenario* s,
   EssentialGraphResult result;
   for (auto _ : state) {
     {
-      std::shared_lock lock(s->atlas.mutex());
+      auto lock = MapReader(s->atlas).Lock();
       problem = CollectEssentialGraph(s->map, s->correction, options);
     }
     result = SolveEssentialGraph(problem, options);
   }
   state.counters["kf_rmse_before"] = testing::KeyFramePositionRmse(*s);
   {
-    std::unique_lock lock(s->atlas.mutex());
+    auto lock = MapEditor(&s->atlas).Write(MapEdit::kFixture);
     ApplyEssentialGraph(s->map, problem, result);
   }
   state.counters["kf_rmse_after"] = testing::KeyFramePositionRmse(*s);
@@ -205,7 +206,7 @@ void BM_EssentialGraphYawTranslation(benchmark::State& state) {
   testing::LoopScenario s;
   testing::BuildLoopScenario(o, scene, &s);
   {
-    std::unique_lock lock(s.atlas.mutex());
+    auto lock = MapEditor(&s.atlas).Write(MapEdit::kFixture);
     for (std::size_t k = 1; k < s.synthetic.keyframes.size(); ++k) {
       s.synthetic.keyframes[k]->imu.previous = s.synthetic.keyframes[k - 1].get();
     }

@@ -6,6 +6,7 @@
 
 #include "core/util/error.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/testing/synthetic_map.h"
 
@@ -24,7 +25,7 @@ TEST(RansacInputsTest, PnpCorrespondencesFromAFrameAndItsMatches) {
   const auto map = testing::MakeMap(&atlas, scene, rig, poses, {});
   std::vector<int> scene_of;
   const Frame f = testing::MakeFrame(scene, rig, poses[1], 99, 0, {}, &scene_of);
-  std::shared_lock lock(atlas.mutex());
+  auto lock = MapReader(atlas).Lock();
   std::vector<MapPointPtr> matches(static_cast<std::size_t>(f.size()));
   int expected = 0;
   for (std::size_t i = 0; i < scene_of.size(); ++i) {
@@ -50,7 +51,7 @@ TEST(RansacInputsTest, Sim3MatchesFromKeyFramesCarryCameraCoordinatesAndKeypoint
   const auto scene = testing::MakeScene(800, 5);
   const auto poses = testing::MakeForwardPath(2, 0.4, 2);
   const auto map = testing::MakeMap(&atlas, scene, rig, poses, {});
-  std::shared_lock lock(atlas.mutex());
+  auto lock = MapReader(atlas).Lock();
   const KeyFrame& kf1 = *map.keyframes[0];
   const KeyFrame& kf2 = *map.keyframes[1];
   // The synthetic map shares points between keyframes: pair each kf1 point with itself.

@@ -14,6 +14,7 @@
 #include "core/bow/vocabulary.h"
 #include "core/geometry/sim3.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
 #include "map_model/testing/synthetic_map.h"
@@ -115,7 +116,7 @@ inline SyntheticMap MakeBowMap(Atlas* atlas, const SyntheticScene& scene,
                                const std::vector<SE3d>& camera_from_world,
                                const FrameOptions& options, const Vocabulary& vocabulary,
                                bool with_points) {
-  std::unique_lock lock(atlas->mutex());
+  auto lock = MapEditor(atlas).Write(MapEdit::kFixture);
   Map* map = atlas->current_map();
   SyntheticMap out;
   out.point_of_scene_index.assign(scene.points_world.size(), nullptr);

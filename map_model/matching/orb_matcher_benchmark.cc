@@ -9,6 +9,7 @@
 #include <shared_mutex>
 
 #include "core/util/log.h"
+#include "map_model/map_editor.h"
 #include "map_model/matching/matching_test_utils.h"
 #include "map_model/matching/orb_matcher.h"
 
@@ -74,7 +75,7 @@ struct Fixture {
 
 void BM_SearchByProjectionLocalMap(benchmark::State& state) {
   Fixture fx;  // rebuilt per run (no statics); not timed
-  std::shared_lock lock(fx.atlas.mutex());
+  auto lock = MapReader(fx.atlas).Lock();
   Frame frame = fx.frame;
   const OrbMatcher matcher(0.8);
   int matches = 0;
@@ -110,7 +111,7 @@ BENCHMARK(BM_FeaturesInAreaLocalMap)->Unit(benchmark::kMicrosecond);
 
 void BM_SearchByProjectionMotionModel(benchmark::State& state) {
   Fixture fx;  // rebuilt per run (no statics); not timed
-  std::shared_lock lock(fx.atlas.mutex());
+  auto lock = MapReader(fx.atlas).Lock();
   Frame frame = fx.frame;
   const OrbMatcher matcher(0.9);
   int matches = 0;
@@ -146,7 +147,7 @@ struct BowFixture {
     o.descriptor_bit_flips = 8;
     std::vector<int> pok1;
     std::vector<int> pok2;
-    std::unique_lock lock(fx.atlas.mutex());
+    auto lock = MapEditor(&fx.atlas).Write(MapEdit::kFixture);
     Frame f1 =
         Truncate(MakePosedFrame(fx.scene, fx.rig, fx.poses[1], 200, o, &pok1), kKeypoints, &pok1);
     Frame f2 =
@@ -168,7 +169,7 @@ struct BowFixture {
 void BM_SearchByBoWKeyFrameFrame(benchmark::State& state) {
   Fixture fx;
   BowFixture bx(fx);
-  std::shared_lock lock(fx.atlas.mutex());
+  auto lock = MapReader(fx.atlas).Lock();
   const OrbMatcher matcher(0.75);
   std::vector<MapPointPtr> matches;
   int n = 0;
@@ -184,7 +185,7 @@ BENCHMARK(BM_SearchByBoWKeyFrameFrame)->Unit(benchmark::kMicrosecond);
 void BM_SearchForTriangulation(benchmark::State& state) {
   Fixture fx;
   BowFixture bx(fx);
-  std::shared_lock lock(fx.atlas.mutex());
+  auto lock = MapReader(fx.atlas).Lock();
   const OrbMatcher matcher(0.6);
   std::size_t n = 0;
   for (auto _ : state) {

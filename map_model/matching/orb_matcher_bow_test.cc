@@ -8,6 +8,7 @@
 #include <set>
 #include <shared_mutex>
 
+#include "map_model/map_editor.h"
 #include "map_model/matching/matching_test_utils.h"
 #include "map_model/matching/orb_matcher.h"
 
@@ -49,7 +50,7 @@ class MatcherBowTest : public ::testing::Test {
     o.descriptor_bit_flips = 6;
     map_ =
         MakeBowMap(&atlas_, scene_, rig_, {poses_[0], poses_[1], poses_[2]}, o, vocabulary_, true);
-    lock_ = std::shared_lock(atlas_.mutex());
+    lock_ = MapReader(atlas_).Lock();
   }
   Frame BowFrame(
       int k, std::vector<int>* pok,
@@ -153,7 +154,7 @@ TEST_F(MatcherBowTest, KeyFrameToKeyFrameAcrossTwoMaps) {
   // A second map of the same place (other noise): loop detection pairs its points with ours.
   lock_.unlock();
   {
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     atlas_.CreateNewMap();
   }
   FrameOptions o;

@@ -7,6 +7,7 @@
 #include <set>
 #include <shared_mutex>
 
+#include "map_model/map_editor.h"
 #include "map_model/matching/matching_test_utils.h"
 #include "map_model/matching/orb_matcher.h"
 
@@ -39,14 +40,14 @@ class MatcherFuseTest : public ::testing::Test {
     map_ = MakeMap(&atlas_, scene_, rig_, poses_, o);
     map_a_ = atlas_.current_map();
     {
-      std::unique_lock lock(atlas_.mutex());
+      auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
       map_b_ptr_ = atlas_.CreateNewMap();
     }
     o.seed = 99;
     map_b_ = MakeMap(&atlas_, TransformScene(scene_, kScaleB, kOffsetB), rig_,
                      TransformPoses(poses_, kScaleB, kOffsetB), o);
     {
-      std::unique_lock lock(atlas_.mutex());
+      auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
       atlas_.SetCurrentMap(map_a_);
     }
     scene_of_b_ = SceneIndexOf(map_b_);
@@ -72,7 +73,7 @@ class MatcherFuseTest : public ::testing::Test {
 };
 
 TEST_F(MatcherFuseTest, FuseMergesDuplicatesKeepingTheBetterObservedPoint) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Map* map = atlas_.current_map();
   KeyFrame* kf0 = map_.keyframes[0].get();
   KeyFrame* kf3 = map_.keyframes[3].get();
@@ -117,7 +118,7 @@ TEST_F(MatcherFuseTest, FuseMergesDuplicatesKeepingTheBetterObservedPoint) {
 }
 
 TEST_F(MatcherFuseTest, FuseAddsMissingObservationsWithinTheReprojectionGate) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   KeyFrame* kf0 = map_.keyframes[0].get();
   std::vector<MapPointPtr> dropped;
   std::vector<int> slots;
@@ -157,7 +158,7 @@ TEST_F(MatcherFuseTest, FuseAddsMissingObservationsWithinTheReprojectionGate) {
 }
 
 TEST_F(MatcherFuseTest, FuseIgnoresPointsWhoseDescriptorDiffers) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Map* map = atlas_.current_map();
   KeyFrame* kf0 = map_.keyframes[0].get();
   KeyFrame* kf3 = map_.keyframes[3].get();
@@ -179,7 +180,7 @@ TEST_F(MatcherFuseTest, FuseIgnoresPointsWhoseDescriptorDiffers) {
 }
 
 TEST_F(MatcherFuseTest, LoopSearchByProjectionWithSim3) {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const KeyFrame& kf = *map_.keyframes[1];
   const std::vector<MapPointPtr>& points_b = points_b_;
   // Two slots preset: kept, and their points are not matched again.
@@ -215,7 +216,7 @@ TEST_F(MatcherFuseTest, LoopSearchByProjectionWithSim3) {
 }
 
 TEST_F(MatcherFuseTest, LoopFuseWithSim3ReportsReplacementsAndFillsEmptySlots) {
-  std::unique_lock lock(atlas_.mutex());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   KeyFrame* kf = map_.keyframes[1].get();
   // Empty 30 of kf's slots (their points keep other observations).
   std::set<int> emptied;
@@ -258,7 +259,7 @@ TEST_F(MatcherFuseTest, LoopFuseWithSim3ReportsReplacementsAndFillsEmptySlots) {
 }
 
 TEST_F(MatcherFuseTest, SearchBySim3FindsMutualMatches) {
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const KeyFrame& kf1 = *map_.keyframes[1];
   const KeyFrame& kf2 = *map_b_.keyframes[2];
   // p_cam1 = S12 * p_cam2, with map B's camera coordinates scaled by kScaleB.

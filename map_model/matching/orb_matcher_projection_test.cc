@@ -8,6 +8,7 @@
 #include <set>
 #include <shared_mutex>
 
+#include "map_model/map_editor.h"
 #include "map_model/matching/matching_test_utils.h"
 #include "map_model/matching/orb_matcher.h"
 #include "map_model/matching/orb_matcher_internal.h"
@@ -88,7 +89,7 @@ class MatcherProjectionTest : public ::testing::Test {
     scene_ = MakeScene(1500, 11);
     poses_ = MakeForwardPath(5, 0.2, 12);
     map_ = MakeMap(&atlas_, scene_, rig_, {poses_[0], poses_[1], poses_[2]}, {});
-    lock_ = std::shared_lock(atlas_.mutex());
+    lock_ = MapReader(atlas_).Lock();
     for (const auto& mp : map_.point_of_scene_index) {
       if (mp) points_.push_back(mp);
     }
@@ -147,7 +148,7 @@ TEST(MatcherProjectionHard, SimilarDescriptorsNoiseAndOutliers) {
   o.pixel_noise = 0.7;
   o.descriptor_bit_flips = 10;
   const auto map = MakeMap(&atlas, scene, rig, {poses[0], poses[1], poses[2]}, o);
-  std::shared_lock lock(atlas.mutex());
+  auto lock = MapReader(atlas).Lock();
   std::vector<MapPointPtr> points;
   for (const auto& mp : map.point_of_scene_index) {
     if (mp) points.push_back(mp);

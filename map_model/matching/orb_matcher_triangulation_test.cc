@@ -5,6 +5,7 @@
 #include <mutex>
 #include <set>
 
+#include "map_model/map_editor.h"
 #include "map_model/matching/matching_test_utils.h"
 #include "map_model/matching/orb_matcher.h"
 
@@ -39,7 +40,7 @@ class MatcherTriangulationTest : public ::testing::Test {
     Frame f = EditFrame(MakePosedFrame(scene_, rig_, pose, atlas_.NextFrameId(), o, pok), edit);
     f.SetPose(pose);
     f.ComputeBoW(vocabulary_);
-    std::unique_lock lock(atlas_.mutex());
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     auto kf = std::make_shared<KeyFrame>(atlas_.NextKeyFrameId(), f, atlas_.current_map());
     atlas_.current_map()->AddKeyFrame(kf);
     return kf;
@@ -65,7 +66,7 @@ TEST_F(MatcherTriangulationTest, PairsAreCorrectAndOneToOne) {
   std::set<int> in2(pok2.begin(), pok2.end());
   int common = 0;
   for (int p : pok1) common += in2.count(p) > 0;
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const auto pairs = OrbMatcher(0.6).SearchForTriangulation(*kf1, *kf2);
   int correct = 0;
   std::set<int> used1;
@@ -82,7 +83,7 @@ TEST_F(MatcherTriangulationTest, PairsAreCorrectAndOneToOne) {
   EXPECT_GE(correct, 0.98 * static_cast<double>(pairs.size()));
   // Keypoints that already have a map point are not paired.
   {
-    std::unique_lock write(atlas_.mutex(), std::defer_lock);
+    auto write = MapEditor(&atlas_).WriteLater(MapEdit::kFixture);
     lock.unlock();
     write.lock();
     for (int i = 0; i < kf1->size(); i += 2) {
@@ -127,7 +128,7 @@ TEST_F(MatcherTriangulationTest, EpipolarConstraintRejectsOffLineKeypoints) {
       kp.pt = cv::Point2f(static_cast<float>(moved.x()), static_cast<float>(moved.y()));
     }
   });
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const auto pairs = OrbMatcher(0.6).SearchForTriangulation(*kf1, *kf2);
   std::set<int> matched2;
   for (const auto& [i1, i2] : pairs) matched2.insert(i2);
@@ -163,7 +164,7 @@ TEST_F(MatcherTriangulationTest, KeypointsNearTheEpipoleAreSkippedWithoutStereo)
     std::vector<int> pok2;
     const auto kf1 = MakeKeyFrame(pose1, 1, stereo, &pok1);
     const auto kf2 = MakeKeyFrame(pose2, 2, stereo, &pok2);
-    std::shared_lock lock(atlas_.mutex());
+    auto lock = MapReader(atlas_).Lock();
     const auto pairs = OrbMatcher(0.6).SearchForTriangulation(*kf1, *kf2);
     int axis = 0;
     int correct = 0;
@@ -192,7 +193,7 @@ TEST_F(MatcherTriangulationTest, OnlyStereoPairsKeypointsWithDepth) {
     }
   });
   const auto kf2 = MakeKeyFrame(poses_[1], 2, true, &pok2);
-  std::shared_lock lock(atlas_.mutex());
+  auto lock = MapReader(atlas_).Lock();
   const auto all = OrbMatcher(0.6).SearchForTriangulation(*kf1, *kf2, false);
   const auto stereo = OrbMatcher(0.6).SearchForTriangulation(*kf1, *kf2, true);
   int all_without_depth = 0;

@@ -16,6 +16,7 @@
 #include "map_model/estimation/essential_graph_collect.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/testing/synthetic_map.h"
 
@@ -109,7 +110,7 @@ inline void BuildLoopScenario(const LoopScenarioOptions& o, const SyntheticScene
   s->map = s->atlas.current_map();
   s->synthetic = MakeMap(&s->atlas, scene, rig, s->true_camera_from_world, {});
 
-  std::unique_lock lock(s->atlas.mutex());
+  auto lock = MapEditor(&s->atlas).Write(MapEdit::kFixture);
   auto& kfs = s->synthetic.keyframes;
   // A chain spanning tree (the fixture picks parents by covisibility, which can form cycles).
   for (int k = 1; k < n; ++k) {

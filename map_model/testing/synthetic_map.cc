@@ -3,6 +3,7 @@
 #include <mutex>
 
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 
 namespace pkslam::testing {
@@ -79,7 +80,7 @@ Frame MakeFrame(const SyntheticScene& scene, const std::shared_ptr<const CameraR
 SyntheticMap MakeMap(Atlas* atlas, const SyntheticScene& scene,
                      const std::shared_ptr<const CameraRig>& rig,
                      const std::vector<SE3d>& camera_from_world, const FrameOptions& options) {
-  std::unique_lock lock(atlas->mutex());
+  auto lock = MapEditor(atlas).Write(MapEdit::kFixture);
   Map* map = atlas->current_map();
   SyntheticMap out;
   out.point_of_scene_index.assign(scene.points_world.size(), nullptr);

@@ -1,0 +1,71 @@
+// The one door to the map model (OpenVINS's StateHelper idea): the Atlas's reader/writer lock
+// is private to it, and only MapEditor::Write takes it exclusively, naming the kind of change
+// (MapEdit). Readers take it shared through MapReader. Every exclusive hold is counted and
+// timed per kind (Atlas::EditStats: how long each kind of change keeps the other threads out),
+// which is what a study of the threads' contention needs.
+//
+// Who writes what (threads as ORB-SLAM3's):
+//   tracking       kInitialise, kInsertKeyFrame, kReset
+//   local mapping  kProcessKeyFrame, kCullPoints, kCreatePoints, kFuse, kCullKeyFrames,
+//                  kApplyBundle, kApplyInertialBundle, kInertialInitialisation
+//   loop closing   kLoopCorrection, kMergeMaps, kGlobalBundle
+//   tests          kFixture (maps built by hand)
+#pragma once
+
+#include <chrono>
+#include <mutex>
+#include <shared_mutex>
+
+#include "map_model/atlas.h"
+
+namespace pkslam {
+
+// The exclusive lock on the Atlas, held for one kind of change. Movable, not copyable; may be
+// released early (unlock) and taken again (lock) like std::unique_lock. Each hold is recorded
+// in the Atlas's edit statistics when it ends.
+class MapWriteLock {
+ public:
+  MapWriteLock(MapWriteLock&& other) noexcept = default;
+  MapWriteLock& operator=(MapWriteLock&& other) = delete;
+  MapWriteLock(const MapWriteLock&) = delete;
+  MapWriteLock& operator=(const MapWriteLock&) = delete;
+  ~MapWriteLock();
+
+  void unlock();
+  void lock();
+  bool owns_lock() const { return lock_.owns_lock(); }
+  MapEdit edit() const { return edit_; }
+
+ private:
+  friend class MapEditor;
+  MapWriteLock(const Atlas* atlas, MapEdit edit, std::defer_lock_t);
+
+  const Atlas* atlas_;
+  MapEdit edit_;
+  std::unique_lock<std::shared_mutex> lock_;
+  std::chrono::steady_clock::time_point since_;
+};
+
+class MapEditor {
+ public:
+  explicit MapEditor(Atlas* atlas);
+  // Blocks until no reader or writer holds the Atlas; the map model may then be changed.
+  [[nodiscard]] MapWriteLock Write(MapEdit edit) const;
+  // As Write, but not locked yet (std::defer_lock): call lock() on it.
+  [[nodiscard]] MapWriteLock WriteLater(MapEdit edit) const;
+
+ private:
+  Atlas* atlas_;
+};
+
+class MapReader {
+ public:
+  explicit MapReader(const Atlas& atlas) : atlas_(&atlas) {}
+  // Shared: any number of readers, no writer, while it is held.
+  [[nodiscard]] std::shared_lock<std::shared_mutex> Lock() const;
+
+ private:
+  const Atlas* atlas_;
+};
+
+}  // namespace pkslam
