@@ -9,6 +9,7 @@
 #include <opengv/absolute_pose/methods.hpp>
 #include <opengv/sac/Ransac.hpp>
 #include <opengv/sac_problems/absolute_pose/AbsolutePoseSacProblem.hpp>
+#include <optional>
 
 #include "core/util/error.h"
 
@@ -64,11 +65,15 @@ std::vector<int> IndicesOf(const std::vector<bool>& mask) {
 
 }  // namespace
 
+// The adapter and the problem live in place, never on the heap on their own: libopengv's
+// deleting destructors release through Eigen's aligned operator delete (free) while this
+// C++17 translation unit allocates with the global operator new (Eigen drops its class
+// operators when the compiler aligns by itself), an alloc-dealloc mismatch under ASan.
 struct PnpRansac::OpenGv {
   opengv::bearingVectors_t bearings;
   opengv::points_t points;
-  std::unique_ptr<CentralAbsoluteAdapter> adapter;
-  std::unique_ptr<AbsolutePoseSacProblem> problem;
+  std::optional<CentralAbsoluteAdapter> adapter;  // the problem refers to it: declared first
+  std::optional<AbsolutePoseSacProblem> problem;
 };
 
 void PnpRansacOptions::Check() const {
@@ -93,10 +98,9 @@ PnpRansac::PnpRansac(std::vector<PnpCorrespondence> correspondences,
       std::max(options_.min_inliers, static_cast<int>(std::ceil(options_.min_inlier_ratio * n)));
   if (n < required_inliers_) return;  // budget 0: nothing to try
   FillOpenGv(correspondences_, camera_, &opengv_->bearings, &opengv_->points);
-  opengv_->adapter = std::make_unique<CentralAbsoluteAdapter>(opengv_->bearings, opengv_->points);
+  opengv_->adapter.emplace(opengv_->bearings, opengv_->points);
   // randomSeed = false: OpenGV's own generator is never used here (we draw the samples).
-  opengv_->problem = std::make_unique<AbsolutePoseSacProblem>(*opengv_->adapter,
-                                                              AbsolutePoseSacProblem::KNEIP, false);
+  opengv_->problem.emplace(*opengv_->adapter, AbsolutePoseSacProblem::KNEIP, false);
   // Iterations to draw one all-inlier 4-sample with `probability` at the acceptance ratio.
   const double ratio = static_cast<double>(required_inliers_) / n;
   const double p_good = std::pow(ratio, 4);

@@ -1,7 +1,7 @@
 // Local bundle adjustment on synthetic maps of ORB-SLAM-like local-BA size (all keyframes
 // covisible; the origin is the fixed gauge), 1 px noise and 2% outlier keypoints, started from
 // a perturbation (1 cm / 0.2 degrees per free keyframe, 1 cm per point).
-//   build/benchmarks/pkslam_core_benchmark --benchmark_filter=Bundle
+//   build/benchmarks/pkslam_map_model_benchmark --benchmark_filter=Bundle
 // Args: keyframes, scene points (about 3/4 become map points). Counters: kf = keyframes,
 // pts = map points, obs = observations, it = solver iterations of both passes.
 #include <benchmark/benchmark.h>
