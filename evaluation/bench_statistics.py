@@ -16,9 +16,10 @@ Rules (docs/bench.md "Statistics"):
 - Relative improvement: the mean over sequences of 100 (mean ATE_base - mean ATE) / mean
   ATE_base (the paper's "mean of per-sequence improvements"), with a bootstrap 95% interval
   (runs resampled within each sequence and configuration, 5,000 draws).
-- Power: (with at least MIN_RUNS_FOR_VERDICT runs per sequence) for the paper's effect (ATE x 0.819 stereo-inertial, x 0.796 mono-inertial, x 0.819
+- Power: for the paper's effect (ATE x 0.819 stereo-inertial, x 0.796 mono-inertial, x 0.819
   otherwise) on log ATE with the observed within-sequence spread, the power of a two-sided 5%
-  test at the present run count, and the runs per sequence that would give 80%.
+  test at the present run count, and the runs per sequence that would give 80%; a missing
+  effect is called "not reproduced" only with at least MIN_RUNS_FOR_VERDICT runs per sequence.
 
   /usr/bin/python3 evaluation/bench_statistics.py OUT/results.csv [--md FILE] [--html FILE]
 """

@@ -53,9 +53,9 @@ MapPointPtr Map::TakeMapPoint(const MapPoint* point) {
 }
 
 KeyFramePtr Map::FindKeyFrame(KeyFrameId id) const {
-  if (auto it = keyframes_.find(id); it != keyframes_.end()) return it->second;
-  if (auto it = retired_.find(id); it != retired_.end()) return it->second;
-  return nullptr;
+  if (KeyFramePtr live = KeyFrameById(id)) return live;
+  const auto it = retired_.find(id);
+  return it == retired_.end() ? nullptr : it->second;
 }
 
 KeyFramePtr Map::KeyFrameById(KeyFrameId id) const {
@@ -69,13 +69,13 @@ MapPointPtr Map::MapPointById(MapPointId id) const {
 }
 
 KeyFramePtr Map::Share(const KeyFrame* kf) const {
-  auto it = keyframes_.find(kf->id());
-  return it != keyframes_.end() && it->second.get() == kf ? it->second : nullptr;
+  KeyFramePtr live = KeyFrameById(kf->id());
+  return live.get() == kf ? live : nullptr;
 }
 
 MapPointPtr Map::Share(const MapPoint* point) const {
-  auto it = map_points_.find(point->id());
-  return it != map_points_.end() && it->second.get() == point ? it->second : nullptr;
+  MapPointPtr live = MapPointById(point->id());
+  return live.get() == point ? live : nullptr;
 }
 
 void Map::RecordWorldChange(const WorldChange& change) {

@@ -22,9 +22,9 @@ void SetIntrinsics(const CameraRig& rig, BundleProblem* problem) {
   problem->bf = rig.bf;
 }
 
-void AddKeyFrame(const KeyFramePtr& kf, bool fixed, BundleProblem* problem,
+void AddKeyFrame(const KeyFrame* kf, bool fixed, BundleProblem* problem,
                  BundleKeyFrameIndex* index) {
-  (*index)[kf.get()] = static_cast<int>(problem->keyframes.size());
+  (*index)[kf] = static_cast<int>(problem->keyframes.size());
   problem->keyframes.push_back({kf->id(), kf->camera_from_world(), fixed});
 }
 
@@ -71,31 +71,29 @@ BundleProblem CollectLocalBundle(KeyFrame* keyframe, const BundleAdjustmentOptio
   if (keyframe == nullptr || keyframe->IsBad()) return problem;
   const Map* map = keyframe->map();
   PKSLAM_CHECK(map != nullptr, "keyframe {} has no map", keyframe->id());
-  const KeyFramePtr self = map->Share(keyframe);
-  PKSLAM_CHECK(self != nullptr, "keyframe {} is not live in its map", keyframe->id());
+  PKSLAM_CHECK(map->Share(keyframe) != nullptr, "keyframe {} is not live in its map",
+               keyframe->id());
   SetIntrinsics(keyframe->rig(), &problem);
   problem.map_id = map->id();
 
   // Local keyframes: the keyframe and its covisibles by decreasing weight. The map's origin
   // stays fixed even when it is local (it anchors the map's frame).
   BundleKeyFrameIndex index;
-  AddKeyFrame(self, keyframe == map->origin(), &problem, &index);
+  std::vector<const KeyFrame*> local{keyframe};
   for (KeyFrame* kf : keyframe->CovisiblesByWeight()) {
     if (options.max_local_keyframes > 0 &&
-        static_cast<int>(problem.keyframes.size()) >= options.max_local_keyframes) {
+        static_cast<int>(local.size()) >= options.max_local_keyframes) {
       break;
     }
-    if (kf->IsBad() || kf->map() != map) continue;
-    const KeyFramePtr shared = map->Share(kf);
-    if (shared) AddKeyFrame(shared, kf == map->origin(), &problem, &index);
+    if (!kf->IsBad() && kf->map() == map && map->Share(kf) != nullptr) local.push_back(kf);
   }
+  for (const KeyFrame* kf : local) AddKeyFrame(kf, kf == map->origin(), &problem, &index);
 
   // Local points: every good point of a local keyframe, in first-seen order.
   std::vector<MapPointPtr> points;
   std::unordered_set<const MapPoint*> seen;
-  for (const auto& k : problem.keyframes) {
-    const KeyFramePtr local = map->KeyFrameById(k.keyframe_id);
-    for (const MapPointPtr& point : local->map_points()) {
+  for (const KeyFrame* kf : local) {
+    for (const MapPointPtr& point : kf->map_points()) {
       if (point && !point->IsBad() && point->map() == map && seen.insert(point.get()).second) {
         points.push_back(point);
       }
@@ -114,9 +112,8 @@ BundleProblem CollectLocalBundle(KeyFrame* keyframe, const BundleAdjustmentOptio
   }
   std::sort(fixed.begin(), fixed.end(),
             [](const KeyFrame* a, const KeyFrame* b) { return a->id() < b->id(); });
-  for (KeyFrame* kf : fixed) {
-    const KeyFramePtr shared = map->Share(kf);
-    if (shared) AddKeyFrame(shared, true, &problem, &index);
+  for (const KeyFrame* kf : fixed) {
+    if (map->Share(kf) != nullptr) AddKeyFrame(kf, true, &problem, &index);
   }
   EnsureFixedKeyFrame(&problem);
 
@@ -131,7 +128,7 @@ BundleProblem CollectGlobalBundle(const Map& map) {
   for (const auto& [id, kf] : map.keyframes()) {
     if (kf->IsBad()) continue;
     if (problem.keyframes.empty()) SetIntrinsics(kf->rig(), &problem);
-    AddKeyFrame(kf, kf.get() == map.origin(), &problem, &index);
+    AddKeyFrame(kf.get(), kf.get() == map.origin(), &problem, &index);
   }
   EnsureFixedKeyFrame(&problem);
   for (const auto& [id, point] : map.map_points()) {
