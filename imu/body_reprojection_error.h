@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "core/geometry/pinhole_intrinsics.h"
 #include "core/geometry/se3.h"
 
 namespace pkslam {
@@ -27,6 +28,10 @@ inline constexpr double kMinBodyReprojectionDepth = 1e-6;
 struct BodyCamera {
   double fx = 0, fy = 0, cx = 0, cy = 0, bf = 0;
   SE3d camera_from_body;
+
+  static BodyCamera Of(const PinholeIntrinsics& k, const SE3d& camera_from_body) {
+    return {k.fx, k.fy, k.cx, k.cy, k.bf, camera_from_body};
+  }
 };
 
 // Squared whitened errors at a body pose; +infinity when the point is not in front.

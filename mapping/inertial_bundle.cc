@@ -1,5 +1,5 @@
-// Collect and Apply phases of visual-inertial bundle adjustment; the solver is in
-// inertial_bundle_solve.cc.
+// Collect and Apply phases of visual-inertial bundle adjustment; the solver is
+// estimators/inertial/inertial_bundle_solve.cc.
 #include "mapping/inertial_bundle.h"
 
 #include <algorithm>
@@ -75,24 +75,6 @@ std::vector<MapPointPtr> PointsOf(const std::vector<KeyFrame*>& keyframes, const
 }
 
 }  // namespace
-
-void InertialBundleOptions::Check() const {
-  PKSLAM_CHECK_OPTION(window >= 2, "inertial_ba.window", "{}", window);
-  PKSLAM_CHECK_OPTION(max_fixed_keyframes >= 0, "inertial_ba.max_fixed_keyframes", "{}",
-                      max_fixed_keyframes);
-  PKSLAM_CHECK_OPTION(iterations_first >= 1 && iterations_second >= 0, "inertial_ba.iterations",
-                      "{} / {}", iterations_first, iterations_second);
-  PKSLAM_CHECK_OPTION(chi2_mono > 0 && chi2_stereo > 0, "inertial_ba.chi2", "{} / {}", chi2_mono,
-                      chi2_stereo);
-  PKSLAM_CHECK_OPTION(num_threads >= 1, "inertial_ba.num_threads", "{}", num_threads);
-  PKSLAM_CHECK_OPTION(gravity_magnitude > 0, "inertial_ba.gravity_magnitude", "{}",
-                      gravity_magnitude);
-  PKSLAM_CHECK_OPTION(marginalization_threshold >= 0 && marginalization_threshold < 1,
-                      "inertial_ba.marginalization_threshold", "{}", marginalization_threshold);
-  PKSLAM_CHECK_OPTION(marginalization_visual_weight > 0 && marginalization_visual_weight <= 1,
-                      "inertial_ba.marginalization_visual_weight", "{}",
-                      marginalization_visual_weight);
-}
 
 std::vector<KeyFrame*> InertialChain(KeyFrame* newest, int max_length) {
   std::vector<KeyFrame*> chain;

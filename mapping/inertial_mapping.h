@@ -2,9 +2,9 @@
 // initialisation of ORB-SLAM3 (../shared/docs/ORBSLAM3_FACTS.md "IMU") and local inertial BA.
 //
 // Stages, per map: (1) once the temporal keyframe chain holds >= min_keyframes spanning
-// >= min_time_*_s: inertial-only MAP (imu/inertial_initializer.h) over gravity direction,
-// scale (monocular), one bias pair and the velocities, with zero-mean bias priors; the map is
-// rotated to gravity (and scaled), then a full visual-inertial BA with shared biases refines
+// >= min_time_*_s: inertial-only MAP (estimators/inertial/inertial_initializer.h) over gravity
+// direction, scale (monocular), one bias pair and the velocities, with zero-mean bias priors; the
+// map is rotated to gravity (and scaled), then a full visual-inertial BA with shared biases refines
 // it. (2) VIBA1 after viba1_s and (3) VIBA2 after viba2_s of motion since the initialisation
 // (time over which the keyframes moved; a stand-still does not count): the same with weaker bias
 // priors. In between, local inertial BA over a sliding window.

@@ -7,7 +7,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
-#include "imu/inertial_initializer.h"
+#include "estimators/inertial/inertial_initializer.h"
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"

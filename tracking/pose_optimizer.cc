@@ -15,8 +15,8 @@ int OptimizePose(Frame* frame, const PoseOptimizerOptions& options) {
       CollectPoseCorrespondences(*frame, /*depth_information=*/true);
   const int num_correspondences = static_cast<int>(corrs.size());
   if (num_correspondences < 3) return 0;
-  const SE3d camera_from_world = SolvePose({rig.fx, rig.fy, rig.cx, rig.cy, rig.bf},
-                                           frame->camera_from_world(), &corrs, options);
+  const SE3d camera_from_world =
+      SolvePose(rig.intrinsics(), frame->camera_from_world(), &corrs, options);
   const int num_outliers = WriteOutlierFlags(corrs, frame);
   frame->SetPose(camera_from_world);
   return num_correspondences - num_outliers;

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/camera/camera_model.h"
+#include "core/geometry/pinhole_intrinsics.h"
 #include "core/geometry/se3.h"
 #include "core/imu/imu_types.h"  // ImuNoise
 #include "core/sensor/scale_pyramid.h"
@@ -31,6 +32,8 @@ struct CameraRig {
   // Stereo baseline (m) and bf = fx * baseline; for RGB-D a virtual baseline.
   double baseline = 0;
   double bf = 0;
+  // The rectified left camera as a value (fx, fy, cx, cy, bf).
+  PinholeIntrinsics intrinsics() const { return {fx, fy, cx, cy, bf}; }
   // Close/far split (m): points closer than this are "close" (ORB-SLAM's ThDepth*b).
   double th_depth = 0;
   // RGB-D depth image factor (pixel value / factor = metres).

@@ -11,13 +11,14 @@
 #include <memory>
 #include <vector>
 
+#include "core/util/error.h"
 #include "core/util/log.h"
+#include "estimators/inertial/inertial_bundle.h"
+#include "estimators/inertial/marginalization.h"
 #include "estimators/optim/ceres_setup.h"
 #include "imu/body_reprojection_error.h"
 #include "imu/imu_factors.h"
 #include "imu/imu_manifolds.h"
-#include "mapping/inertial_bundle.h"
-#include "mapping/inertial_marginalization.h"
 
 namespace pkslam {
 namespace {
@@ -103,6 +104,24 @@ std::optional<InertialStatePrior> MarginalPrior(
 
 }  // namespace
 
+void InertialBundleOptions::Check() const {
+  PKSLAM_CHECK_OPTION(window >= 2, "inertial_ba.window", "{}", window);
+  PKSLAM_CHECK_OPTION(max_fixed_keyframes >= 0, "inertial_ba.max_fixed_keyframes", "{}",
+                      max_fixed_keyframes);
+  PKSLAM_CHECK_OPTION(iterations_first >= 1 && iterations_second >= 0, "inertial_ba.iterations",
+                      "{} / {}", iterations_first, iterations_second);
+  PKSLAM_CHECK_OPTION(chi2_mono > 0 && chi2_stereo > 0, "inertial_ba.chi2", "{} / {}", chi2_mono,
+                      chi2_stereo);
+  PKSLAM_CHECK_OPTION(num_threads >= 1, "inertial_ba.num_threads", "{}", num_threads);
+  PKSLAM_CHECK_OPTION(gravity_magnitude > 0, "inertial_ba.gravity_magnitude", "{}",
+                      gravity_magnitude);
+  PKSLAM_CHECK_OPTION(marginalization_threshold >= 0 && marginalization_threshold < 1,
+                      "inertial_ba.marginalization_threshold", "{}", marginalization_threshold);
+  PKSLAM_CHECK_OPTION(marginalization_visual_weight > 0 && marginalization_visual_weight <= 1,
+                      "inertial_ba.marginalization_visual_weight", "{}",
+                      marginalization_visual_weight);
+}
+
 InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
                                          const InertialBundleOptions& options,
                                          const std::atomic<bool>* abort) {
@@ -110,13 +129,8 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
   const BundleProblem& visual = problem.visual;
   const int num_kf = static_cast<int>(visual.keyframes.size());
   const int num_points = static_cast<int>(visual.points.size());
-  BodyCamera camera;
-  camera.fx = visual.fx;
-  camera.fy = visual.fy;
-  camera.cx = visual.cx;
-  camera.cy = visual.cy;
-  camera.bf = visual.bf;
-  camera.camera_from_body = problem.camera_from_body;
+  const BodyCamera camera = BodyCamera::Of({visual.fx, visual.fy, visual.cx, visual.cy, visual.bf},
+                                           problem.camera_from_body);
   const SE3d body_from_camera = problem.camera_from_body.Inverse();
 
   State s(num_kf, num_points);

@@ -1,4 +1,4 @@
-#include "imu/inertial_initializer.h"
+#include "estimators/inertial/inertial_initializer.h"
 
 #include <ceres/ceres.h>
 
