@@ -66,7 +66,7 @@ void LoopClosing::Start() {
 
 void LoopClosing::Finish() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     finish_requested_ = true;
   }
   wake_.notify_all();
@@ -81,7 +81,7 @@ void LoopClosing::InsertKeyFrame(const KeyFramePtr& kf) {
     return;
   }
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     queue_.push_back(kf);
   }
   wake_.notify_all();
@@ -89,19 +89,19 @@ void LoopClosing::InsertKeyFrame(const KeyFramePtr& kf) {
 
 void LoopClosing::WaitUntilIdle() {
   if (options_.synchronous) return;
-  std::unique_lock lock(mutex_);
-  idle_.wait(lock, [this] { return (queue_.empty() && !busy_) || !thread_.joinable(); });
+  MutexLock lock(mutex_);
+  while (!((queue_.empty() && !busy_) || !thread_.joinable())) idle_.wait(lock);
 }
 
 LoopClosingStats LoopClosing::stats() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return stats_;
 }
 
 void LoopClosing::Run() {
-  std::unique_lock lock(mutex_);
+  MutexLock lock(mutex_);
   while (true) {
-    wake_.wait(lock, [this] { return finish_requested_ || !queue_.empty(); });
+    while (!finish_requested_ && queue_.empty()) wake_.wait(lock);
     if (queue_.empty()) {
       if (finish_requested_) break;
       continue;
@@ -134,7 +134,7 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
   double verification_ms = 0;
   std::optional<CommonRegion> region = Detect(kf, &verification_ms);
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     stats_.detection_ms.push_back(MsSince(start));
     ++stats_.keyframes;
   }
@@ -155,12 +155,12 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
     event.matched_map = region->matched->map()->id();
     merge = region->query->map() != region->matched->map();
     if (!merge && !AcceptsInertialLoop(*region)) {
-      std::lock_guard stats_lock(mutex_);
+      MutexLock stats_lock(mutex_);
       ++stats_.rejected_inertial;
       return;
     }
     if (!merge && !AcceptsLoopCorrection(*region)) {
-      std::lock_guard stats_lock(mutex_);
+      MutexLock stats_lock(mutex_);
       ++stats_.rejected_implausible;
       return;
     }
@@ -178,7 +178,7 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
       event.correction_ms);
   std::size_t index = 0;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     auto& events = merge ? stats_.merges : stats_.loops;
     index = events.size();
     events.push_back(event);
@@ -231,7 +231,7 @@ std::optional<CommonRegion> LoopClosing::Detect(const KeyFramePtr& kf, double* v
                        merge ? "merge" : "loop", pending->matched->id());
       pending.reset();
       failures = 0;
-      std::lock_guard stats_lock(mutex_);
+      MutexLock stats_lock(mutex_);
       ++stats_.rejected_regions;
     }
   }
@@ -255,7 +255,7 @@ std::optional<CommonRegion> LoopClosing::Detect(const KeyFramePtr& kf, double* v
       }
       *verification_ms += MsSince(t);
       {
-        std::lock_guard stats_lock(mutex_);
+        MutexLock stats_lock(mutex_);
         ++stats_.tested_candidates;
         if (region) ++stats_.verified_regions;
       }
@@ -276,7 +276,7 @@ void LoopClosing::StartGlobalBundle(Map* map, bool merge, std::size_t index) {
   if (!options_.global_ba) return;
   StopGlobalBundle();
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     ++stats_.global_ba_started;
   }
   if (options_.synchronous) {
@@ -357,7 +357,7 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
   }
   const double ms = MsSince(start);
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     if (applied) {
       ++stats_.global_ba_finished;
       auto& events = merge ? stats_.merges : stats_.loops;

@@ -23,18 +23,17 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <map>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "core/sensor/camera_rig.h"
+#include "core/util/annotated_mutex.h"
 #include "loopclosing/place_verifier.h"
 #include "map_model/atlas.h"
 #include "map_model/estimation/bundle_collect.h"
@@ -186,13 +185,13 @@ class LoopClosing {
   MappingControl mapping_;
   LoopClosingOptions options_;
 
-  mutable std::mutex mutex_;  // guards queue_, busy_, finish_requested_, stats_
-  std::condition_variable wake_;
-  std::condition_variable idle_;
-  std::deque<KeyFramePtr> queue_;
-  bool busy_ = false;
-  bool finish_requested_ = false;
-  LoopClosingStats stats_;
+  mutable Mutex mutex_;  // guards the members marked PKSLAM_GUARDED_BY(mutex_)
+  ConditionVariable wake_;
+  ConditionVariable idle_;
+  std::deque<KeyFramePtr> queue_ PKSLAM_GUARDED_BY(mutex_);
+  bool busy_ PKSLAM_GUARDED_BY(mutex_) = false;
+  bool finish_requested_ PKSLAM_GUARDED_BY(mutex_) = false;
+  LoopClosingStats stats_ PKSLAM_GUARDED_BY(mutex_);
   std::thread thread_;
 
   // Owned by the processing thread.

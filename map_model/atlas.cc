@@ -43,12 +43,12 @@ std::vector<Map*> Atlas::maps() const {
 }
 
 MapEditTable Atlas::EditStats() const {
-  std::lock_guard lock(edit_stats_mutex_);
+  MutexLock lock(edit_stats_mutex_);
   return edit_stats_;
 }
 
 void Atlas::RecordEdit(MapEdit edit, double held_s) const {
-  std::lock_guard lock(edit_stats_mutex_);
+  MutexLock lock(edit_stats_mutex_);
   MapEditStats& s = edit_stats_[static_cast<std::size_t>(edit)];
   ++s.holds;
   s.total_s += held_s;

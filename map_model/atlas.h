@@ -6,10 +6,10 @@
 
 #include <atomic>
 #include <memory>
-#include <mutex>
 #include <shared_mutex>
 #include <vector>
 
+#include "core/util/annotated_mutex.h"
 #include "map_model/ids.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/map.h"
@@ -61,8 +61,8 @@ class Atlas {
   // Shared: read the map model. Exclusive: change it. Taken only by MapReader / MapEditor.
   mutable std::shared_mutex mutex_;
   // Guards edit_stats_ (written when a MapWriteLock ends, read by EditStats()).
-  mutable std::mutex edit_stats_mutex_;
-  mutable MapEditTable edit_stats_{};
+  mutable Mutex edit_stats_mutex_;
+  mutable MapEditTable edit_stats_ PKSLAM_GUARDED_BY(edit_stats_mutex_){};
   std::unique_ptr<KeyFrameDatabase> database_;  // declared before maps_: outlives them
   std::vector<std::unique_ptr<Map>> maps_;
   Map* current_ = nullptr;

@@ -41,7 +41,7 @@ void LocalMapper::Start() {
 
 void LocalMapper::Finish() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     finish_requested_ = true;
     stop_requested_ = false;
   }
@@ -56,7 +56,7 @@ void LocalMapper::Finish() {
 
 void LocalMapper::InsertKeyFrame(const KeyFramePtr& kf) {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     queue_.push_back(kf);
     abort_ba_.store(true);  // a running BA yields to the newer keyframe
   }
@@ -64,17 +64,17 @@ void LocalMapper::InsertKeyFrame(const KeyFramePtr& kf) {
 }
 
 bool LocalMapper::HasQueued() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return !queue_.empty();
 }
 
 int LocalMapper::QueueSize() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return static_cast<int>(queue_.size());
 }
 
 bool LocalMapper::IsStoppedOrStopRequested() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return stop_requested_ || stopped_;
 }
 
@@ -83,14 +83,14 @@ void LocalMapper::WaitUntilIdle() {
     while (HasQueued()) ProcessNext();
     return;
   }
-  std::unique_lock lock(mutex_);
-  idle_.wait(lock, [this] { return (queue_.empty() && !busy_) || stopped_ || finish_requested_; });
+  MutexLock lock(mutex_);
+  while (!((queue_.empty() && !busy_) || stopped_ || finish_requested_)) idle_.wait(lock);
 }
 
 bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
   if (!emulate_live_ || !thread_.joinable()) return AcceptsKeyFrames();
   const auto wait_start = std::chrono::steady_clock::now();
-  std::unique_lock lock(mutex_);
+  MutexLock lock(mutex_);
   while (true) {
     if (stopped_ || stop_requested_ || finish_requested_ || reset_requested_) break;
     if (!busy_ && queue_.empty()) break;
@@ -118,20 +118,20 @@ std::int64_t LocalMapper::DataNs(double wall_s) const {
 
 void LocalMapper::ResetQueue() {
   if (!thread_.joinable()) {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     queue_.clear();
     recent_points_.clear();
     return;
   }
-  std::unique_lock lock(mutex_);
+  MutexLock lock(mutex_);
   reset_requested_ = true;
   wake_.notify_all();
-  idle_.wait(lock, [this] { return !reset_requested_ || finish_requested_; });
+  while (reset_requested_ && !finish_requested_) idle_.wait(lock);
 }
 
 void LocalMapper::RequestStop() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     stop_requested_ = true;
   }
   abort_ba_.store(true);
@@ -139,29 +139,29 @@ void LocalMapper::RequestStop() {
 }
 
 bool LocalMapper::IsStopped() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return stopped_;
 }
 
 void LocalMapper::Release() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     stop_requested_ = false;
   }
   wake_.notify_all();
 }
 
 LocalMappingStats LocalMapper::stats() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return stats_;
 }
 
 void LocalMapper::Run() {
-  std::unique_lock lock(mutex_);
+  MutexLock lock(mutex_);
   while (true) {
-    wake_.wait(lock, [this] {
-      return finish_requested_ || reset_requested_ || stop_requested_ || !queue_.empty();
-    });
+    while (!(finish_requested_ || reset_requested_ || stop_requested_ || !queue_.empty())) {
+      wake_.wait(lock);
+    }
     if (reset_requested_) {
       live_free_ns_ = std::numeric_limits<std::int64_t>::min();
       queue_.clear();
@@ -174,7 +174,7 @@ void LocalMapper::Run() {
       stopped_ = true;
       accept_keyframes_.store(false);
       idle_.notify_all();
-      wake_.wait(lock, [this] { return !stop_requested_ || finish_requested_; });
+      while (stop_requested_ && !finish_requested_) wake_.wait(lock);
       stopped_ = false;
       accept_keyframes_.store(true);
       continue;

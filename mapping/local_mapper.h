@@ -3,26 +3,26 @@
 // fuses duplicates, runs local bundle adjustment and culls redundant keyframes, then hands the
 // keyframe on (to loop closing).
 //
-// Threads: the queue and flags are guarded by `mutex_` (plus atomics for flags read on hot
-// paths); the map model by the Atlas mutex, taken shared for computation and exclusive for
-// the short apply steps (docs/architecture.md). Owned by System; Stop() joins the thread.
+// Threads: the queue and flags are guarded by `mutex_` (PKSLAM_GUARDED_BY, checked by Clang
+// in CTest layering.thread_safety; plus atomics for flags read on hot paths); the map model by the
+// Atlas mutex, taken shared for computation and exclusive for the short apply steps
+// (docs/architecture.md). Owned by System; Stop() joins the thread.
 #pragma once
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <thread>
 #include <utility>
 #include <vector>
 
 #include "core/imu/imu_types.h"
 #include "core/sensor/camera_rig.h"
+#include "core/util/annotated_mutex.h"
 #include "map_model/atlas.h"
 #include "map_model/estimation/bundle_collect.h"
 #include "map_model/mapping_backend.h"
@@ -161,23 +161,24 @@ class LocalMapper : public MappingBackend {
   LocalMappingOptions options_;
   std::function<void(const KeyFramePtr&)> consumer_;
 
-  mutable std::mutex mutex_;  // guards queue_, busy_, stop/reset/finish requests, stats_
-  std::condition_variable wake_;
-  std::condition_variable idle_;
-  std::deque<KeyFramePtr> queue_;
-  bool busy_ = false;
-  // Live emulation (guarded by mutex_): the data-clock time at which the last finished
-  // keyframe's processing ends, and the data-clock start and wall start of the current one.
+  mutable Mutex mutex_;  // guards the members marked PKSLAM_GUARDED_BY(mutex_)
+  ConditionVariable wake_;
+  ConditionVariable idle_;
+  std::deque<KeyFramePtr> queue_ PKSLAM_GUARDED_BY(mutex_);
+  bool busy_ PKSLAM_GUARDED_BY(mutex_) = false;
+  // Live emulation: the switch and pace are set before Start() and read-only afterwards; the
+  // data-clock time at which the last finished keyframe's processing ends, and the data-clock
+  // start and wall start of the current one, are guarded.
   bool emulate_live_ = false;
   double live_pace_ = 1.0;
-  std::int64_t live_free_ns_ = std::numeric_limits<std::int64_t>::min();
-  std::int64_t live_job_start_ns_ = 0;
-  std::chrono::steady_clock::time_point live_job_wall_start_;
-  bool finish_requested_ = false;
-  bool stop_requested_ = false;
-  bool stopped_ = false;
-  bool reset_requested_ = false;
-  LocalMappingStats stats_;
+  std::int64_t live_free_ns_ PKSLAM_GUARDED_BY(mutex_) = std::numeric_limits<std::int64_t>::min();
+  std::int64_t live_job_start_ns_ PKSLAM_GUARDED_BY(mutex_) = 0;
+  std::chrono::steady_clock::time_point live_job_wall_start_ PKSLAM_GUARDED_BY(mutex_);
+  bool finish_requested_ PKSLAM_GUARDED_BY(mutex_) = false;
+  bool stop_requested_ PKSLAM_GUARDED_BY(mutex_) = false;
+  bool stopped_ PKSLAM_GUARDED_BY(mutex_) = false;
+  bool reset_requested_ PKSLAM_GUARDED_BY(mutex_) = false;
+  LocalMappingStats stats_ PKSLAM_GUARDED_BY(mutex_);
 
   std::atomic<bool> accept_keyframes_{true};
   std::atomic<bool> abort_ba_{false};

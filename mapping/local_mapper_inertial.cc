@@ -184,7 +184,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
       // keyframe tries again.
       PKSLAM_LOG_INFO("gravity refinement at t = {:.2f} s dropped: the map moved meanwhile",
                       kf->t_s());
-      std::lock_guard stats_lock(mutex_);
+      MutexLock stats_lock(mutex_);
       ++stats_.gravity_refinements_dropped;
       return;
     }
@@ -218,7 +218,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
       result.visual.aborted
           ? fmt::format(" (interrupted after {} iterations)", result.visual.iterations)
           : std::string());
-  std::lock_guard stats_lock(mutex_);
+  MutexLock stats_lock(mutex_);
   stats_.gravity_refinements.push_back(stat);
 }
 
@@ -318,7 +318,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
       snapshot.world_from_body.emplace_back(k->t_ns(), k->world_from_body());
     }
   }
-  std::lock_guard stats_lock(mutex_);
+  MutexLock stats_lock(mutex_);
   stats_.imu_stages.push_back(std::move(snapshot));
   return true;
 }
@@ -397,7 +397,7 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
       result.next_prior ? result.next_prior->information.block<3, 3>(6, 6).trace() : 0.0,
       result.next_prior ? result.next_prior->information.block<3, 3>(9, 9).trace() : 0.0,
       result.next_prior ? result.next_prior->information.block<3, 3>(12, 12).trace() : 0.0);
-  std::lock_guard stats_lock(mutex_);
+  MutexLock stats_lock(mutex_);
   if (result.visual.aborted) ++stats_.ba_aborted;
   ++(problem.anchor_prior ? stats_.inertial_ba_with_prior : stats_.inertial_ba_fixed_anchor);
   return true;

@@ -29,7 +29,7 @@ double MsSince(std::chrono::steady_clock::time_point t) {
 void LocalMapper::ProcessNext() {
   KeyFramePtr kf;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     if (queue_.empty()) return;
     kf = queue_.front();
     queue_.pop_front();
@@ -64,7 +64,7 @@ void LocalMapper::ProcessNext() {
   }
   if (IsInertial(rig_->sensor) && !IsStoppedOrStopRequested()) InertialStep(kf);
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     stats_.keyframe_ms.push_back(MsSince(start));
     stats_.ba_ms.push_back(ba_ms);
     stats_.keyframe_cpu_ms.push_back(1e3 * (ThreadCpuSeconds() - cpu_start));
@@ -115,7 +115,7 @@ void LocalMapper::CullRecentPoints(const KeyFramePtr& kf) {
     return age >= 3;  // survived its probation
   });
   lock.unlock();
-  std::lock_guard stats_lock(mutex_);
+  MutexLock stats_lock(mutex_);
   stats_.points_culled += culled;
 }
 
@@ -166,7 +166,7 @@ void LocalMapper::CreateNewMapPoints(const KeyFramePtr& kf) {
     ++added;
   }
   lock.unlock();
-  std::lock_guard stats_lock(mutex_);
+  MutexLock stats_lock(mutex_);
   stats_.points_created += added;
 }
 
@@ -223,7 +223,7 @@ void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
   if (Map* map = atlas_->FindMap(problem.map_id)) ApplyBundle(map, problem, result);
   if (result.aborted) {
     lock.unlock();
-    std::lock_guard stats_lock(mutex_);
+    MutexLock stats_lock(mutex_);
     ++stats_.ba_aborted;
   }
 }
@@ -284,7 +284,7 @@ void LocalMapper::CullKeyFrames(const KeyFramePtr& kf) {
     }
   }
   lock.unlock();
-  std::lock_guard stats_lock(mutex_);
+  MutexLock stats_lock(mutex_);
   stats_.keyframes_culled += culled;
 }
 

@@ -8,19 +8,18 @@
 //
 // Threads: one consumer thread calls Next(); the loader thread is owned by the object and
 // joined by the destructor (which stops loading early). mutex_ guards queue_, error_,
-// handed_out_ and stop_.
+// handed_out_ and stop_ (PKSLAM_GUARDED_BY, core/util/annotated_mutex.h).
 #pragma once
 
-#include <condition_variable>
 #include <cstddef>
 #include <deque>
 #include <exception>
 #include <functional>
-#include <mutex>
 #include <optional>
 #include <thread>
 #include <utility>
 
+#include "core/util/annotated_mutex.h"
 #include "core/util/error.h"
 
 namespace pkslam {
@@ -35,7 +34,7 @@ class Prefetcher {
   }
   ~Prefetcher() {
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       stop_ = true;
     }
     space_.notify_all();
@@ -46,9 +45,9 @@ class Prefetcher {
 
   // The next item in order, waiting for it if needed; std::nullopt after the last.
   std::optional<T> Next() {
-    std::unique_lock lock(mutex_);
+    MutexLock lock(mutex_);
     if (handed_out_ >= count_) return std::nullopt;
-    ready_.wait(lock, [this] { return !queue_.empty() || error_ != nullptr; });
+    while (queue_.empty() && error_ == nullptr) ready_.wait(lock);
     if (queue_.empty()) {
       handed_out_ = count_;  // nothing follows a failed item
       std::rethrow_exception(error_);
@@ -65,16 +64,16 @@ class Prefetcher {
   void Run() {
     for (std::size_t i = 0; i < count_; ++i) {
       {
-        std::unique_lock lock(mutex_);
-        space_.wait(lock, [this] { return stop_ || queue_.size() < depth_; });
+        MutexLock lock(mutex_);
+        while (!stop_ && queue_.size() >= depth_) space_.wait(lock);
         if (stop_) return;
       }
       try {
         T item = load_(i);
-        std::lock_guard lock(mutex_);
+        MutexLock lock(mutex_);
         queue_.push_back(std::move(item));
       } catch (...) {
-        std::lock_guard lock(mutex_);
+        MutexLock lock(mutex_);
         error_ = std::current_exception();
         ready_.notify_all();
         return;
@@ -86,13 +85,13 @@ class Prefetcher {
   const std::size_t count_;
   const std::function<T(std::size_t)> load_;
   const std::size_t depth_;
-  std::mutex mutex_;
-  std::condition_variable ready_;  // an item or an error arrived
-  std::condition_variable space_;  // an item was taken, or stop
-  std::deque<T> queue_;
-  std::exception_ptr error_;
-  std::size_t handed_out_ = 0;  // consumer side
-  bool stop_ = false;
+  Mutex mutex_;
+  ConditionVariable ready_;  // an item or an error arrived
+  ConditionVariable space_;  // an item was taken, or stop
+  std::deque<T> queue_ PKSLAM_GUARDED_BY(mutex_);
+  std::exception_ptr error_ PKSLAM_GUARDED_BY(mutex_);
+  std::size_t handed_out_ PKSLAM_GUARDED_BY(mutex_) = 0;  // consumer side
+  bool stop_ PKSLAM_GUARDED_BY(mutex_) = false;
   std::thread thread_;
 };
 
