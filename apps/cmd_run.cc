@@ -116,6 +116,17 @@ void RegisterRunCommand(CLI::App& app) {
                   "came twice as fast as their timestamps)")
       ->capture_default_str();
   cmd->add_option("--max-frames", args->options.max_frames, "Stop after N frames (0: all)");
+  cmd->add_option("--first-frame", args->options.first_frame,
+                  "Skip the dataset's first N frames (run on a slice)")
+      ->capture_default_str();
+  cmd->add_option("--load-map", args->options.load_map,
+                  "Start from a map file (--save-map of an earlier run with the same camera and "
+                  "vocabulary); the new session's map merges into it when recognised");
+  cmd->add_option("--save-map", args->options.save_map,
+                  "Write the final Atlas to a map file (also after Ctrl-C)");
+  cmd->add_flag("--localise-only", args->options.system.tracking.localise_only,
+                "With --load-map: track in the loaded map only, no keyframes or points; lost "
+                "frames relocalise");
   cmd->add_flag("--trace", args->options.system.trace, "Write OUT/keyframe_trace.csv");
   cmd->add_flag("--quiet", args->options.quiet, "No progress line");
   cmd->add_flag("--allow-imu-gaps", args->options.allow_imu_gaps,

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterEvalCommand(app);
   pkslam::apps::RegisterInfoCommand(app);
   pkslam::apps::RegisterRunCommand(app);
+  pkslam::apps::RegisterMapCommand(app);
   pkslam::apps::RegisterVocabCommand(app);
   pkslam::apps::RegisterDenseCommand(app);
   pkslam::apps::RegisterCloudCompareCommand(app);

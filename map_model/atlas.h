@@ -53,6 +53,7 @@ class Atlas {
   MapEditTable EditStats() const;
 
  private:
+  friend class AtlasStorage;  // map files: map_model/storage/atlas_storage.h
   friend class MapEditor;
   friend class MapReader;
   friend class MapWriteLock;

@@ -40,6 +40,10 @@ KeyFrame::KeyFrame(KeyFrameId id, const Frame& frame, Map* map)
   if (frame.HasPose()) SetPose(frame.camera_from_world());
 }
 
+KeyFrame::KeyFrame(KeyFrameId id, FrameId frame_id, std::int64_t t_ns,
+                   std::shared_ptr<const CameraRig> rig, Map* map)
+    : id_(id), frame_id_(frame_id), t_ns_(t_ns), rig_(std::move(rig)), map_(map) {}
+
 double KeyFrame::DisparityInformation(int i) const {
   if (depth_sigma_.empty() || !HasDepth(i)) return 0.0;
   return pkslam::DisparityInformation(rig_->bf, depth_[i], depth_sigma_[i]);

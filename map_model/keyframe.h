@@ -124,6 +124,10 @@ class KeyFrame {
   KeyFrameImu imu;
 
  private:
+  friend class AtlasStorage;  // map files: map_model/storage/atlas_storage.h
+  // An empty keyframe that AtlasStorage fills from a map file.
+  KeyFrame(KeyFrameId id, FrameId frame_id, std::int64_t t_ns, std::shared_ptr<const CameraRig> rig,
+           Map* map);
   void UpdateBestCovisibles();
   void ReleaseFeatures();
 

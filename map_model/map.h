@@ -99,6 +99,7 @@ class Map {
   KeyFrameDatabase* database() const { return database_; }
 
  private:
+  friend class AtlasStorage;  // map files: map_model/storage/atlas_storage.h
   MapId id_;
   std::map<KeyFrameId, KeyFramePtr> keyframes_;
   std::map<KeyFrameId, KeyFramePtr> retired_;

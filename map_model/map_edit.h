@@ -23,6 +23,7 @@ enum class MapEdit : std::uint8_t {
   kLoopCorrection,          // loop closing: a loop's correction and the essential graph
   kMergeMaps,               // loop closing: two maps merged
   kGlobalBundle,            // loop closing: a global BA result merged in
+  kLoadMap,                 // system: a map file restored into the Atlas (--load-map)
   kFixture,                 // tests and benchmarks that build maps by hand
 };
 inline constexpr int kNumMapEdits = static_cast<int>(MapEdit::kFixture) + 1;

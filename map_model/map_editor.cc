@@ -34,6 +34,8 @@ std::string_view MapEditName(MapEdit edit) {
       return "merge_maps";
     case MapEdit::kGlobalBundle:
       return "global_bundle";
+    case MapEdit::kLoadMap:
+      return "load_map";
     case MapEdit::kFixture:
       return "fixture";
   }

@@ -78,6 +78,7 @@ class MapPoint : public std::enable_shared_from_this<MapPoint> {
   double FoundRatio() const { return static_cast<double>(found()) / std::max(1, visible()); }
 
  private:
+  friend class AtlasStorage;  // map files: map_model/storage/atlas_storage.h
   MapPointId id_;
   KeyFrameId first_kf_id_;
   Map* map_;

@@ -40,6 +40,10 @@ struct FrameSource {
 void RunOptions::Check() const {
   if (dataset.empty()) throw OptionError("--dataset is required");
   if (max_frames < 0) throw OptionError(fmt::format("--max-frames {} < 0", max_frames));
+  if (first_frame < 0) throw OptionError(fmt::format("--first-frame {} < 0", first_frame));
+  if (system.tracking.localise_only && !load_map) {
+    throw OptionError("--localise-only needs --load-map (a map to localise in)");
+  }
   imu_limits.Check();
   system.Check();
 }
@@ -147,6 +151,13 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   }
   if (sources.empty()) throw InputError(options.dataset, "no frames to process");
   summary.dataset_fingerprint = DatasetFingerprint(euroc ? euroc->cam0() : tum->rgb());
+  if (options.first_frame > 0) {
+    if (options.first_frame >= static_cast<int>(sources.size())) {
+      throw InputError(options.dataset, fmt::format("--first-frame {}: the dataset has {} frames",
+                                                    options.first_frame, sources.size()));
+    }
+    sources.erase(sources.begin(), sources.begin() + options.first_frame);
+  }
   if (options.max_frames > 0 && static_cast<int>(sources.size()) > options.max_frames) {
     sources.resize(options.max_frames);
   }
@@ -187,6 +198,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
     system_options.mapping_sync = !options.realtime && IsMonocular(sensor) ? "live" : "free";
   }
   SlamSystem system(settings, vocabulary, system_options);
+  if (options.load_map) summary.map_loaded = system.LoadMap(*options.load_map);
   // Written now as well as at the end: evaluating a killed run's partial trajectory against
   // body-frame ground truth needs it.
   WriteRigidTransform(system.rig().body_from_camera, options.out / "body_from_camera.txt",
@@ -330,6 +342,8 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   WriteTrajectoryOutputs(system, options);
   if (control.trajectory_written) control.trajectory_written();
   system.Shutdown();
+  // Saved also after an interruption: the map of the frames processed.
+  if (options.save_map) summary.map_saved = system.SaveMap(*options.save_map);
   summary.wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   // Data time without the timestamp jumps --realtime does not sleep through (the real-time

@@ -39,8 +39,14 @@ struct RunOptions {
   std::filesystem::path out = "out";
   // Pace frames to their timestamps instead of running as fast as possible.
   bool realtime = false;
-  // Stop after this many frames (0: all).
+  // Skip the dataset's first frames (a slice of a sequence: --first-frame), then stop after
+  // max_frames of the rest (0: all).
+  int first_frame = 0;
   int max_frames = 0;
+  // Map files (--load-map, --save-map; map_model/storage/map_file.h). Localisation only
+  // (system.tracking.localise_only) needs load_map.
+  std::optional<std::filesystem::path> load_map;
+  std::optional<std::filesystem::path> save_map;
   // SystemOptions::mapping_sync; empty: "live" for offline monocular runs, "free" otherwise.
   std::string mapping_sync;
   // No progress line.
@@ -66,6 +72,9 @@ struct RunSummary {
   double sequence_s = 0;
   double median_tracking_ms = 0;
   bool interrupted = false;
+  // Map files read and written (sizes, counts, wall seconds).
+  std::optional<SlamSystem::MapFileInfo> map_loaded;
+  std::optional<SlamSystem::MapFileInfo> map_saved;
   std::string dataset_fingerprint;  // io/dataset_fingerprint.h
   // Keyframes created, per reason: the selector rule that fired, or "initialisation".
   std::map<std::string, int> keyframe_reasons;

@@ -228,6 +228,21 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   json.Member("selector", options.system.selector);
   json.Member("deterministic", options.system.deterministic);
   json.Member("interrupted", summary->interrupted);
+  json.Member("localise_only", options.system.tracking.localise_only);
+  const auto map_file = [&json](const char* key, const std::optional<std::filesystem::path>& file,
+                                const std::optional<SlamSystem::MapFileInfo>& info) {
+    if (!file || !info) return;
+    json.Key(key).BeginObject();
+    json.Member("file", file->string());
+    json.Member("maps", info->maps);
+    json.Member("keyframes", info->keyframes);
+    json.Member("map_points", info->map_points);
+    json.Member("bytes", static_cast<std::int64_t>(info->bytes));
+    json.Member("seconds", info->seconds);
+    json.EndObject();
+  };
+  map_file("map_loaded", options.load_map, summary->map_loaded);
+  map_file("map_saved", options.save_map, summary->map_saved);
   json.Member("degraded", summary->input.degraded());
   WriteInputReport(summary->input, &json);
   json.Member("frames", summary->frames);

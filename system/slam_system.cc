@@ -1,8 +1,10 @@
 #include "system/slam_system.h"
 
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <mutex>
+#include <set>
 #include <shared_mutex>
 
 #include "core/util/error.h"
@@ -13,6 +15,8 @@
 #include "map_model/keyframe_database.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
+#include "map_model/storage/atlas_storage.h"
+#include "map_model/storage/map_file.h"
 
 namespace pkslam {
 
@@ -88,6 +92,71 @@ void SlamSystem::Shutdown() {
   if (loop_) loop_->Finish();
 }
 
+namespace {
+
+SlamSystem::MapFileInfo CountMaps(const AtlasRecord& record) {
+  SlamSystem::MapFileInfo info;
+  info.maps = static_cast<int>(record.maps.size());
+  for (const MapRecord& m : record.maps) {
+    info.keyframes += static_cast<int>(m.keyframes.size());
+    info.map_points += static_cast<int>(m.points.size());
+  }
+  return info;
+}
+
+}  // namespace
+
+SlamSystem::MapFileInfo SlamSystem::SaveMap(const std::filesystem::path& file) const {
+  const auto start = std::chrono::steady_clock::now();
+  AtlasRecord record;
+  {
+    auto lock = MapReader(atlas_).Lock();
+    record = AtlasStorage::Snapshot(atlas_, *setup_.rig, vocabulary_->Fingerprint());
+  }
+  WriteMapFile(file, record);
+  MapFileInfo info = CountMaps(record);
+  info.bytes = std::filesystem::file_size(file);
+  info.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  PKSLAM_LOG_INFO("map saved to {}: {} map(s), {} keyframes, {} points, {:.1f} MB, {:.2f} s",
+                  file.string(), info.maps, info.keyframes, info.map_points, info.bytes / 1e6,
+                  info.seconds);
+  return info;
+}
+
+SlamSystem::MapFileInfo SlamSystem::LoadMap(const std::filesystem::path& file) {
+  const auto start = std::chrono::steady_clock::now();
+  const AtlasRecord record = ReadMapFile(file);
+  CheckCompatible(file, record, vocabulary_->Fingerprint(), *setup_.rig);
+  if (record.maps.empty()) throw InputError(file, "the map file holds no map");
+  {
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kLoadMap);
+    try {
+      AtlasStorage::Restore(record, setup_.rig, &atlas_);
+    } catch (const InputError&) {
+      throw;
+    } catch (const Error& e) {
+      throw InputError(file, fmt::format("inconsistent map: {}", e.what()));
+    }
+    if (options_.tracking.localise_only) {
+      Map* largest = nullptr;
+      for (Map* m : atlas_.maps()) {
+        if (largest == nullptr || m->NumKeyFrames() > largest->NumKeyFrames()) largest = m;
+      }
+      atlas_.SetCurrentMap(largest);
+    } else {
+      atlas_.CreateNewMap();  // this session's map; loop closing merges it when it recognises one
+    }
+  }
+  if (options_.tracking.localise_only) tracker_->StartLocalisation();
+  MapFileInfo info = CountMaps(record);
+  info.bytes = std::filesystem::file_size(file);
+  info.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  PKSLAM_LOG_INFO("map loaded from {}: {} map(s), {} keyframes, {} points, {:.2f} s{}",
+                  file.string(), info.maps, info.keyframes, info.map_points, info.seconds,
+                  options_.tracking.localise_only ? "; localisation only" : "");
+  return info;
+}
+
 TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
   if (setup_.rectification) {
     const auto [l, r] = setup_.rectification->Rectify(left, right);
@@ -105,8 +174,17 @@ TrackResult SlamSystem::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) 
 }
 
 const Map* SlamSystem::LargestMap() const {
+  // Among the maps this session tracked frames in: a map loaded from a file (--load-map) that
+  // this session neither localised in nor merged into describes none of its frames, and an
+  // output of it would be an empty trajectory. Without a loaded map every map holds frames of
+  // this session, and this is the largest map, as ORB-SLAM3 chooses.
+  std::set<const Map*> session_maps;
+  for (const FrameRecord& r : tracker_->records()) {
+    if (r.reference && r.reference->map() != nullptr) session_maps.insert(r.reference->map());
+  }
   const Map* best = nullptr;
   for (const Map* m : atlas_.maps()) {
+    if (!session_maps.empty() && session_maps.count(m) == 0) continue;
     if (best == nullptr || m->NumKeyFrames() > best->NumKeyFrames()) best = m;
   }
   return best;

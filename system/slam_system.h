@@ -68,6 +68,21 @@ class SlamSystem {
   // Lets local mapping finish its queue and stops the threads (idempotent).
   void Shutdown();
 
+  // Map files (map_model/storage/map_file.h). SaveMap writes the whole Atlas (call after
+  // Shutdown for the final map). LoadMap restores a file into this new system before its
+  // first frame: with tracking.localise_only the tracker relocalises into the loaded current
+  // map and only tracks; otherwise a new map starts for this session and loop closing merges
+  // it into a loaded one it recognises. Both throw InputError / OutputError naming the file.
+  struct MapFileInfo {
+    int maps = 0;
+    int keyframes = 0;
+    int map_points = 0;
+    std::uintmax_t bytes = 0;
+    double seconds = 0;  // wall time of the read + restore, or of the snapshot + write
+  };
+  MapFileInfo SaveMap(const std::filesystem::path& file) const;
+  MapFileInfo LoadMap(const std::filesystem::path& file);
+
   // Camera poses (world_from_camera) of every tracked frame whose map is the largest map
   // (ORB-SLAM3's choice when saving), with poses re-expressed through their reference
   // keyframes' final poses. Frames without a pose are left out.
@@ -87,7 +102,8 @@ class SlamSystem {
   int NumMaps() const;
 
   // For output writers (system/sparse_model_builder.h): the Atlas (take its mutex shared to
-  // read) and the map the outputs describe, the one with the most keyframes.
+  // read) and the map the outputs describe: the one with the most keyframes among the maps
+  // this session tracked frames in.
   const Atlas& atlas() const { return atlas_; }
   const Map* LargestMap() const;  // requires the Atlas lock
 

@@ -147,33 +147,37 @@ TrackResult Tracker::Track(Frame frame) {
       for (auto& mp : last_.map_points) {
         while (mp && mp->replaced_by()) mp = mp->replaced_by();
       }
-      if (state_ == TrackingState::kOk && ImuReady()) {
-        ok = TrackWithImu();
-        if (!ok) ok = TrackReferenceKeyFrame();
-      } else if (state_ == TrackingState::kRecentlyLost && ImuReady()) {
-        ok = PredictWithImu();  // IMU-only prediction; the local map search decides
-      } else if (state_ == TrackingState::kOk) {
-        if (!velocity_ || current_.id() < last_reloc_frame_id_ + 2) {
-          ok = TrackReferenceKeyFrame();
-        } else {
-          ok = TrackWithMotionModel();
+      if (options_.localise_only) {
+        ok = TrackLocalisationOnly();
+      } else {
+        if (state_ == TrackingState::kOk && ImuReady()) {
+          ok = TrackWithImu();
           if (!ok) ok = TrackReferenceKeyFrame();
+        } else if (state_ == TrackingState::kRecentlyLost && ImuReady()) {
+          ok = PredictWithImu();  // IMU-only prediction; the local map search decides
+        } else if (state_ == TrackingState::kOk) {
+          if (!velocity_ || current_.id() < last_reloc_frame_id_ + 2) {
+            ok = TrackReferenceKeyFrame();
+          } else {
+            ok = TrackWithMotionModel();
+            if (!ok) ok = TrackReferenceKeyFrame();
+          }
+        } else if (state_ == TrackingState::kRecentlyLost) {
+          ok = Relocalize();
         }
-      } else if (state_ == TrackingState::kRecentlyLost) {
-        ok = Relocalize();
-      }
-      if (ok) ok = TrackLocalMap();
+        if (ok) ok = TrackLocalMap();
 
-      if (ok) {
-        state_ = TrackingState::kOk;
-      } else if (state_ == TrackingState::kOk) {
-        const bool keep =
-            atlas_->current_map()->NumKeyFrames() > options_.min_keyframes_to_keep_map;
-        state_ = keep ? TrackingState::kRecentlyLost : TrackingState::kLost;
-        lost_since_t_ns_ = current_.t_ns();
-      } else if (state_ == TrackingState::kRecentlyLost &&
-                 (current_.t_ns() - lost_since_t_ns_) * 1e-9 > options_.recently_lost_timeout_s) {
-        state_ = TrackingState::kLost;
+        if (ok) {
+          state_ = TrackingState::kOk;
+        } else if (state_ == TrackingState::kOk) {
+          const bool keep =
+              atlas_->current_map()->NumKeyFrames() > options_.min_keyframes_to_keep_map;
+          state_ = keep ? TrackingState::kRecentlyLost : TrackingState::kLost;
+          lost_since_t_ns_ = current_.t_ns();
+        } else if (state_ == TrackingState::kRecentlyLost &&
+                   (current_.t_ns() - lost_since_t_ns_) * 1e-9 > options_.recently_lost_timeout_s) {
+          state_ = TrackingState::kLost;
+        }
       }
 
       if (ok) {
@@ -186,6 +190,8 @@ TrackResult Tracker::Track(Frame frame) {
             current_.outliers[i] = 0;
           }
         }
+      }
+      if (ok && !options_.localise_only) {
         selector_input =
             BuildSelectorInput(emulated ? idle_at_frame : mapping_->AcceptsKeyFrames());
         // Taken once per decision (a keyframe's second input, SnapshotAfterCreation, has none).
@@ -204,7 +210,7 @@ TrackResult Tracker::Track(Frame frame) {
     }
     if (ok) {
       if (last_decision_.interrupt_local_ba) mapping_->InterruptBundleAdjustment();
-      if (last_decision_.insert) {
+      if (last_decision_.insert && !options_.localise_only) {
         CreateNewKeyFrame(selector_input);
         new_keyframe = true;
       }
@@ -214,7 +220,7 @@ TrackResult Tracker::Track(Frame frame) {
         if (current_.map_points[i] && current_.outliers[i]) current_.map_points[i].reset();
       }
       result.keyframe_reason = last_decision_.reason;
-      result.selector_decided = true;
+      result.selector_decided = !options_.localise_only;
       for (const auto& [key, value] : last_decision_.trace) {
         if (key.starts_with("criterion") && value != 0) result.criteria_held.push_back(key);
       }
@@ -223,7 +229,8 @@ TrackResult Tracker::Track(Frame frame) {
     }
   }
 
-  if (state_ == TrackingState::kLost) HandleLost();
+  // Localisation only keeps the loaded map whatever happens: the next frame relocalises.
+  if (state_ == TrackingState::kLost && !options_.localise_only) HandleLost();
 
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() -

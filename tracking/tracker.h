@@ -90,6 +90,9 @@ class Tracker {
   };
   const std::vector<TraceRow>& trace() const { return trace_; }
   void EnableTrace(bool on) { trace_enabled_ = on; }
+  // Localisation only (TrackingOptions::localise_only) on a map loaded into the Atlas: the
+  // next frame is relocalised against the current map (tracking/tracker_localisation.cc).
+  void StartLocalisation();
   int relocalisations() const { return relocalisations_; }
 
   // Drops the current map (a reset) and starts again from NOT_INITIALIZED.
@@ -105,6 +108,9 @@ class Tracker {
   bool TrackReferenceKeyFrame();
   bool TrackWithMotionModel();
   bool TrackLocalMap();
+  // Localisation only: motion model or reference keyframe while tracked, relocalisation
+  // otherwise, then the local map; sets state_ (kOk or kLost). Atlas lock held (shared).
+  bool TrackLocalisationOnly();
   void UpdateLastFrame();
   void UpdateLocalKeyFrames();
   void UpdateLocalPoints();

@@ -46,7 +46,10 @@ void Tracker::AddImu(const std::vector<ImuMeasurement>& samples) {
 }
 
 bool Tracker::ImuReady() const {
-  return imu_ != nullptr && atlas_->current_map()->imu_status().imu_initialized;
+  // Localisation only tracks visually: the frames' velocities and biases are not estimated
+  // (no keyframes to anchor them), so an inertial prior would pull the pose off.
+  return imu_ != nullptr && !options_.localise_only &&
+         atlas_->current_map()->imu_status().imu_initialized;
 }
 
 std::optional<PreintegratedImu> Tracker::PreintegrateBetween(std::int64_t t0_ns, std::int64_t t1_ns,

@@ -47,6 +47,10 @@ struct TrackingOptions {
   int min_keyframes_to_keep_map = 10;
   // Deterministic mode: wait for local mapping to finish each keyframe before going on.
   bool lockstep = false;
+  // Localisation only (--localise-only, on a loaded map; ORB-SLAM3's localisation mode):
+  // track against the map without creating keyframes or points; a lost frame is
+  // relocalised (the map is never reset), the inertial paths are not used.
+  bool localise_only = false;
   // Monocular sensors, while local mapping is busy (ORB-SLAM refuses monocular keyframes
   // then): tracking inserts a keyframe anyway, interrupting the local BA, when its map is
   // about to starve: the selector wanted one and tracking holds fewer than

@@ -363,4 +363,23 @@ void VocabularyTrainOptions::Check() const {
   PKSLAM_CHECK_OPTION(parallel_assign_min >= 1, "parallel_assign_min", "{}", parallel_assign_min);
 }
 
+std::uint64_t Vocabulary::Fingerprint() const {
+  std::uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* data, std::size_t n) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) {
+      h ^= bytes[i];
+      h *= 1099511628211ull;
+    }
+  };
+  const std::int32_t params[4] = {params_.branching, params_.levels,
+                                  static_cast<std::int32_t>(params_.scoring),
+                                  static_cast<std::int32_t>(params_.weighting)};
+  mix(params, sizeof(params));
+  for (const Descriptor& d : descriptors_) mix(d.bytes.data(), d.bytes.size());
+  mix(parents_.data(), parents_.size() * sizeof(NodeId));
+  mix(weights_.data(), weights_.size() * sizeof(double));
+  return h;
+}
+
 }  // namespace pkslam

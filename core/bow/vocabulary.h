@@ -145,6 +145,9 @@ class Vocabulary {
   WordId word_of_node(NodeId node) const { return node_words_[node]; }
   NodeId word_node(WordId word) const { return word_nodes_[word]; }
   double WordWeight(WordId word) const { return weights_[word_nodes_[word]]; }
+  // 64-bit FNV-1a hash of the tree (parameters, node descriptors, parents, weights): map
+  // files record it, so a map is only loaded with the vocabulary its BoW vectors came from.
+  std::uint64_t Fingerprint() const;
   // The node list as stored in files (inverse of FromNodes).
   std::vector<VocabularyNode> Nodes() const;
   // Deepest level of any word (<= levels()).

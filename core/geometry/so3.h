@@ -8,11 +8,10 @@
 // - Names say which frames a rotation maps: R_world_from_body * p_body = p_world.
 #pragma once
 
-#include <cmath>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <cmath>
 
 namespace pkslam {
 
@@ -29,6 +28,13 @@ class SO3 {
   SO3() : q_(Quat::Identity()) {}
   // Normalises q (a non-unit quaternion is accepted and projected).
   explicit SO3(const Quat& q) : q_(q.normalized()) {}
+  // A quaternion an SO3 gave out (quaternion()), taken back bit for bit: no re-normalisation,
+  // which would change the last bits (map files restore poses exactly).
+  static SO3 FromStoredQuaternion(const Quat& q) {
+    SO3 r;
+    r.q_ = q;
+    return r;
+  }
   // From a rotation matrix; a slightly non-orthonormal matrix is projected (via quaternion).
   explicit SO3(const Mat3& rotation) : q_(Quat(rotation).normalized()) {}
 
@@ -37,7 +43,7 @@ class SO3 {
     const Eigen::JacobiSVD<Mat3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
     Mat3 d = Mat3::Identity();
     d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < Scalar(0) ? Scalar(-1)
-                                                                                     : Scalar(1);
+                                                                                    : Scalar(1);
     return SO3(Mat3(svd.matrixU() * d * svd.matrixV().transpose()));
   }
 
