@@ -3,10 +3,13 @@
 
 #include <atomic>
 #include <csignal>
+#include <memory>
+#include <optional>
 
 #include "apps/commands.h"
 #include "core/util/error.h"
 #include "system/run_dataset.h"
+#include "system/run_source.h"
 
 namespace pkslam::apps {
 namespace {
@@ -47,6 +50,11 @@ struct RunArgs {
   std::string out = "out";
   std::vector<std::string> params;
   bool strict = false;
+  std::string video;
+  std::optional<double> fps;
+  std::optional<int> camera;
+  std::string images;
+  std::string timestamps;
 };
 
 std::map<std::string, double> ParseParams(const std::vector<std::string>& params) {
@@ -78,9 +86,23 @@ std::map<std::string, double> ParseParams(const std::vector<std::string>& params
 
 void RegisterRunCommand(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
-  auto* cmd = app.add_subcommand("run", "Run SLAM over a EuRoC or TUM RGB-D dataset");
-  cmd->add_option("--dataset", args->options.dataset, "Dataset directory (EuRoC ASL or TUM RGB-D)")
-      ->required();
+  auto* cmd = app.add_subcommand(
+      "run", "Run SLAM over a EuRoC or TUM RGB-D dataset, a video, a camera or an image folder");
+  cmd->add_option("--dataset", args->options.dataset, "Dataset directory (EuRoC ASL or TUM RGB-D)");
+  cmd->add_option("--video", args->video,
+                  "Monocular: a video file (OpenCV VideoCapture), with --settings CAM.yaml; "
+                  "timestamps from the container or --fps");
+  cmd->add_option("--fps", args->fps,
+                  "--video: stamp frame k at k / FPS s instead of the "
+                  "container's timestamps");
+  cmd->add_option("--camera", args->camera,
+                  "Monocular: live camera N (e.g. 0 for /dev/video0), "
+                  "with --settings; Ctrl-C stops");
+  cmd->add_option("--images", args->images,
+                  "Monocular: a folder of images, with --timestamps and --settings");
+  cmd->add_option("--timestamps", args->timestamps,
+                  "--images: one frame per line, 't_ns' (DIR/t_ns.png) or 't name' (t in s "
+                  "with a decimal point, else ns)");
   cmd->add_option("--sensor", args->sensor,
                   "mono | stereo | rgbd | mono-inertial | stereo-inertial | rgbd-inertial")
       ->capture_default_str();
@@ -159,7 +181,21 @@ void RegisterRunCommand(CLI::App& app) {
       std::signal(SIGTERM, OnSignal);
     };
     control.trajectory_written = OnTrajectoryWritten;
-    const RunSummary s = RunDataset(o, control);
+    const int inputs = (o.dataset.empty() ? 0 : 1) + (args->video.empty() ? 0 : 1) +
+                       (args->camera ? 1 : 0) + (args->images.empty() ? 0 : 1);
+    if (inputs != 1) {
+      throw OptionError("give exactly one input: --dataset, --video, --camera or --images");
+    }
+    if (args->fps && args->video.empty()) throw OptionError("--fps goes with --video");
+    if (args->images.empty() != args->timestamps.empty()) {
+      throw OptionError("--images and --timestamps go together");
+    }
+    std::unique_ptr<FrameSource> source;
+    if (!args->video.empty()) source = OpenVideoFile(args->video, args->fps);
+    if (args->camera) source = OpenCamera(*args->camera);
+    if (!args->images.empty()) source = OpenImageFolder(args->images, args->timestamps);
+    if (source) o.dataset = source->Name();
+    const RunSummary s = source ? RunFrameSource(o, *source, control) : RunDataset(o, control);
     fmt::print("frames {} tracked {} lost {} keyframes {} map points {} maps {}\n", s.frames,
                s.tracked, s.lost, s.keyframes, s.map_points, s.maps);
     fmt::print(

@@ -1,7 +1,7 @@
 # Every dependency is a Debian 12 package (scripts/setup installs them).
 find_package(Threads REQUIRED)
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
-find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs features2d calib3d)
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs features2d calib3d videoio)
 find_package(Ceres 2.1 REQUIRED)
 find_package(opengv REQUIRED)
 find_package(yaml-cpp REQUIRED)

@@ -29,7 +29,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // One input frame, however the dataset stores it.
-struct FrameSource {
+struct DatasetFrame {
   std::int64_t t_ns;
   std::size_t a;  // left / rgb index
   std::size_t b;  // right / depth index
@@ -63,6 +63,19 @@ fs::path DefaultVocabularyPath() {
   return fs::path(PKSLAM_SOURCE_DIR) / name;
 }
 
+std::shared_ptr<const Vocabulary> LoadRunVocabulary(const RunOptions& options) {
+  const fs::path vocabulary_path = options.vocabulary.value_or(DefaultVocabularyPath());
+  if (!fs::exists(vocabulary_path)) {
+    throw InputError(vocabulary_path, "vocabulary not found (pass --vocabulary)");
+  }
+  if (!fs::is_regular_file(vocabulary_path)) {
+    // A directory read as a file failed with "basic_filebuf::underflow error".
+    throw InputError(vocabulary_path, "vocabulary is not a file (pass the .bin or .txt file)");
+  }
+  PKSLAM_LOG_INFO("loading vocabulary {}", vocabulary_path.string());
+  return std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary_path));
+}
+
 RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   const std::atomic<bool>* interrupt = control.interrupt;
   options.Check();
@@ -82,7 +95,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   // --- dataset and settings ---
   std::optional<EurocDataset> euroc;
   std::optional<TumRgbdDataset> tum;
-  std::vector<FrameSource> sources;
+  std::vector<DatasetFrame> sources;
   Settings settings;
   if (EurocDataset::LooksLikeEuroc(options.dataset)) {
     EurocOptions eo;
@@ -163,22 +176,13 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   }
   std::vector<std::int64_t> frame_t_ns;
   frame_t_ns.reserve(sources.size());
-  for (const FrameSource& s : sources) frame_t_ns.push_back(s.t_ns);
+  for (const DatasetFrame& s : sources) frame_t_ns.push_back(s.t_ns);
   // Jumps of more than a few frame periods: a recording pause, a dropped stretch, a broken
   // stamp. Listed, and --realtime restarts its pacing after those over kMaxFrameGapNs.
   const std::vector<TimestampJump> jumps =
       ReportTimestampJumps(frame_t_ns, options.dataset.string(), &report);
 
-  const fs::path vocabulary_path = options.vocabulary.value_or(DefaultVocabularyPath());
-  if (!fs::exists(vocabulary_path)) {
-    throw InputError(vocabulary_path, "vocabulary not found (pass --vocabulary)");
-  }
-  if (!fs::is_regular_file(vocabulary_path)) {
-    // A directory read as a file failed with "basic_filebuf::underflow error".
-    throw InputError(vocabulary_path, "vocabulary is not a file (pass the .bin or .txt file)");
-  }
-  PKSLAM_LOG_INFO("loading vocabulary {}", vocabulary_path.string());
-  auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary_path));
+  auto vocabulary = LoadRunVocabulary(options);
 
   SystemOptions system_options = options.system;
   // Offline runs feed frames as fast as tracking takes them (hundreds per second). A
@@ -234,7 +238,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   Prefetcher<LoadedImages> images(
       sources.size(),
       [&](std::size_t k) {
-        const FrameSource& s = sources[k];
+        const DatasetFrame& s = sources[k];
         std::future<cv::Mat> second;  // its destructor waits, also when the first one throws
         if (euroc && IsStereo(sensor)) {
           second = std::async(std::launch::async, [&] { return euroc->LoadCam1(s.b); });
@@ -277,7 +281,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   partial.Append(kTumHeader);
   bool partial_warned = false;
   if (control.frames_starting) control.frames_starting();
-  for (const FrameSource& s : sources) {
+  for (const DatasetFrame& s : sources) {
     if (options.realtime && summary.frames > 0 &&
         (s.t_ns - previous_t_ns > kMaxFrameGapNs || s.t_ns <= previous_t_ns)) {
       PKSLAM_LOG_INFO("--realtime pacing restarts after the timestamp jump at frame {}",

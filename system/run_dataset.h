@@ -88,6 +88,8 @@ struct RunSummary {
 
 // The vocabulary shipped with pkslam (Vocabulary/ in the source tree or next to the binary).
 std::filesystem::path DefaultVocabularyPath();
+// The run's vocabulary (--vocabulary or the default); InputError naming a missing file.
+std::shared_ptr<const Vocabulary> LoadRunVocabulary(const RunOptions& options);
 
 // How a caller stops and follows a run (every member optional).
 struct RunControl {
