@@ -28,3 +28,11 @@ endif()
 if(PKSLAM_BUILD_BENCHMARKS)
   find_package(benchmark REQUIRED)
 endif()
+
+# Debian's interpreter: it has python3-opencv, numpy, pytest and the pybind11 headers'
+# Python (scripts/setup); a python3 earlier on PATH (pyenv, a venv) may not. The Python module
+# (python/) is built for it and the Python tests run with it.
+find_program(PKSLAM_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT PKSLAM_SYSTEM_PYTHON)
+  find_program(PKSLAM_SYSTEM_PYTHON NAMES python3 REQUIRED)
+endif()

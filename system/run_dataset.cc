@@ -50,14 +50,17 @@ void RunOptions::Check() const {
 
 fs::path DefaultVocabularyPath() {
   const fs::path name = "Vocabulary/pkslam_orb_k10_L6.bin";
-  // Next to the executable's build tree first (build/bin/pkslam -> source/Vocabulary), then the
-  // source tree this binary was built from.
+  // Next to the executable's build tree first (build/bin/pkslam -> source/Vocabulary), or an
+  // installed prefix (PREFIX/bin/pkslam -> PREFIX/share/pkslam), then the source tree this
+  // binary was built from.
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
     for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path();
          dir = dir.parent_path()) {
       if (fs::exists(dir / name)) return dir / name;
+      const fs::path installed = dir / "share/pkslam" / name.filename();
+      if (fs::exists(installed)) return installed;
     }
   }
   return fs::path(PKSLAM_SOURCE_DIR) / name;

@@ -17,7 +17,7 @@ EXTRA = {
     "pkslam_testsupport": {"folder": "tests/support", "deps": []},
 }
 SKIP_FOLDERS = {"build", "build-address", "build-fuzz", "build-thread", ".git", "third_party"}
-TOP_FOLDERS = {"apps", "tests", "fuzz", "examples"}  # may include anything
+TOP_FOLDERS = {"apps", "tests", "fuzz", "examples", "api", "python"}  # may include anything
 
 
 def parse_libraries(repo):

@@ -1,0 +1,104 @@
+// pkslam as a library: the one public header of the installed package
+// (find_package(pkslam) -> pkslam::pkslam). A SLAM system made from an ORB-SLAM3 settings file
+// and a vocabulary; feed it images (and IMU samples) with timestamps, read the pose and the
+// tracking state, save and load maps, get the trajectories. Everything else in pkslam is
+// internal to the library (namespace pkslam::api keeps these names apart from it).
+//
+//   pkslam::api::Slam slam({.settings = "cam.yaml", .vocabulary = "ORBvoc.bin", .sensor =
+//   "stereo"}); for (...) slam.TrackStereo(left, right, t_ns); slam.Shutdown(); for (const
+//   pkslam::api::StampedPose& p : slam.Trajectory()) ...
+//
+// Threads: one Slam per caller thread; it runs its own local-mapping and loop-closing threads.
+// Errors: std::runtime_error with a one-line message (bad files name the file).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <opencv2/core/mat.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pkslam::api {
+
+inline constexpr const char* kApiVersion = "0.1.0";
+
+enum class SlamState { kNotInitialized, kOk, kRecentlyLost, kLost };
+const char* SlamStateName(SlamState state);
+
+struct StampedPose {
+  std::int64_t t_ns = 0;
+  Eigen::Matrix4d world_from_camera = Eigen::Matrix4d::Identity();
+};
+
+struct ImuSample {
+  std::int64_t t_ns = 0;
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   // rad/s
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // m/s^2
+};
+
+struct SlamOptions {
+  std::string settings;    // ORB-SLAM3 v1.0 settings file (camera, ORB, IMU)
+  std::string vocabulary;  // DBoW2 text or pkslam binary vocabulary
+  // mono | stereo | rgbd | mono-inertial | stereo-inertial | rgbd-inertial
+  std::string sensor = "stereo";
+  std::string selector = "orbslam3";  // keyframe selector (orbslam3, pks, pks-released, ...)
+  bool deterministic = false;         // fixed seeds, local mapping in lock-step
+  bool localise_only = false;         // with LoadMap before the first frame
+  bool loop_closing = true;
+};
+
+class Slam {
+ public:
+  explicit Slam(const SlamOptions& options);
+  ~Slam();
+  Slam(const Slam&) = delete;
+  Slam& operator=(const Slam&) = delete;
+
+  // Images: 8-bit grey or BGR; depth: 16-bit (settings' depth factor) or 32-bit float metres.
+  // Stereo pairs raw or rectified, as the settings describe the rig. Inertial sensors: add
+  // the IMU samples up to (a little past) each frame's time first.
+  SlamState TrackMonocular(const cv::Mat& image, std::int64_t t_ns);
+  SlamState TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns);
+  SlamState TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns);
+  void AddImu(const std::vector<ImuSample>& samples);
+
+  SlamState state() const;
+  // world_from_camera of the last frame when it was tracked.
+  std::optional<Eigen::Matrix4d> CurrentPose() const;
+  int NumKeyFrames() const;
+  int NumMapPoints() const;
+
+  // Map files (docs/maps.md): SaveMap after Shutdown for the final map; LoadMap before the
+  // first frame.
+  void SaveMap(const std::string& file) const;
+  void LoadMap(const std::string& file);
+
+  // Finishes local mapping and loop closing (idempotent; the destructor calls it).
+  void Shutdown();
+  // Every tracked frame, re-expressed through its keyframe's final pose; the keyframes.
+  std::vector<StampedPose> Trajectory() const;
+  std::vector<StampedPose> KeyFrameTrajectory() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// ATE / RPE of an estimate against ground truth (`pkslam eval`, evo-compatible): associate by
+// time (max 10 ms), align ("se3", "sim3", "posyaw", "none"), RPE over 1-frame pairs. The ground
+// truth and the estimate are files (TUM, EuRoC csv or ORB-SLAM3 format, detected) or poses.
+struct Evaluation {
+  std::size_t pairs = 0;
+  double scale = 1.0;  // of the alignment (1 unless sim3)
+  double ate_rmse_m = 0, ate_mean_m = 0, ate_median_m = 0, ate_max_m = 0;
+  double ate_rot_rmse_deg = 0;
+  double rpe_trans_rmse_m = 0, rpe_rot_rmse_deg = 0;
+};
+Evaluation Evaluate(const std::string& ground_truth_file, const std::string& estimate_file,
+                    const std::string& align = "se3");
+Evaluation Evaluate(const std::string& ground_truth_file, const std::vector<StampedPose>& estimate,
+                    const std::string& align = "se3");
+
+}  // namespace pkslam::api

@@ -1,0 +1,188 @@
+// The Python module `pkslam` (its native part, pkslam._pkslam): the public C++ API
+// (api/include/pkslam/pkslam.h) with NumPy arrays in and out. Images are uint8 (H, W) or
+// (H, W, 3) arrays, depth uint16 or float32 (H, W), poses 4x4 float64 world_from_camera.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <opencv2/core/mat.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "pkslam/pkslam.h"
+
+namespace py = pybind11;
+namespace api = pkslam::api;
+
+namespace {
+
+// A cv::Mat view of a C-contiguous array (no copy; valid while the array lives).
+cv::Mat View(const py::array& a, const char* what) {
+  const py::buffer_info b = a.request();
+  if (b.ndim != 2 && !(b.ndim == 3 && (b.shape[2] == 3 || b.shape[2] == 1))) {
+    throw std::invalid_argument(std::string(what) + ": expected an (H, W) or (H, W, 3) array");
+  }
+  if (!(a.flags() & py::array::c_style)) {
+    throw std::invalid_argument(std::string(what) + ": array must be C-contiguous");
+  }
+  int depth = 0;
+  if (b.format == py::format_descriptor<std::uint8_t>::format()) {
+    depth = CV_8U;
+  } else if (b.format == py::format_descriptor<std::uint16_t>::format()) {
+    depth = CV_16U;
+  } else if (b.format == py::format_descriptor<float>::format()) {
+    depth = CV_32F;
+  } else {
+    throw std::invalid_argument(std::string(what) + ": dtype must be uint8, uint16 or float32");
+  }
+  const int channels = b.ndim == 3 ? static_cast<int>(b.shape[2]) : 1;
+  return cv::Mat(static_cast<int>(b.shape[0]), static_cast<int>(b.shape[1]),
+                 CV_MAKETYPE(depth, channels), b.ptr);
+}
+
+py::tuple TrajectoryArrays(const std::vector<api::StampedPose>& poses) {
+  py::array_t<std::int64_t> t(static_cast<py::ssize_t>(poses.size()));
+  py::array_t<double> m({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}, py::ssize_t{4}});
+  auto tv = t.mutable_unchecked<1>();
+  auto mv = m.mutable_unchecked<3>();
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    tv(static_cast<py::ssize_t>(i)) = poses[i].t_ns;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c)
+        mv(static_cast<py::ssize_t>(i), r, c) = poses[i].world_from_camera(r, c);
+    }
+  }
+  return py::make_tuple(t, m);
+}
+
+std::vector<api::StampedPose> PosesFromArrays(const py::array_t<std::int64_t>& t,
+                                              const py::array_t<double>& m) {
+  if (m.ndim() != 3 || m.shape(1) != 4 || m.shape(2) != 4 || t.ndim() != 1 ||
+      t.shape(0) != m.shape(0)) {
+    throw std::invalid_argument("estimate: expected (t_ns[N], poses[N, 4, 4])");
+  }
+  auto tv = t.unchecked<1>();
+  auto mv = m.unchecked<3>();
+  std::vector<api::StampedPose> out(static_cast<std::size_t>(t.shape(0)));
+  for (py::ssize_t i = 0; i < t.shape(0); ++i) {
+    out[static_cast<std::size_t>(i)].t_ns = tv(i);
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c)
+        out[static_cast<std::size_t>(i)].world_from_camera(r, c) = mv(i, r, c);
+    }
+  }
+  return out;
+}
+
+py::dict EvaluationDict(const api::Evaluation& e) {
+  py::dict d;
+  d["pairs"] = e.pairs;
+  d["scale"] = e.scale;
+  d["ate_rmse_m"] = e.ate_rmse_m;
+  d["ate_mean_m"] = e.ate_mean_m;
+  d["ate_median_m"] = e.ate_median_m;
+  d["ate_max_m"] = e.ate_max_m;
+  d["ate_rot_rmse_deg"] = e.ate_rot_rmse_deg;
+  d["rpe_trans_rmse_m"] = e.rpe_trans_rmse_m;
+  d["rpe_rot_rmse_deg"] = e.rpe_rot_rmse_deg;
+  return d;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_pkslam, m) {
+  m.doc() = "pkslam: keyframe SLAM (the C++ library's public API with NumPy arrays)";
+  m.attr("__version__") = api::kApiVersion;
+  py::class_<api::Slam>(m, "Slam")
+      .def(py::init([](const std::string& settings, const std::string& vocabulary,
+                       const std::string& sensor, const std::string& selector, bool deterministic,
+                       bool localise_only, bool loop_closing) {
+             api::SlamOptions o;
+             o.settings = settings;
+             o.vocabulary = vocabulary;
+             o.sensor = sensor;
+             o.selector = selector;
+             o.deterministic = deterministic;
+             o.localise_only = localise_only;
+             o.loop_closing = loop_closing;
+             return std::make_unique<api::Slam>(o);
+           }),
+           py::arg("settings"), py::arg("vocabulary"), py::arg("sensor") = "stereo",
+           py::arg("selector") = "orbslam3", py::arg("deterministic") = false,
+           py::arg("localise_only") = false, py::arg("loop_closing") = true)
+      .def(
+          "track_mono",
+          [](api::Slam& s, const py::array& image, std::int64_t t_ns) {
+            return api::SlamStateName(s.TrackMonocular(View(image, "image"), t_ns));
+          },
+          py::arg("image"), py::arg("t_ns"), "Track one image; returns the tracking state")
+      .def(
+          "track_stereo",
+          [](api::Slam& s, const py::array& left, const py::array& right, std::int64_t t_ns) {
+            return api::SlamStateName(
+                s.TrackStereo(View(left, "left"), View(right, "right"), t_ns));
+          },
+          py::arg("left"), py::arg("right"), py::arg("t_ns"))
+      .def(
+          "track_rgbd",
+          [](api::Slam& s, const py::array& image, const py::array& depth, std::int64_t t_ns) {
+            return api::SlamStateName(
+                s.TrackRgbd(View(image, "image"), View(depth, "depth"), t_ns));
+          },
+          py::arg("image"), py::arg("depth"), py::arg("t_ns"))
+      .def(
+          "add_imu",
+          [](api::Slam& s, const py::array_t<std::int64_t>& t_ns, const py::array_t<double>& gyro,
+             const py::array_t<double>& accel) {
+            if (gyro.ndim() != 2 || gyro.shape(1) != 3 || accel.ndim() != 2 ||
+                accel.shape(1) != 3 || t_ns.ndim() != 1 || gyro.shape(0) != t_ns.shape(0) ||
+                accel.shape(0) != t_ns.shape(0)) {
+              throw std::invalid_argument("add_imu: expected t_ns[N], gyro[N, 3], accel[N, 3]");
+            }
+            auto t = t_ns.unchecked<1>();
+            auto g = gyro.unchecked<2>();
+            auto a = accel.unchecked<2>();
+            std::vector<api::ImuSample> samples(static_cast<std::size_t>(t_ns.shape(0)));
+            for (py::ssize_t i = 0; i < t_ns.shape(0); ++i) {
+              auto& x = samples[static_cast<std::size_t>(i)];
+              x.t_ns = t(i);
+              x.gyro = {g(i, 0), g(i, 1), g(i, 2)};
+              x.accel = {a(i, 0), a(i, 1), a(i, 2)};
+            }
+            s.AddImu(samples);
+          },
+          py::arg("t_ns"), py::arg("gyro"), py::arg("accel"))
+      .def_property_readonly("state",
+                             [](const api::Slam& s) { return api::SlamStateName(s.state()); })
+      .def("pose", &api::Slam::CurrentPose,
+           "world_from_camera (4x4) of the last frame, or None when it was not tracked")
+      .def_property_readonly("num_keyframes", &api::Slam::NumKeyFrames)
+      .def_property_readonly("num_map_points", &api::Slam::NumMapPoints)
+      .def("save_map", &api::Slam::SaveMap, py::arg("file"))
+      .def("load_map", &api::Slam::LoadMap, py::arg("file"))
+      .def("shutdown", &api::Slam::Shutdown, py::call_guard<py::gil_scoped_release>())
+      .def(
+          "trajectory", [](const api::Slam& s) { return TrajectoryArrays(s.Trajectory()); },
+          "(t_ns[N], world_from_camera[N, 4, 4]) of every tracked frame")
+      .def("keyframe_trajectory",
+           [](const api::Slam& s) { return TrajectoryArrays(s.KeyFrameTrajectory()); });
+  m.def(
+      "evaluate",
+      [](const std::string& gt, const py::object& est, const std::string& align) {
+        if (py::isinstance<py::str>(est)) {
+          return EvaluationDict(api::Evaluate(gt, est.cast<std::string>(), align));
+        }
+        const auto pair = est.cast<py::tuple>();
+        if (pair.size() != 2) throw std::invalid_argument("estimate: a file or (t_ns, poses)");
+        return EvaluationDict(
+            api::Evaluate(gt,
+                          PosesFromArrays(pair[0].cast<py::array_t<std::int64_t>>(),
+                                          pair[1].cast<py::array_t<double>>()),
+                          align));
+      },
+      py::arg("gt"), py::arg("est"), py::arg("align") = "se3",
+      "ATE/RPE of an estimate (a trajectory file, or Slam.trajectory()'s arrays) against a "
+      "ground-truth file");
+}
