@@ -22,6 +22,7 @@ void RegisterEvalCommand(CLI::App& app);
 void RegisterInfoCommand(CLI::App& app);
 void RegisterRunCommand(CLI::App& app);
 void RegisterMapCommand(CLI::App& app);
+void RegisterTracksCommand(CLI::App& app);
 void RegisterVocabCommand(CLI::App& app);
 void RegisterDenseCommand(CLI::App& app);
 void RegisterCloudCompareCommand(CLI::App& app);

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterInfoCommand(app);
   pkslam::apps::RegisterRunCommand(app);
   pkslam::apps::RegisterMapCommand(app);
+  pkslam::apps::RegisterTracksCommand(app);
   pkslam::apps::RegisterVocabCommand(app);
   pkslam::apps::RegisterDenseCommand(app);
   pkslam::apps::RegisterCloudCompareCommand(app);
