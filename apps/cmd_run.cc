@@ -194,7 +194,6 @@ void RegisterRunCommand(CLI::App& app) {
     if (!args->video.empty()) source = OpenVideoFile(args->video, args->fps);
     if (args->camera) source = OpenCamera(*args->camera);
     if (!args->images.empty()) source = OpenImageFolder(args->images, args->timestamps);
-    if (source) o.dataset = source->Name();
     const RunSummary s = source ? RunFrameSource(o, *source, control) : RunDataset(o, control);
     fmt::print("frames {} tracked {} lost {} keyframes {} map points {} maps {}\n", s.frames,
                s.tracked, s.lost, s.keyframes, s.map_points, s.maps);

@@ -13,16 +13,10 @@
 #include <string>
 
 #include "core/util/error.h"
+#include "tests/support/test_data.h"
 
 namespace pkslam {
 namespace {
-
-std::filesystem::path TempDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("pkslam_frame_source_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
 
 cv::Mat Pattern(int k) {
   cv::Mat image(120, 160, CV_8UC3, cv::Scalar(30, 30, 30));
@@ -31,7 +25,7 @@ cv::Mat Pattern(int k) {
 }
 
 TEST(FrameSource, VideoFileFramesAndTimestamps) {
-  const auto dir = TempDir("video");
+  const auto dir = testing::MakeTempDir("frame_source_video");
   const auto file = dir / "clip.avi";
   {
     cv::VideoWriter writer(file.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 20.0,
@@ -63,7 +57,7 @@ TEST(FrameSource, VideoFileFramesAndTimestamps) {
 }
 
 TEST(FrameSource, ImageFolderFollowsItsTimestamps) {
-  const auto dir = TempDir("folder");
+  const auto dir = testing::MakeTempDir("frame_source_folder");
   for (int k = 0; k < 3; ++k) {
     cv::imwrite((dir / (std::to_string(1000 + k) + ".png")).string(), Pattern(k));
   }

@@ -66,6 +66,24 @@ fs::path DefaultVocabularyPath() {
   return fs::path(PKSLAM_SOURCE_DIR) / name;
 }
 
+void RunSummary::Count(const TrackResult& result) {
+  ++frames;
+  if (result.state == TrackingState::kOk) ++tracked;
+  if (result.new_keyframe) {
+    ++keyframe_reasons[result.keyframe_reason.empty() ? "unnamed" : result.keyframe_reason];
+  }
+  if (result.selector_decided) ++selector_decisions;
+  for (const auto& criterion : result.criteria_held) ++criteria_held[criterion];
+}
+
+void SleepUntilOrInterrupted(std::chrono::steady_clock::time_point due,
+                             const std::atomic<bool>* interrupt) {
+  while ((interrupt == nullptr || !interrupt->load()) && std::chrono::steady_clock::now() < due) {
+    std::this_thread::sleep_until(
+        std::min(due, std::chrono::steady_clock::now() + std::chrono::milliseconds(50)));
+  }
+}
+
 std::shared_ptr<const Vocabulary> LoadRunVocabulary(const RunOptions& options) {
   const fs::path vocabulary_path = options.vocabulary.value_or(DefaultVocabularyPath());
   if (!fs::exists(vocabulary_path)) {
@@ -294,12 +312,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
     }
     previous_t_ns = s.t_ns;
     if (options.realtime) {
-      // In slices, so that Ctrl-C or SIGTERM ends the wait promptly.
-      const auto due = pace_wall + std::chrono::nanoseconds(s.t_ns - pace_t_ns);
-      while (!interrupted() && std::chrono::steady_clock::now() < due) {
-        std::this_thread::sleep_until(
-            std::min(due, std::chrono::steady_clock::now() + std::chrono::milliseconds(50)));
-      }
+      SleepUntilOrInterrupted(pace_wall + std::chrono::nanoseconds(s.t_ns - pace_t_ns), interrupt);
     }
     if (interrupted()) {
       summary.interrupted = true;
@@ -320,13 +333,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
     } else {
       r = system.TrackMonocular(loaded.a, s.t_ns);
     }
-    ++summary.frames;
-    if (r.state == TrackingState::kOk) ++summary.tracked;
-    if (r.new_keyframe) {
-      ++summary.keyframe_reasons[r.keyframe_reason.empty() ? "unnamed" : r.keyframe_reason];
-    }
-    if (r.selector_decided) ++summary.selector_decisions;
-    for (const auto& criterion : r.criteria_held) ++summary.criteria_held[criterion];
+    summary.Count(r);
     if (r.camera_from_world) {
       partial.Append(FormatTumLine({s.t_ns, r.camera_from_world->Inverse()}));
       if (!partial.ok() && !partial_warned) {

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -84,7 +85,15 @@ struct RunSummary {
   std::map<std::string, int> criteria_held;
   // What was wrong with the input without stopping the run (degraded() when anything was).
   InputReport input;
+
+  // Adds one tracked frame: frames, tracked, keyframe reasons, selector decisions, criteria.
+  void Count(const TrackResult& result);
 };
+
+// Sleeps until `due` in short slices, returning early once `interrupt` (may be null) is set:
+// --realtime pacing that Ctrl-C or SIGTERM ends promptly.
+void SleepUntilOrInterrupted(std::chrono::steady_clock::time_point due,
+                             const std::atomic<bool>* interrupt);
 
 // The vocabulary shipped with pkslam (Vocabulary/ in the source tree or next to the binary).
 std::filesystem::path DefaultVocabularyPath();

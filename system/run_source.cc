@@ -1,7 +1,6 @@
 #include "system/run_source.h"
 
 #include <chrono>
-#include <thread>
 
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -16,8 +15,10 @@ namespace pkslam {
 
 namespace fs = std::filesystem;
 
-RunSummary RunFrameSource(const RunOptions& options, FrameSource& source,
+RunSummary RunFrameSource(const RunOptions& options_in, FrameSource& source,
                           const RunControl& control) {
+  RunOptions options = options_in;
+  if (options.dataset.empty()) options.dataset = source.Name();  // the label in stats.json
   if (options.system.sensor != Sensor::kMonocular) {
     throw OptionError(
         fmt::format("{}: sensor {} needs a dataset; a video, camera or image folder "
@@ -28,10 +29,7 @@ RunSummary RunFrameSource(const RunOptions& options, FrameSource& source,
     throw OptionError(
         fmt::format("{}: pass --settings (the camera's ORB-SLAM3 settings file)", source.Name()));
   }
-  if (options.max_frames < 0 || options.first_frame < 0) {
-    throw OptionError("--max-frames and --first-frame must be >= 0");
-  }
-  options.system.Check();
+  options.Check();
   fs::create_directories(options.out);
   RemoveRunOutputs(options.out);
   AddLogFile(options.out / "run.log");
@@ -92,22 +90,13 @@ RunSummary RunFrameSource(const RunOptions& options, FrameSource& source,
                       frame->image.cols, frame->image.rows, camera.width(), camera.height()));
     }
     if (options.realtime && first_t_ns) {
-      const auto due = wall_start + std::chrono::nanoseconds(frame->t_ns - *first_t_ns);
-      while (!interrupted() && std::chrono::steady_clock::now() < due) {
-        std::this_thread::sleep_until(
-            std::min(due, std::chrono::steady_clock::now() + std::chrono::milliseconds(50)));
-      }
+      SleepUntilOrInterrupted(wall_start + std::chrono::nanoseconds(frame->t_ns - *first_t_ns),
+                              control.interrupt);
     }
     if (!first_t_ns) first_t_ns = frame->t_ns;
     last_t_ns = frame->t_ns;
     const TrackResult r = system.TrackMonocular(frame->image, frame->t_ns);
-    ++summary.frames;
-    if (r.state == TrackingState::kOk) ++summary.tracked;
-    if (r.new_keyframe) {
-      ++summary.keyframe_reasons[r.keyframe_reason.empty() ? "unnamed" : r.keyframe_reason];
-    }
-    if (r.selector_decided) ++summary.selector_decisions;
-    for (const auto& criterion : r.criteria_held) ++summary.criteria_held[criterion];
+    summary.Count(r);
     if (r.camera_from_world) {
       partial.Append(FormatTumLine({frame->t_ns, r.camera_from_world->Inverse()}));
     }

@@ -8,8 +8,8 @@
 
 namespace pkslam {
 
-// options.dataset is only a label here (the source's name); options.settings is required and
-// the sensor must be monocular (a video carries no IMU stream).
+// options.dataset is only a label here (default: the source's name); options.settings is required
+// and the sensor must be monocular (a video carries no IMU stream).
 RunSummary RunFrameSource(const RunOptions& options, FrameSource& source,
                           const RunControl& control = {});
 

@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <fstream>
 #include <mutex>
-#include <set>
 #include <shared_mutex>
 
 #include "core/util/error.h"
@@ -138,15 +137,13 @@ SlamSystem::MapFileInfo SlamSystem::LoadMap(const std::filesystem::path& file) {
       throw InputError(file, fmt::format("inconsistent map: {}", e.what()));
     }
     if (options_.tracking.localise_only) {
-      Map* largest = nullptr;
-      for (Map* m : atlas_.maps()) {
-        if (largest == nullptr || m->NumKeyFrames() > largest->NumKeyFrames()) largest = m;
-      }
-      atlas_.SetCurrentMap(largest);
+      // Every loaded map still counts as this session's here: the largest one.
+      atlas_.SetCurrentMap(atlas_.FindMap(LargestMap()->id()));
     } else {
       atlas_.CreateNewMap();  // this session's map; loop closing merges it when it recognises one
     }
   }
+  session_first_keyframe_id_ = record.next_keyframe_id;
   if (options_.tracking.localise_only) tracker_->StartLocalisation();
   MapFileInfo info = CountMaps(record);
   info.bytes = std::filesystem::file_size(file);
@@ -174,18 +171,22 @@ TrackResult SlamSystem::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) 
 }
 
 const Map* SlamSystem::LargestMap() const {
-  // Among the maps this session tracked frames in: a map loaded from a file (--load-map) that
-  // this session neither localised in nor merged into describes none of its frames, and an
-  // output of it would be an empty trajectory. Without a loaded map every map holds frames of
-  // this session, and this is the largest map, as ORB-SLAM3 chooses.
-  std::set<const Map*> session_maps;
-  for (const FrameRecord& r : tracker_->records()) {
-    if (r.reference && r.reference->map() != nullptr) session_maps.insert(r.reference->map());
-  }
+  // Among the maps of this session: a map loaded from a file (--load-map) describes this
+  // session's frames only once it holds one of its keyframes (merged with the session's map) or
+  // the session localises in it; an output of any other loaded map would be an empty
+  // trajectory. Without a loaded map every map qualifies, and this is the largest map, as
+  // ORB-SLAM3 chooses. O(maps): NumKeyFrames() asks it for every frame's progress line.
+  const auto of_session = [this](const Map* m) {
+    return m->max_keyframe_id() >= session_first_keyframe_id_ ||
+           (options_.tracking.localise_only && m == atlas_.current_map());
+  };
   const Map* best = nullptr;
-  for (const Map* m : atlas_.maps()) {
-    if (!session_maps.empty() && session_maps.count(m) == 0) continue;
-    if (best == nullptr || m->NumKeyFrames() > best->NumKeyFrames()) best = m;
+  for (const bool session_only : {true, false}) {
+    for (const Map* m : atlas_.maps()) {
+      if (session_only && !of_session(m)) continue;
+      if (best == nullptr || m->NumKeyFrames() > best->NumKeyFrames()) best = m;
+    }
+    if (best != nullptr) break;
   }
   return best;
 }

@@ -103,7 +103,7 @@ class SlamSystem {
 
   // For output writers (system/sparse_model_builder.h): the Atlas (take its mutex shared to
   // read) and the map the outputs describe: the one with the most keyframes among the maps
-  // this session tracked frames in.
+  // of this session (a loaded map counts once merged with it or localised in).
   const Atlas& atlas() const { return atlas_; }
   const Map* LargestMap() const;  // requires the Atlas lock
 
@@ -117,6 +117,8 @@ class SlamSystem {
   std::atomic<bool> mapper_finished_{false};  // read by loop closing's MappingControl
   std::unique_ptr<Tracker> tracker_;
   bool shut_down_ = false;
+  // Keyframes with smaller ids came from a map file (LoadMap); see LargestMap.
+  KeyFrameId session_first_keyframe_id_ = 0;
 };
 
 }  // namespace pkslam

@@ -17,9 +17,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
-testing::CommandResult RunPkslam(const std::string& args) {
-  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
-}
+using testing::RunPkslam;
 
 void WriteText(const fs::path& file, const std::string& text) {
   fs::create_directories(file.parent_path());

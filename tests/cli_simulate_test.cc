@@ -15,9 +15,7 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
 
-testing::CommandResult RunPkslam(const std::string& args) {
-  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
-}
+using testing::RunPkslam;
 
 TEST(SimulateCli, ReplayThenInfo) {
   PKSLAM_REQUIRE_SHARED_DATA(shared);

@@ -17,9 +17,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-testing::CommandResult RunPkslam(const std::string& args) {
-  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
-}
+using testing::RunPkslam;
 
 TEST(InertialRun, StereoInertialSimulatedReplayMeetsAteBar) {
   PKSLAM_REQUIRE_SHARED_DATA(shared);

@@ -17,9 +17,7 @@
 namespace pkslam {
 namespace {
 
-testing::CommandResult RunPkslam(const std::string& args) {
-  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
-}
+using testing::RunPkslam;
 
 // world_from_body samples (TUM) of a circle of `radius` m at 1.4 m height, the camera looking
 // outwards (25 deg towards the direction of travel), `laps` laps of `lap_s` seconds.

@@ -8,7 +8,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <string>
 
 #include "tests/support/test_data.h"
@@ -18,18 +17,9 @@ namespace {
 
 using ::testing::HasSubstr;
 
-testing::CommandResult RunPkslam(const std::string& args) {
-  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
-}
+using testing::RunPkslam;
 
-// The integer value of "key": N in a stats.json (first occurrence), -1 when absent.
-long long JsonInt(const std::filesystem::path& file, const std::string& key) {
-  std::ifstream in(file);
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  std::smatch m;
-  if (!std::regex_search(text, m, std::regex("\"" + key + "\": (-?[0-9]+)"))) return -1;
-  return std::stoll(m[1].str());
-}
+using testing::JsonIntField;
 
 TEST(MapFileCli, SaveRoundTripLocaliseAndRefuseDamage) {
   const auto dir = testing::MakeTempDir("map_file_cli");
@@ -46,7 +36,7 @@ TEST(MapFileCli, SaveRoundTripLocaliseAndRefuseDamage) {
       seq.string(), map.string(), (dir / "mapping").string()));
   ASSERT_EQ(mapping.exit_code, 0) << mapping.output;
   ASSERT_TRUE(std::filesystem::exists(map));
-  const long long keyframes = JsonInt(dir / "mapping/stats.json", "keyframes");
+  const long long keyframes = JsonIntField(dir / "mapping/stats.json", "keyframes");
   ASSERT_GT(keyframes, 2);
 
   const auto info = RunPkslam(fmt::format("map info '{}'", map.string()));
@@ -64,13 +54,12 @@ TEST(MapFileCli, SaveRoundTripLocaliseAndRefuseDamage) {
                   seq.string(), map.string(), (dir / "localise").string()));
   ASSERT_EQ(localise.exit_code, 0) << localise.output;
   const auto stats = dir / "localise/stats.json";
-  const long long frames = JsonInt(stats, "frames");
-  EXPECT_GE(JsonInt(stats, "frames_in_trajectory"), frames * 9 / 10);
-  EXPECT_EQ(JsonInt(stats, "keyframes"), keyframes);  // no keyframe added
+  const long long frames = JsonIntField(stats, "frames");
+  EXPECT_GE(JsonIntField(stats, "frames_in_trajectory"), frames * 9 / 10);
+  EXPECT_EQ(JsonIntField(stats, "keyframes"), keyframes);  // no keyframe added
 
   // Damage: truncated, one bit flipped; and --localise-only without a map.
-  std::ifstream in(map, std::ios::binary);
-  std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::string bytes = testing::ReadFileBytes(map);
   std::ofstream(dir / "truncated.pkmap", std::ios::binary) << bytes.substr(0, bytes.size() / 3);
   bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x04);
   std::ofstream(dir / "flipped.pkmap", std::ios::binary) << bytes;

@@ -20,9 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-testing::CommandResult RunPkslam(const std::string& args) {
-  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
-}
+using testing::RunPkslam;
 
 struct Gyro {
   std::vector<std::int64_t> t_ns;

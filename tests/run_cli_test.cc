@@ -20,9 +20,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-testing::CommandResult RunPkslam(const std::string& args) {
-  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
-}
+using testing::RunPkslam;
 
 // A 3 s simulated flight (EuRoC layout, fast rendering) with `seed` into `seq`; gtest failure
 // with the simulator's output when it fails.

@@ -11,7 +11,6 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
-#include <regex>
 #include <set>
 #include <string>
 #include <vector>
@@ -23,17 +22,9 @@ namespace {
 
 using ::testing::HasSubstr;
 
-testing::CommandResult RunPkslam(const std::string& args) {
-  return testing::RunCommand(fmt::format("'{}' {}", testing::PkslamExecutable().string(), args));
-}
+using testing::RunPkslam;
 
-long long JsonInt(const std::filesystem::path& file, const std::string& key) {
-  std::ifstream in(file);
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  std::smatch m;
-  if (!std::regex_search(text, m, std::regex("\"" + key + "\": (-?[0-9]+)"))) return -1;
-  return std::stoll(m[1].str());
-}
+using testing::JsonIntField;
 
 // A TUM trajectory's lines without their time column.
 std::vector<std::string> PosesOf(const std::filesystem::path& file) {
@@ -73,7 +64,7 @@ TEST(VideoCli, VideoAndImageFolderRunMonocularSlam) {
       "run --video '{}' --settings '{}' --sensor mono --deterministic --quiet --out '{}'",
       video.string(), settings.string(), (dir / "video").string()));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  const long long frames = JsonInt(dir / "video/stats.json", "frames");
+  const long long frames = JsonIntField(dir / "video/stats.json", "frames");
   EXPECT_EQ(frames, static_cast<long long>(names.size()));
 
   // The same frames as an image folder with a timestamps file (ns per line).
@@ -87,10 +78,10 @@ TEST(VideoCli, VideoAndImageFolderRunMonocularSlam) {
       (seq / "mav0/cam0/data").string(), (dir / "times.txt").string(), settings.string(),
       (dir / "folder").string()));
   ASSERT_EQ(folder.exit_code, 0) << folder.output;
-  EXPECT_EQ(JsonInt(dir / "folder/stats.json", "frames"), frames);
-  const long long posed = JsonInt(dir / "folder/stats.json", "frames_in_trajectory");
+  EXPECT_EQ(JsonIntField(dir / "folder/stats.json", "frames"), frames);
+  const long long posed = JsonIntField(dir / "folder/stats.json", "frames_in_trajectory");
   EXPECT_GT(posed, 0);
-  EXPECT_EQ(JsonInt(dir / "video/stats.json", "frames_in_trajectory"), posed);
+  EXPECT_EQ(JsonIntField(dir / "video/stats.json", "frames_in_trajectory"), posed);
   EXPECT_EQ(PosesOf(dir / "video/trajectory.txt"), PosesOf(dir / "folder/trajectory.txt"));
 
   // Input errors: one line, non-zero exit.

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/util/error.h"
+#include "tests/support/test_data.h"
 #include "tracks/synthetic_tracks.h"
 #include "tracks/track_file.h"
 
@@ -16,8 +17,7 @@ namespace pkslam {
 namespace {
 
 std::filesystem::path TempFile(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "pkslam_tracks_test";
-  std::filesystem::create_directories(dir);
+  static const std::filesystem::path dir = testing::MakeTempDir("tracks");
   return dir / name;
 }
 

@@ -18,16 +18,12 @@
 #include "map_model/map_point.h"
 #include "map_model/storage/atlas_storage.h"
 #include "map_model/testing/synthetic_map.h"
+#include "tests/support/test_data.h"
 
 namespace pkslam {
 namespace {
 
 constexpr std::uint64_t kVocabulary = 0x1234abcd5678ef00ull;
-
-std::string ReadBytes(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 void WriteBytes(const std::filesystem::path& file, const std::string& bytes) {
   std::ofstream(file, std::ios::binary) << bytes;
@@ -36,10 +32,7 @@ void WriteBytes(const std::filesystem::path& file, const std::string& bytes) {
 class MapFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("pkslam_map_file_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
+    dir_ = testing::MakeTempDir("map_file");
     rig_ = testing::MakeStereoRig(Sensor::kStereoInertial);
     map_ = testing::MakeMap(&atlas_, testing::MakeScene(500, 7), rig_,
                             testing::MakeForwardPath(8, 0.15, 4), {});
@@ -70,12 +63,11 @@ class MapFileTest : public ::testing::Test {
     prior.map_id = map()->id();
     map_.keyframes[3]->imu.prior = prior;
     map()->mutable_imu_status().imu_initialized = true;
-    map()->RecordWorldChange({WorldChange::Kind::kTransform, SO3d::Exp(Eigen::Vector3d(0, 0, 1)),
-                              1.5});
+    map()->RecordWorldChange(
+        {WorldChange::Kind::kTransform, SO3d::Exp(Eigen::Vector3d(0, 0, 1)), 1.5});
     map_.keyframes[6]->AddLoopEdge(map_.keyframes[1].get());
     map_.keyframes[1]->AddLoopEdge(map_.keyframes[6].get());
   }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
   Map* map() { return map_.keyframes[0]->map(); }
 
   std::filesystem::path Save(const Atlas& atlas, const std::string& name) {
@@ -153,14 +145,14 @@ TEST_F(MapFileTest, RoundTripGivesTheSameMapAndTheSameBytes) {
   // Everything that is written was restored: the reloaded Atlas writes the same bytes (compared
   // as one bool: gtest would print a megabyte of binary on failure).
   const auto second = Save(loaded, "second.pkmap");
-  EXPECT_TRUE(ReadBytes(second) == ReadBytes(first));
+  EXPECT_TRUE(testing::ReadFileBytes(second) == testing::ReadFileBytes(first));
   // New objects continue after the loaded ids.
   EXPECT_EQ(loaded.NextKeyFrameId(), atlas_.NextKeyFrameId());
 }
 
 TEST_F(MapFileTest, DamagedFilesGiveOneLineErrorsNamingTheFile) {
   const auto good = Save(atlas_, "good.pkmap");
-  const std::string bytes = ReadBytes(good);
+  const std::string bytes = testing::ReadFileBytes(good);
   auto expect_error = [&](const std::string& name, const std::string& content,
                           const std::string& reason) {
     const auto file = dir_ / name;

@@ -9,6 +9,7 @@
 #include <iterator>
 #include <mutex>
 #include <random>
+#include <regex>
 #include <vector>
 
 namespace pkslam::testing {
@@ -90,6 +91,17 @@ CommandResult RunCommand(const std::string& command) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+CommandResult RunPkslam(const std::string& args) {
+  return RunCommand(fmt::format("'{}' {}", PkslamExecutable().string(), args));
+}
+
+long long JsonIntField(const std::filesystem::path& file, const std::string& key) {
+  const std::string text = ReadFileBytes(file);
+  std::smatch m;
+  if (!std::regex_search(text, m, std::regex("\"" + key + "\": (-?[0-9]+)"))) return -1;
+  return std::stoll(m[1].str());
 }
 
 }  // namespace pkslam::testing

@@ -27,6 +27,11 @@ struct CommandResult {
 };
 // Runs a shell command, capturing its combined output.
 CommandResult RunCommand(const std::string& command);
+// Runs the built pkslam executable with `args` (shell-quoted by the caller).
+CommandResult RunPkslam(const std::string& args);
+
+// The integer value of the first `"key": N` in a JSON file such as stats.json; -1 when absent.
+long long JsonIntField(const std::filesystem::path& file, const std::string& key);
 
 }  // namespace pkslam::testing
 
