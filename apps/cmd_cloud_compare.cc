@@ -18,9 +18,9 @@
 #include "dense/cloud_compare.h"
 #include "dense/histogram_plot.h"
 #include "dense/keyframe_images.h"
-#include "dense/point_cloud.h"
 #include "dense/visibility.h"
 #include "evaluation/evaluate.h"
+#include "io/point_cloud.h"
 #include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
 
@@ -90,8 +90,8 @@ void RunCompare(const CompareArgs& args) {
   if (!args.dataset.empty() && args.align_run.empty()) {
     throw OptionError("--dataset (restricted completeness) needs --align-run and --gt");
   }
-  dense::PointCloud cloud = dense::ReadPly(args.cloud);
-  const dense::PointCloud ref = dense::ReadPly(args.ref);
+  PointCloud cloud = ReadPly(args.cloud);
+  const PointCloud ref = ReadPly(args.ref);
   if (cloud.empty()) throw InputError(args.cloud, "the cloud has no points");
   if (ref.empty()) throw InputError(args.ref, "the reference cloud has no points");
 
@@ -105,9 +105,8 @@ void RunCompare(const CompareArgs& args) {
                args.align, alignment->evaluation.pairs.size(), alignment->estimate.string(),
                alignment->evaluation.ate_translation_m.rmse, alignment->ref_from_slam.scale());
     if (!args.write_aligned.empty()) {
-      dense::WritePly(cloud, args.write_aligned,
-                      cloud.has_colour() ? dense::PlyColour::kRgb : dense::PlyColour::kNone,
-                      "pkslam cloud-compare: cloud aligned to the reference frame");
+      WritePly(cloud, args.write_aligned, cloud.has_colour() ? PlyColour::kRgb : PlyColour::kNone,
+               "pkslam cloud-compare: cloud aligned to the reference frame");
     }
   }
 
@@ -153,7 +152,7 @@ void RunCompare(const CompareArgs& args) {
   };
   std::vector<ObservedCompleteness> observed;
   for (const std::string& file : args.observed_refs) {
-    const dense::PointCloud ref_observed = dense::ReadPly(file);
+    const PointCloud ref_observed = ReadPly(file);
     if (ref_observed.empty()) throw InputError(file, "the reference cloud has no points");
     observed.push_back(
         {file, ref_observed.size(),

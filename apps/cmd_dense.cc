@@ -41,14 +41,14 @@ void RunDense(const DenseArgs& args) {
       args.options.full_view);
   RequireRunOfDataset(args.run, args.dataset);
   dense::DenseStats stats;
-  const dense::PointCloud cloud = BuildDenseCloud(keyframes, source, args.options, &stats);
+  const PointCloud cloud = BuildDenseCloud(keyframes, source, args.options, &stats);
   if (cloud.empty()) {
     throw Error("the dense cloud is empty (no depth passed the multi-view filter)");
   }
-  const auto colour = args.colour ? dense::PlyColour::kRgb : dense::PlyColour::kGrey;
-  dense::WritePly(cloud, args.out, colour,
-                  fmt::format("pkslam dense: {} keyframes, voxel {} m, min views {}",
-                              stats.keyframes_used, args.options.voxel_m, args.options.min_views));
+  const auto colour = args.colour ? PlyColour::kRgb : PlyColour::kGrey;
+  WritePly(cloud, args.out, colour,
+           fmt::format("pkslam dense: {} keyframes, voxel {} m, min views {}", stats.keyframes_used,
+                       args.options.voxel_m, args.options.min_views));
   fmt::print("keyframes {} used {} (missing {}), depth source {}, max depth {:.2f} m\n",
              stats.keyframes, stats.keyframes_used, stats.missing_t_ns.size(),
              source.source() == dense::DepthSource::kStereo ? "stereo SGBM" : "RGB-D",

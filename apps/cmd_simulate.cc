@@ -230,6 +230,10 @@ void RegisterSimulateCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--quality", args->quality, "fast|default|high")->capture_default_str();
   cmd->add_flag("--no-cloud", args->no_cloud, "Do not write reference_cloud.ply");
+  cmd->add_option("--tracks", o.landmark_tracks,
+                  "Also write the exact 2-D tracks of this many surface landmarks in cam0 "
+                  "(truth/tracks_*.txt, for `pkslam tracks export --simulated`; 0: none)")
+      ->capture_default_str();
   cmd->add_flag("--no-images", args->no_images, "IMU and ground truth only (no rendering)");
   cmd->add_option("--cloud-spacing", o.cloud_spacing_m, "Reference cloud point spacing (m)")
       ->capture_default_str();

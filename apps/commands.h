@@ -23,6 +23,7 @@ void RegisterInfoCommand(CLI::App& app);
 void RegisterRunCommand(CLI::App& app);
 void RegisterMapCommand(CLI::App& app);
 void RegisterTracksCommand(CLI::App& app);
+void RegisterViewCommand(CLI::App& app);
 void RegisterVocabCommand(CLI::App& app);
 void RegisterDenseCommand(CLI::App& app);
 void RegisterCloudCompareCommand(CLI::App& app);

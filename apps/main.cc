@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterRunCommand(app);
   pkslam::apps::RegisterMapCommand(app);
   pkslam::apps::RegisterTracksCommand(app);
+  pkslam::apps::RegisterViewCommand(app);
   pkslam::apps::RegisterVocabCommand(app);
   pkslam::apps::RegisterDenseCommand(app);
   pkslam::apps::RegisterCloudCompareCommand(app);

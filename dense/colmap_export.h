@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "dense/keyframe_images.h"
-#include "dense/point_cloud.h"
+#include "io/point_cloud.h"
 #include "io/sparse_model.h"
 
 namespace pkslam::dense {

@@ -19,8 +19,8 @@
 
 #include "dense/depth_consistency.h"
 #include "dense/keyframe_images.h"
-#include "dense/point_cloud.h"
 #include "dense/stereo_depth.h"
+#include "io/point_cloud.h"
 #include "io/trajectory.h"
 
 namespace pkslam::dense {

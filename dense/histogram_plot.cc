@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/util/error.h"
+#include "core/util/project_file.h"
 
 namespace pkslam::dense {
 
@@ -32,17 +33,8 @@ std::string ShellQuote(const std::string& s) {
 }  // namespace
 
 fs::path HistogramScriptPath() {
-  const fs::path name = "dense/plot_cloud_histogram.py";
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path();
-         dir = dir.parent_path()) {
-      if (fs::exists(dir / name)) return dir / name;
-    }
-  }
-  const fs::path source = fs::path(PKSLAM_SOURCE_DIR) / name;
-  return fs::exists(source) ? source : fs::path();
+  const fs::path script = FindProjectFile("dense/plot_cloud_histogram.py");
+  return fs::exists(script) ? script : fs::path();
 }
 
 void PlotDistanceHistograms(const std::vector<HistogramSeries>& series, const std::string& title,

@@ -13,7 +13,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "dense/point_cloud.h"
+#include "io/point_cloud.h"
 
 namespace pkslam::dense {
 

@@ -49,23 +49,9 @@ std::size_t WriteReferenceCloud(const Scene& scene, const SurfaceVisibility* vis
           const Eigen::Vector2f uv((iu + 0.5f) * frame.size.x() / nu,
                                    (iv + 0.5f) * frame.size.y() / nv);
           if (visibility != nullptr && !visibility->Seen(si, f, uv)) continue;
-          Eigen::Vector3f p_local;
-          Eigen::Vector3f n_local;
-          if (shape.type == ShapeType::kCylinder && f == 0) {
-            const float r = shape.half.x();
-            const float angle = uv.x() / r - std::numbers::pi_v<float>;
-            n_local = Eigen::Vector3f(std::cos(angle), std::sin(angle), 0.0f);
-            p_local = Eigen::Vector3f(r * n_local.x(), r * n_local.y(), uv.y() - shape.half.z());
-          } else {
-            p_local = frame.origin + uv.x() * frame.axis_u + uv.y() * frame.axis_v;
-            n_local = frame.normal;
-            if (shape.type == ShapeType::kCylinder &&
-                p_local.head<2>().squaredNorm() > shape.half.x() * shape.half.x()) {
-              continue;  // cap samples outside the disc
-            }
-          }
-          const Eigen::Vector3f p = shape.center + shape.world_from_local * p_local;
-          const Eigen::Vector3f n = shape.world_from_local * n_local;
+          Eigen::Vector3f p;
+          Eigen::Vector3f n;
+          if (!Scene::SurfacePoint(shape, f, uv, &p, &n)) continue;
           const float a = Albedo(scene, shape, f, uv);
           points.push_back({p.x(), p.y(), p.z(), n.x(), n.y(), n.z(),
                             static_cast<std::uint8_t>(std::lround(255.0f * a))});

@@ -144,4 +144,27 @@ Scene::FaceFrame Scene::Face(const Shape& shape, int face) {
   return f;
 }
 
+bool Scene::SurfacePoint(const Shape& shape, int face, const Eigen::Vector2f& uv,
+                         Eigen::Vector3f* p_world, Eigen::Vector3f* n_world) {
+  Eigen::Vector3f p_local;
+  Eigen::Vector3f n_local;
+  if (shape.type == ShapeType::kCylinder && face == 0) {
+    const float r = shape.half.x();
+    const float angle = uv.x() / r - std::numbers::pi_v<float>;
+    n_local = Eigen::Vector3f(std::cos(angle), std::sin(angle), 0.0f);
+    p_local = Eigen::Vector3f(r * n_local.x(), r * n_local.y(), uv.y() - shape.half.z());
+  } else {
+    const FaceFrame frame = Face(shape, face);
+    p_local = frame.origin + uv.x() * frame.axis_u + uv.y() * frame.axis_v;
+    n_local = frame.normal;
+    if (shape.type == ShapeType::kCylinder &&
+        p_local.head<2>().squaredNorm() > shape.half.x() * shape.half.x()) {
+      return false;  // cap samples outside the disc
+    }
+  }
+  *p_world = shape.center + shape.world_from_local * p_local;
+  *n_world = shape.world_from_local * n_local;
+  return true;
+}
+
 }  // namespace pkslam::sim

@@ -127,6 +127,10 @@ struct Scene {
     Eigen::Vector2f size;    // metres along u, v (cylinder side: circumference, height)
   };
   static FaceFrame Face(const Shape& shape, int face);
+  // The world point and outward normal at face coordinates uv (metres, within Face().size);
+  // false for a cylinder cap sample outside its disc.
+  static bool SurfacePoint(const Shape& shape, int face, const Eigen::Vector2f& uv,
+                           Eigen::Vector3f* p_world, Eigen::Vector3f* n_world);
 };
 
 }  // namespace pkslam::sim

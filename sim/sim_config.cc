@@ -68,6 +68,8 @@ void SimulationOptions::Check() const {
   PKSLAM_CHECK_OPTION(!reference_only || (write_cloud && write_images && !bench),
                       "--reference-only", "{}", "needs images and the cloud (no --bench)");
   PKSLAM_CHECK_OPTION(bench_frames >= 0, "bench_frames", "{}", bench_frames);
+  PKSLAM_CHECK_OPTION(landmark_tracks >= 0 && (landmark_tracks == 0 || !rgbd), "--tracks",
+                      "{} (EuRoC output only)", landmark_tracks);
   PKSLAM_CHECK_OPTION(cam1_relative_gain > 0.1 && cam1_relative_gain < 10.0, "cam1_relative_gain",
                       "{}", cam1_relative_gain);
   if (trajectory.empty()) motion.Check();
@@ -216,6 +218,7 @@ void WriteSimYaml(const std::filesystem::path& file, const SimulationOptions& o,
   e << YAML::Key << "saturated_share" << YAML::Value << s.saturated_share;
   e << YAML::EndMap;
 
+  e << YAML::Key << "landmark_tracks" << YAML::Value << o.landmark_tracks;
   e << YAML::Key << "reference_cloud" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "written" << YAML::Value << o.write_cloud;
   e << YAML::Key << "spacing_m" << YAML::Value << o.cloud_spacing_m;

@@ -381,6 +381,11 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
       }
     }
   } wait_on_exit{writers};
+  std::unique_ptr<LandmarkTracks> landmark_tracks;
+  if (o.landmark_tracks > 0 && frames > 0 && !o.bench && !o.reference_only) {
+    landmark_tracks = std::make_unique<LandmarkTracks>(
+        scene, cameras[0].camera, LandmarkTracksOptions{o.landmark_tracks, 8.0, o.seed});
+  }
   const auto loop_start = std::chrono::steady_clock::now();
   for (int k = 0; k < frames; ++k) {
     const std::int64_t t = first + k * period;
@@ -431,6 +436,11 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
         images[c] = cv::Mat::zeros(cameras[c].camera.height(), cameras[c].camera.width(),
                                    o.rgbd ? CV_8UC3 : CV_8UC1);
       }
+    }
+    if (landmark_tracks) {
+      // The pose the image shows (mid-exposure), stamped with the image's timestamp.
+      landmark_tracks->AddFrame(k, t,
+                                motion.WorldFromBody(t_exposure) * cameras[0].body_from_camera);
     }
     render_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     render_cpu += static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
@@ -494,6 +504,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     summary.layout = "euroc";
   }
   if (o.write_cloud) WriteReferenceClouds(scene, visibility.get(), observed.get(), o, &summary);
+  if (landmark_tracks) landmark_tracks->Write(o.output_dir / "truth");
   WriteSimYaml(o.output_dir / "sim.yaml", o, summary);
   return summary;
 }

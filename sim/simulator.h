@@ -19,6 +19,7 @@
 #include <string>
 
 #include "sim/imu_simulator.h"
+#include "sim/landmark_tracks.h"
 #include "sim/motion_generator.h"
 #include "sim/realism.h"
 #include "sim/renderer.h"
@@ -67,6 +68,9 @@ struct SimulationOptions {
   // keyframes see what the frames between them saw from a little farther away.
   double observed_range_m = 3.0;
   double observed_cell_m = 0.02;  // granularity of its "seen" cells
+  // > 0: exact 2-D tracks of this many surface landmarks in cam0 (landmark_tracks.h), written
+  // to DIR/truth/tracks_*.txt for `pkslam tracks export --simulated`.
+  int landmark_tracks = 0;
   // Render cam0 only for the reference clouds; write no images, IMU or sim.yaml.
   bool reference_only = false;
   bool bench = false;      // render and develop only; write nothing

@@ -10,6 +10,8 @@
 // OUT/stats.json       timings, counts, tracking states, memory
 // OUT/run.log          the log of the run
 // OUT/keyframe_trace.csv  per-frame keyframe decisions (with trace enabled)
+// OUT/frames.csv       per frame: time, tracking state, tracked map points, keyframe flag,
+//                      tracking time (the viewer's timeline)
 // OUT/trajectory.txt.partial  online poses appended frame by frame while the run goes; left
 //                      only by a run that did not finish (SIGKILL, crash)
 // (system/run_outputs.h lists them again to clear them before a re-run into the same OUT.)

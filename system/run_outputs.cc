@@ -57,6 +57,20 @@ void WriteTrace(const Tracker& tracker, const std::filesystem::path& file) {
   output.Commit();
 }
 
+// One row per frame the tracker saw (the viewer's timeline): time, frame id, tracking state,
+// map points tracked (pose inliers), keyframe flag, tracking time.
+void WriteFramesCsv(const Tracker& tracker, const std::filesystem::path& file) {
+  OutputFile output(file);
+  std::ostream& out = output.stream();
+  out << "time,frame,state,tracked_points,keyframe,tracking_ms\n";
+  for (const FrameRecord& r : tracker.records()) {
+    out << fmt::format("{:.9f},{},{},{},{},{:.3f}\n", static_cast<double>(r.t_ns) * 1e-9,
+                       r.frame_id, TrackingStateName(r.state), r.inliers, r.keyframe ? 1 : 0,
+                       r.tracking_ms);
+  }
+  output.Commit();
+}
+
 void WriteLoopEvents(JsonWriter* json, std::string_view key, const std::vector<LoopEvent>& events) {
   json->Key(key).BeginArray();
   for (const LoopEvent& e : events) {
@@ -140,7 +154,7 @@ void RemoveRunOutputs(const std::filesystem::path& out) {
       "trajectory.txt", "trajectory_body.txt", "trajectory_online_body.txt",
       "keyframes.txt",  "keyframes_imu.csv",   "body_from_camera.txt",
       "map_points.ply", "sparse_model.txt",    "keyframe_trace.csv",
-      "stats.json",     kPartialTrajectory};
+      "frames.csv",     "stats.json",          kPartialTrajectory};
   std::vector<std::filesystem::path> files;
   for (const char* name : kOutputs) files.push_back(out / name);
   // WriteInertialOutputs' keyframe chains, one per IMU initialisation stage.
@@ -196,6 +210,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   system.WriteMapPly(out / "map_points.ply");
   WriteSparseModel(BuildSparseModel(system), out / "sparse_model.txt");
   if (options.system.trace) WriteTrace(system.tracker(), out / "keyframe_trace.csv");
+  WriteFramesCsv(system.tracker(), out / "frames.csv");
   WriteInertialOutputs(system, out);
 
   const auto& records = system.tracker().records();

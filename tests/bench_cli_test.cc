@@ -82,6 +82,17 @@ TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
     EXPECT_TRUE(fs::exists(out / "plots/ate_bars.png")) << r.output;
     EXPECT_TRUE(fs::exists(out / "plots/sweep_delta.png")) << r.output;
   }
+  // Each run has its viewer page, linked from the report; the report opens in headless
+  // Chromium with every image loaded (tests/viewer/check_view.py).
+  EXPECT_TRUE(fs::exists(out / "runs/sim_medium_5s/stereo/pks@delta=40/seed2/view.html"));
+  EXPECT_TRUE(fs::exists(out / "viewer/three.min.js"));
+  EXPECT_THAT(testing::ReadFileBytes(out / "report.html"),
+              HasSubstr("runs/sim_medium_5s/stereo/pks@delta=40/seed2/view.html"));
+  const auto opened = testing::RunCommand(
+      fmt::format("/usr/bin/python3 '{}' report '{}'",
+                  (fs::path(PKSLAM_SOURCE_DIR) / "tests/viewer/check_view.py").string(),
+                  (out / "report.html").string()));
+  EXPECT_EQ(opened.exit_code, 0) << opened.output;
 
   // Resume: everything is finished, nothing runs again; --reevaluate measures the finished
   // runs again (same numbers: the same files and ground truth).

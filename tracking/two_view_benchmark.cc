@@ -6,10 +6,10 @@
 #include <cmath>
 #include <random>
 
+#include "estimators/two_view/two_view_models.h"
+#include "estimators/two_view/two_view_motion.h"
 #include "map_model/testing/synthetic_map.h"
 #include "tracking/two_view_initializer.h"
-#include "tracking/two_view_models.h"
-#include "tracking/two_view_motion.h"
 
 namespace pkslam {
 namespace {

@@ -7,9 +7,9 @@
 #include <random>
 
 #include "core/util/error.h"
-#include "tracking/two_view_models.h"
-#include "tracking/two_view_motion.h"
-#include "tracking/two_view_refine.h"
+#include "estimators/two_view/two_view_models.h"
+#include "estimators/two_view/two_view_motion.h"
+#include "estimators/two_view/two_view_refine.h"
 
 namespace pkslam {
 
@@ -68,31 +68,6 @@ constexpr double kReprojectionGateSigmas2 = 4.0;
 Pinhole PinholeOf(const Frame& frame) {
   const CameraRig& rig = frame.rig();
   return Pinhole{rig.fx, rig.fy, rig.cx, rig.cy};
-}
-
-// Uniform integer in [0, range) from one 64-bit draw (multiply-shift; bias < 2^-32 for the
-// ranges used here). Written out rather than std::uniform_int_distribution so the sets are
-// the same with every standard library.
-int UniformIndex(std::mt19937_64& rng, int range) {
-  const std::uint64_t r = rng() >> 32;
-  return static_cast<int>((r * static_cast<std::uint64_t>(range)) >> 32);
-}
-
-// `iterations` sets of eight distinct correspondence indices in [0, n), drawn once and shared
-// by both models (partial Fisher-Yates on a running permutation).
-std::vector<MinimalSet> DrawMinimalSets(int n, int iterations, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::vector<int> pool(n);
-  std::iota(pool.begin(), pool.end(), 0);
-  std::vector<MinimalSet> sets(iterations);
-  for (MinimalSet& set : sets) {
-    for (int j = 0; j < two_view::kMinimalSetSize; ++j) {
-      const int k = j + UniformIndex(rng, n - j);
-      std::swap(pool[j], pool[k]);
-      set[j] = pool[j];
-    }
-  }
-  return sets;
 }
 
 struct Hypotheses {
@@ -200,7 +175,8 @@ std::optional<TwoViewResult> ReconstructTwoView(const Frame& first, const Frame&
   }
 
   // Both models on the same minimal sets, concurrently (each task only reads shared data).
-  const std::vector<MinimalSet> sets = DrawMinimalSets(n, options.iterations, options.seed);
+  const std::vector<MinimalSet> sets =
+      two_view::DrawMinimalSets(n, options.iterations, options.seed);
   const two_view::NormalizedPoints normalized1 = two_view::NormalizePoints(pixels.first);
   const two_view::NormalizedPoints normalized2 = two_view::NormalizePoints(pixels.second);
   two_view::RansacOptions ransac;

@@ -11,9 +11,9 @@
 #include <random>
 #include <string>
 
+#include "estimators/two_view/two_view_refine.h"
 #include "map_model/testing/synthetic_map.h"
 #include "tracking/two_view_initializer.h"
-#include "tracking/two_view_refine.h"
 
 namespace pkslam {
 namespace {

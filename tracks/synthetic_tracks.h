@@ -11,7 +11,8 @@
 #include <vector>
 
 #include "core/geometry/se3.h"
-#include "tracks/track_file.h"
+#include "io/track_file.h"
+#include "io/trajectory.h"
 
 namespace pkslam {
 
@@ -29,6 +30,14 @@ struct SyntheticTracksOptions {
   std::uint64_t seed = 1;
   PinholeIntrinsics camera{700, 700, 640, 360, 0};
   int width = 1280, height = 720;
+  // A replayed path instead of the shape (e.g. EuRoC ground truth, see ReplayPath): one
+  // world_from_camera per frame with its time. Points are then drawn along random rays of
+  // random frames at a depth in [replay_depth_min, replay_depth_max] (the path's units), so
+  // they lie where the camera looks; tracks start and end as the camera moves on, and no point
+  // is dropped. num_frames and fps are ignored.
+  std::vector<SE3d> replay_world_from_camera;
+  std::vector<double> replay_times_s;
+  double replay_depth_min = 1.0, replay_depth_max = 6.0;
 
   void Check() const;
 };
@@ -42,5 +51,12 @@ struct SyntheticTracks {
 };
 
 SyntheticTracks SimulateTracks(const SyntheticTracksOptions& options);
+
+// The camera path of a ground-truth trajectory (world_from_body) resampled at `fps` (the
+// nearest pose to each tick, within 10 ms) over [start_s, start_s + duration_s) from its
+// first pose (duration 0: to the end), times body_from_camera. Sets the replay fields of
+// *options. Throws Error when fewer than two frames result.
+void ReplayPath(const Trajectory& world_from_body, const SE3d& body_from_camera, double fps,
+                double start_s, double duration_s, SyntheticTracksOptions* options);
 
 }  // namespace pkslam

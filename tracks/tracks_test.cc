@@ -3,15 +3,17 @@
 // of the requested size) and is reproducible from its seed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "core/util/error.h"
+#include "io/track_file.h"
 #include "tests/support/test_data.h"
 #include "tracks/synthetic_tracks.h"
-#include "tracks/track_file.h"
 
 namespace pkslam {
 namespace {
@@ -54,6 +56,37 @@ TEST(SyntheticTracks, FollowTheThesisSetupAndTheSeed) {
   EXPECT_EQ(SimulateTracks(options).tracks.observations.size(), noisy.tracks.observations.size());
   options.shape = "spiral";
   EXPECT_THROW(SimulateTracks(options), OptionError);
+}
+
+TEST(SyntheticTracks, ReplayAGroundTruthPath) {
+  // 3 s of a 200 Hz path along x, yawing slowly; resampled at 20 Hz from 1 s in.
+  Trajectory gt;
+  for (int i = 0; i <= 800; ++i) {
+    gt.poses.push_back(
+        {1'000'000'000'000LL + i * 5'000'000LL,
+         SE3d(SO3d::Exp(Eigen::Vector3d(0, 0.001 * i, 0)), Eigen::Vector3d(0.002 * i, 0, 0))});
+  }
+  SyntheticTracksOptions options;
+  options.num_points = 500;
+  ReplayPath(gt, SE3d(), 20, 1.0, 2.0, &options);
+  ASSERT_EQ(options.replay_world_from_camera.size(), 40u);
+  EXPECT_DOUBLE_EQ(options.replay_times_s.front(), 1001.0);
+  const SyntheticTracks s = SimulateTracks(options);
+  EXPECT_EQ(s.points.size(), 500u);
+  EXPECT_EQ(s.dropped_points, 0);
+  EXPECT_EQ(s.tracks.NumFrames(), 40);
+  for (const TrackObservation& o : s.tracks.observations) {
+    const Eigen::Vector3d c = s.camera_from_world[static_cast<std::size_t>(o.frame)] *
+                              s.points[static_cast<std::size_t>(o.track)];
+    const Eigen::Vector2d uv = options.camera.Project(c);
+    EXPECT_NEAR(uv.x(), o.u, 1e-9);
+    EXPECT_NEAR(o.t_s, options.replay_times_s[static_cast<std::size_t>(o.frame)], 0);
+  }
+  // Every point is seen by the frame whose ray drew it, so each track has an observation.
+  std::vector<int> seen(500, 0);
+  for (const TrackObservation& o : s.tracks.observations) ++seen[static_cast<std::size_t>(o.track)];
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 0), 0);
+  EXPECT_THROW(ReplayPath(gt, SE3d(), 20, 10.0, 1.0, &options), Error);  // past the end
 }
 
 TEST(TrackFile, RoundTripsAndRefusesMalformedFiles) {

@@ -1,6 +1,7 @@
 #include "evaluation/bench/report.h"
 
 #include <algorithm>
+#include <cmath>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -9,6 +10,7 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/output_file.h"
+#include "core/util/project_file.h"
 #include "evaluation/bench/process.h"
 
 namespace pkslam::bench {
@@ -123,6 +125,38 @@ struct Document {
   }
 };
 
+// Links to each run's viewer page (RUN/view.html, written when the run was evaluated).
+void AddRunViews(Document* doc, const std::vector<RunResult>& results, const ReportOptions& o) {
+  const auto roots = o.run_roots.empty() ? std::vector<fs::path>{o.out / "runs"} : o.run_roots;
+  std::string rows;
+  std::string md;
+  int pages = 0;
+  for (const RunResult& r : results) {
+    for (const fs::path& root : roots) {
+      const fs::path page = root / r.run_id / "view.html";
+      if (!fs::exists(page)) continue;
+      const std::string link = fs::relative(page, o.out).generic_string();
+      const std::string ate = std::isfinite(r.ate_m) ? fmt::format("{:.4f}", r.ate_m) : "-";
+      rows += fmt::format("<tr><td><a href=\"{}\">{}</a></td><td>{}</td></tr>\n", Html(link),
+                          Html(r.run_id), ate);
+      md += fmt::format("- [{}]({}) ATE {}\n", r.run_id, link, ate);
+      ++pages;
+      break;
+    }
+  }
+  if (pages == 0) return;
+  doc->Heading(2, "Runs in 3-D");
+  doc->Paragraph(
+      "Each run's viewer page (pkslam view): the trajectory coloured by its ATE over the ground "
+      "truth, keyframes coloured by the rule that created them, map points, and a timeline of "
+      "tracking state and keyframe decisions.");
+  doc->md += md + "\n";
+  doc->html += fmt::format(
+      "<details><summary>{} runs</summary>\n<table>\n<tr><th>run</th><th>ATE (m)</th></tr>\n{}"
+      "</table></details>\n",
+      pages, rows);
+}
+
 // The Speed section, when the runs measured their speed (pkslam run's stats.json since
 // realtime_factor; peers through peer_import.cc).
 void AddSpeed(Document* doc, const std::vector<GroupSummary>& groups) {
@@ -174,8 +208,11 @@ std::string Now() {
 const char* kHtmlHead = R"(<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>{}</title>
 <style>
-body {{ font-family: sans-serif; max-width: 1200px; margin: 2em auto; color: #222; }}
-table {{ border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.9em; }}
+body {{ font-family: sans-serif; max-width: 1200px; margin: 2em auto; padding: 0 1em;
+  color: #222; }}
+.wide {{ overflow-x: auto; }}
+table {{ border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.85em; }}
+tr:nth-child(even) td {{ background: #fafafa; }}
 th, td {{ border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: right; }}
 th:first-child, td:first-child {{ text-align: left; }}
 th {{ background: #eee; }}
@@ -186,21 +223,11 @@ figcaption {{ font-style: italic; color: #555; }}
 
 }  // namespace
 
-fs::path DefaultPlotsScript() {
-  const fs::path name = "evaluation/plots.py";
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path();
-         dir = dir.parent_path()) {
-      if (fs::exists(dir / name)) return dir / name;
-    }
-  }
-  return fs::path(PKSLAM_SOURCE_DIR) / name;
-}
+fs::path DefaultPlotsScript() { return FindProjectFile("evaluation/plots.py"); }
 
 std::string HtmlTable(const Table& table) {
-  std::string out = "<table>\n<tr>";
+  // Wide tables scroll inside their own box on a laptop screen instead of widening the page.
+  std::string out = "<div class=\"wide\"><table>\n<tr>";
   for (const auto& h : table.header) out += "<th>" + Html(h) + "</th>";
   out += "</tr>\n";
   for (const auto& row : table.rows) {
@@ -208,7 +235,7 @@ std::string HtmlTable(const Table& table) {
     for (const auto& c : row) out += "<td>" + Html(c) + "</td>";
     out += "</tr>\n";
   }
-  return out + "</table>\n";
+  return out + "</table></div>\n";
 }
 
 ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& options) {
@@ -281,6 +308,7 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
     doc.Heading(2, "Failed runs");
     doc.AddTable(failures);
   }
+  AddRunViews(&doc, results, options);
   if (!files.plot_error.empty()) doc.Paragraph("Plots unavailable: " + files.plot_error);
 
   WriteFileAtomically(options.out / "report.md", doc.md);

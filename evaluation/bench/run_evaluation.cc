@@ -8,10 +8,13 @@
 #include <type_traits>
 
 #include "core/util/error.h"
+#include "core/util/log.h"
 #include "evaluation/bench/bias_evaluation.h"
 #include "evaluation/evaluate.h"
 #include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
+#include "viewer/view_data.h"
+#include "viewer/view_html.h"
 
 namespace pkslam::bench {
 namespace {
@@ -123,6 +126,34 @@ void WritePlotFiles(const fs::path& dir, const Trajectory& gt, const Trajectory&
 
 }  // namespace
 
+namespace {
+
+// RUN/view.html (`pkslam view`), its scripts shared in the bench folder's viewer/ (the parent
+// of runs/). A page that cannot be made (no libjs-three) costs a warning, not the run.
+void WriteRunView(const fs::path& run_dir, const fs::path& gt_file) {
+  try {
+    fs::path out = run_dir;
+    while (!out.empty() && out.filename() != "runs" && out != out.root_path()) {
+      out = out.parent_path();
+    }
+    ViewPageOptions page;
+    if (out.filename() == "runs") {
+      const fs::path scripts = out.parent_path() / "viewer";
+      if (!fs::exists(scripts / "viewer.js")) CopyViewScripts(scripts, page);
+      page.shared_scripts = fs::relative(scripts, run_dir);
+    }
+    ViewOptions view;
+    view.run = run_dir;
+    view.ground_truth = gt_file;
+    view.max_map_points = 50000;
+    WriteViewPage(LoadViewData(view), run_dir / "view.html", page);
+  } catch (const Error& e) {
+    PKSLAM_LOG_WARN("no viewer page for {}: {}", run_dir.string(), e.what());
+  }
+}
+
+}  // namespace
+
 fs::path FindGroundTruth(const fs::path& dataset) {
   const fs::path euroc = dataset / "mav0" / "state_groundtruth_estimate0" / "data.csv";
   if (fs::exists(euroc)) return euroc;
@@ -192,6 +223,7 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
     result->accel_bias_err_pct = bias->accel_pct;
   }
   WritePlotFiles(files.run_dir, gt, est, keyframes, use_sim3 ? sim3 : se3);
+  WriteRunView(files.run_dir, gt_file);
   result->ok = true;
   result->error.clear();
 }

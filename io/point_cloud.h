@@ -1,5 +1,5 @@
-// Point clouds and their PLY files (what `pkslam dense` writes and `pkslam cloud-compare`
-// reads). A PointCloud is a plain value type.
+// Point clouds and their PLY files: the project's PLY module (`pkslam dense` and `pkslam tracks`
+// write it, `pkslam cloud-compare` reads it). A PointCloud is a plain value type.
 //
 // Reading: PLY "ascii 1.0" or "binary_little_endian 1.0"; the vertex element must come first
 // (elements after it, e.g. faces, are ignored). x, y, z are required (any numeric type);
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-namespace pkslam::dense {
+namespace pkslam {
 
 using Rgb = std::array<std::uint8_t, 3>;
 
@@ -50,4 +50,4 @@ PointCloud ReadPly(const std::filesystem::path& file);
 void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyColour colour,
               const std::string& comment = "");
 
-}  // namespace pkslam::dense
+}  // namespace pkslam

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "tracking/two_view_models.h"
+#include "estimators/two_view/two_view_models.h"
 
 namespace pkslam::two_view {
 

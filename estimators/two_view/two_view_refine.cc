@@ -1,4 +1,4 @@
-#include "tracking/two_view_refine.h"
+#include "estimators/two_view/two_view_refine.h"
 
 #include <Eigen/Cholesky>
 #include <cmath>

@@ -1,10 +1,12 @@
-#include "tracking/two_view_models.h"
+#include "estimators/two_view/two_view_models.h"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <cmath>
+#include <numeric>
+#include <random>
 
 #include "core/util/error.h"
 
@@ -369,6 +371,35 @@ ModelFit RansacFundamental(const Correspondences& c, const NormalizedPoints& nor
         return options.reject_degenerate_samples &&
                SetFitsOneHomography(c, set, s1, s2, normalized1, t2_inv, options.sigma);
       });
+}
+
+namespace {
+
+// Uniform integer in [0, range) from one 64-bit draw (multiply-shift; bias < 2^-32 for the
+// ranges used here). Written out rather than std::uniform_int_distribution so the sets are
+// the same with every standard library.
+int UniformIndex(std::mt19937_64& rng, int range) {
+  const std::uint64_t r = rng() >> 32;
+  return static_cast<int>((r * static_cast<std::uint64_t>(range)) >> 32);
+}
+
+}  // namespace
+
+// Partial Fisher-Yates on a running permutation (both models of the monocular initialiser
+// share the sets).
+std::vector<MinimalSet> DrawMinimalSets(int n, int iterations, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<int> pool(n);
+  std::iota(pool.begin(), pool.end(), 0);
+  std::vector<MinimalSet> sets(iterations);
+  for (MinimalSet& set : sets) {
+    for (int j = 0; j < kMinimalSetSize; ++j) {
+      const int k = j + UniformIndex(rng, n - j);
+      std::swap(pool[j], pool[k]);
+      set[j] = pool[j];
+    }
+  }
+  return sets;
 }
 
 }  // namespace pkslam::two_view

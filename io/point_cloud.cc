@@ -1,4 +1,4 @@
-#include "dense/point_cloud.h"
+#include "io/point_cloud.h"
 
 #include <fmt/format.h>
 
@@ -12,7 +12,7 @@
 #include "core/util/error.h"
 #include "core/util/output_file.h"
 
-namespace pkslam::dense {
+namespace pkslam {
 namespace {
 
 static_assert(std::endian::native == std::endian::little,
@@ -284,4 +284,4 @@ void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyCol
   WriteFileAtomically(file, std::string_view(buffer.data(), buffer.size()));
 }
 
-}  // namespace pkslam::dense
+}  // namespace pkslam

@@ -1,6 +1,6 @@
 // Building blocks of the two-view initialiser on exact synthetic geometry: model fitting,
 // scoring, decompositions and triangulation.
-#include "tracking/two_view_models.h"
+#include "estimators/two_view/two_view_models.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <random>
 
 #include "core/geometry/so3.h"
-#include "tracking/two_view_motion.h"
-#include "tracking/two_view_refine.h"
+#include "estimators/two_view/two_view_motion.h"
+#include "estimators/two_view/two_view_refine.h"
 
 namespace pkslam::two_view {
 namespace {

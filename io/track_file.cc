@@ -1,4 +1,4 @@
-#include "tracks/track_file.h"
+#include "io/track_file.h"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-#include "dense/point_cloud.h"
+#include "io/point_cloud.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include "core/util/error.h"
 #include "tests/support/test_data.h"
 
-namespace pkslam::dense {
+namespace pkslam {
 namespace {
 
 namespace fs = std::filesystem;
@@ -117,4 +117,4 @@ TEST_F(PointCloudTest, MalformedFilesNameFileAndLine) {
 }
 
 }  // namespace
-}  // namespace pkslam::dense
+}  // namespace pkslam

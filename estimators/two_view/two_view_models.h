@@ -79,6 +79,11 @@ double ScoreHomography(const Eigen::Matrix3d& h21, const Eigen::Matrix3d& h12,
 double ScoreFundamental(const Eigen::Matrix3d& f21, const Correspondences& c, double sigma,
                         std::vector<std::uint8_t>* inliers);
 
+// `iterations` sets of eight distinct correspondence indices in [0, n) (n >= 8), drawn from a
+// std::mt19937_64 seeded with `seed` without std::uniform_int_distribution, so the sets are
+// the same with every standard library.
+std::vector<MinimalSet> DrawMinimalSets(int n, int iterations, std::uint64_t seed);
+
 struct ModelFit {
   Eigen::Matrix3d matrix = Eigen::Matrix3d::Zero();  // in pixel coordinates (H21 or F21)
   double score = 0;                                  // 0 when no sample gave a usable model

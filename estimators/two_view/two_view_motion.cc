@@ -1,4 +1,4 @@
-#include "tracking/two_view_motion.h"
+#include "estimators/two_view/two_view_motion.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "tracking/two_view_models.h"
-#include "tracking/two_view_motion.h"
+#include "estimators/two_view/two_view_models.h"
+#include "estimators/two_view/two_view_motion.h"
 
 namespace pkslam::two_view {
 

@@ -1,0 +1,285 @@
+#include "viewer/view_data.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "core/util/error.h"
+#include "core/util/json_writer.h"
+#include "evaluation/evaluate.h"
+#include "io/point_cloud.h"
+#include "io/rigid_transform_file.h"
+#include "io/text_rows.h"
+#include "io/trajectory.h"
+
+namespace pkslam {
+
+namespace fs = std::filesystem;
+
+void ViewOptions::Check() const {
+  PKSLAM_CHECK_OPTION(!run.empty(), "--run", "{}", "a run folder is required");
+  PKSLAM_CHECK_OPTION(max_map_points > 0 && max_cloud_points > 0, "point budgets", "{} / {}",
+                      max_map_points, max_cloud_points);
+}
+
+namespace {
+
+// A CSV with a header line: calls fn(header, row) for each data row.
+void ForEachCsvRow(const fs::path& file,
+                   const std::function<void(const std::vector<std::string>&, const TextRow&)>& fn) {
+  std::vector<std::string> header;
+  ForEachDataRow(file, FieldSeparator::kComma, [&](const TextRow& row) {
+    if (header.empty()) {
+      for (auto f : row.fields) header.emplace_back(f);
+      return;
+    }
+    if (row.fields.size() != header.size()) {
+      throw InputError(
+          file, row.line,
+          fmt::format("{} fields, the header has {}", row.fields.size(), header.size()));
+    }
+    fn(header, row);
+  });
+}
+
+std::int64_t Micros(double t_s) { return std::llround(t_s * 1e6); }
+
+fs::path DatasetGroundTruth(const fs::path& dataset) {
+  for (const fs::path& candidate :
+       {dataset / "mav0/state_groundtruth_estimate0/data.csv", dataset / "groundtruth.txt"}) {
+    if (fs::exists(candidate)) return candidate;
+  }
+  throw InputError(dataset,
+                   "no ground truth (mav0/state_groundtruth_estimate0/data.csv or "
+                   "groundtruth.txt)");
+}
+
+// Every k-th point so at most `budget` remain (deterministic).
+template <class T>
+std::vector<T> Subsample(const std::vector<T>& in, std::size_t budget) {
+  if (in.size() <= budget) return in;
+  std::vector<T> out;
+  const double step = static_cast<double>(in.size()) / static_cast<double>(budget);
+  for (std::size_t i = 0; i < budget; ++i) {
+    out.push_back(in[static_cast<std::size_t>(static_cast<double>(i) * step)]);
+  }
+  return out;
+}
+
+}  // namespace
+
+ViewData LoadViewData(const ViewOptions& options) {
+  options.Check();
+  const fs::path& run = options.run;
+  if (!fs::is_directory(run)) throw InputError(run, "not a run folder");
+  ViewData data;
+  data.title = fs::absolute(run).filename().string();
+  fs::path gt = options.ground_truth;
+  if (gt.empty() && !options.dataset.empty()) gt = DatasetGroundTruth(options.dataset);
+
+  Sim3d world_from_map;  // the displayed world from the run's map world
+  if (!gt.empty()) {
+    const RunAndGroundTruth pair = ReadRunAndGroundTruth(run, gt, std::nullopt);
+    const bool monocular = !fs::exists(run / "trajectory_body.txt");
+    EvaluationOptions eval;
+    eval.alignment = monocular ? AlignmentMethod::kSim3 : AlignmentMethod::kSE3;
+    eval.compute_rpe = false;
+    const EvaluationResult e = EvaluateTrajectories(pair.ground_truth, pair.estimate, eval);
+    world_from_map = e.ref_from_est;
+    data.alignment = monocular ? "sim3" : "se3";
+    data.ate_rmse_m = e.ate_translation_m.rmse;
+    std::vector<double> ate(pair.estimate.poses.size(), -1.0);
+    for (std::size_t i = 0; i < e.pairs.size(); ++i) {
+      ate[e.pairs[i].est] = e.ate_translation_errors_m[i];
+    }
+    for (std::size_t i = 0; i < pair.estimate.poses.size(); ++i) {
+      const StampedPose& p = pair.estimate.poses[i];
+      data.estimate.push_back(
+          {static_cast<double>(p.t_ns) * 1e-9,
+           SE3d(world_from_map.so3() * p.pose.so3(), world_from_map * p.pose.translation()),
+           ate[i]});
+    }
+    // The ground truth over the estimate's time span, at most ~5000 vertices.
+    const auto& g = pair.ground_truth.poses;
+    const std::int64_t t0 = pair.estimate.poses.empty() ? 0 : pair.estimate.poses.front().t_ns;
+    const std::int64_t t1 = pair.estimate.poses.empty() ? 0 : pair.estimate.poses.back().t_ns;
+    std::vector<Eigen::Vector3d> path;
+    for (const StampedPose& p : g) {
+      if (p.t_ns >= t0 - 1'000'000'000 && p.t_ns <= t1 + 1'000'000'000) {
+        path.push_back(p.pose.translation());
+      }
+    }
+    data.ground_truth = Subsample(path, 5000);
+  } else {
+    data.alignment = "none";
+    const Trajectory t = ReadTrajectory(run / "trajectory.txt");
+    for (const StampedPose& p : t.poses) {
+      data.estimate.push_back({static_cast<double>(p.t_ns) * 1e-9, p.pose, -1.0});
+    }
+  }
+  auto to_world = [&](const SE3d& pose) {
+    return SE3d(world_from_map.so3() * pose.so3(), world_from_map * pose.translation());
+  };
+
+  // Keyframes and the rule that created each.
+  std::unordered_map<std::int64_t, std::string> reasons;  // by time (us)
+  std::unordered_map<std::int64_t, std::size_t> trace_row_of_frame;
+  std::vector<std::pair<std::string, std::map<std::string, double>>> trace_rows;
+  const fs::path trace = run / "keyframe_trace.csv";
+  if (fs::exists(trace)) {
+    ForEachCsvRow(trace, [&](const std::vector<std::string>& header, const TextRow& row) {
+      double t = 0;
+      std::int64_t frame = -1;
+      bool insert = false;
+      std::string reason;
+      std::map<std::string, double> values;
+      for (std::size_t i = 0; i < header.size(); ++i) {
+        const std::string_view f = row.fields[i];
+        if (header[i] == "time") {
+          t = DoubleField(f, trace, row.line, "time");
+        } else if (header[i] == "frame") {
+          frame = Int64Field(f, trace, row.line, "frame");
+        } else if (header[i] == "decision") {
+          insert = f == "1";
+        } else if (header[i] == "reason") {
+          reason = std::string(f);
+        } else if (header[i] != "selector" && !f.empty()) {
+          if (const auto v = ParseDouble(f)) values[header[i]] = *v;
+        }
+      }
+      if (insert) reasons[Micros(t)] = reason;
+      trace_row_of_frame[frame] = trace_rows.size();
+      trace_rows.emplace_back(reason, std::move(values));
+    });
+  }
+  if (fs::exists(run / "keyframes.txt")) {
+    for (const StampedPose& p : ReadTrajectory(run / "keyframes.txt").poses) {
+      const double t = static_cast<double>(p.t_ns) * 1e-9;
+      const auto it = reasons.find(Micros(t));
+      data.keyframes.push_back({t, to_world(p.pose), it != reasons.end() ? it->second : ""});
+    }
+  }
+
+  // Map points and the dense cloud, in the displayed world.
+  auto load_points = [&](const fs::path& file, std::size_t budget, bool colours) {
+    const PointCloud cloud = ReadPly(file);
+    std::vector<std::size_t> index(cloud.size());
+    for (std::size_t i = 0; i < index.size(); ++i) index[i] = i;
+    index = Subsample(index, budget);
+    std::vector<Eigen::Vector3f> points;
+    for (std::size_t i : index) {
+      points.push_back((world_from_map * cloud.points[i].cast<double>()).cast<float>());
+      if (colours && cloud.has_colour()) data.cloud_colours.push_back(cloud.colours[i]);
+    }
+    return points;
+  };
+  if (fs::exists(run / "map_points.ply")) {
+    data.map_points = load_points(run / "map_points.ply", options.max_map_points, false);
+  }
+  const fs::path cloud = options.cloud.empty() ? run / "dense.ply" : options.cloud;
+  if (!options.cloud.empty() && !fs::exists(cloud)) throw InputError(cloud, "not found (--cloud)");
+  if (fs::exists(cloud)) data.cloud = load_points(cloud, options.max_cloud_points, true);
+
+  // Timeline: frames.csv, joined with the trace by frame id.
+  const fs::path frames = run / "frames.csv";
+  if (fs::exists(frames)) {
+    ForEachCsvRow(frames, [&](const std::vector<std::string>& header, const TextRow& row) {
+      ViewTimelineRow r;
+      for (std::size_t i = 0; i < header.size(); ++i) {
+        const std::string_view f = row.fields[i];
+        if (header[i] == "time") r.t_s = DoubleField(f, frames, row.line, "time");
+        if (header[i] == "frame") r.frame = Int64Field(f, frames, row.line, "frame");
+        if (header[i] == "state") r.state = std::string(f);
+        if (header[i] == "tracked_points") {
+          r.tracked_points = static_cast<int>(Int64Field(f, frames, row.line, "tracked_points"));
+        }
+        if (header[i] == "keyframe") r.keyframe = f == "1";
+      }
+      if (const auto it = trace_row_of_frame.find(r.frame); it != trace_row_of_frame.end()) {
+        r.decision_reason = trace_rows[it->second].first;
+        r.quantities = trace_rows[it->second].second;
+      }
+      data.timeline.push_back(std::move(r));
+    });
+  }
+  return data;
+}
+
+namespace {
+
+void Vec3(JsonWriter& json, const Eigen::Vector3d& v) {
+  json.BeginArray();
+  for (int i = 0; i < 3; ++i) json.Value(std::round(v[i] * 1e4) / 1e4);
+  json.EndArray();
+}
+
+}  // namespace
+
+std::string ViewDataJson(const ViewData& data) {
+  JsonWriter json(0);
+  json.BeginObject();
+  json.Member("title", data.title);
+  json.Member("alignment", data.alignment);
+  json.Member("ate_rmse_m", data.ate_rmse_m);
+  // Flat arrays keep a 60 s run small: t, x, y, z, qx, qy, qz, qw, ate per pose.
+  json.Key("estimate").BeginArray();
+  for (const ViewPose& p : data.estimate) {
+    const Eigen::Vector3d& t = p.world_from_camera.translation();
+    const Eigen::Quaterniond& q = p.world_from_camera.quaternion();
+    for (double v : {p.t_s, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w(), p.ate_m}) {
+      json.Value(std::round(v * 1e5) / 1e5);
+    }
+  }
+  json.EndArray();
+  json.Key("ground_truth").BeginArray();
+  for (const Eigen::Vector3d& p : data.ground_truth) {
+    for (int i = 0; i < 3; ++i) json.Value(std::round(p[i] * 1e4) / 1e4);
+  }
+  json.EndArray();
+  json.Key("keyframes").BeginArray();
+  for (const ViewKeyframe& k : data.keyframes) {
+    json.BeginObject();
+    json.Member("t", k.t_s);
+    json.Key("p");
+    Vec3(json, k.world_from_camera.translation());
+    const Eigen::Quaterniond& q = k.world_from_camera.quaternion();
+    json.Key("q").BeginArray().Value(q.x()).Value(q.y()).Value(q.z()).Value(q.w()).EndArray();
+    json.Member("reason", k.reason);
+    json.EndObject();
+  }
+  json.EndArray();
+  auto points = [&](std::string_view key, const std::vector<Eigen::Vector3f>& pts) {
+    json.Key(key).BeginArray();
+    for (const Eigen::Vector3f& p : pts) {
+      for (int i = 0; i < 3; ++i) json.Value(std::round(static_cast<double>(p[i]) * 1e3) / 1e3);
+    }
+    json.EndArray();
+  };
+  points("map_points", data.map_points);
+  points("cloud", data.cloud);
+  json.Key("cloud_colours").BeginArray();
+  for (const auto& c : data.cloud_colours) {
+    for (int i = 0; i < 3; ++i) json.Value(static_cast<int>(c[static_cast<std::size_t>(i)]));
+  }
+  json.EndArray();
+  json.Key("timeline").BeginArray();
+  for (const ViewTimelineRow& r : data.timeline) {
+    json.BeginObject();
+    json.Member("t", r.t_s).Member("frame", r.frame).Member("state", r.state);
+    json.Member("tracked", r.tracked_points).Member("kf", r.keyframe);
+    if (!r.decision_reason.empty()) json.Member("reason", r.decision_reason);
+    if (!r.quantities.empty()) {
+      json.Key("q").BeginObject();
+      for (const auto& [k, v] : r.quantities) json.Member(k, v);
+      json.EndObject();
+    }
+    json.EndObject();
+  }
+  json.EndArray();
+  json.EndObject();
+  return json.str();
+}
+
+}  // namespace pkslam

@@ -1,0 +1,73 @@
+// What `pkslam view` shows of a run, gathered from its output folder (issue 25): the estimated
+// trajectory (aligned to ground truth when given, each pose with its ATE), the ground truth,
+// the keyframes with the rule that created each (keyframe_trace.csv, from --trace), the map
+// points, an optional dense cloud or mesh vertices (subsampled), and the per-frame timeline
+// (frames.csv: tracking state and tracked points; keyframe_trace.csv: decision, reason and
+// every selector quantity such as PKS's M, D, Th and ECOG).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/geometry/se3.h"
+
+namespace pkslam {
+
+struct ViewOptions {
+  std::filesystem::path run;
+  std::filesystem::path ground_truth;  // empty: none (or from `dataset`)
+  std::filesystem::path dataset;       // empty: none; its ground truth when `ground_truth` empty
+  std::filesystem::path cloud;         // empty: RUN/dense.ply when present
+  std::size_t max_map_points = 200000;
+  std::size_t max_cloud_points = 300000;
+
+  void Check() const;
+};
+
+struct ViewPose {
+  double t_s = 0;
+  SE3d world_from_camera;  // in the displayed world (ground truth's after alignment)
+  double ate_m = -1;       // translation error after alignment (-1: no ground truth)
+};
+
+struct ViewKeyframe {
+  double t_s = 0;
+  SE3d world_from_camera;
+  std::string reason;  // rule that created it ("" when the run had no --trace)
+};
+
+struct ViewTimelineRow {
+  double t_s = 0;
+  std::int64_t frame = 0;
+  std::string state;
+  int tracked_points = 0;
+  bool keyframe = false;
+  std::string decision_reason;               // from keyframe_trace.csv ("" when absent)
+  std::map<std::string, double> quantities;  // selector trace values of the frame
+};
+
+struct ViewData {
+  std::string title;
+  std::string alignment;  // "se3", "sim3" or "none"
+  double ate_rmse_m = -1;
+  std::vector<ViewPose> estimate;
+  std::vector<Eigen::Vector3d> ground_truth;
+  std::vector<ViewKeyframe> keyframes;
+  std::vector<Eigen::Vector3f> map_points;
+  std::vector<Eigen::Vector3f> cloud;  // dense cloud (or mesh vertices), subsampled
+  std::vector<std::array<std::uint8_t, 3>> cloud_colours;  // empty or one per cloud point
+  std::vector<ViewTimelineRow> timeline;
+};
+
+// Reads the run (InputError naming the missing or malformed file).
+ViewData LoadViewData(const ViewOptions& options);
+
+// The data as one JSON object (the page's PKSLAM_DATA).
+std::string ViewDataJson(const ViewData& data);
+
+}  // namespace pkslam
