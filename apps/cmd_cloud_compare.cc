@@ -18,6 +18,7 @@
 #include "dense/cloud_compare.h"
 #include "dense/histogram_plot.h"
 #include "dense/keyframe_images.h"
+#include "dense/mesh.h"
 #include "dense/visibility.h"
 #include "evaluation/evaluate.h"
 #include "io/point_cloud.h"
@@ -42,6 +43,7 @@ struct CompareArgs {
   std::string write_aligned;
   std::vector<std::string> observed_refs;
   double max_diff_s = 0.01;
+  double mesh_spacing_m = 0.005;
   dense::CompareOptions compare;
   dense::VisibilityOptions visibility;
 };
@@ -90,7 +92,16 @@ void RunCompare(const CompareArgs& args) {
   if (!args.dataset.empty() && args.align_run.empty()) {
     throw OptionError("--dataset (restricted completeness) needs --align-run and --gt");
   }
-  PointCloud cloud = ReadPly(args.cloud);
+  // A mesh (a PLY with faces, e.g. `pkslam dense --mesh`) is measured through points sampled
+  // uniformly on its triangles.
+  PointCloud cloud;
+  if (dense::PlyHasFaces(args.cloud)) {
+    cloud = dense::SampleMesh(args.cloud, args.mesh_spacing_m);
+    fmt::print("mesh: {} points sampled on its triangles ({} m spacing)\n", cloud.size(),
+               args.mesh_spacing_m);
+  } else {
+    cloud = ReadPly(args.cloud);
+  }
   const PointCloud ref = ReadPly(args.ref);
   if (cloud.empty()) throw InputError(args.cloud, "the cloud has no points");
   if (ref.empty()) throw InputError(args.ref, "the reference cloud has no points");
@@ -233,7 +244,10 @@ void RegisterCloudCompareCommand(CLI::App& app) {
       "cloud-compare",
       "Accuracy (cloud -> reference nearest-neighbour distances) and completeness (share of "
       "reference points within 5 cm of the cloud) of a point cloud");
-  cmd->add_option("--cloud", args->cloud, "The cloud to evaluate (PLY)")->required();
+  cmd->add_option("--cloud", args->cloud, "The cloud or mesh to evaluate (PLY)")->required();
+  cmd->add_option("--mesh-spacing", args->mesh_spacing_m,
+                  "A mesh is sampled with about one point per this spacing squared (m)")
+      ->capture_default_str();
   cmd->add_option("--ref", args->ref, "The reference cloud (PLY)")->required();
   cmd->add_option("--hist", args->hist, "Write a histogram of the distances (PNG)");
   cmd->add_option("--json", args->json, "Write the results as JSON");

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "apps/commands.h"
@@ -11,6 +12,7 @@
 #include "core/util/json_writer.h"
 #include "core/util/output_file.h"
 #include "dense/dense_cloud.h"
+#include "dense/mesh.h"
 #include "io/dataset_fingerprint.h"
 
 namespace pkslam::apps {
@@ -24,12 +26,15 @@ struct DenseArgs {
   std::string settings;
   std::string out;
   std::string json;
+  std::string mesh;
   bool colour = false;
   dense::DenseOptions options;
+  dense::MeshOptions mesh_options;
 };
 
 void RunDense(const DenseArgs& args) {
   args.options.Check();
+  if (args.out.empty() && args.mesh.empty()) throw OptionError("dense: give --out and/or --mesh");
   const fs::path keyframes_file = fs::path(args.run) / "keyframes.txt";
   if (!fs::is_directory(args.run)) throw InputError(args.run, "run directory does not exist");
   if (!fs::exists(keyframes_file)) {
@@ -40,6 +45,33 @@ void RunDense(const DenseArgs& args) {
       args.dataset, args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings),
       args.options.full_view);
   RequireRunOfDataset(args.run, args.dataset);
+  std::optional<dense::MeshStats> mesh;
+  if (!args.mesh.empty()) {
+    dense::MeshOptions mo = args.mesh_options;
+    mo.depth = args.options;
+    mesh = dense::BuildTsdfMesh(keyframes, source, mo, args.mesh);
+    fmt::print(
+        "mesh: {} keyframes fused (TSDF voxel {} m, truncation {} m), {} vertices, {} triangles, "
+        "{:.1f} s, peak memory {:.0f} MiB; {}\n",
+        mesh->keyframes_used, mo.voxel_m, mo.truncation_m, mesh->vertices, mesh->triangles,
+        mesh->seconds, mesh->peak_memory_mib, args.mesh);
+    if (args.out.empty()) {
+      if (!args.json.empty()) {
+        JsonWriter json;
+        json.BeginObject();
+        json.Member("run", args.run).Member("dataset", args.dataset).Member("mesh", args.mesh);
+        json.Member("mesh_voxel_m", mo.voxel_m).Member("mesh_truncation_m", mo.truncation_m);
+        json.Member("mesh_keyframes", mesh->keyframes_used);
+        json.Member("mesh_vertices", static_cast<std::uint64_t>(mesh->vertices));
+        json.Member("mesh_triangles", static_cast<std::uint64_t>(mesh->triangles));
+        json.Member("mesh_seconds", mesh->seconds)
+            .Member("mesh_peak_memory_mib", mesh->peak_memory_mib);
+        json.EndObject();
+        WriteFileAtomically(args.json, json.str());
+      }
+      return;
+    }
+  }
   dense::DenseStats stats;
   const PointCloud cloud = BuildDenseCloud(keyframes, source, args.options, &stats);
   if (cloud.empty()) {
@@ -105,6 +137,15 @@ void RunDense(const DenseArgs& args) {
     json.Member("voxels", static_cast<std::uint64_t>(stats.voxels));
     json.Member("points", static_cast<std::uint64_t>(stats.points));
     json.Member("seconds", stats.seconds);
+    if (mesh) {
+      json.Member("mesh", args.mesh);
+      json.Member("mesh_voxel_m", args.mesh_options.voxel_m);
+      json.Member("mesh_truncation_m", args.mesh_options.truncation_m);
+      json.Member("mesh_vertices", static_cast<std::uint64_t>(mesh->vertices));
+      json.Member("mesh_triangles", static_cast<std::uint64_t>(mesh->triangles));
+      json.Member("mesh_seconds", mesh->seconds);
+      json.Member("mesh_peak_memory_mib", mesh->peak_memory_mib);
+    }
     json.EndObject();
     WriteFileAtomically(args.json, json.str());
   }
@@ -118,11 +159,20 @@ void RegisterDenseCommand(CLI::App& app) {
       "dense",
       "Dense point cloud from a run's keyframes: stereo SGBM (full-view rectified, left-right "
       "checked) or RGB-D depth; depths >= --min-views keyframes agree on are averaged, "
-      "single-view depths no keyframe contradicts are kept (views 1); fused in a voxel grid");
+      "single-view depths no keyframe contradicts are kept (views 1); fused in a voxel grid. "
+      "--mesh: a triangle mesh by TSDF fusion (Open3D)");
   cmd->add_option("--run", args->run, "Run directory of `pkslam run` (keyframes.txt)")->required();
   cmd->add_option("--dataset", args->dataset, "The dataset the run used (EuRoC or TUM RGB-D)")
       ->required();
-  cmd->add_option("--out", args->out, "Output cloud (binary PLY)")->required();
+  cmd->add_option("--out", args->out, "Output cloud (binary PLY)");
+  cmd->add_option("--mesh", args->mesh,
+                  "Also (or only) fuse the keyframes' depth maps in a TSDF volume (Open3D) and "
+                  "write its triangle mesh here (PLY)");
+  cmd->add_option("--mesh-voxel", args->mesh_options.voxel_m, "TSDF voxel side (m)")
+      ->capture_default_str();
+  cmd->add_option("--mesh-truncation", args->mesh_options.truncation_m,
+                  "TSDF truncation distance (m)")
+      ->capture_default_str();
   cmd->add_option("--settings", args->settings, "The settings file the run used (if any)");
   dense::DenseOptions& o = args->options;
   cmd->add_option("--voxel", o.voxel_m, "Voxel side (m)")->capture_default_str();

@@ -11,6 +11,7 @@ find_package(spdlog REQUIRED)
 find_package(TBB REQUIRED)
 find_package(ZLIB REQUIRED)    # map file checksums (map_model/storage)
 find_package(cereal REQUIRED)  # map file payloads (map_model/storage)
+find_package(Open3D REQUIRED)  # TSDF fusion and meshes (dense/mesh.h)
 
 # nanoflann ships no CMake config in Debian 12; it is a single header.
 find_path(NANOFLANN_INCLUDE_DIR nanoflann.hpp REQUIRED)

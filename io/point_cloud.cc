@@ -250,13 +250,22 @@ PointCloud ReadPly(const std::filesystem::path& file) {
 
 void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyColour colour,
               const std::string& comment) {
+  WritePly(cloud, file, colour,
+           comment.empty() ? std::vector<std::string>{} : std::vector<std::string>{comment});
+}
+
+void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyColour colour,
+              const std::vector<std::string>& comments) {
   cloud.CheckSizes();
   PKSLAM_CHECK(colour == PlyColour::kNone || cloud.has_colour(), "colour output needs colours");
-  PKSLAM_CHECK(comment.find('\n') == std::string::npos, "multi-line PLY comment");
   std::string header = "ply\nformat binary_little_endian 1.0\n";
-  if (!comment.empty()) header += "comment " + comment + '\n';
+  for (const std::string& comment : comments) {
+    PKSLAM_CHECK(comment.find('\n') == std::string::npos, "multi-line PLY comment");
+    header += "comment " + comment + '\n';
+  }
   header += fmt::format("element vertex {}\nproperty float x\nproperty float y\n", cloud.size());
   header += "property float z\n";
+  if (cloud.has_normals()) header += "property float nx\nproperty float ny\nproperty float nz\n";
   if (colour == PlyColour::kGrey) header += "property uchar intensity\n";
   if (colour == PlyColour::kRgb) {
     header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
@@ -264,7 +273,7 @@ void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyCol
   if (cloud.has_views()) header += "property uchar views\n";
   header += "end_header\n";
   std::vector<char> buffer;
-  buffer.reserve(header.size() + cloud.size() * 17);
+  buffer.reserve(header.size() + cloud.size() * (cloud.has_normals() ? 29 : 17));
   buffer.insert(buffer.end(), header.begin(), header.end());
   auto put = [&buffer](const void* p, std::size_t n) {
     const char* c = static_cast<const char*>(p);
@@ -272,6 +281,7 @@ void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyCol
   };
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     put(cloud.points[i].data(), 3 * sizeof(float));
+    if (cloud.has_normals()) put(cloud.normals[i].data(), 3 * sizeof(float));
     if (colour == PlyColour::kGrey) {
       const Rgb& c = cloud.colours[i];
       const auto grey = static_cast<std::uint8_t>((c[0] + c[1] + c[2] + 1) / 3);

@@ -6,8 +6,11 @@
 // colour comes from red/green/blue (or r/g/b), grey from intensity/grey/gray (replicated to
 // r = g = b); a "views" property is kept, and nx, ny, nz normals (the simulator's reference).
 // Errors throw InputError naming the file and the header line (or the vertex) at fault. Writing:
-// binary little-endian, x y z float, then optionally one uchar "intensity" (grey) or uchar red
-// green blue (colour), then optionally uchar "views".
+// binary little-endian, x y z float, then nx ny nz float when the cloud has normals, then
+// optionally one uchar "intensity" (grey) or uchar red green blue (colour), then optionally
+// uchar "views". Every PLY point file of the project goes through here (map points, dense
+// clouds, the RGB-D voxel map, the simulator's reference clouds, the tracks map); meshes are
+// Open3D's (dense/mesh.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -25,7 +28,7 @@ struct PointCloud {
   std::vector<Eigen::Vector3f> points;
   std::vector<Rgb> colours;              // empty or one per point (grey: r = g = b)
   std::vector<std::uint8_t> views;       // empty or one per point: keyframes that saw it (capped)
-  std::vector<Eigen::Vector3f> normals;  // empty or one unit normal per point (read, not written)
+  std::vector<Eigen::Vector3f> normals;  // empty or one unit normal per point
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }
@@ -49,5 +52,8 @@ PointCloud ReadPly(const std::filesystem::path& file);
 // into the header. Throws Error when the file cannot be written.
 void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyColour colour,
               const std::string& comment = "");
+// The same with several header comment lines.
+void WritePly(const PointCloud& cloud, const std::filesystem::path& file, PlyColour colour,
+              const std::vector<std::string>& comments);
 
 }  // namespace pkslam

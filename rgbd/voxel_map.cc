@@ -8,6 +8,7 @@
 
 #include "core/util/error.h"
 #include "core/util/output_file.h"
+#include "io/point_cloud.h"
 
 namespace pkslam::rgbd {
 namespace {
@@ -72,20 +73,14 @@ void VoxelMap::WritePly(const std::filesystem::path& file) const {
 
 void WriteColouredPly(const std::vector<VoxelMap::Point>& points, const std::filesystem::path& file,
                       const std::string& comment) {
-  OutputFile output(file);
-  std::ostream& out = output.stream();
-  out << "ply\nformat binary_little_endian 1.0\ncomment " << comment << "\nelement vertex "
-      << points.size()
-      << "\nproperty float x\nproperty float y\nproperty float z\n"
-         "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  PointCloud cloud;
+  cloud.points.reserve(points.size());
+  cloud.colours.reserve(points.size());
   for (const auto& p : points) {
-    const float xyz[3] = {p.position.x(), p.position.y(), p.position.z()};
-    out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
-    const char rgb[3] = {static_cast<char>(p.bgr[2]), static_cast<char>(p.bgr[1]),
-                         static_cast<char>(p.bgr[0])};
-    out.write(rgb, sizeof(rgb));
+    cloud.points.push_back(p.position);
+    cloud.colours.push_back({p.bgr[2], p.bgr[1], p.bgr[0]});
   }
-  output.Commit();
+  WritePly(cloud, file, PlyColour::kRgb, comment);
 }
 
 }  // namespace pkslam::rgbd

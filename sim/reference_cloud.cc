@@ -10,17 +10,10 @@
 #include <vector>
 
 #include "core/util/error.h"
+#include "io/point_cloud.h"
 
 namespace pkslam::sim {
 namespace {
-
-#pragma pack(push, 1)
-struct PlyVertex {
-  float x, y, z, nx, ny, nz;
-  std::uint8_t intensity;
-};
-#pragma pack(pop)
-static_assert(sizeof(PlyVertex) == 25);
 
 // Albedo (grey, 0..1) of a face point, from the finest texture level.
 float Albedo(const Scene& scene, const Shape& shape, int face, const Eigen::Vector2f& uv) {
@@ -37,7 +30,7 @@ std::size_t WriteReferenceCloud(const Scene& scene, const SurfaceVisibility* vis
                                 const std::string& description) {
   PKSLAM_CHECK(spacing_m > 0.0, "cloud spacing must be > 0");
   const float step = static_cast<float>(spacing_m);
-  std::vector<PlyVertex> points;
+  PointCloud points;
   for (int si = 0; si < static_cast<int>(scene.shapes.size()); ++si) {
     const Shape& shape = scene.shapes[si];
     for (int f = 0; f < shape.num_faces(); ++f) {
@@ -53,28 +46,22 @@ std::size_t WriteReferenceCloud(const Scene& scene, const SurfaceVisibility* vis
           Eigen::Vector3f n;
           if (!Scene::SurfacePoint(shape, f, uv, &p, &n)) continue;
           const float a = Albedo(scene, shape, f, uv);
-          points.push_back({p.x(), p.y(), p.z(), n.x(), n.y(), n.z(),
-                            static_cast<std::uint8_t>(std::lround(255.0f * a))});
+          const auto grey = static_cast<std::uint8_t>(std::lround(255.0f * a));
+          points.points.push_back(p);
+          points.normals.push_back(n);
+          points.colours.push_back({grey, grey, grey});
         }
       }
     }
   }
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
-  out << "ply\nformat binary_little_endian 1.0\n"
-      << fmt::format("comment pkslam simulate {}\n", description)
-      << fmt::format("comment spacing_m {}\n", spacing_m);
+  std::vector<std::string> comments = {fmt::format("pkslam simulate {}", description),
+                                       fmt::format("spacing_m {}", spacing_m)};
   if (visibility != nullptr && visibility->max_depth_m() > 0) {
-    out << fmt::format("comment visibility_cell_m {}\ncomment max_depth_m {}\n",
-                       visibility->cell_m(), visibility->max_depth_m());
+    comments.push_back(fmt::format("visibility_cell_m {}", visibility->cell_m()));
+    comments.push_back(fmt::format("max_depth_m {}", visibility->max_depth_m()));
   }
-  out << fmt::format("element vertex {}\n", points.size())
-      << "property float x\nproperty float y\nproperty float z\n"
-         "property float nx\nproperty float ny\nproperty float nz\n"
-         "property uchar intensity\nend_header\n";
-  out.write(reinterpret_cast<const char*>(points.data()),
-            static_cast<std::streamsize>(points.size() * sizeof(PlyVertex)));
-  if (!out) throw Error(fmt::format("cannot write {}", file.string()));
+  // x y z, nx ny nz, intensity (io/point_cloud.h).
+  WritePly(points, file, PlyColour::kGrey, comments);
   return points.size();
 }
 

@@ -9,6 +9,7 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/output_file.h"
+#include "io/point_cloud.h"
 #include "keyframe/selector_factory.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
@@ -231,27 +232,20 @@ Trajectory SlamSystem::KeyFrameTrajectory() const {
 }
 
 void SlamSystem::WriteMapPly(const std::filesystem::path& file) const {
-  auto lock = MapReader(atlas_).Lock();
-  const Map* map = LargestMap();
-  OutputFile output(file);
-  std::ostream& out = output.stream();
-  const std::size_t n = map != nullptr ? map->map_points().size() : 0;
-  out << "ply\nformat binary_little_endian 1.0\ncomment pkslam map points (world frame)\n"
-      << "element vertex " << n << "\nproperty float x\nproperty float y\nproperty float z\n"
-      << "property uchar observations\nend_header\n";
-  if (map != nullptr) {
-    for (const auto& [id, mp] : map->map_points()) {
-      const float xyz[3] = {static_cast<float>(mp->position().x()),
-                            static_cast<float>(mp->position().y()),
-                            static_cast<float>(mp->position().z())};
-      out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
-      const auto obs =
-          static_cast<unsigned char>(std::min<std::size_t>(255, mp->observations().size()));
-      out.put(static_cast<char>(obs));
+  // Copied under the shared lock, written after it (io/point_cloud.h: "views" = the keyframes
+  // observing each point, capped at 255).
+  PointCloud cloud;
+  {
+    auto lock = MapReader(atlas_).Lock();
+    if (const Map* map = LargestMap()) {
+      for (const auto& [id, mp] : map->map_points()) {
+        cloud.points.push_back(mp->position().cast<float>());
+        cloud.views.push_back(
+            static_cast<std::uint8_t>(std::min<std::size_t>(255, mp->observations().size())));
+      }
     }
   }
-  lock.unlock();
-  output.Commit();
+  WritePly(cloud, file, PlyColour::kNone, "pkslam map points (world frame)");
 }
 
 int SlamSystem::NumKeyFrames() const {

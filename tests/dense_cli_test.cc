@@ -74,24 +74,24 @@ TEST_F(DenseCliTest, DenseBadInputIsOneLine) {
 
 TEST_F(DenseCliTest, CloudCompareBadInputIsOneLine) {
   const std::string good = Write("good.ply", kTinyPly);
-  const std::string bad = Write("bad.ply", "ply\nformat ascii 1.0\nelement vertex 2\n"
-                                           "property float x\nproperty float y\n"
-                                           "property float z\nend_header\n0 0 0\n");
+  const std::string bad = Write("bad.ply",
+                                "ply\nformat ascii 1.0\nelement vertex 2\n"
+                                "property float x\nproperty float y\n"
+                                "property float z\nend_header\n0 0 0\n");
   EXPECT_NE(ExpectOneLineError(fmt::format("cloud-compare --cloud {} --ref {}", bad, good))
                 .find("bad.ply:9:"),
             std::string::npos);
-  EXPECT_NE(ExpectOneLineError(fmt::format("cloud-compare --cloud {} --ref {}/none.ply", good,
-                                           dir_.string()))
+  EXPECT_NE(ExpectOneLineError(
+                fmt::format("cloud-compare --cloud {} --ref {}/none.ply", good, dir_.string()))
                 .find("cannot open"),
             std::string::npos);
-  EXPECT_NE(ExpectOneLineError(
-                fmt::format("cloud-compare --cloud {} --ref {} --align-run {}", good, good,
-                            dir_.string()))
+  EXPECT_NE(ExpectOneLineError(fmt::format("cloud-compare --cloud {} --ref {} --align-run {}", good,
+                                           good, dir_.string()))
                 .find("--gt"),
             std::string::npos);
   // Identical clouds: perfect scores, JSON written.
-  const auto r = Pkslam(fmt::format("cloud-compare --cloud {} --ref {} --json {}/r.json", good,
-                                    good, dir_.string()));
+  const auto r = Pkslam(
+      fmt::format("cloud-compare --cloud {} --ref {} --json {}/r.json", good, good, dir_.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("completeness  100.0%"), std::string::npos) << r.output;
   std::ifstream json(dir_ / "r.json");
@@ -118,9 +118,10 @@ TEST_F(DenseCliTest, RealRunExportsAColmapModelAndADenseCloud) {
   PKSLAM_REQUIRE_SHARED_DATA(shared);
   const fs::path dataset = shared / "euroc" / "V1_01_easy_static";
   const fs::path run = dir_ / "run";
-  const auto r = Pkslam(fmt::format("run --dataset '{}' --sensor stereo --out '{}' --quiet "
-                                    "--max-frames 40 --deterministic",
-                                    dataset.string(), run.string()));
+  const auto r =
+      Pkslam(fmt::format("run --dataset '{}' --sensor stereo --out '{}' --quiet "
+                         "--max-frames 40 --deterministic",
+                         dataset.string(), run.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   ASSERT_TRUE(fs::exists(run / "sparse_model.txt"));
   const auto e = Pkslam(fmt::format("export-colmap --run '{}' --dataset '{}' --out '{}' --quiet",
@@ -129,18 +130,37 @@ TEST_F(DenseCliTest, RealRunExportsAColmapModelAndADenseCloud) {
   EXPECT_TRUE(fs::exists(dir_ / "colmap" / "sparse" / "points3D.txt"));
   EXPECT_FALSE(fs::is_empty(dir_ / "colmap" / "images"));
   if (fs::exists("/usr/bin/colmap")) {
-    const auto a = testing::RunCommand(fmt::format(
-        "QT_QPA_PLATFORM=offscreen /usr/bin/colmap model_analyzer --path '{}'",
-        (dir_ / "colmap" / "sparse").string()));
+    const auto a = testing::RunCommand(
+        fmt::format("QT_QPA_PLATFORM=offscreen /usr/bin/colmap model_analyzer --path '{}'",
+                    (dir_ / "colmap" / "sparse").string()));
     EXPECT_EQ(a.exit_code, 0) << a.output;
     EXPECT_NE(a.output.find("Cameras: 1"), std::string::npos) << a.output;
     EXPECT_NE(a.output.find("Mean reprojection error"), std::string::npos) << a.output;
   }
-  const auto d = Pkslam(fmt::format("dense --run '{}' --dataset '{}' --out '{}' --quiet "
-                                    "--max-depth 8 --min-views 1",
-                                    run.string(), dataset.string(), (dir_ / "d.ply").string()));
+  const auto d =
+      Pkslam(fmt::format("dense --run '{}' --dataset '{}' --out '{}' --quiet "
+                         "--max-depth 8 --min-views 1",
+                         run.string(), dataset.string(), (dir_ / "d.ply").string()));
   ASSERT_EQ(d.exit_code, 0) << d.output;
   EXPECT_GT(fs::file_size(dir_ / "d.ply"), 100000u);
+  // The TSDF mesh of the same keyframes: a PLY with faces whose surface lies on the cloud (a
+  // mesh fused at the wrong poses or with the wrong intrinsics would not).
+  const auto m =
+      Pkslam(fmt::format("dense --run '{}' --dataset '{}' --mesh '{}' --quiet "
+                         "--max-depth 8",
+                         run.string(), dataset.string(), (dir_ / "m.ply").string()));
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  EXPECT_NE(m.output.find("triangles"), std::string::npos) << m.output;
+  const auto c = Pkslam(fmt::format("cloud-compare --cloud '{}' --ref '{}' --json '{}'",
+                                    (dir_ / "m.ply").string(), (dir_ / "d.ply").string(),
+                                    (dir_ / "c.json").string()));
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_NE(c.output.find("sampled on its triangles"), std::string::npos) << c.output;
+  std::ifstream json(dir_ / "c.json");
+  const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  const auto at = text.find("\"median\": ", text.find("\"accuracy\""));
+  ASSERT_NE(at, std::string::npos) << text;
+  EXPECT_LT(std::stod(text.substr(at + 10)), 0.05) << text.substr(0, 400);
 }
 
 }  // namespace

@@ -7,6 +7,8 @@ would see.
                                       the page reports "drawn" without console errors, and the
                                       screenshot has pixels of the trajectory (ATE colours), the
                                       keyframe frustums (rule colours) and the map points.
+  check_view.py page VIEW.html [PNG]  open an existing viewer page: the same checks, its size and
+                                      time to the first frame, the screenshot kept as PNG.
   check_view.py report REPORT.html    every <img> of a bench report loads (naturalWidth > 0).
 
 Exits 1 with one line per failed check. CTest: viewer.page, viewer.bench_report.
@@ -55,7 +57,12 @@ def check_view(pkslam, work):
          "--trace", "--out", out, "--quiet"])
     page = os.path.join(work, "view.html")
     print(run([pkslam, "view", "--run", out, "--dataset", seq, "--out", page]).strip())
+    return check_page(page, os.path.join(work, "view.png"))
+
+
+def check_page(page, shot):
     failures = []
+    page = os.path.abspath(page)
     dom, log = chromium(["--dump-dom"], "file://" + page)
     m = re.search(r'<div id="status"([^>]*)>', dom)
     attrs = dict(re.findall(r'data-([\w-]+)="([^"]*)"', m.group(1))) if m else {}
@@ -66,7 +73,7 @@ def check_view(pkslam, work):
     console = [line for line in log.splitlines() if "CONSOLE" in line and "ERROR" in line]
     if console:
         failures.append("console errors: " + " | ".join(console[:3]))
-    shot = os.path.join(work, "view.png")
+    shot = os.path.abspath(shot)
     chromium([f"--screenshot={shot}", "--virtual-time-budget=5000"], "file://" + page)
     img = cv2.imread(shot)
     if img is None:
@@ -112,6 +119,9 @@ def check_report(report):
 def main():
     if len(sys.argv) >= 2 and sys.argv[1] == "view" and len(sys.argv) == 4:
         failures = check_view(sys.argv[2], sys.argv[3])
+    elif len(sys.argv) in (3, 4) and sys.argv[1] == "page":
+        failures = check_page(sys.argv[2], sys.argv[3] if len(sys.argv) == 4 else
+                              os.path.splitext(sys.argv[2])[0] + ".png")
     elif len(sys.argv) == 3 and sys.argv[1] == "report":
         failures = check_report(sys.argv[2])
     else:
