@@ -147,6 +147,15 @@ void RunCompare(const CompareArgs& args) {
   PrintStats("ref->cloud", r.reference_to_cloud);
   fmt::print("completeness  {:.1f}% of reference points have a cloud point within {:g} cm\n",
              100 * r.completeness, args.compare.completeness_m * 100);
+  // A SLAM cloud lives in the run's map frame: compared unaligned with a reference in the
+  // ground truth's frame, every number above is meaningless. Say so instead of letting a
+  // 0% completeness pass for a result.
+  if (!alignment && r.accuracy.median > 0.25) {
+    fmt::print(
+        "warning: the median distance to the reference is {:.2f} m: the cloud is probably not "
+        "in the reference's frame; pass --align-run RUN --gt GROUND_TRUTH\n",
+        r.accuracy.median);
+  }
   if (r.subset_completeness) {
     fmt::print(
         "completeness  {:.1f}% of the {} reference points ({:.1f}%) visible from the "
