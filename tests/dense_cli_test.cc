@@ -97,6 +97,17 @@ TEST_F(DenseCliTest, CloudCompareBadInputIsOneLine) {
   std::ifstream json(dir_ / "r.json");
   std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"completeness\": 1"), std::string::npos) << text;
+  EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
+  // The same cloud 3 m away and unaligned: the numbers come with a warning naming the fix.
+  const std::string far = Write("far.ply",
+                                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                "property float y\nproperty float z\nend_header\n3 0 0\n4 0 0\n"
+                                "3 1 0\n");
+  const auto w = Pkslam(fmt::format("cloud-compare --cloud {} --ref {}", far, good));
+  ASSERT_EQ(w.exit_code, 0) << w.output;
+  EXPECT_NE(w.output.find("warning: the median distance to the reference is"), std::string::npos)
+      << w.output;
+  EXPECT_NE(w.output.find("--align-run"), std::string::npos) << w.output;
 }
 
 TEST_F(DenseCliTest, ExportColmapBadInputIsOneLine) {
