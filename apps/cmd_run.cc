@@ -150,6 +150,9 @@ void RegisterRunCommand(CLI::App& app) {
                 "With --load-map: track in the loaded map only, no keyframes or points; lost "
                 "frames relocalise");
   cmd->add_flag("--trace", args->options.system.trace, "Write OUT/keyframe_trace.csv");
+  cmd->add_flag("--frame-tracks", args->options.system.frame_tracks,
+                "Write OUT/frame_tracks.txt: every tracked frame's matched map points as 2-D "
+                "tracks (for `pkslam tracks reconstruct`)");
   cmd->add_flag("--quiet", args->options.quiet, "No progress line");
   cmd->add_flag("--allow-imu-gaps", args->options.allow_imu_gaps,
                 "Inertial sensors: run although some frames have no IMU samples (tracked "

@@ -245,6 +245,7 @@ struct ExportArgs {
   std::string run;
   std::string dataset;
   std::string out;
+  bool every_frame = false;
 };
 
 void RegisterExport(CLI::App* cmd) {
@@ -260,6 +261,9 @@ void RegisterExport(CLI::App* cmd) {
   sim->excludes(run);
   ex->add_option("--dataset", args->dataset,
                  "--run: the dataset it ran on, for the truth (cam0 at each keyframe)");
+  ex->add_flag("--every-frame", args->every_frame,
+               "--run: every tracked frame's matched map points (the run's frame_tracks.txt, from "
+               "`run --frame-tracks`) instead of the keyframe observations");
   ex->add_option("--out", args->out, "Output directory")->required();
   ex->add_option("--noise", o->noise_px, "--simulated: pixel noise sigma")->capture_default_str();
   ex->add_option("--seed", o->seed, "--simulated: noise seed")->capture_default_str();
@@ -272,8 +276,9 @@ void RegisterExport(CLI::App* cmd) {
     if (args->simulated.empty() == args->run.empty()) {
       throw OptionError("tracks export: give --simulated SEQ or --run RUN");
     }
-    const ExportedTracks e = args->simulated.empty() ? ExportRunTracks(args->run, args->dataset)
-                                                     : ExportSimulatedTracks(args->simulated, *o);
+    const ExportedTracks e = args->simulated.empty()
+                                 ? ExportRunTracks(args->run, args->dataset, args->every_frame)
+                                 : ExportSimulatedTracks(args->simulated, *o);
     WriteExportedTracks(e, args->out);
     std::cout << fmt::format("{} frames, {} observations{}; written to {}\n", e.tracks.NumFrames(),
                              e.tracks.observations.size(),

@@ -14,6 +14,7 @@
 #include "core/util/output_file.h"
 #include "core/util/quantile.h"
 #include "io/rigid_transform_file.h"
+#include "io/track_file.h"
 #include "map_model/map_editor.h"
 #include "system/inertial_outputs.h"
 #include "system/sparse_model_builder.h"
@@ -69,6 +70,30 @@ void WriteFramesCsv(const Tracker& tracker, const std::filesystem::path& file) {
                        r.tracking_ms);
   }
   output.Commit();
+}
+
+// Every tracked frame's matched map points as 2-D tracks (io/track_file.h; --frame-tracks):
+// frames numbered in order, tracks = map point ids, undistorted pixels of the tracking camera.
+void WriteFrameTracks(const SlamSystem& system, const std::filesystem::path& file) {
+  TrackSet tracks;
+  tracks.camera = system.rig().intrinsics();
+  tracks.camera.bf = 0;
+  tracks.width = system.rig().camera.width();
+  tracks.height = system.rig().camera.height();
+  int frame = 0;
+  for (const FrameRecord& r : system.tracker().records()) {
+    if (r.observations.empty()) continue;
+    std::vector<FrameRecord::Observation> sorted = r.observations;
+    std::sort(sorted.begin(), sorted.end(),
+              [](const auto& a, const auto& b) { return a.point < b.point; });
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+      if (i > 0 && sorted[i].point == sorted[i - 1].point) continue;
+      tracks.observations.push_back({frame, static_cast<double>(r.t_ns) * 1e-9,
+                                     static_cast<int>(sorted[i].point), sorted[i].u, sorted[i].v});
+    }
+    ++frame;
+  }
+  WriteTrackFile(tracks, file);
 }
 
 void WriteLoopEvents(JsonWriter* json, std::string_view key, const std::vector<LoopEvent>& events) {
@@ -151,10 +176,11 @@ void RemoveRunOutputs(const std::filesystem::path& out) {
   // Every file WriteRunOutputs and WriteInertialOutputs may write (run.log is truncated by its
   // logger).
   static constexpr const char* kOutputs[] = {
-      "trajectory.txt", "trajectory_body.txt", "trajectory_online_body.txt",
-      "keyframes.txt",  "keyframes_imu.csv",   "body_from_camera.txt",
-      "map_points.ply", "sparse_model.txt",    "keyframe_trace.csv",
-      "frames.csv",     "stats.json",          kPartialTrajectory};
+      "trajectory.txt",  "trajectory_body.txt", "trajectory_online_body.txt",
+      "keyframes.txt",   "keyframes_imu.csv",   "body_from_camera.txt",
+      "map_points.ply",  "sparse_model.txt",    "keyframe_trace.csv",
+      "frames.csv",      "frame_tracks.txt",    "stats.json",
+      kPartialTrajectory};
   std::vector<std::filesystem::path> files;
   for (const char* name : kOutputs) files.push_back(out / name);
   // WriteInertialOutputs' keyframe chains, one per IMU initialisation stage.
@@ -211,6 +237,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   WriteSparseModel(BuildSparseModel(system), out / "sparse_model.txt");
   if (options.system.trace) WriteTrace(system.tracker(), out / "keyframe_trace.csv");
   WriteFramesCsv(system.tracker(), out / "frames.csv");
+  if (options.system.frame_tracks) WriteFrameTracks(system, out / "frame_tracks.txt");
   WriteInertialOutputs(system, out);
 
   const auto& records = system.tracker().records();

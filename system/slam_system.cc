@@ -63,6 +63,7 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   tracker_ = std::make_unique<Tracker>(&atlas_, vocabulary_.get(), setup_.rig, std::move(selector),
                                        mapper_.get(), options_.tracking, orb);
   tracker_->EnableTrace(options_.trace);
+  tracker_->EnableFrameTracks(options_.frame_tracks);
   if (!options_.no_loop) {
     LocalMapper* mapper = mapper_.get();
     MappingControl control;

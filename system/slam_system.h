@@ -41,6 +41,8 @@ struct SystemOptions {
   double live_pace = 2.0;
   // Record per-frame keyframe decisions (keyframe_trace.csv).
   bool trace = false;
+  // Record each tracked frame's matched map points (RUN/frame_tracks.txt).
+  bool frame_tracks = false;
   TrackingOptions tracking;
   LocalMappingOptions mapping;
   // --no-loop: no loop closing and no map merging.

@@ -108,5 +108,31 @@ TEST(TracksCli, ExportsAKeyframeObservationPerMapPoint) {
   EXPECT_FALSE(fs::exists(dir / "t" / "truth_trajectory.txt"));
 }
 
+TEST(TracksCli, EveryFrameTracksOfARun) {
+  PKSLAM_REQUIRE_SHARED_DATA(shared);
+  const fs::path dataset = shared / "euroc" / "V1_01_easy_static";
+  const fs::path dir = testing::MakeTempDir("tracks_frames");
+  const auto r =
+      RunPkslam("run --dataset " + dataset.string() + " --sensor stereo --out " +
+                (dir / "run").string() + " --quiet --max-frames 30 --deterministic --frame-tracks");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const TrackSet frames = ReadTrackFile(dir / "run" / "frame_tracks.txt");
+  EXPECT_EQ(frames.NumFrames(), testing::JsonIntField(dir / "run" / "stats.json", "frames"));
+  EXPECT_GT(frames.observations.size(), 30u * 100u);  // every frame tracks its map points
+  // (The static recording has no ground truth: no --dataset, no truth file.)
+  const auto e = RunPkslam("tracks export --run " + (dir / "run").string() +
+                           " --every-frame --out " + (dir / "t").string());
+  ASSERT_EQ(e.exit_code, 0) << e.output;
+  const TrackSet exported = ReadTrackFile(dir / "t" / "tracks.txt");
+  EXPECT_EQ(exported.observations.size(), frames.observations.size());
+  EXPECT_FALSE(fs::exists(dir / "t" / "truth_trajectory.txt"));
+  // Without --frame-tracks there is nothing to export frame by frame.
+  fs::remove(dir / "run" / "frame_tracks.txt");
+  const auto missing = RunPkslam("tracks export --run " + (dir / "run").string() +
+                                 " --every-frame --out " + (dir / "t2").string());
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.output.find("frame_tracks.txt"), std::string::npos) << missing.output;
+}
+
 }  // namespace
 }  // namespace pkslam

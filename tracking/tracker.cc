@@ -277,6 +277,14 @@ void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
     }
     r.reference = ref;
     r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
+    if (frame_tracks_enabled_) {
+      const auto& keypoints = current_.keypoints_undistorted();
+      for (std::size_t i = 0; i < current_.map_points.size(); ++i) {
+        const MapPointPtr& mp = current_.map_points[i];
+        if (!mp || current_.outliers[i] != 0) continue;
+        r.observations.push_back({mp->id(), keypoints[i].pt.x, keypoints[i].pt.y});
+      }
+    }
   }
   records_.push_back(std::move(r));
 }

@@ -46,6 +46,13 @@ struct FrameRecord {
   double build_cpu_ms = 0;
   double tracking_cpu_ms = 0;
   int inliers = 0;
+  // With EnableFrameTracks: the frame's pose inliers, as (map point id, undistorted pixel):
+  // `pkslam run --frame-tracks` writes them as a tracks file (io/track_file.h).
+  struct Observation {
+    MapPointId point = kInvalidId;
+    float u = 0, v = 0;
+  };
+  std::vector<Observation> observations;
 };
 
 struct TrackResult {
@@ -90,6 +97,8 @@ class Tracker {
   };
   const std::vector<TraceRow>& trace() const { return trace_; }
   void EnableTrace(bool on) { trace_enabled_ = on; }
+  // Record every frame's matched map points in its FrameRecord (for --frame-tracks).
+  void EnableFrameTracks(bool on) { frame_tracks_enabled_ = on; }
   // Localisation only (TrackingOptions::localise_only) on a map loaded into the Atlas: the
   // next frame is relocalised against the current map (tracking/tracker_localisation.cc).
   void StartLocalisation();
@@ -175,6 +184,7 @@ class Tracker {
 
   std::vector<FrameRecord> records_;
   bool trace_enabled_ = false;
+  bool frame_tracks_enabled_ = false;
   std::vector<TraceRow> trace_;
   SelectorDecision last_decision_;
   std::unique_ptr<InertialTrackingState> imu_;  // inertial sensors only

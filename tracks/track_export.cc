@@ -122,7 +122,23 @@ ExportedTracks ExportSimulatedTracks(const fs::path& sequence,
   return out;
 }
 
-ExportedTracks ExportRunTracks(const fs::path& run, const fs::path& dataset) {
+ExportedTracks ExportRunTracks(const fs::path& run, const fs::path& dataset, bool every_frame) {
+  if (every_frame) {
+    ExportedTracks out;
+    out.tracks = ReadTrackFile(Require(run / "frame_tracks.txt", "run with --frame-tracks"));
+    if (!dataset.empty()) {
+      const CameraTruth truth(dataset);
+      int last = -1;
+      for (const TrackObservation& o : out.tracks.observations) {
+        if (o.frame == last) continue;
+        last = o.frame;
+        const std::int64_t t_ns = std::llround(o.t_s * 1e9);
+        if (const std::optional<SE3d> pose = truth.At(t_ns))
+          out.truth.poses.push_back({t_ns, *pose});
+      }
+    }
+    return out;
+  }
   const SparseModel model = ReadSparseModel(Require(run / "sparse_model.txt", "a pkslam run"));
   ExportedTracks out;
   out.tracks.camera = {model.camera.fx, model.camera.fy, model.camera.cx, model.camera.cy, 0};

@@ -5,8 +5,10 @@
 //              (Gaussian, sigma per coordinate), optionally every N-th frame of a time window;
 //              the truth is the sequence's exact cam0 poses and landmark positions.
 //   run        the keyframe observations of a pkslam run (RUN/sparse_model.txt): one frame per
-//              keyframe, one track per map point, the keypoints' undistorted pixels; the truth
-//              (optional) is cam0's pose at each keyframe from the dataset's ground truth.
+//              keyframe, one track per map point, the keypoints' undistorted pixels; or, with
+//              every_frame, every tracked frame's matched map points (RUN/frame_tracks.txt,
+//              written by `pkslam run --frame-tracks`). The truth (optional) is cam0's pose at
+//              each frame from the dataset's ground truth.
 #pragma once
 
 #include <Eigen/Core>
@@ -40,9 +42,10 @@ struct SimulatedTracksExportOptions {
 ExportedTracks ExportSimulatedTracks(const std::filesystem::path& sequence,
                                      const SimulatedTracksExportOptions& options);
 
-// dataset may be empty (no truth). Throws InputError for a run without sparse_model.txt.
+// dataset may be empty (no truth). Throws InputError for a run without sparse_model.txt (or,
+// with every_frame, without frame_tracks.txt).
 ExportedTracks ExportRunTracks(const std::filesystem::path& run,
-                               const std::filesystem::path& dataset);
+                               const std::filesystem::path& dataset, bool every_frame = false);
 
 // OUT/tracks.txt, and truth_trajectory.txt + truth_points.txt when known.
 void WriteExportedTracks(const ExportedTracks& exported, const std::filesystem::path& out);
