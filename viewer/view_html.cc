@@ -47,14 +47,15 @@ std::string ScriptSafe(const std::string& text) {
 
 constexpr const char* kStyle = R"(
 html, body { margin: 0; height: 100%; overflow: hidden; font: 13px sans-serif; background: #fff; }
-#view { position: absolute; inset: 0 0 64px 0; }
+#view { position: absolute; inset: 0 0 110px 0; }
 #panel { position: absolute; top: 8px; left: 8px; background: rgba(255,255,255,0.92);
   border: 1px solid #ccc; padding: 6px 10px; max-width: 320px; }
 #panel h1 { font-size: 14px; margin: 0 0 4px 0; }
 #legend span { display: inline-block; width: 10px; height: 10px; margin-right: 4px; }
-#timeline { position: absolute; left: 0; right: 0; bottom: 0; height: 64px; background: #f4f4f4;
+#timeline { position: absolute; left: 0; right: 0; bottom: 0; height: 110px; background: #f4f4f4;
   border-top: 1px solid #ccc; padding: 4px 10px; box-sizing: border-box; }
 #scrub { width: 100%; }
+#strip { width: 100%; height: 46px; display: block; }
 #frameinfo { white-space: nowrap; overflow: hidden; text-overflow: ellipsis; }
 )";
 
@@ -109,8 +110,8 @@ void WriteViewPage(const ViewData& data, const fs::path& file, const ViewPageOpt
   page +=
       "</style>\n</head><body>\n"
       "<div id=\"view\"></div>\n<div id=\"panel\"></div>\n"
-      "<div id=\"timeline\"><input id=\"scrub\" type=\"range\" min=\"0\" max=\"0\" "
-      "value=\"0\"><div id=\"frameinfo\"></div></div>\n"
+      "<div id=\"timeline\"><canvas id=\"strip\"></canvas><input id=\"scrub\" "
+      "type=\"range\" min=\"0\" max=\"0\" value=\"0\"><div id=\"frameinfo\"></div></div>\n"
       "<div id=\"status\" data-state=\"loading\" hidden></div>\n";
   page += script(scripts.three);
   page += script(scripts.orbit);

@@ -212,7 +212,8 @@
     if (r.reason) text += ` · decision: ${esc(r.reason)}`;
     if (p && p.ate >= 0) text += ` · ATE ${p.ate.toFixed(3)} m`;
     if (r.q) {
-      const order = ['M_c', 'D_c', 'A_c', 'Th', 'E_c', 'M_r', 'D_r'];
+      const order = ['M_c', 'D_c', 'Th_adaptive', 'A_c', 'E_c', 'criterion1', 'criterion2',
+                     'M_r', 'D_r'];
       const keys = Object.keys(r.q).sort((a, b) => {
         const ia = order.indexOf(a), ib = order.indexOf(b);
         return (ia < 0 ? 99 : ia) - (ib < 0 ? 99 : ib) || a.localeCompare(b);
@@ -221,7 +222,48 @@
     }
     info.innerHTML = text;
   }
-  scrub.addEventListener('input', () => { showRow(Number(scrub.value)); draw(); });
+  // The timeline strip: tracked points (grey), keyframes (red ticks), and when the trace has
+  // them PKS's D_c (blue) against its adaptive threshold Th_adaptive (orange), each scaled to
+  // its own maximum; a black line marks the current frame.
+  const strip = document.getElementById('strip');
+  function drawStrip(current) {
+    const w = strip.clientWidth, h = strip.clientHeight;
+    strip.width = w;
+    strip.height = h;
+    const g = strip.getContext('2d');
+    g.clearRect(0, 0, w, h);
+    if (rows.length < 2) return;
+    const x = (i) => (i / (rows.length - 1)) * (w - 1);
+    function series(value, colour) {
+      const v = rows.map(value);
+      const top = Math.max(...v.filter((a) => a !== undefined && isFinite(a)), 0);
+      if (!(top > 0)) return;
+      g.strokeStyle = colour;
+      g.beginPath();
+      let pen = false;
+      v.forEach((a, i) => {
+        if (a === undefined || !isFinite(a)) { pen = false; return; }
+        const y = h - 2 - (a / top) * (h - 4);
+        if (pen) g.lineTo(x(i), y); else g.moveTo(x(i), y);
+        pen = true;
+      });
+      g.stroke();
+    }
+    series((r) => r.tracked, '#999999');
+    series((r) => (r.q ? r.q.D_c : undefined), '#1f77b4');
+    series((r) => (r.q ? r.q.Th_adaptive : undefined), '#ff7f0e');
+    g.fillStyle = '#d62728';
+    rows.forEach((r, i) => { if (r.kf) g.fillRect(x(i), 0, 1, 6); });
+    g.fillStyle = '#000000';
+    g.fillRect(x(current), 0, 1, h);
+  }
+  scrub.addEventListener('input', () => {
+    showRow(Number(scrub.value));
+    drawStrip(Number(scrub.value));
+    draw();
+  });
+  window.addEventListener('resize', () => drawStrip(Number(scrub.value)));
+  drawStrip(0);
   showRow(0);
 
   function draw() { renderer.render(scene, camera); }

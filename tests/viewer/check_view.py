@@ -78,7 +78,7 @@ def check_page(page, shot):
     img = cv2.imread(shot)
     if img is None:
         sys.exit(f"no screenshot at {shot}")
-    img = img[:736]  # above the timeline bar
+    img = img[:690]  # above the timeline bar
     points = count(img, (40, 40, 200))
     rules = sum(count(img, c) for c in [(214, 39, 40), (44, 160, 44), (255, 127, 14),
                                         (148, 103, 189), (140, 86, 75), (227, 119, 194),
