@@ -46,15 +46,24 @@ void RunDense(const DenseArgs& args) {
       args.options.full_view);
   RequireRunOfDataset(args.run, args.dataset);
   std::optional<dense::MeshStats> mesh;
+  dense::DenseStats stats;
+  std::optional<PointCloud> filtered_cloud;  // the cloud the filtered-depth mesh pass made
   if (!args.mesh.empty()) {
     dense::MeshOptions mo = args.mesh_options;
     mo.depth = args.options;
-    mesh = dense::BuildTsdfMesh(keyframes, source, mo, args.mesh);
+    if (mo.filtered_depth) {
+      filtered_cloud.emplace();
+      mesh =
+          dense::BuildFilteredTsdfMesh(keyframes, source, mo, args.mesh, &*filtered_cloud, &stats);
+    } else {
+      mesh = dense::BuildTsdfMesh(keyframes, source, mo, args.mesh);
+    }
     fmt::print(
-        "mesh: {} keyframes fused (TSDF voxel {} m, truncation {} m), {} vertices, {} triangles, "
-        "{:.1f} s, peak memory {:.0f} MiB; {}\n",
-        mesh->keyframes_used, mo.voxel_m, mo.truncation_m, mesh->vertices, mesh->triangles,
-        mesh->seconds, mesh->peak_memory_mib, args.mesh);
+        "mesh: {} keyframes fused ({} depth; TSDF voxel {} m, truncation {} m), {} vertices, {} "
+        "triangles, {:.1f} s, peak memory {:.0f} MiB; {}\n",
+        mesh->keyframes_used, mo.filtered_depth ? "multi-view filtered" : "raw", mo.voxel_m,
+        mo.truncation_m, mesh->vertices, mesh->triangles, mesh->seconds, mesh->peak_memory_mib,
+        args.mesh);
     if (args.out.empty()) {
       if (!args.json.empty()) {
         JsonWriter json;
@@ -72,8 +81,9 @@ void RunDense(const DenseArgs& args) {
       return;
     }
   }
-  dense::DenseStats stats;
-  const PointCloud cloud = BuildDenseCloud(keyframes, source, args.options, &stats);
+  const PointCloud cloud = filtered_cloud
+                               ? std::move(*filtered_cloud)
+                               : BuildDenseCloud(keyframes, source, args.options, &stats);
   if (cloud.empty()) {
     throw Error("the dense cloud is empty (no depth passed the multi-view filter)");
   }
@@ -170,6 +180,9 @@ void RegisterDenseCommand(CLI::App& app) {
                   "write its triangle mesh here (PLY)");
   cmd->add_option("--mesh-voxel", args->mesh_options.voxel_m, "TSDF voxel side (m)")
       ->capture_default_str();
+  cmd->add_flag("!--mesh-raw-depth", args->mesh_options.filtered_depth,
+                "Fuse each keyframe's raw depth map into the mesh (default: the depth after the "
+                "point cloud's multi-view filter)");
   cmd->add_option("--mesh-truncation", args->mesh_options.truncation_m,
                   "TSDF truncation distance (m)")
       ->capture_default_str();

@@ -34,6 +34,8 @@ void FilterDisparityEdges(double max_step, cv::Mat* disparity) {
 }
 
 struct ViewPoints {
+  cv::Mat depth;  // the filtered depth map (kept only for a FilteredDepthSink)
+  cv::Mat grey, colour;
   std::vector<Eigen::Vector3f> points;
   std::vector<Rgb> colours;
   std::vector<std::uint8_t> support;
@@ -160,7 +162,8 @@ void BackProject(const cv::Mat& depth_m, const cv::Mat& rays, const SE3d& world_
 }
 
 PointCloud BuildDenseCloud(const Trajectory& keyframes, const KeyframeImageSource& source,
-                           const DenseOptions& options, DenseStats* stats) {
+                           const DenseOptions& options, DenseStats* stats,
+                           const FilteredDepthSink& sink) {
   options.Check();
   PKSLAM_CHECK(stats != nullptr, "stats is null");
   const auto start = std::chrono::steady_clock::now();
@@ -238,6 +241,11 @@ PointCloud BuildDenseCloud(const Trajectory& keyframes, const KeyframeImageSourc
       v.deferred = static_cast<std::size_t>(filtered.deferred);
       BackProject(filtered.depth, rays, jobs[i].world_from_camera, d.grey, d.colour,
                   options.pixel_step, &v.points, &v.colours, filtered.views, &v.support);
+      if (sink) {
+        v.depth = filtered.depth;
+        v.grey = d.grey;
+        v.colour = d.colour;
+      }
     });
     for (std::size_t i = begin; i < end; ++i) {
       ViewPoints& v = views[i - begin];
@@ -248,6 +256,7 @@ PointCloud BuildDenseCloud(const Trajectory& keyframes, const KeyframeImageSourc
       stats->deferred_points += v.deferred;
       valid_share_sum += v.valid_share;
       grid.AddView(static_cast<int>(i), v.points, v.colours, v.support);
+      if (sink) sink(v.depth, v.grey, v.colour, jobs[i].world_from_camera);
       v = ViewPoints{};
       progress.Add();
     }

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -118,7 +119,14 @@ void BackProject(const cv::Mat& depth_m, const cv::Mat& rays, const SE3d& world_
 // The fused cloud of all keyframes. Keyframes without a dataset frame of the same timestamp
 // are skipped and listed in stats (a warning is logged). Throws InputError when no keyframe
 // matches a frame (the run belongs to another dataset).
+// Called in keyframe order with each keyframe's depth map after the multi-view filter (metres,
+// 0 = dropped), its grey and colour (may be empty) images and its pose (dense/mesh.h fuses
+// them into a TSDF).
+using FilteredDepthSink =
+    std::function<void(const cv::Mat& depth_m, const cv::Mat& grey, const cv::Mat& colour_bgr,
+                       const SE3d& world_from_camera)>;
 PointCloud BuildDenseCloud(const Trajectory& keyframes, const KeyframeImageSource& source,
-                           const DenseOptions& options, DenseStats* stats);
+                           const DenseOptions& options, DenseStats* stats,
+                           const FilteredDepthSink& sink = {});
 
 }  // namespace pkslam::dense

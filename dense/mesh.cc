@@ -53,6 +53,64 @@ double PeakMemoryMiB() {
 
 }  // namespace
 
+namespace {
+
+// The TSDF volume and what it fuses: depth maps of `camera`'s pixels (ideal pinhole).
+class TsdfFusion {
+ public:
+  TsdfFusion(const MeshOptions& options, const CameraModel& camera)
+      : intrinsic_(camera.width(), camera.height(), camera.fx(), camera.fy(), camera.cx(),
+                   camera.cy()),
+        max_depth_(options.depth.MaxDepth()),
+        volume_(options.voxel_m, options.truncation_m,
+                open3d::pipelines::integration::TSDFVolumeColorType::RGB8) {}
+
+  void Integrate(const cv::Mat& depth_m, const cv::Mat& grey, const cv::Mat& colour_bgr,
+                 const SE3d& world_from_camera) {
+    cv::Mat rgb;
+    if (!colour_bgr.empty()) {
+      cv::cvtColor(colour_bgr, rgb, cv::COLOR_BGR2RGB);
+    } else {
+      cv::cvtColor(grey, rgb, cv::COLOR_GRAY2RGB);
+    }
+    const auto rgbd = open3d::geometry::RGBDImage::CreateFromColorAndDepth(
+        ToOpen3d(rgb), ToOpen3d(depth_m), 1.0, max_depth_, false);
+    volume_.Integrate(*rgbd, intrinsic_, world_from_camera.Inverse().Matrix());
+    ++integrated_;
+  }
+
+  // Extracts the mesh and writes it; fills the mesh counts of *stats.
+  void Write(const fs::path& file, MeshStats* stats) {
+    const auto mesh = volume_.ExtractTriangleMesh();
+    stats->vertices = mesh->vertices_.size();
+    stats->triangles = mesh->triangles_.size();
+    if (stats->triangles == 0) throw Error("the TSDF mesh is empty (no depth was fused)");
+    mesh->ComputeVertexNormals();
+    if (!open3d::io::WriteTriangleMesh(file.string(), *mesh, /*write_ascii=*/false,
+                                       /*compressed=*/false, /*write_vertex_normals=*/true,
+                                       /*write_vertex_colors=*/true,
+                                       /*write_triangle_uvs=*/false,
+                                       /*print_progress=*/false)) {
+      throw OutputError(file, "Open3D could not write the mesh");
+    }
+    stats->peak_memory_mib = PeakMemoryMiB();
+  }
+
+  int integrated() const { return integrated_; }
+
+ private:
+  open3d::camera::PinholeCameraIntrinsic intrinsic_;
+  double max_depth_;
+  open3d::pipelines::integration::ScalableTSDFVolume volume_;
+  int integrated_ = 0;
+};
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
 MeshStats BuildTsdfMesh(const Trajectory& keyframes, const KeyframeImageSource& source,
                         const MeshOptions& options, const fs::path& file) {
   options.Check();
@@ -74,50 +132,46 @@ MeshStats BuildTsdfMesh(const Trajectory& keyframes, const KeyframeImageSource& 
   }
   // The pixels are the depth map's camera: the rectified pinhole for stereo (RGB-D: camera1's
   // pinhole part; its distortion, small on TUM, is ignored here).
-  const CameraModel& camera = source.camera();
-  const open3d::camera::PinholeCameraIntrinsic intrinsic(
-      camera.width(), camera.height(), camera.fx(), camera.fy(), camera.cx(), camera.cy());
-  const double max_depth = options.depth.MaxDepth();
-  open3d::pipelines::integration::ScalableTSDFVolume volume(
-      options.voxel_m, options.truncation_m,
-      open3d::pipelines::integration::TSDFVolumeColorType::RGB8);
+  TsdfFusion fusion(options, source.camera());
   Progress progress("mesh", jobs.size(), options.depth.quiet);
   const std::size_t batch = static_cast<std::size_t>(std::max(1, options.depth.batch));
   for (std::size_t begin = 0; begin < jobs.size(); begin += batch) {
     const std::size_t end = std::min(jobs.size(), begin + batch);
-    std::vector<cv::Mat> depth(end - begin), colour(end - begin);
+    std::vector<KeyframeImages> images(end - begin);
+    std::vector<cv::Mat> depth(end - begin);
     tbb::parallel_for(begin, end, [&](std::size_t j) {
-      KeyframeImages images = source.Load(jobs[j].frame);
-      depth[j - begin] = KeyframeDepth(images, source, options.depth, max_depth);
-      cv::Mat rgb;
-      if (!images.colour.empty()) {
-        cv::cvtColor(images.colour, rgb, cv::COLOR_BGR2RGB);
-      } else {
-        cv::cvtColor(images.grey, rgb, cv::COLOR_GRAY2RGB);
-      }
-      colour[j - begin] = rgb;
+      images[j - begin] = source.Load(jobs[j].frame);
+      depth[j - begin] =
+          KeyframeDepth(images[j - begin], source, options.depth, options.depth.MaxDepth());
     });
     for (std::size_t j = begin; j < end; ++j) {
-      const auto rgbd = open3d::geometry::RGBDImage::CreateFromColorAndDepth(
-          ToOpen3d(colour[j - begin]), ToOpen3d(depth[j - begin]), 1.0, max_depth, false);
-      volume.Integrate(*rgbd, intrinsic, jobs[j].world_from_camera.Inverse().Matrix());
+      fusion.Integrate(depth[j - begin], images[j - begin].grey, images[j - begin].colour,
+                       jobs[j].world_from_camera);
       progress.Add();
     }
   }
   progress.Finish();
-  const auto mesh = volume.ExtractTriangleMesh();
-  stats.vertices = mesh->vertices_.size();
-  stats.triangles = mesh->triangles_.size();
-  if (stats.triangles == 0) throw Error("the TSDF mesh is empty (no depth was fused)");
-  mesh->ComputeVertexNormals();
-  if (!open3d::io::WriteTriangleMesh(file.string(), *mesh, /*write_ascii=*/false,
-                                     /*compressed=*/false, /*write_vertex_normals=*/true,
-                                     /*write_vertex_colors=*/true, /*write_triangle_uvs=*/false,
-                                     /*print_progress=*/false)) {
-    throw OutputError(file, "Open3D could not write the mesh");
-  }
-  stats.peak_memory_mib = PeakMemoryMiB();
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  fusion.Write(file, &stats);
+  stats.seconds = SecondsSince(start);
+  return stats;
+}
+
+MeshStats BuildFilteredTsdfMesh(const Trajectory& keyframes, const KeyframeImageSource& source,
+                                const MeshOptions& options, const fs::path& file, PointCloud* cloud,
+                                DenseStats* cloud_stats) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  TsdfFusion fusion(options, source.camera());
+  *cloud = BuildDenseCloud(keyframes, source, options.depth, cloud_stats,
+                           [&](const cv::Mat& depth, const cv::Mat& grey, const cv::Mat& colour,
+                               const SE3d& world_from_camera) {
+                             fusion.Integrate(depth, grey, colour, world_from_camera);
+                           });
+  MeshStats stats;
+  stats.keyframes = cloud_stats->keyframes;
+  stats.keyframes_used = fusion.integrated();
+  fusion.Write(file, &stats);
+  stats.seconds = SecondsSince(start);
   return stats;
 }
 

@@ -1,8 +1,10 @@
-// Meshes from the keyframes (`pkslam dense --mesh`): each keyframe's depth map (stereo SGBM
-// with the left-right check, or RGB-D depth; dense/dense_cloud.h's KeyframeDepth) is fused at
-// the run's keyframe pose into Open3D's ScalableTSDFVolume (a hashed, sparse truncated signed
+// Meshes from the keyframes (`pkslam dense --mesh`): each keyframe's depth map is fused at the
+// run's keyframe pose into Open3D's ScalableTSDFVolume (a hashed, sparse truncated signed
 // distance volume, Curless & Levoy averaging), and its zero level set is extracted with
-// Open3D's marching cubes as a triangle mesh written as binary PLY (Open3D's writer).
+// Open3D's marching cubes as a triangle mesh written as binary PLY (Open3D's writer). The depth
+// maps are those the point cloud keeps after its multi-view filter (BuildFilteredTsdfMesh, the
+// default: on a 40 s V1_02 replay 1.44 cm mean accuracy against the cloud's 1.93) or each
+// keyframe's raw SGBM / RGB-D depth (BuildTsdfMesh: 2.20 cm).
 // cloud-compare measures a mesh through points sampled uniformly on its triangles.
 //
 // Depth maps are computed in parallel batches (TBB) and integrated in keyframe order: the mesh
@@ -25,6 +27,9 @@ struct MeshOptions {
   double truncation_m = 0.06;  // signed distance truncation (three voxels)
   // Depth maps as `pkslam dense` computes them (range, border, stereo settings, batch size).
   DenseOptions depth;
+  // Fuse the depth after the point cloud's multi-view filter (BuildFilteredTsdfMesh) rather
+  // than each keyframe's raw depth map.
+  bool filtered_depth = true;
   void Check() const;
 };
 
@@ -41,6 +46,12 @@ struct MeshStats {
 // matches a dataset frame, Error when the mesh is empty or cannot be written.
 MeshStats BuildTsdfMesh(const Trajectory& keyframes, const KeyframeImageSource& source,
                         const MeshOptions& options, const std::filesystem::path& file);
+
+// The same fusion fed with the depth maps after the point cloud's multi-view filter
+// (dense/dense_cloud.h): one pass builds the cloud (*cloud, *cloud_stats) and the mesh.
+MeshStats BuildFilteredTsdfMesh(const Trajectory& keyframes, const KeyframeImageSource& source,
+                                const MeshOptions& options, const std::filesystem::path& file,
+                                PointCloud* cloud, DenseStats* cloud_stats);
 
 // Whether a PLY file has a face element with at least one face.
 bool PlyHasFaces(const std::filesystem::path& file);
