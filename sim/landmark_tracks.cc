@@ -65,7 +65,7 @@ void LandmarkTracks::AddFrame(int frame, std::int64_t t_ns, const SE3d& world_fr
                "landmark tracks: frames must be consecutive and in time order");
   trajectory_.poses.push_back({t_ns, world_from_camera});
   const SE3d camera_from_world = world_from_camera.Inverse();
-  const Eigen::Vector3d centre = world_from_camera.translation();
+  const Eigen::Vector3d& centre = world_from_camera.translation();
   const Eigen::Vector3f origin = centre.cast<float>();
   for (std::size_t i = 0; i < landmarks_.size(); ++i) {
     const Eigen::Vector3d& p = landmarks_[i];

@@ -237,7 +237,7 @@ class Reconstructor {
     return true;
   }
 
-  void AddKeyframe(int frame, const SE3d& camera_from_world, std::string reason) {
+  void AddKeyframe(int frame, const SE3d& camera_from_world, const std::string& reason) {
     keyframes_.push_back(frame);
     keyframe_poses_.push_back(camera_from_world);
     const int kf = static_cast<int>(keyframes_.size()) - 1;
