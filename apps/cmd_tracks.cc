@@ -101,12 +101,11 @@ void RegisterSimulate(CLI::App* cmd) {
       truth.poses.push_back({std::llround(t * 1e9), s.camera_from_world[k].Inverse()});
     }
     WriteTrajectoryTum(truth, dir / "truth_trajectory.txt");
-    std::string points = "# track x y z\n";
+    TrackPoints points;
     for (std::size_t i = 0; i < s.points.size(); ++i) {
-      points += fmt::format("{} {:.9g} {:.9g} {:.9g}\n", i, s.points[i].x(), s.points[i].y(),
-                            s.points[i].z());
+      points.emplace_back(static_cast<int>(i), s.points[i]);
     }
-    WriteFileAtomically(dir / "truth_points.txt", points);
+    WriteTrackPoints(points, dir / "truth_points.txt");
     std::cout << fmt::format(
         "{} frames, {} tracks ({} points dropped: not in the first frame), {} observations, "
         "{} projections outside the image left out; outputs in {}\n",

@@ -90,4 +90,29 @@ void WriteTrackFile(const TrackSet& tracks, const std::filesystem::path& file) {
   WriteFileAtomically(file, text);
 }
 
+TrackPoints ReadTrackPoints(const std::filesystem::path& file) {
+  TrackPoints points;
+  std::set<int> seen;
+  ForEachDataRow(file, FieldSeparator::kWhitespace, [&](const TextRow& row) {
+    RequireFieldCount(row, 4, file, "track x y z");
+    const int id = static_cast<int>(Int64Field(row.fields[0], file, row.line, "track"));
+    if (!seen.insert(id).second) {
+      throw InputError(file, row.line, fmt::format("track {} listed twice", id));
+    }
+    points.emplace_back(id, Eigen::Vector3d(DoubleField(row.fields[1], file, row.line, "x"),
+                                            DoubleField(row.fields[2], file, row.line, "y"),
+                                            DoubleField(row.fields[3], file, row.line, "z")));
+  });
+  return points;
+}
+
+void WriteTrackPoints(const TrackPoints& points, const std::filesystem::path& file,
+                      const std::string& comment) {
+  std::string text = "# " + comment + "\n";
+  for (const auto& [id, p] : points) {
+    text += fmt::format("{} {:.9g} {:.9g} {:.9g}\n", id, p.x(), p.y(), p.z());
+  }
+  WriteFileAtomically(file, text);
+}
+
 }  // namespace pkslam

@@ -11,8 +11,11 @@
 // undistorted image. '#' lines and blank lines are comments.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "core/geometry/pinhole_intrinsics.h"
@@ -33,6 +36,14 @@ struct TrackSet {
 
   int NumFrames() const { return observations.empty() ? 0 : observations.back().frame + 1; }
 };
+
+// The 3-D points of tracks ("track x y z" rows, '#' comments): the truth beside a tracks
+// file. The reader refuses a track listed twice (InputError with file and line); the writer is
+// atomic, `comment` is its first line.
+using TrackPoints = std::vector<std::pair<int, Eigen::Vector3d>>;
+TrackPoints ReadTrackPoints(const std::filesystem::path& file);
+void WriteTrackPoints(const TrackPoints& points, const std::filesystem::path& file,
+                      const std::string& comment = "track x y z");
 
 // Throws InputError naming the file and line.
 TrackSet ReadTrackFile(const std::filesystem::path& file);

@@ -94,12 +94,11 @@ void LandmarkTracks::Write(const std::filesystem::path& dir) const {
   if (ec) throw OutputError(dir, "cannot create: " + ec.message());
   WriteTrackFile(tracks_, dir / "tracks_exact.txt");
   WriteTrajectoryTum(trajectory_, dir / "tracks_trajectory.txt");
-  std::string text = "# track x y z (world, metres)\n";
+  TrackPoints points;
   for (std::size_t i = 0; i < landmarks_.size(); ++i) {
-    text += fmt::format("{} {:.9g} {:.9g} {:.9g}\n", i, landmarks_[i].x(), landmarks_[i].y(),
-                        landmarks_[i].z());
+    points.emplace_back(static_cast<int>(i), landmarks_[i]);
   }
-  WriteFileAtomically(dir / "tracks_points.txt", text);
+  WriteTrackPoints(points, dir / "tracks_points.txt", "track x y z (world, metres)");
 }
 
 }  // namespace pkslam::sim

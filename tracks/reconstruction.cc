@@ -249,6 +249,38 @@ class Reconstructor {
     ++out_.keyframe_reasons[reason];
   }
 
+  // The frame's observations of tracks that have a map point (index = observation index).
+  std::vector<PnpCorrespondence> MappedCorrespondences(int frame) const {
+    std::vector<PnpCorrespondence> mapped;
+    const auto& obs = Observations(frame);
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      const auto& point = out_.points[static_cast<std::size_t>(obs[i].track)];
+      if (!point) continue;
+      mapped.push_back({obs[i].uv, options_.two_view.sigma * options_.two_view.sigma, *point,
+                        static_cast<int>(i)});
+    }
+    return mapped;
+  }
+
+  // Motion-only refinement from `start`; *refined holds the correspondences (null block =
+  // outlier at the result) and *inliers their inlier count.
+  SE3d RefinePose(const std::vector<PnpCorrespondence>& mapped, const SE3d& start,
+                  std::vector<PoseCorrespondence>* refined, int* inliers) const {
+    refined->clear();
+    refined->reserve(mapped.size());
+    for (const PnpCorrespondence& c : mapped) {
+      PoseCorrespondence& p = refined->emplace_back();
+      p.keypoint = c.index;
+      p.p_world = c.point_world;
+      p.obs = Eigen::Vector3d(c.uv.x(), c.uv.y(), -1.0);
+      p.inv_sigma2 = inv_sigma2_;
+    }
+    const SE3d pose = SolvePose(camera_, start, refined, PoseOptimizerOptions{});
+    *inliers = static_cast<int>(std::count_if(refined->begin(), refined->end(),
+                                              [](const PoseCorrespondence& c) { return c.block; }));
+    return pose;
+  }
+
   void ProcessFrame(int k, bool may_be_keyframe) {
     const Clock::time_point t0 = Clock::now();
     TracksFrameResult& fr = out_.frames[static_cast<std::size_t>(k)];
@@ -256,13 +288,7 @@ class Reconstructor {
     fr.observations = static_cast<int>(obs.size());
     // Prediction: the latest tracked pose (the processor has no motion model in the thesis).
     const SE3d predicted = last_tracked_ >= 0 ? CurrentPose(last_tracked_) : KeyframePose(0);
-    std::vector<PnpCorrespondence> pnp;
-    for (std::size_t i = 0; i < obs.size(); ++i) {
-      const auto& point = out_.points[static_cast<std::size_t>(obs[i].track)];
-      if (!point) continue;
-      pnp.push_back({obs[i].uv, options_.two_view.sigma * options_.two_view.sigma, *point,
-                     static_cast<int>(i)});
-    }
+    const std::vector<PnpCorrespondence> pnp = MappedCorrespondences(k);
     fr.map_matches = static_cast<int>(pnp.size());
     if (fr.map_matches < options_.min_tracked) {
       ++out_.lost_frames;
@@ -278,18 +304,7 @@ class Reconstructor {
     const PnpResult found = solver.Iterate(ransac.max_iterations);
     if (found.found) start = found.camera_from_world;
     std::vector<PoseCorrespondence> refine;
-    refine.reserve(pnp.size());
-    for (const PnpCorrespondence& c : pnp) {
-      PoseCorrespondence& p = refine.emplace_back();
-      p.keypoint = c.index;
-      p.p_world = c.point_world;
-      p.obs = Eigen::Vector3d(c.uv.x(), c.uv.y(), -1.0);
-      p.inv_sigma2 = inv_sigma2_;
-    }
-    PoseOptimizerOptions pose_options;
-    const SE3d pose = SolvePose(camera_, start, &refine, pose_options);
-    fr.inliers = static_cast<int>(std::count_if(
-        refine.begin(), refine.end(), [](const PoseCorrespondence& c) { return c.block; }));
+    const SE3d pose = RefinePose(pnp, start, &refine, &fr.inliers);
     out_.seconds_tracking += SecondsSince(t0);
     if (fr.inliers < options_.min_tracked) {
       ++out_.lost_frames;
@@ -500,19 +515,11 @@ class Reconstructor {
       if (fr.keyframe || !options_.refine_frames) continue;
       // The pose against the final map: a frame tracked before the last bundle adjustments
       // moved its keyframe and points only follows its keyframe rigidly.
+      const std::vector<PnpCorrespondence> mapped = MappedCorrespondences(static_cast<int>(k));
+      if (static_cast<int>(mapped.size()) < options_.min_tracked) continue;
       std::vector<PoseCorrespondence> refine;
-      for (const IndexedObservation& o : Observations(static_cast<int>(k))) {
-        const auto& point = out_.points[static_cast<std::size_t>(o.track)];
-        if (!point) continue;
-        PoseCorrespondence& p = refine.emplace_back();
-        p.p_world = *point;
-        p.obs = Eigen::Vector3d(o.uv.x(), o.uv.y(), -1.0);
-        p.inv_sigma2 = inv_sigma2_;
-      }
-      if (static_cast<int>(refine.size()) < options_.min_tracked) continue;
-      const SE3d pose = SolvePose(camera_, fr.camera_from_world, &refine, PoseOptimizerOptions{});
-      const auto inliers = std::count_if(refine.begin(), refine.end(),
-                                         [](const PoseCorrespondence& c) { return c.block; });
+      int inliers = 0;
+      const SE3d pose = RefinePose(mapped, fr.camera_from_world, &refine, &inliers);
       if (inliers >= options_.min_tracked) fr.camera_from_world = pose;
     }
     out_.num_keyframes = static_cast<int>(keyframes_.size());

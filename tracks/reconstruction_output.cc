@@ -24,16 +24,7 @@ std::optional<TracksTruth> ReadTracksTruth(const fs::path& dir) {
   truth.trajectory = ReadTrajectory(trajectory, TrajectoryFormat::kTum);
   const fs::path points = dir / "truth_points.txt";
   if (fs::exists(points)) {
-    ForEachDataRow(points, FieldSeparator::kWhitespace, [&](const TextRow& row) {
-      RequireFieldCount(row, 4, points, "track x y z");
-      const int id = static_cast<int>(Int64Field(row.fields[0], points, row.line, "track"));
-      const Eigen::Vector3d p(DoubleField(row.fields[1], points, row.line, "x"),
-                              DoubleField(row.fields[2], points, row.line, "y"),
-                              DoubleField(row.fields[3], points, row.line, "z"));
-      if (!truth.points.emplace(id, p).second) {
-        throw InputError(points, row.line, fmt::format("track {} listed twice", id));
-      }
-    });
+    for (const auto& [id, p] : ReadTrackPoints(points)) truth.points.emplace(id, p);
   }
   return truth;
 }

@@ -27,18 +27,6 @@ void SimulatedTracksExportOptions::Check() const {
 
 namespace {
 
-std::vector<std::pair<int, Eigen::Vector3d>> ReadPoints(const fs::path& file) {
-  std::vector<std::pair<int, Eigen::Vector3d>> points;
-  ForEachDataRow(file, FieldSeparator::kWhitespace, [&](const TextRow& row) {
-    RequireFieldCount(row, 4, file, "track x y z");
-    points.emplace_back(static_cast<int>(Int64Field(row.fields[0], file, row.line, "track")),
-                        Eigen::Vector3d(DoubleField(row.fields[1], file, row.line, "x"),
-                                        DoubleField(row.fields[2], file, row.line, "y"),
-                                        DoubleField(row.fields[3], file, row.line, "z")));
-  });
-  return points;
-}
-
 fs::path Require(const fs::path& file, const std::string& hint) {
   if (!fs::exists(file)) throw InputError(file, "not found (" + hint + ")");
   return file;
@@ -92,7 +80,7 @@ ExportedTracks ExportSimulatedTracks(const fs::path& sequence,
   out.tracks.camera = exact.camera;
   out.tracks.width = exact.width;
   out.tracks.height = exact.height;
-  out.truth_points = ReadPoints(Require(sequence / "truth" / "tracks_points.txt", hint));
+  out.truth_points = ReadTrackPoints(Require(sequence / "truth" / "tracks_points.txt", hint));
   if (exact.observations.empty()) throw InputError(sequence / "truth/tracks_exact.txt", "empty");
   const double t0 = exact.observations.front().t_s;
   std::mt19937_64 rng(options.seed);
@@ -185,13 +173,8 @@ void WriteExportedTracks(const ExportedTracks& exported, const fs::path& out) {
   WriteTrackFile(exported.tracks, out / "tracks.txt");
   if (!exported.truth.poses.empty())
     WriteTrajectoryTum(exported.truth, out / "truth_trajectory.txt");
-  if (!exported.truth_points.empty()) {
-    std::string text = "# track x y z\n";
-    for (const auto& [id, p] : exported.truth_points) {
-      text += fmt::format("{} {:.9g} {:.9g} {:.9g}\n", id, p.x(), p.y(), p.z());
-    }
-    WriteFileAtomically(out / "truth_points.txt", text);
-  }
+  if (!exported.truth_points.empty())
+    WriteTrackPoints(exported.truth_points, out / "truth_points.txt");
 }
 
 }  // namespace pkslam

@@ -24,8 +24,8 @@ namespace pkslam {
 
 struct ExportedTracks {
   TrackSet tracks;
-  Trajectory truth;  // world_from_camera per frame (empty: no truth)
-  std::vector<std::pair<int, Eigen::Vector3d>> truth_points;  // (track, position)
+  Trajectory truth;          // world_from_camera per frame (empty: no truth)
+  TrackPoints truth_points;  // (track, position)
 };
 
 struct SimulatedTracksExportOptions {
