@@ -455,4 +455,12 @@ std::optional<std::int64_t> ParseDecimalAsInt64(std::string_view text, int decim
   return static_cast<std::int64_t>(value);
 }
 
+std::optional<std::filesystem::path> FindDatasetGroundTruth(const std::filesystem::path& dataset) {
+  for (const std::filesystem::path& f :
+       {dataset / "mav0/state_groundtruth_estimate0/data.csv", dataset / "groundtruth.txt"}) {
+    if (std::filesystem::exists(f)) return f;
+  }
+  return std::nullopt;
+}
+
 }  // namespace pkslam

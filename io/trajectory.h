@@ -92,6 +92,10 @@ Trajectory ReadTrajectory(const std::filesystem::path& file,
                           TrajectoryFormat format = TrajectoryFormat::kAuto,
                           DuplicateTimestamps duplicates = DuplicateTimestamps::kKeepFirst);
 
+// A dataset folder's ground truth: EuRoC's mav0/state_groundtruth_estimate0/data.csv or TUM
+// RGB-D's groundtruth.txt (nullopt when it has neither).
+std::optional<std::filesystem::path> FindDatasetGroundTruth(const std::filesystem::path& dataset);
+
 // Writers (kAuto is not allowed). tum: seconds with exactly 9 decimals, so nanosecond
 // timestamps survive a write/read round trip; positions and quaternions with 9 decimals.
 // euroc: integer nanoseconds, 17 columns when the trajectory has extras, 8 otherwise.

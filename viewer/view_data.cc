@@ -46,16 +46,6 @@ void ForEachCsvRow(const fs::path& file,
 
 std::int64_t Micros(double t_s) { return std::llround(t_s * 1e6); }
 
-fs::path DatasetGroundTruth(const fs::path& dataset) {
-  for (const fs::path& candidate :
-       {dataset / "mav0/state_groundtruth_estimate0/data.csv", dataset / "groundtruth.txt"}) {
-    if (fs::exists(candidate)) return candidate;
-  }
-  throw InputError(dataset,
-                   "no ground truth (mav0/state_groundtruth_estimate0/data.csv or "
-                   "groundtruth.txt)");
-}
-
 // Every k-th point so at most `budget` remain (deterministic).
 template <class T>
 std::vector<T> Subsample(const std::vector<T>& in, std::size_t budget) {
@@ -77,7 +67,15 @@ ViewData LoadViewData(const ViewOptions& options) {
   ViewData data;
   data.title = fs::absolute(run).filename().string();
   fs::path gt = options.ground_truth;
-  if (gt.empty() && !options.dataset.empty()) gt = DatasetGroundTruth(options.dataset);
+  if (gt.empty() && !options.dataset.empty()) {
+    const auto found = FindDatasetGroundTruth(options.dataset);
+    if (!found) {
+      throw InputError(options.dataset,
+                       "no ground truth (mav0/state_groundtruth_estimate0/"
+                       "data.csv or groundtruth.txt)");
+    }
+    gt = *found;
+  }
 
   Sim3d world_from_map;  // the displayed world from the run's map world
   if (!gt.empty()) {

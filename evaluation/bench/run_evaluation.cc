@@ -155,10 +155,7 @@ void WriteRunView(const fs::path& run_dir, const fs::path& gt_file) {
 }  // namespace
 
 fs::path FindGroundTruth(const fs::path& dataset) {
-  const fs::path euroc = dataset / "mav0" / "state_groundtruth_estimate0" / "data.csv";
-  if (fs::exists(euroc)) return euroc;
-  const fs::path tum = dataset / "groundtruth.txt";
-  if (fs::exists(tum)) return tum;
+  if (auto file = FindDatasetGroundTruth(dataset)) return *file;
   throw InputError(dataset,
                    "no ground truth (mav0/state_groundtruth_estimate0/data.csv or groundtruth.txt);"
                    " set the dataset's ground_truth in the suite");
