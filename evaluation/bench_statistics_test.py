@@ -84,6 +84,23 @@ class BenchStatisticsTest(unittest.TestCase):
         self.assertGreater(pooled["power_for_paper"], 0.99)
         self.assertIn("not reproduced", pooled["sentence"])
 
+    def test_sequences_disagreeing_in_sign_are_named_when_interval_and_test_part(self):
+        # Three sequences 30% worse, two 10% better, tight runs: the mean relative change
+        # (+14%) has an interval that excludes 0, the stratified rank test (mean effect -0.1)
+        # does not reach 5%. The sentence must say both and give the per-sequence range.
+        rng = np.random.default_rng(6)
+        noise = rng.normal(0, 0.02, size=(2, 5, 10))
+        rows = rows_for({"orbslam3": lambda d, r: 0.05 * math.exp(noise[0, d, r]),
+                         "pks": lambda d, r: (1.3 if d < 3 else 0.9) * 0.05
+                         * math.exp(noise[1, d, r])})
+        pooled = bs.analyse(rows)["pooled"][0]
+        self.assertGreater(pooled["p_holm"], 0.05)
+        self.assertLess(pooled["ci_high"], 0)
+        self.assertAlmostEqual(pooled["sequence_change_min_pct"], -10, delta=2)
+        self.assertAlmostEqual(pooled["sequence_change_max_pct"], 30, delta=2)
+        self.assertIn("excludes 0 but the rank test does not", pooled["sentence"])
+        self.assertIn("-10", pooled["sentence"].split("per-sequence changes")[1][:6])
+
     def test_failures_count_against_a_configuration(self):
         # Equal ATE where both succeed, but pks fails half its runs on every sequence.
         rows = rows_for({"orbslam3": lambda d, r: 0.05 + 0.001 * r,

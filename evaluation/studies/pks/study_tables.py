@@ -1,0 +1,156 @@
+#!/usr/bin/python3
+"""Tables of the PKS study (docs/pks_study.md) from a collected bench report.
+
+Reads REPORT/results.csv (one row per run) and the analysis of evaluation/bench_statistics.py
+(run here, on the same rows), and prints markdown:
+  1. per sequence and sensor: mean ± std ATE (Sim(3)) per configuration, with the change
+     against the baseline, its bootstrap 95% interval and the Mann-Whitney p;
+  2. per sensor and configuration: ATE Sim(3) and SE(3), failure rate, coverage, keyframes in
+     the final map, CPU time and mapping CPU time (means over runs);
+  3. keyframes created per rule (mean per run), the reason counts;
+  4. the pooled significance sentences.
+
+  /usr/bin/python3 evaluation/studies/pks/study_tables.py REPORT/results.csv \
+      [--datasets real_MH_01_easy,real_V1_01_easy] > tables.md
+"""
+
+import argparse
+import collections
+import csv
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+import bench_statistics  # noqa: E402  (evaluation/bench_statistics.py)
+
+
+def num(text):
+    try:
+        v = float(text)
+    except (TypeError, ValueError):
+        return math.nan
+    return v
+
+
+def short(dataset):
+    return dataset.replace("real_", "").rsplit("_", 1)[0] if dataset.startswith("real_") \
+        else dataset
+
+
+def mean(values):
+    values = [v for v in values if math.isfinite(v)]
+    return sum(values) / len(values) if values else math.nan
+
+
+def pct(v):
+    return "n/a" if not math.isfinite(v) else f"{v:+.0f}%"
+
+
+def per_sequence_table(result, datasets, sensors, configs, baseline):
+    outcome = {(o["dataset"], o["sensor"], o["config"]): o for o in result["outcomes"]}
+    change = {(s["dataset"], s["sensor"], s["config"]): s for s in result["per_sequence"]}
+    lines = ["| sequence | sensor | " + " | ".join(configs) + " |",
+             "|---|---|" + "---|" * len(configs)]
+    for sensor in sensors:
+        for dataset in datasets:
+            if (dataset, sensor, baseline) not in outcome:
+                continue
+            cells = []
+            for config in configs:
+                o = outcome.get((dataset, sensor, config))
+                if o is None:
+                    cells.append("—")
+                    continue
+                text = (f"{bench_statistics.fmt(o['ate_mean'])} ± "
+                        f"{bench_statistics.fmt(o['ate_std'])}")
+                if o["failures"]:
+                    text += f", {o['failures']}/{o['runs']} failed"
+                s = change.get((dataset, sensor, config))
+                if s is not None:
+                    text += (f" ({pct(-s['improvement_pct'])} [{pct(-s['ci_high'])}, "
+                             f"{pct(-s['ci_low'])}], p = {s['p']:.2g})")
+                cells.append(text)
+            lines.append(f"| {short(dataset)} | {sensor} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def summary_table(rows, sensors, configs):
+    lines = ["| sensor | config | runs | failed | coverage | ATE Sim(3) [m] | ATE SE(3) [m] | "
+             "keyframes | CPU [s] | mapping CPU [s] |", "|---|---|" + "---|" * 8]
+    for sensor in sensors:
+        for config in configs:
+            g = [r for r in rows if r["sensor"] == sensor and r["config"] == config]
+            if not g:
+                continue
+            ok = [r for r in g if r["ok"]]
+            lines.append(
+                f"| {sensor} | {config} | {len(g)} | {len(g) - len(ok)} | "
+                f"{mean([r['coverage'] for r in g]):.1%} | "
+                f"{mean([r['ate'] for r in ok]):.4f} | "
+                f"{mean([num(r['raw']['ate_se3_rmse_m']) for r in ok]):.4f} | "
+                f"{mean([num(r['raw']['keyframes']) for r in g]):.0f} | "
+                f"{mean([num(r['raw']['cpu_s']) for r in g]):.0f} | "
+                f"{mean([num(r['raw']['mapping_cpu_s']) for r in g]):.0f} |")
+    return lines
+
+
+def reason_table(rows, sensors, configs, top=6):
+    lines = ["| sensor | config | keyframes created per run, by rule |", "|---|---|---|"]
+    for sensor in sensors:
+        for config in configs:
+            g = [r for r in rows if r["sensor"] == sensor and r["config"] == config]
+            if not g:
+                continue
+            counts = collections.Counter()
+            for r in g:
+                for item in (r["raw"].get("keyframe_reasons") or "").split():
+                    name, _, value = item.rpartition("=")
+                    counts[name] += num(value) if math.isfinite(num(value)) else 0
+            total = sum(counts.values()) / len(g)
+            parts = [f"{name} {value / len(g):.0f}" for name, value in counts.most_common(top)]
+            rest = len(counts) - top
+            lines.append(f"| {sensor} | {config} | {total:.0f}: " + ", ".join(parts) +
+                         (f", … ({rest} more)" if rest > 0 else "") + " |")
+    return lines
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("results", help="REPORT/results.csv of pkslam bench --collect")
+    parser.add_argument("--datasets", default="",
+                        help="comma-separated datasets to keep (default: all)")
+    args = parser.parse_args()
+    try:
+        rows = bench_statistics.read_rows(args.results)
+    except (OSError, ValueError) as e:
+        sys.exit(f"study_tables: {args.results}: {e}")
+    with open(args.results, newline="") as f:
+        raw = {int(x["index"]): x for x in csv.DictReader(f)}
+    for r in rows:
+        r["raw"] = raw[r["index"]]
+    if args.datasets:
+        keep = set(args.datasets.split(","))
+        rows = [r for r in rows if r["dataset"] in keep]
+    if not rows:
+        sys.exit(f"study_tables: {args.results}: no runs left")
+    result = bench_statistics.analyse(rows)
+    datasets = bench_statistics.unique(r["dataset"] for r in rows)
+    sensors = bench_statistics.unique(r["sensor"] for r in rows)
+    configs = bench_statistics.unique(r["config"] for r in rows)
+    baseline = rows[0]["baseline"]
+    configs = [baseline] + [c for c in configs if c != baseline]
+    out = ["**Per sequence** (mean ± std ATE Sim(3) [m]; change against "
+           f"{baseline}, bootstrap 95% CI, Mann-Whitney p)", ""]
+    out += per_sequence_table(result, datasets, sensors, configs, baseline)
+    out += ["", "**Per selector** (means over runs)", ""]
+    out += summary_table(rows, sensors, configs)
+    out += ["", "**Reason counts** (keyframes created, before culling)", ""]
+    out += reason_table(rows, sensors, configs)
+    out += ["", "**Pooled** (stratified permutation test, Holm over the configurations)", ""]
+    out += ["- " + e["sentence"] for e in result["pooled"]]
+    print("\n".join(out))
+
+
+if __name__ == "__main__":
+    main()

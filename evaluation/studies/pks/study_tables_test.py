@@ -1,0 +1,74 @@
+"""Tests of study_tables.py on a hand-made results.csv (CTest: pks_study_tables).
+
+  /usr/bin/python3 -m unittest study_tables_test   (from evaluation/studies/pks)
+"""
+
+import csv
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+FIELDS = ["index", "dataset", "sensor", "config", "baseline", "status", "ate_m",
+          "ate_se3_rmse_m", "coverage", "keyframes", "cpu_s", "mapping_cpu_s",
+          "keyframe_reasons", "sweep_param"]
+
+
+def write_results(path):
+    rows, index = [], 0
+    for dataset in ("real_MH_01_easy", "real_V1_01_easy"):
+        for config in ("orbslam3", "pks"):
+            for run in range(4):
+                failed = config == "pks" and dataset == "real_V1_01_easy" and run == 0
+                rows.append({
+                    "index": index, "dataset": dataset, "sensor": "stereo-inertial",
+                    "config": config, "baseline": "orbslam3",
+                    "status": "failed" if failed else "ok",
+                    "ate_m": "" if failed else 0.010 + 0.001 * run,
+                    "ate_se3_rmse_m": "" if failed else 0.020, "coverage": 0.1 if failed else 1,
+                    "keyframes": 100 if config == "pks" else 50, "cpu_s": 10, "mapping_cpu_s": 4,
+                    "keyframe_reasons": ("imu=6 time=2" if config == "pks" else "c1b+c2=3"),
+                    "sweep_param": ""})
+                index += 1
+    # A sweep row: left out of every table.
+    rows.append(dict(rows[0], index=index, config="orbslam3-sweep", sweep_param="min_frames"))
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=FIELDS)
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+class StudyTablesTest(unittest.TestCase):
+    def run_tables(self, *extra):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "results.csv")
+            write_results(path)
+            return subprocess.run([sys.executable, os.path.join(HERE, "study_tables.py"), path,
+                                   *extra], capture_output=True, text=True)
+
+    def test_tables_count_failures_keyframes_and_reasons(self):
+        out = self.run_tables()
+        self.assertEqual(out.returncode, 0, out.stderr)
+        text = out.stdout
+        self.assertIn("| MH_01 | stereo-inertial | 0.0115 ± 0.0013 |", text)
+        self.assertIn("1/4 failed", text)  # pks on V1_01
+        self.assertIn("| stereo-inertial | pks | 8 | 1 | 88.8% |", text)
+        self.assertIn("| stereo-inertial | pks | 8: imu 6, time 2 |", text)
+        self.assertIn("| stereo-inertial | orbslam3 | 3: c1b+c2 3 |", text)
+        self.assertNotIn("orbslam3-sweep", text)
+        self.assertIn("pks vs orbslam3 (stereo-inertial, 2 sequences", text)
+        self.assertIn("fewer than 5 runs per sequence", text)  # 4 runs: no verdict
+
+    def test_dataset_filter_and_empty_selection(self):
+        out = self.run_tables("--datasets", "real_MH_01_easy")
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertNotIn("V1_01", out.stdout)
+        out = self.run_tables("--datasets", "real_V2_01_easy")
+        self.assertNotEqual(out.returncode, 0)
+        self.assertIn("no runs left", out.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
