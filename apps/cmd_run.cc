@@ -165,7 +165,9 @@ void RegisterRunCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--strict", args->strict,
                 "Exit 3 when the run finished on degraded input (skipped frames, timestamp "
-                "jumps, frames without IMU or depth; see stats.json \"input\")");
+                "jumps, frames without IMU or depth; see stats.json \"input\"), 4 when its "
+                "estimate is suspect (tracking lost for good, maps stitched or left apart; "
+                "see stats.json \"estimate\")");
   cmd->callback([args] {
     RunOptions& o = args->options;
     const auto sensor = ParseSensor(args->sensor);
@@ -210,6 +212,10 @@ void RegisterRunCommand(CLI::App& app) {
       fmt::print("degraded input: {} warning(s), see {}/stats.json \"input\"\n",
                  s.input.warnings.size(), o.out.string());
     }
+    if (s.estimate.suspect()) {
+      fmt::print("suspect estimate: {}; see {}/stats.json \"estimate\"\n",
+                 s.estimate.warnings.front(), o.out.string());
+    }
     if (s.interrupted) {
       const int signal = interrupt_signal.load();
       throw CommandExit{128 + signal,
@@ -219,6 +225,9 @@ void RegisterRunCommand(CLI::App& app) {
     }
     if (args->strict && s.input.degraded()) {
       throw CommandExit{kExitDegraded, "--strict: the run finished on degraded input"};
+    }
+    if (args->strict && s.estimate.suspect()) {
+      throw CommandExit{kExitSuspect, "--strict: the run's estimate is suspect"};
     }
   });
 }

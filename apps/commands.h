@@ -8,8 +8,10 @@
 namespace pkslam::apps {
 
 // Exit codes (docs/run.md): 0 success, 1 error (bad input, failed write), 2 internal error,
-// 3 finished on degraded input under --strict, 128 + signal when interrupted (outputs written).
+// 3 finished on degraded input under --strict, 4 finished with a suspect estimate under --strict
+// (system/estimate_health.h), 128 + signal when interrupted (outputs written).
 inline constexpr int kExitDegraded = 3;
+inline constexpr int kExitSuspect = 4;
 
 // Thrown by a command that finished its work but must exit with `code`; main() prints
 // `message` (when not empty) as one line.

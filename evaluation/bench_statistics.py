@@ -67,6 +67,7 @@ def read_rows(path):
         out.append({"dataset": r["dataset"], "sensor": r["sensor"], "config": r["config"],
                     "baseline": r["baseline"], "ok": ok, "ate": ate if ok else math.inf,
                     "coverage": coverage if math.isfinite(coverage) else 0.0,
+                    "suspect": number(r.get("suspect")),
                     "index": int(r["index"])})
     out.sort(key=lambda r: r["index"])
     return out
@@ -208,6 +209,10 @@ def analyse(rows, seed=1):
             "dataset": key[0], "sensor": key[1], "config": key[2], "runs": len(g),
             "failures": len(g) - len(ok), "failure_rate": (len(g) - len(ok)) / len(g),
             "coverage": float(np.mean([r["coverage"] for r in g])),
+            # Successful runs whose own signals call the estimate suspect (a loss for good):
+            # None when the results predate the flag.
+            "suspect": (sum(1 for r in g if r["ok"] and r.get("suspect") == 1)
+                        if any(math.isfinite(r.get("suspect", math.nan)) for r in g) else None),
             "ate_mean": float(np.mean(ok)) if ok else math.nan,
             "ate_std": float(np.std(ok, ddof=1)) if len(ok) > 1 else math.nan})
     for sensor in unique(r["sensor"] for r in rows):
@@ -301,9 +306,11 @@ def tables(result):
     """(title, header, rows) tables of the analysis."""
     out = []
     out.append(("Outcomes: failure rate and coverage beside the ATE (mean ± std over successful "
-                "runs)", ["dataset", "sensor", "config", "runs", "failed", "coverage", "ATE [m]"],
+                "runs)", ["dataset", "sensor", "config", "runs", "failed", "suspect", "coverage",
+                          "ATE [m]"],
                 [[o["dataset"], o["sensor"], o["config"], str(o["runs"]),
-                  f"{o['failures']} ({o['failure_rate']:.0%})", f"{o['coverage']:.1%}",
+                  f"{o['failures']} ({o['failure_rate']:.0%})",
+                  "—" if o.get("suspect") is None else str(o["suspect"]), f"{o['coverage']:.1%}",
                   f"{fmt(o['ate_mean'])} ± {fmt(o['ate_std'])}"] for o in result["outcomes"]]))
     out.append(("Per sequence: Mann-Whitney U against the baseline (failures ranked worst)",
                 ["dataset", "sensor", "config", "ATE change", "95% CI", "effect", "p"],
@@ -324,6 +331,8 @@ def tables(result):
 
 RULES = ("A run fails when pkslam or its evaluation failed or its trajectory covers less than "
          f"{MIN_COVERAGE:.0%} of the frames; a successful run's ATE is over its tracked part. "
+         "Suspect: successful runs that flagged their own estimate (tracking lost for good; "
+         "stats.json \"estimate\"); they stay in the ATE. "
          "ATE change = -(mean over sequences of 100 (ATE_base - ATE) / ATE_base), negative = "
          "more accurate; 95% CI by bootstrap over runs; effect = rank-biserial (positive = more "
          "accurate); tests are two-sided at 5%.")

@@ -115,6 +115,20 @@ class BenchStatisticsTest(unittest.TestCase):
         self.assertLess(pooled["p"], 0.05)
         self.assertIn("significantly less accurate", pooled["sentence"])
 
+    def test_suspect_runs_are_counted_among_successes_and_unknown_stays_unknown(self):
+        rows = rows_for({"orbslam3": lambda d, r: 0.05, "pks": lambda d, r: 0.05},
+                        failures=lambda c, d, r: c == "pks" and r == 0)
+        outcome = [o for o in bs.analyse(rows)["outcomes"] if o["config"] == "pks"][0]
+        self.assertIsNone(outcome["suspect"])  # results from before the flag
+        for row in rows:
+            # Runs 0-2 flagged; run 0 of pks failed, so it counts as a failure, not as suspect.
+            row["suspect"] = 1.0 if row["index"] % 10 < 3 else 0.0
+        result = bs.analyse(rows)
+        outcome = [o for o in result["outcomes"] if o["config"] == "pks"
+                   and o["dataset"] == "A"][0]
+        self.assertEqual(outcome["suspect"], 2)
+        self.assertIn("| suspect |", bs.markdown(result))
+
     def test_markdown_names_the_rules_and_every_comparison(self):
         rows = rows_for({"orbslam3": lambda d, r: 0.05 + 0.001 * r,
                          "pks": lambda d, r: 0.05 + 0.001 * r,

@@ -27,6 +27,7 @@
 #include <string>
 
 #include "io/euroc_dataset.h"
+#include "system/estimate_health.h"
 #include "system/input_report.h"
 #include "system/slam_system.h"
 
@@ -87,6 +88,9 @@ struct RunSummary {
   std::map<std::string, int> criteria_held;
   // What was wrong with the input without stopping the run (degraded() when anything was).
   InputReport input;
+  // What the run's own signals say about its trajectory (suspect() when tracking was lost for
+  // good or maps stayed apart).
+  EstimateHealth estimate;
 
   // Adds one tracked frame: frames, tracked, keyframe reasons, selector decisions, criteria.
   void Count(const TrackResult& result);

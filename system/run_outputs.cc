@@ -11,11 +11,13 @@
 #include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
+#include "core/util/log.h"
 #include "core/util/output_file.h"
 #include "core/util/quantile.h"
 #include "io/rigid_transform_file.h"
 #include "io/track_file.h"
 #include "map_model/map_editor.h"
+#include "system/estimate_health.h"
 #include "system/inertial_outputs.h"
 #include "system/sparse_model_builder.h"
 
@@ -120,20 +122,12 @@ void WriteLoopEvents(JsonWriter* json, std::string_view key, const std::vector<L
 void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonWriter* json) {
   const LoopClosingStats stats = system.loop_stats();
   std::vector<double> relocalisations;
-  std::vector<double> lost;
   const auto& records = system.tracker().records();
   for (std::size_t i = 1; i < records.size(); ++i) {
-    const double t = static_cast<double>(records[i].t_ns) * 1e-9;
     if (records[i].state == TrackingState::kOk &&
         records[i - 1].state == TrackingState::kRecentlyLost) {
-      relocalisations.push_back(t);
+      relocalisations.push_back(static_cast<double>(records[i].t_ns) * 1e-9);
     }
-    // Lost for good: the tracker starts a new map (or resets) and is NOT_INITIALIZED again.
-    const bool was_tracking = records[i - 1].state == TrackingState::kOk ||
-                              records[i - 1].state == TrackingState::kRecentlyLost;
-    const bool gave_up = records[i].state == TrackingState::kLost ||
-                         records[i].state == TrackingState::kNotInitialized;
-    if (was_tracking && gave_up) lost.push_back(t);
   }
   json->Key("loop_closing").BeginObject();
   json->Member("enabled", !options.system.no_loop);
@@ -143,7 +137,7 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
   WriteLoopEvents(json, "loops", stats.loops);
   WriteLoopEvents(json, "merges", stats.merges);
   WriteArray(json, "relocalisation_times_s", relocalisations);
-  WriteArray(json, "new_map_or_reset_times_s", lost);
+  WriteArray(json, "new_map_or_reset_times_s", LostForGoodTimes(records));
   json->Member("tested_candidates", stats.tested_candidates);
   json->Member("verified_candidates", stats.verified_regions);
   json->Member("unconfirmed_candidates", stats.rejected_regions);
@@ -153,6 +147,19 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
   json->Member("global_ba_finished", stats.global_ba_finished);
   json->Member("global_ba_aborted", stats.global_ba_aborted);
   json->Member("median_detection_ms", Median(stats.detection_ms));
+  json->EndObject();
+}
+
+// What the run can tell about its own trajectory (system/estimate_health.h).
+void WriteEstimateHealth(const EstimateHealth& health, JsonWriter* json) {
+  json->Key("estimate").BeginObject();
+  json->Member("suspect", health.suspect());
+  json->Member("lost_for_good", static_cast<int>(health.lost_for_good_s.size()));
+  json->Member("maps_at_end", health.maps_at_end);
+  json->Member("largest_merge_correction_m", health.largest_merge_correction_m);
+  json->Key("warnings").BeginArray();
+  for (const std::string& w : health.warnings) json->Value(w);
+  json->EndArray();
   json->EndObject();
 }
 
@@ -261,6 +268,10 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   summary->maps = system.NumMaps();
   summary->lost = lost;
   summary->median_tracking_ms = Median(tracking_ms);
+  summary->estimate =
+      AssessEstimate(LostForGoodTimes(records), system.loop_stats().merges, summary->maps);
+  for (const std::string& w : summary->estimate.warnings)
+    PKSLAM_LOG_WARN("suspect estimate: {}", w);
 
   JsonWriter json;
   json.BeginObject();
@@ -287,6 +298,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   map_file("map_saved", options.save_map, summary->map_saved);
   json.Member("degraded", summary->input.degraded());
   WriteInputReport(summary->input, &json);
+  WriteEstimateHealth(summary->estimate, &json);
   json.Member("frames", summary->frames);
   json.Member("frames_in_trajectory", frames_in_trajectory);
   json.Member("lost_frames", lost);

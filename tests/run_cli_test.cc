@@ -132,6 +132,44 @@ TEST(RunCli, ImuCoverageIsChecked) {
   EXPECT_THAT(single.output, HasSubstr("imu0/data.csv: a single IMU sample"));
 }
 
+// Overwrites frames [first, last) of cam0 and cam1 with a uniform grey image: nothing to track.
+void BlankFrames(const std::filesystem::path& dataset, std::size_t first, std::size_t last) {
+  for (const char* cam : {"cam0", "cam1"}) {
+    std::vector<std::filesystem::path> images;
+    for (const auto& e : std::filesystem::directory_iterator(dataset / "mav0" / cam / "data")) {
+      images.push_back(e.path());
+    }
+    std::sort(images.begin(), images.end());
+    for (std::size_t i = first; i < last && i < images.size(); ++i) {
+      const cv::Mat image = cv::imread(images[i].string(), cv::IMREAD_UNCHANGED);
+      cv::imwrite(images[i].string(), cv::Mat(image.size(), image.type(), cv::Scalar::all(128)));
+    }
+  }
+}
+
+// A run that loses tracking for good says its estimate is suspect (summary line, stats.json
+// "estimate", --strict exit 4); the same flight without the blank stretch does not.
+TEST(RunCli, LossForGoodMakesTheEstimateSuspect) {
+  const auto dir = testing::MakeTempDir("run_cli_suspect");
+  const auto seq = dir / "seq";
+  ASSERT_TRUE(Simulate(seq, 2));
+  const std::string run = fmt::format("run --dataset '{}' --sensor stereo --quiet --out '{}'",
+                                      seq.string(), (dir / "out").string());
+  const auto clean = RunPkslam(run);
+  EXPECT_EQ(clean.exit_code, 0) << clean.output;
+  EXPECT_THAT(clean.output, ::testing::Not(HasSubstr("suspect estimate")));
+  EXPECT_THAT(testing::ReadFileBytes(dir / "out/stats.json"), HasSubstr("\"suspect\": false"));
+
+  BlankFrames(seq, 25, 40);  // 0.75 s of grey in a 3 s flight
+  const auto lost = RunPkslam(run);
+  EXPECT_EQ(lost.exit_code, 0) << lost.output;
+  EXPECT_THAT(lost.output, HasSubstr("suspect estimate: tracking lost for good at t = "));
+  const std::string stats = testing::ReadFileBytes(dir / "out/stats.json");
+  EXPECT_THAT(stats, HasSubstr("\"suspect\": true"));
+  EXPECT_THAT(stats, HasSubstr("\"lost_for_good\": 1"));
+  EXPECT_EQ(RunPkslam(run + " --strict").exit_code, 4);
+}
+
 // A frame of another size than the calibration is an error naming that image (mono tracked it
 // with the wrong intrinsics; stereo failed inside the rectification, naming a source file).
 TEST(RunCli, ImageSizeMustMatchTheCalibration) {

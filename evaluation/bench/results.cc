@@ -101,7 +101,8 @@ std::vector<std::string> ResultColumns() {
           "sequence_s",
           "mapping_cpu_s",
           "degraded",
-          "keyframe_reasons"};
+          "keyframe_reasons",
+          "suspect"};
 }
 
 std::string CsvField(const std::string& text) {
@@ -187,7 +188,8 @@ std::string ResultCsvRow(const RunResult& r) {
                                       Num(r.sequence_s),
                                       Num(r.mapping_cpu_s),
                                       Num(r.degraded),
-                                      CsvField(r.keyframe_reasons)};
+                                      CsvField(r.keyframe_reasons),
+                                      Num(r.suspect)};
   std::string out;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (i > 0) out.push_back(',');
@@ -270,12 +272,13 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
                           &r.realtime_factor, &r.p95_tracking_ms,   &r.mapping_ms_per_kf,
                           &r.cpu_s,           &r.peak_memory_mib,   &r.sequence_s,
                           &r.mapping_cpu_s,   &r.degraded};
-    // The last column (keyframe_reasons) is text.
-    PKSLAM_CHECK(required + std::size(optional) + 1 == columns.size(), "optional columns");
+    // Then keyframe_reasons (text) and suspect, the columns added last.
+    PKSLAM_CHECK(required + std::size(optional) + 2 == columns.size(), "optional columns");
     for (std::size_t k = 0; k < std::size(optional) && required + k < header.size(); ++k) {
       *optional[k] = ParseDouble(next(), file, n, header[required + k]);
     }
-    if (header.size() == columns.size()) r.keyframe_reasons = next();
+    if (header.size() > columns.size() - 2) r.keyframe_reasons = next();
+    if (header.size() == columns.size()) r.suspect = ParseDouble(next(), file, n, "suspect");
     out.push_back(std::move(r));
   }
   return out;

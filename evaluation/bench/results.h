@@ -61,6 +61,9 @@ struct RunResult {
   // Keyframes per creating rule, "reason=count" separated by spaces (stats.json
   // keyframe_reasons; empty for peers and older runs).
   std::string keyframe_reasons;
+  // 1: the run's own signals call its estimate suspect (stats.json "estimate", or for runs
+  // written before it, a loss for good in loop_closing.new_map_or_reset_times_s); NaN: unknown.
+  double suspect = kNaN;
 };
 
 // The headline alignment of a run: `suite_choice` when "se3"/"sim3"; for "auto" "sim3" for

@@ -117,8 +117,8 @@ RunResult MeasuredRun() {
 // result.csv files of runs finished before the optional trailing columns still read (a resumed or
 // collected bench must not run them again).
 TEST(ResultsCsv, ReadsFilesWithoutTheDenseColumn) {
-  // dense_points, the bias errors, the 5 speed columns and the 4 study columns came later.
-  const auto back = ReadWithoutTrailingColumns(MeasuredRun(), 12, "bench_results_legacy");
+  // dense_points, the bias errors, the 5 speed columns and the 5 study columns came later.
+  const auto back = ReadWithoutTrailingColumns(MeasuredRun(), 13, "bench_results_legacy");
   ASSERT_EQ(back.size(), 1u);
   EXPECT_TRUE(back[0].ok);
   EXPECT_DOUBLE_EQ(back[0].ate_m, 0.01);
@@ -127,7 +127,7 @@ TEST(ResultsCsv, ReadsFilesWithoutTheDenseColumn) {
 }
 
 TEST(ResultsCsv, ReadsFilesWithoutTheSpeedColumns) {
-  const auto back = ReadWithoutTrailingColumns(MeasuredRun(), 9, "bench_results_no_speed");
+  const auto back = ReadWithoutTrailingColumns(MeasuredRun(), 10, "bench_results_no_speed");
   ASSERT_EQ(back.size(), 1u);
   EXPECT_DOUBLE_EQ(back[0].dense_points, 5);  // the older optional columns still read
   EXPECT_DOUBLE_EQ(back[0].gyro_bias_err_pct, 7);
@@ -135,18 +135,18 @@ TEST(ResultsCsv, ReadsFilesWithoutTheSpeedColumns) {
   EXPECT_TRUE(std::isnan(back[0].cpu_s));
   EXPECT_TRUE(std::isnan(back[0].peak_memory_mib));
   // Only the speed columns a file has are read: with realtime_factor, without cpu_s.
-  const auto partial = ReadWithoutTrailingColumns(MeasuredRun(), 8, "bench_results_part_speed");
+  const auto partial = ReadWithoutTrailingColumns(MeasuredRun(), 9, "bench_results_part_speed");
   EXPECT_DOUBLE_EQ(partial[0].realtime_factor, 2.5);
   EXPECT_TRUE(std::isnan(partial[0].cpu_s));
 }
 
 TEST(ResultsCsv, SpeedColumnsTrailTheOlderOptionalOnes) {
   const auto columns = ResultColumns();
-  const std::vector<std::string> tail(columns.end() - 10, columns.end());
+  const std::vector<std::string> tail(columns.end() - 11, columns.end());
   EXPECT_EQ(tail,
             (std::vector<std::string>{"accel_bias_err_pct", "realtime_factor", "p95_tracking_ms",
                                       "mapping_ms_per_kf", "cpu_s", "peak_memory_mib", "sequence_s",
-                                      "mapping_cpu_s", "degraded", "keyframe_reasons"}));
+                                      "mapping_cpu_s", "degraded", "keyframe_reasons", "suspect"}));
 }
 
 TEST(ResultsCsv, StudyColumnsRoundTripAndOlderFilesLackThem) {
@@ -155,12 +155,18 @@ TEST(ResultsCsv, StudyColumnsRoundTripAndOlderFilesLackThem) {
   r.mapping_cpu_s = 21.5;
   r.degraded = 1;
   r.keyframe_reasons = "camera=3 forced+imu=2 time=40";
+  r.suspect = 1;
   const auto back = ReadWithoutTrailingColumns(r, 0, "bench_results_study");
   ASSERT_EQ(back.size(), 1u);
   EXPECT_DOUBLE_EQ(back[0].mapping_cpu_s, 21.5);
   EXPECT_DOUBLE_EQ(back[0].degraded, 1.0);
   EXPECT_EQ(back[0].keyframe_reasons, "camera=3 forced+imu=2 time=40");
-  const auto older = ReadWithoutTrailingColumns(r, 4, "bench_results_no_study");
+  EXPECT_DOUBLE_EQ(back[0].suspect, 1.0);
+  // Files from before the suspect column keep their keyframe reasons.
+  const auto no_suspect = ReadWithoutTrailingColumns(r, 1, "bench_results_no_suspect");
+  EXPECT_EQ(no_suspect[0].keyframe_reasons, "camera=3 forced+imu=2 time=40");
+  EXPECT_TRUE(std::isnan(no_suspect[0].suspect));
+  const auto older = ReadWithoutTrailingColumns(r, 5, "bench_results_no_study");
   EXPECT_DOUBLE_EQ(older[0].cpu_s, 12.0);
   EXPECT_TRUE(std::isnan(older[0].sequence_s));
   EXPECT_TRUE(older[0].keyframe_reasons.empty());

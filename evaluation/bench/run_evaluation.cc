@@ -37,6 +37,7 @@ struct StatsJson {
   double sequence_s = kNaN;
   double mapping_cpu_s = kNaN;
   double degraded = kNaN;
+  double suspect = kNaN;
   std::string keyframe_reasons;  // "reason=count ..."
 };
 
@@ -86,6 +87,19 @@ StatsJson ReadStats(const fs::path& file) {
   s.sequence_s = optional("sequence_duration_s");
   s.mapping_cpu_s = optional("local_mapping_cpu_s");
   if (root["degraded"]) s.degraded = get("degraded", false) ? 1.0 : 0.0;
+  // system/estimate_health.h; stats.json files from before it carry the losses for good only.
+  const YAML::Node estimate = root["estimate"];
+  const YAML::Node loops = root["loop_closing"];
+  if (estimate && estimate.IsMap() && estimate["suspect"]) {
+    try {
+      s.suspect = estimate["suspect"].as<bool>() ? 1.0 : 0.0;
+    } catch (const YAML::Exception&) {
+      throw InputError(file, estimate["suspect"].Mark().line + 1, "bad 'estimate.suspect'");
+    }
+  } else if (loops && loops.IsMap() && loops["new_map_or_reset_times_s"] &&
+             loops["new_map_or_reset_times_s"].IsSequence()) {
+    s.suspect = loops["new_map_or_reset_times_s"].size() > 0 ? 1.0 : 0.0;
+  }
   if (const YAML::Node reasons = root["keyframe_reasons"]; reasons && reasons.IsMap()) {
     for (const auto& kv : reasons) {
       if (!s.keyframe_reasons.empty()) s.keyframe_reasons += ' ';
@@ -177,6 +191,7 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   result->sequence_s = stats.sequence_s;
   result->mapping_cpu_s = stats.mapping_cpu_s;
   result->degraded = stats.degraded;
+  result->suspect = stats.suspect;
   result->keyframe_reasons = stats.keyframe_reasons;
 
   const fs::path gt_file =

@@ -132,6 +132,34 @@ TEST(EvaluateRun, ReadsSpeedFromStatsWhenPresent) {
   EXPECT_THROW(EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r), InputError);
 }
 
+// The suspect flag: stats.json "estimate" when present, else (runs written before it) a loss
+// for good in loop_closing; unknown when neither is there.
+TEST(EvaluateRun, ReadsTheSuspectFlagOfNewAndOlderStats) {
+  const Fixture f = MakeRun("bench_eval_suspect", 1.0, 0.0);
+  RunResult r;
+  r.alignment = "se3";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_TRUE(std::isnan(r.suspect));
+  const std::string head =
+      R"({"frames": 120, "keyframes": 10, "map_points": 0, "lost_frames": 3,
+          "wall_time_s": 4.5, "median_tracking_ms": 21.5, )";
+  std::ofstream(f.run / "stats.json", std::ios::trunc)
+      << head << R"("estimate": {"suspect": true, "warnings": ["lost"]}})";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_DOUBLE_EQ(r.suspect, 1.0);
+  std::ofstream(f.run / "stats.json", std::ios::trunc)
+      << head << R"("loop_closing": {"new_map_or_reset_times_s": [14.2]}})";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_DOUBLE_EQ(r.suspect, 1.0);
+  std::ofstream(f.run / "stats.json", std::ios::trunc)
+      << head << R"("loop_closing": {"new_map_or_reset_times_s": []}})";
+  EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r);
+  EXPECT_DOUBLE_EQ(r.suspect, 0.0);
+  std::ofstream(f.run / "stats.json", std::ios::trunc)
+      << head << R"("estimate": {"suspect": "maybe"}})";
+  EXPECT_THROW(EvaluateRun({f.run, f.dataset, std::nullopt, 1.0}, &r), InputError);
+}
+
 TEST(EvaluateRun, MonocularUsesSim3AndRecoversScale) {
   const Fixture f = MakeRun("bench_eval_mono", 0.5, 0.0);
   RunResult r;

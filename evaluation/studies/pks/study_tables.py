@@ -5,7 +5,8 @@ Reads REPORT/results.csv (one row per run) and the analysis of evaluation/bench_
 (run here, on the same rows), and prints markdown:
   1. per sequence and sensor: mean ± std ATE (Sim(3)) per configuration, with the change
      against the baseline, its bootstrap 95% interval and the Mann-Whitney p;
-  2. per sensor and configuration: ATE Sim(3) and SE(3), failure rate, coverage, keyframes in
+  2. per sensor and configuration: ATE Sim(3) and SE(3), failures, suspect runs (stats.json
+     "estimate"), coverage, keyframes in
      the final map, CPU time and mapping CPU time (means over runs);
   3. keyframes created per rule (mean per run), the reason counts;
   4. the pooled significance sentences.
@@ -76,16 +77,18 @@ def per_sequence_table(result, datasets, sensors, configs, baseline):
 
 
 def summary_table(rows, sensors, configs):
-    lines = ["| sensor | config | runs | failed | coverage | ATE Sim(3) [m] | ATE SE(3) [m] | "
-             "keyframes | CPU [s] | mapping CPU [s] |", "|---|---|" + "---|" * 8]
+    lines = ["| sensor | config | runs | failed | suspect | coverage | ATE Sim(3) [m] | "
+             "ATE SE(3) [m] | keyframes | CPU [s] | mapping CPU [s] |", "|---|---|" + "---|" * 9]
     for sensor in sensors:
         for config in configs:
             g = [r for r in rows if r["sensor"] == sensor and r["config"] == config]
             if not g:
                 continue
             ok = [r for r in g if r["ok"]]
+            known = [r for r in ok if math.isfinite(r.get("suspect", math.nan))]
+            suspect = str(sum(1 for r in known if r["suspect"] == 1)) if known else "—"
             lines.append(
-                f"| {sensor} | {config} | {len(g)} | {len(g) - len(ok)} | "
+                f"| {sensor} | {config} | {len(g)} | {len(g) - len(ok)} | {suspect} | "
                 f"{mean([r['coverage'] for r in g]):.1%} | "
                 f"{mean([r['ate'] for r in ok]):.4f} | "
                 f"{mean([num(r['raw']['ate_se3_rmse_m']) for r in ok]):.4f} | "
