@@ -1,8 +1,8 @@
 #include "system/estimate_health.h"
 
-#include <algorithm>
-
 #include <fmt/format.h>
+
+#include <algorithm>
 
 namespace pkslam {
 
@@ -11,7 +11,8 @@ std::vector<double> LostForGoodTimes(const std::vector<FrameRecord>& records) {
   for (std::size_t i = 1; i < records.size(); ++i) {
     const TrackingState before = records[i - 1].state;
     const TrackingState now = records[i].state;
-    const bool was_tracking = before == TrackingState::kOk || before == TrackingState::kRecentlyLost;
+    const bool was_tracking =
+        before == TrackingState::kOk || before == TrackingState::kRecentlyLost;
     const bool gave_up = now == TrackingState::kLost || now == TrackingState::kNotInitialized;
     if (was_tracking && gave_up) out.push_back(static_cast<double>(records[i].t_ns) * 1e-9);
   }
@@ -36,11 +37,11 @@ EstimateHealth AssessEstimate(const std::vector<double>& lost_for_good_s,
       return tm > t && tm < next;
     });
     std::string text = fmt::format("tracking lost for good at t = {:.3f} s: ", t);
-    text += merge == merges.end()
-                ? std::string("the trajectory continues in a new map")
-                : fmt::format(
-                      "the new map was merged back at t = {:.3f} s, moving a keyframe {:.2f} m",
-                      static_cast<double>(merge->t_ns) * 1e-9, merge->correction_m);
+    text +=
+        merge == merges.end()
+            ? std::string("the trajectory continues in a new (or reset) map")
+            : fmt::format("the new map was merged back at t = {:.3f} s, moving a keyframe {:.2f} m",
+                          static_cast<double>(merge->t_ns) * 1e-9, merge->correction_m);
     h.warnings.push_back(std::move(text));
   }
   if (lost_for_good_s.size() > kMaxLossWarnings) {
@@ -48,9 +49,9 @@ EstimateHealth AssessEstimate(const std::vector<double>& lost_for_good_s,
                                      lost_for_good_s.size() - kMaxLossWarnings));
   }
   if (maps_at_end > 1) {
-    h.warnings.push_back(fmt::format(
-        "{} maps at the end were never merged: their poses are in frames of their own",
-        maps_at_end));
+    h.warnings.push_back(
+        fmt::format("{} maps at the end were never merged: their poses are in frames of their own",
+                    maps_at_end));
   }
   return h;
 }

@@ -50,7 +50,7 @@ TEST(AssessEstimate, NamesEachLossAndTheMergeThatJoinedItsMapBack) {
   ASSERT_EQ(h.warnings.size(), 3u);
   EXPECT_THAT(h.warnings[0], HasSubstr("t = 14.000 s"));
   EXPECT_THAT(h.warnings[0], HasSubstr("merged back at t = 80.000 s, moving a keyframe 3.22 m"));
-  EXPECT_THAT(h.warnings[1], HasSubstr("continues in a new map"));
+  EXPECT_THAT(h.warnings[1], HasSubstr("continues in a new (or reset) map"));
   EXPECT_THAT(h.warnings[2], HasSubstr("2 maps at the end"));
   EXPECT_DOUBLE_EQ(h.largest_merge_correction_m, 3.22);
 }

@@ -1,6 +1,7 @@
 #include "viewer/view_data.h"
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -54,6 +55,26 @@ std::vector<T> Subsample(const std::vector<T>& in, std::size_t budget) {
   const double step = static_cast<double>(in.size()) / static_cast<double>(budget);
   for (std::size_t i = 0; i < budget; ++i) {
     out.push_back(in[static_cast<std::size_t>(static_cast<double>(i) * step)]);
+  }
+  return out;
+}
+
+// stats.json's warnings (none when the file is absent: a run cut short by a kill).
+std::vector<std::string> RunWarnings(const fs::path& stats) {
+  std::vector<std::string> out;
+  if (!fs::exists(stats)) return out;
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(stats.string());  // JSON is YAML flow style
+  } catch (const YAML::Exception& e) {
+    throw InputError(stats, e.mark.line + 1, "not valid JSON: " + e.msg);
+  }
+  for (const char* section : {"input", "estimate"}) {
+    const YAML::Node node = root[section];
+    if (!node || !node.IsMap() || !node["warnings"] || !node["warnings"].IsSequence()) continue;
+    for (const YAML::Node& w : node["warnings"]) {
+      out.push_back(std::string(section) + ": " + w.as<std::string>(""));
+    }
   }
   return out;
 }
@@ -202,6 +223,7 @@ ViewData LoadViewData(const ViewOptions& options) {
       data.timeline.push_back(std::move(r));
     });
   }
+  data.warnings = RunWarnings(run / "stats.json");
   return data;
 }
 
@@ -221,6 +243,9 @@ std::string ViewDataJson(const ViewData& data) {
   json.Member("title", data.title);
   json.Member("alignment", data.alignment);
   json.Member("ate_rmse_m", data.ate_rmse_m);
+  json.Key("warnings").BeginArray();
+  for (const std::string& w : data.warnings) json.Value(w);
+  json.EndArray();
   // Flat arrays keep a 60 s run small: t, x, y, z, qx, qy, qz, qw, ate per pose.
   json.Key("estimate").BeginArray();
   for (const ViewPose& p : data.estimate) {

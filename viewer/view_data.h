@@ -62,6 +62,9 @@ struct ViewData {
   std::vector<Eigen::Vector3f> cloud;  // dense cloud (or mesh vertices), subsampled
   std::vector<std::array<std::uint8_t, 3>> cloud_colours;  // empty or one per cloud point
   std::vector<ViewTimelineRow> timeline;
+  // The run's own warnings from stats.json: "input: ..." (degraded input) and "estimate: ..."
+  // (suspect estimate, system/estimate_health.h); the page shows them above everything else.
+  std::vector<std::string> warnings;
 };
 
 // Reads the run (InputError naming the missing or malformed file).

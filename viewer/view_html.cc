@@ -51,6 +51,7 @@ html, body { margin: 0; height: 100%; overflow: hidden; font: 13px sans-serif; b
 #panel { position: absolute; top: 8px; left: 8px; background: rgba(255,255,255,0.92);
   border: 1px solid #ccc; padding: 6px 10px; max-width: 320px; }
 #panel h1 { font-size: 14px; margin: 0 0 4px 0; }
+#panel .warning { color: #b00000; font-weight: bold; margin: 2px 0 4px 0; }
 #legend span { display: inline-block; width: 10px; height: 10px; margin-right: 4px; }
 #timeline { position: absolute; left: 0; right: 0; bottom: 0; height: 110px; background: #f4f4f4;
   border-top: 1px solid #ccc; padding: 4px 10px; box-sizing: border-box; }

@@ -159,6 +159,8 @@
   const panel = document.getElementById('panel');
   const esc = (s) => String(s).replace(/[&<>]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;' })[c]);
   let html = `<h1>${esc(D.title)}</h1>`;
+  // The run's own warnings (degraded input, suspect estimate) come before any number.
+  (D.warnings || []).forEach((w) => { html += `<div class="warning">⚠ ${esc(w)}</div>`; });
   html += `${poses.length} poses, ${D.keyframes.length} keyframes, ` +
           `${D.map_points.length / 3} map points`;
   if (D.cloud.length) html += `, ${D.cloud.length / 3} cloud points`;
