@@ -137,6 +137,12 @@ void RegisterRunCommand(CLI::App& app) {
                   "--mapping-sync live: playback speed of the emulated live run (2: as if frames "
                   "came twice as fast as their timestamps)")
       ->capture_default_str();
+  cmd->add_option("--live-clock", args->options.system.live_clock,
+                  "--mapping-sync live: measure local mapping's work in its thread's CPU time "
+                  "(cpu: the same emulated machine however loaded this one is) or in wall time "
+                  "(wall: this machine under its present load)")
+      ->check(CLI::IsMember({"cpu", "wall"}))
+      ->capture_default_str();
   cmd->add_option("--max-frames", args->options.max_frames, "Stop after N frames (0: all)");
   cmd->add_option("--first-frame", args->options.first_frame,
                   "Skip the dataset's first N frames (run on a slice)")

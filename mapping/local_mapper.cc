@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "map_model/keyframe.h"
 
@@ -96,9 +97,8 @@ bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
     if (!busy_ && queue_.empty()) break;
     if (busy_) {
       // Where the current keyframe's processing has got to on the data clock, at least.
-      const auto elapsed = std::chrono::steady_clock::now() - live_job_wall_start_;
       const std::int64_t reached =
-          live_job_start_ns_ + DataNs(std::chrono::duration<double>(elapsed).count());
+          live_job_start_ns_ + DataNs(LiveClockSeconds() - live_job_clock_start_);
       if (reached >= t_ns) break;  // still busy at t_ns, for certain
       idle_.wait_for(lock, std::chrono::duration<double>(static_cast<double>(t_ns - reached) *
                                                          1e-9 / live_pace_));
@@ -110,6 +110,11 @@ bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start)
           .count();
   return !busy_ && queue_.empty() && !stopped_ && !stop_requested_ && live_free_ns_ <= t_ns;
+}
+
+double LocalMapper::LiveClockSeconds() const {
+  if (live_cpu_clock_ && mapping_cpu_clock_) return ClockSeconds(*mapping_cpu_clock_);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 std::int64_t LocalMapper::DataNs(double wall_s) const {
@@ -158,6 +163,7 @@ LocalMappingStats LocalMapper::stats() const {
 
 void LocalMapper::Run() {
   MutexLock lock(mutex_);
+  mapping_cpu_clock_ = CallingThreadCpuClock();
   while (true) {
     while (!(finish_requested_ || reset_requested_ || stop_requested_ || !queue_.empty())) {
       wake_.wait(lock);
@@ -186,15 +192,12 @@ void LocalMapper::Run() {
     busy_ = true;
     accept_keyframes_.store(false);
     live_job_start_ns_ = std::max(queue_.front()->t_ns(), live_free_ns_);
-    live_job_wall_start_ = std::chrono::steady_clock::now();
+    live_job_clock_start_ = LiveClockSeconds();
     idle_.notify_all();  // AcceptsKeyFramesAt waits for a queued keyframe to be taken
     lock.unlock();
     ProcessNext();
     lock.lock();
-    live_free_ns_ =
-        live_job_start_ns_ + DataNs(std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                                                  live_job_wall_start_)
-                                        .count());
+    live_free_ns_ = live_job_start_ns_ + DataNs(LiveClockSeconds() - live_job_clock_start_);
     busy_ = false;
     if (queue_.empty()) accept_keyframes_.store(true);
     idle_.notify_all();

@@ -9,6 +9,8 @@
 // (docs/architecture.md). Owned by System; Stop() joins the thread.
 #pragma once
 
+#include <time.h>
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -16,6 +18,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -117,9 +120,14 @@ class LocalMapper : public MappingBackend {
   // Offline runs: emulate a live run's timing (AcceptsKeyFramesAt); set before Start().
   // `pace`: playback speed of the emulated live run (2: frames arrive twice as fast as their
   // timestamps say, so mapping's work spans twice as much data time).
-  void EmulateLive(bool on, double pace = 1.0) {
+  // `cpu_clock`: measure each keyframe's processing in the mapping thread's CPU time (true) or
+  // in wall time (false). Wall time grows with the machine's load (a run sharing a core with
+  // another one maps "twice as slowly"), so CPU time emulates the same machine whatever the
+  // load; wall time emulates the loaded machine.
+  void EmulateLive(bool on, double pace = 1.0, bool cpu_clock = true) {
     emulate_live_ = on;
     live_pace_ = pace;
+    live_cpu_clock_ = cpu_clock;
   }
   // Total wall ms AcceptsKeyFramesAt blocked.
   double live_wait_ms() const { return stats().live_wait_ms; }
@@ -173,7 +181,13 @@ class LocalMapper : public MappingBackend {
   double live_pace_ = 1.0;
   std::int64_t live_free_ns_ PKSLAM_GUARDED_BY(mutex_) = std::numeric_limits<std::int64_t>::min();
   std::int64_t live_job_start_ns_ PKSLAM_GUARDED_BY(mutex_) = 0;
-  std::chrono::steady_clock::time_point live_job_wall_start_ PKSLAM_GUARDED_BY(mutex_);
+  bool live_cpu_clock_ = true;
+  // The mapping thread's CPU clock (set by Run() before it takes a keyframe).
+  std::optional<clockid_t> mapping_cpu_clock_ PKSLAM_GUARDED_BY(mutex_);
+  // The emulation clock (mapping CPU or wall seconds) when the current keyframe was taken.
+  double live_job_clock_start_ PKSLAM_GUARDED_BY(mutex_) = 0;
+  // Seconds on the emulation clock: the mapping thread's CPU time, or steady wall time.
+  double LiveClockSeconds() const PKSLAM_REQUIRES(mutex_);
   bool finish_requested_ PKSLAM_GUARDED_BY(mutex_) = false;
   bool stop_requested_ PKSLAM_GUARDED_BY(mutex_) = false;
   bool stopped_ PKSLAM_GUARDED_BY(mutex_) = false;

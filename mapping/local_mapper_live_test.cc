@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/util/cpu_time.h"
 #include "map_model/keyframe.h"
 #include "map_model/testing/synthetic_map.h"
 #include "mapping/local_mapper.h"
@@ -35,19 +36,34 @@ struct Fixture {
   }
 };
 
-// A started mapper whose every keyframe takes at least `work` of wall time (the consumer runs
-// inside the processing); live emulation at `pace` (0: off).
-std::unique_ptr<LocalMapper> StartMapper(Fixture* f, std::chrono::milliseconds work, double pace) {
+// Keeps the calling thread computing for `work` of its own CPU time.
+void Compute(std::chrono::milliseconds work) {
+  const double end = ThreadCpuSeconds() + std::chrono::duration<double>(work).count();
+  volatile double sink = 0;
+  while (ThreadCpuSeconds() < end) sink = sink + 1.0;
+}
+
+// A started mapper whose every keyframe takes at least `work` (the consumer runs inside the
+// processing): computing (CPU time) or, with `sleep`, sleeping (wall time only); live
+// emulation at `pace` (0: off) on the CPU clock or, with `wall_clock`, the wall clock.
+std::unique_ptr<LocalMapper> StartMapper(Fixture* f, std::chrono::milliseconds work, double pace,
+                                         bool sleep = false, bool wall_clock = false) {
   LocalMappingOptions options;
   options.cull_keyframes = false;
   auto mapper = std::make_unique<LocalMapper>(&f->atlas, f->rig, options);
-  mapper->SetKeyFrameConsumer([work](const KeyFramePtr&) { std::this_thread::sleep_for(work); });
-  if (pace > 0) mapper->EmulateLive(true, pace);
+  mapper->SetKeyFrameConsumer([work, sleep](const KeyFramePtr&) {
+    if (sleep) {
+      std::this_thread::sleep_for(work);
+    } else {
+      Compute(work);
+    }
+  });
+  if (pace > 0) mapper->EmulateLive(true, pace, /*cpu_clock=*/!wall_clock);
   mapper->Start();
   return mapper;
 }
 
-TEST(LocalMapperLive, BusyOnTheDataClockForTheWallTimeOfItsWork) {
+TEST(LocalMapperLive, BusyOnTheDataClockForTheCpuTimeOfItsWork) {
   Fixture f;
   auto owned = StartMapper(&f, 1000ms, 1.0);
   LocalMapper& mapper = *owned;
@@ -83,6 +99,29 @@ TEST(LocalMapperLive, PaceScalesTheDataTimeOfTheWork) {
   EXPECT_TRUE(mapper.AcceptsKeyFramesAt(t0 + 10'000 * kMs));  // waits for the end
   EXPECT_FALSE(mapper.AcceptsKeyFramesAt(t0 + 500 * kMs));    // >= 300 ms x 2 of data
   mapper.Finish();
+}
+
+// The CPU clock counts work, not waiting: a keyframe whose processing only sleeps spans no
+// data time, so a frame 100 ms later finds mapping idle once it is done; on the wall clock
+// (--live-clock wall) the same sleep spans 300 ms of data, as a loaded machine would.
+TEST(LocalMapperLive, CpuClockIgnoresTimeNotSpentWorking) {
+  {
+    Fixture f;
+    auto owned = StartMapper(&f, 300ms, 1.0, /*sleep=*/true);
+    const std::int64_t t0 = f.map.keyframes[0]->t_ns();
+    owned->InsertKeyFrame(f.map.keyframes[0]);
+    EXPECT_TRUE(owned->AcceptsKeyFramesAt(t0 + 100 * kMs));
+    owned->Finish();
+  }
+  {
+    Fixture f;
+    auto owned = StartMapper(&f, 300ms, 1.0, /*sleep=*/true, /*wall_clock=*/true);
+    const std::int64_t t0 = f.map.keyframes[0]->t_ns();
+    owned->InsertKeyFrame(f.map.keyframes[0]);
+    EXPECT_FALSE(owned->AcceptsKeyFramesAt(t0 + 100 * kMs));
+    EXPECT_TRUE(owned->AcceptsKeyFramesAt(t0 + 10'000 * kMs));
+    owned->Finish();
+  }
 }
 
 // Without emulation the answer is the wall-clock state, whatever the data time.

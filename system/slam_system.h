@@ -39,6 +39,9 @@ struct SystemOptions {
   // "live": playback speed of the emulated live run (1: frames at their timestamps; 2: twice
   // as fast, so local mapping's work spans twice as much data time).
   double live_pace = 2.0;
+  // "live": the clock local mapping's work is measured in, "cpu" (its thread's CPU time: the
+  // same emulated machine whatever else runs) or "wall" (the loaded machine as it is).
+  std::string live_clock = "cpu";
   // Record per-frame keyframe decisions (keyframe_trace.csv).
   bool trace = false;
   // Record each tracked frame's matched map points (RUN/frame_tracks.txt).

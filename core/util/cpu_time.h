@@ -3,7 +3,10 @@
 // waiting on locks; CPU milliseconds do not).
 #pragma once
 
+#include <pthread.h>
 #include <time.h>
+
+#include <optional>
 
 namespace pkslam {
 
@@ -18,6 +21,22 @@ inline double ThreadCpuSeconds() {
 inline double ProcessCpuSeconds() {
   timespec ts{};
   if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0) return 0.0;
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The calling thread's CPU clock, which other threads of the process may read with
+// ClockSeconds (live emulation measures local mapping's work in its thread's CPU time, so a
+// shared machine's load does not make the emulated machine slower); nullopt if unavailable.
+inline std::optional<clockid_t> CallingThreadCpuClock() {
+  clockid_t id{};
+  if (pthread_getcpuclockid(pthread_self(), &id) != 0) return std::nullopt;
+  return id;
+}
+
+// Seconds on `clock`; 0 if it cannot be read.
+inline double ClockSeconds(clockid_t clock) {
+  timespec ts{};
+  if (clock_gettime(clock, &ts) != 0) return 0.0;
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
