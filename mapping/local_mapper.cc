@@ -117,8 +117,8 @@ double LocalMapper::LiveClockSeconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::int64_t LocalMapper::DataNs(double wall_s) const {
-  return static_cast<std::int64_t>(wall_s * live_pace_ * 1e9);
+std::int64_t LocalMapper::DataNs(double work_s) const {
+  return static_cast<std::int64_t>(work_s * live_pace_ * 1e9);
 }
 
 void LocalMapper::ResetQueue() {

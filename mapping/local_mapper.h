@@ -142,8 +142,8 @@ class LocalMapper : public MappingBackend {
 
  private:
   void Run();
-  // Live emulation: data-clock nanoseconds spanned by `wall_s` seconds of work.
-  std::int64_t DataNs(double wall_s) const;
+  // Live emulation: data-clock nanoseconds spanned by `work_s` seconds of work (emulation clock).
+  std::int64_t DataNs(double work_s) const;
   bool HasQueued() const;
   void ProcessNext();
   void ProcessNewKeyFrame(const KeyFramePtr& kf);
@@ -176,7 +176,7 @@ class LocalMapper : public MappingBackend {
   bool busy_ PKSLAM_GUARDED_BY(mutex_) = false;
   // Live emulation: the switch and pace are set before Start() and read-only afterwards; the
   // data-clock time at which the last finished keyframe's processing ends, and the data-clock
-  // start and wall start of the current one, are guarded.
+  // start and emulation-clock start of the current one, are guarded.
   bool emulate_live_ = false;
   double live_pace_ = 1.0;
   std::int64_t live_free_ns_ PKSLAM_GUARDED_BY(mutex_) = std::numeric_limits<std::int64_t>::min();

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <numeric>
 #include <set>
+#include <string>
 #include <utility>
 
 #include "core/util/cpu_time.h"
@@ -30,6 +31,12 @@ double Median(std::vector<double> v) { return Quantile(std::move(v), 0.5).value_
 void WriteArray(JsonWriter* json, std::string_view key, const std::vector<double>& values) {
   json->Key(key).BeginArray();
   for (double v : values) json->Value(std::round(v * 1000.0) / 1000.0);
+  json->EndArray();
+}
+
+void WriteStrings(JsonWriter* json, std::string_view key, const std::vector<std::string>& values) {
+  json->Key(key).BeginArray();
+  for (const std::string& v : values) json->Value(v);
   json->EndArray();
 }
 
@@ -117,10 +124,12 @@ void WriteLoopEvents(JsonWriter* json, std::string_view key, const std::vector<L
   json->EndArray();
 }
 
-// Loops, merges (loop closing's record) and relocalisations / new maps (tracking states:
-// RECENTLY_LOST -> OK is a relocalisation; giving up starts a new map or resets).
-void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonWriter* json) {
-  const LoopClosingStats stats = system.loop_stats();
+// Loops, merges (loop closing's record `stats`) and relocalisations / new maps (tracking
+// states: RECENTLY_LOST -> OK is a relocalisation; giving up, `lost_for_good_s`, starts a new
+// map or resets).
+void WriteLoopClosing(const SlamSystem& system, const RunOptions& options,
+                      const LoopClosingStats& stats, const std::vector<double>& lost_for_good_s,
+                      JsonWriter* json) {
   std::vector<double> relocalisations;
   const auto& records = system.tracker().records();
   for (std::size_t i = 1; i < records.size(); ++i) {
@@ -137,7 +146,7 @@ void WriteLoopClosing(const SlamSystem& system, const RunOptions& options, JsonW
   WriteLoopEvents(json, "loops", stats.loops);
   WriteLoopEvents(json, "merges", stats.merges);
   WriteArray(json, "relocalisation_times_s", relocalisations);
-  WriteArray(json, "new_map_or_reset_times_s", LostForGoodTimes(records));
+  WriteArray(json, "new_map_or_reset_times_s", lost_for_good_s);
   json->Member("tested_candidates", stats.tested_candidates);
   json->Member("verified_candidates", stats.verified_regions);
   json->Member("unconfirmed_candidates", stats.rejected_regions);
@@ -157,9 +166,7 @@ void WriteEstimateHealth(const EstimateHealth& health, JsonWriter* json) {
   json->Member("lost_for_good", static_cast<int>(health.lost_for_good_s.size()));
   json->Member("maps_at_end", health.maps_at_end);
   json->Member("largest_merge_correction_m", health.largest_merge_correction_m);
-  json->Key("warnings").BeginArray();
-  for (const std::string& w : health.warnings) json->Value(w);
-  json->EndArray();
+  WriteStrings(json, "warnings", health.warnings);
   json->EndObject();
 }
 
@@ -171,9 +178,7 @@ void WriteInputReport(const InputReport& input, JsonWriter* json) {
   json->Member("imu_gaps", input.imu_gaps);
   json->Member("frames_without_imu", input.frames_without_imu);
   json->Member("frames_without_depth", input.frames_without_depth);
-  json->Key("warnings").BeginArray();
-  for (const std::string& w : input.warnings) json->Value(w);
-  json->EndArray();
+  WriteStrings(json, "warnings", input.warnings);
   json->EndObject();
 }
 
@@ -268,8 +273,8 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   summary->maps = system.NumMaps();
   summary->lost = lost;
   summary->median_tracking_ms = Median(tracking_ms);
-  summary->estimate =
-      AssessEstimate(LostForGoodTimes(records), system.loop_stats().merges, summary->maps);
+  const LoopClosingStats loop_stats = system.loop_stats();
+  summary->estimate = AssessEstimate(LostForGoodTimes(records), loop_stats.merges, summary->maps);
   for (const std::string& w : summary->estimate.warnings)
     PKSLAM_LOG_WARN("suspect estimate: {}", w);
 
@@ -374,7 +379,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
     json.EndObject();
   }
   json.EndObject();
-  WriteLoopClosing(system, options, &json);
+  WriteLoopClosing(system, options, loop_stats, summary->estimate.lost_for_good_s, &json);
   WriteArray(&json, "tracking_ms", tracking_ms);
   WriteArray(&json, "local_mapping_ms", mapping.keyframe_ms);
   WriteArray(&json, "local_ba_ms", mapping.ba_ms);

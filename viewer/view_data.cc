@@ -1,7 +1,6 @@
 #include "viewer/view_data.h"
 
 #include <fmt/format.h>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +9,7 @@
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "evaluation/evaluate.h"
+#include "io/json_file.h"
 #include "io/point_cloud.h"
 #include "io/rigid_transform_file.h"
 #include "io/text_rows.h"
@@ -63,12 +63,7 @@ std::vector<T> Subsample(const std::vector<T>& in, std::size_t budget) {
 std::vector<std::string> RunWarnings(const fs::path& stats) {
   std::vector<std::string> out;
   if (!fs::exists(stats)) return out;
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(stats.string());  // JSON is YAML flow style
-  } catch (const YAML::Exception& e) {
-    throw InputError(stats, e.mark.line + 1, "not valid JSON: " + e.msg);
-  }
+  const YAML::Node root = ReadJsonFile(stats);
   for (const char* section : {"input", "estimate"}) {
     const YAML::Node node = root[section];
     if (!node || !node.IsMap() || !node["warnings"] || !node["warnings"].IsSequence()) continue;

@@ -11,6 +11,7 @@
 #include "evaluation/bench/peer_import.h"
 #include "evaluation/bench/process.h"
 #include "evaluation/bench/run_evaluation.h"
+#include "io/json_file.h"
 
 namespace pkslam::bench {
 namespace {
@@ -45,9 +46,9 @@ void WriteResult(const fs::path& run_dir, const RunResult& r) {
 // The "points" field of `pkslam dense --json` (plain JSON, read as YAML flow style).
 double ReadDensePoints(const fs::path& file) {
   if (!fs::exists(file)) throw InputError(file, "missing (pkslam dense wrote no statistics)");
+  const YAML::Node root = ReadJsonFile(file);
+  if (!root["points"]) throw InputError(file, "no 'points' field");
   try {
-    const YAML::Node root = YAML::LoadFile(file.string());
-    if (!root["points"]) throw InputError(file, "no 'points' field");
     return root["points"].as<double>();
   } catch (const YAML::Exception& e) {
     throw InputError(file, e.mark.line + 1, "not valid JSON: " + e.msg);

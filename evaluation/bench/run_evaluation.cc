@@ -11,6 +11,7 @@
 #include "core/util/log.h"
 #include "evaluation/bench/bias_evaluation.h"
 #include "evaluation/evaluate.h"
+#include "io/json_file.h"
 #include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
 #include "viewer/view_data.h"
@@ -51,12 +52,7 @@ double RealtimeFactor(double written, double sequence_s, double wall_s) {
 // stats.json is plain JSON, which yaml-cpp reads as YAML flow style.
 StatsJson ReadStats(const fs::path& file) {
   if (!fs::exists(file)) throw InputError(file, "missing (the run did not finish)");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file.string());
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, e.mark.line + 1, "not valid JSON: " + e.msg);
-  }
+  const YAML::Node root = ReadJsonFile(file);
   auto get = [&](const char* key, auto fallback) {
     using T = decltype(fallback);
     if (!root[key]) throw InputError(file, std::string("no '") + key + "' field");

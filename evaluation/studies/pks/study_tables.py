@@ -26,12 +26,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import bench_statistics  # noqa: E402  (evaluation/bench_statistics.py)
 
 
-def num(text):
-    try:
-        v = float(text)
-    except (TypeError, ValueError):
-        return math.nan
-    return v
+num = bench_statistics.number  # float or NaN
 
 
 def short(dataset):

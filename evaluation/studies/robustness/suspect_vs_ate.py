@@ -10,14 +10,11 @@ threshold, per sensor, from a bench's results.csv (after `pkslam bench SUITE --o
 import argparse
 import csv
 import math
+import os
 import sys
 
-
-def number(text):
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return math.nan
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+from bench_statistics import number  # noqa: E402  (evaluation/bench_statistics.py)
 
 
 def main():
