@@ -72,6 +72,7 @@ void Settings::Check() const {
   PKSLAM_CHECK_OPTION(th_depth > 0 && std::isfinite(th_depth), "th_depth", "{}", th_depth);
   PKSLAM_CHECK_OPTION(imu.has_value() == body_from_cam0.has_value(), "imu/body_from_cam0",
                       "both or neither");
+  PKSLAM_CHECK_OPTION(std::abs(time_offset_s) <= 1.0, "time_offset_s", "{} s", time_offset_s);
   if (imu) {
     CheckRigid(*body_from_cam0, "body_from_cam0");
     for (const auto& [name, value] :
@@ -229,6 +230,12 @@ Settings ReadOrbSlam3Settings(const std::filesystem::path& file) {
     imu.rate_hz = Positive(yaml, "IMU.Frequency");
     s.imu = imu;
     s.body_from_cam0 = SE3d(yaml.RigidTransform("IMU.T_b_c1"));
+    if (const auto offset = yaml.OptionalDouble("IMU.TimeOffset")) {
+      if (!(std::abs(*offset) <= 1.0)) {
+        yaml.Fail("IMU.TimeOffset", fmt::format("must be within [-1, 1] s, found {}", *offset));
+      }
+      s.time_offset_s = *offset;
+    }
   }
   if (yaml.Has("RGBD.DepthMapFactor")) s.depth_map_factor = Positive(yaml, "RGBD.DepthMapFactor");
   if (yaml.Has("RGBD.DepthNoise")) s.depth_noise_k = Positive(yaml, "RGBD.DepthNoise");

@@ -66,6 +66,9 @@ struct Settings {
   // IMU.NoiseGyro -> gyro_noise_density, IMU.NoiseAcc -> accel_noise_density, IMU.GyroWalk
   // -> gyro_random_walk, IMU.AccWalk -> accel_random_walk, IMU.Frequency -> rate_hz.
   std::optional<ImuNoise> imu;
+  // IMU.TimeOffset [s] (pkslam; optional, default 0): the image stamped t was taken at IMU time
+  // t + time_offset_s (Kalibr's timeshift_cam_imu). ORB-SLAM3 has no such key and ignores it.
+  double time_offset_s = 0.0;
   // RGBD.DepthMapFactor: depth image value per metre (TUM: 5000). Optional.
   std::optional<double> depth_map_factor;
   // RGBD.DepthNoise (pkslam): k of the depth noise sigma_z = k z^2 [1/m]; optional, default

@@ -114,6 +114,10 @@ void WriteOrbSlam3Settings(const Settings& s, const std::filesystem::path& file)
     w.RealKey("IMU.GyroWalk", s.imu->gyro_random_walk);
     w.RealKey("IMU.AccWalk", s.imu->accel_random_walk);
     w.RealKey("IMU.Frequency", s.imu->rate_hz);
+    if (s.time_offset_s != 0.0) {
+      w.Comment("pkslam: the image stamped t was taken at IMU time t + TimeOffset (s)");
+      w.RealKey("IMU.TimeOffset", s.time_offset_s);
+    }
     w.Blank();
   }
   if (s.depth_noise_k) {

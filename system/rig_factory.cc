@@ -6,65 +6,54 @@
 
 namespace pkslam {
 
+RigCalibration CalibrationFromSettings(const Settings& settings, Sensor sensor) {
+  RigCalibration c;
+  c.cameras.push_back(settings.camera1);
+  c.body_from_cam0 = settings.body_from_cam0.value_or(SE3d());
+  c.time_offset_s = settings.time_offset_s;
+  if (IsStereo(sensor) && settings.IsStereo()) {
+    if (settings.rectified_stereo) {
+      c.cameras.push_back(settings.camera1);
+      c.cam1_from_cam0 = SE3d(SO3d(), Eigen::Vector3d(-settings.BaselineM(), 0.0, 0.0));
+    } else {
+      c.cameras.push_back(*settings.camera2);
+      c.cam1_from_cam0 = *settings.right_from_left;
+    }
+  }
+  return c;
+}
+
+RigShape ShapeFromSettings(const Settings& settings, Sensor sensor) {
+  RigShape shape;
+  shape.sensor = sensor;
+  shape.fps = settings.fps > 0 ? settings.fps : 20.0;
+  shape.pyramid = ScalePyramid(settings.orb.n_levels, settings.orb.scale_factor);
+  shape.th_depth_baselines = settings.th_depth;
+  if (IsInertial(sensor)) shape.imu = settings.imu;
+  shape.rectified_input = settings.rectified_stereo;
+  if (settings.depth_map_factor) shape.depth_factor = *settings.depth_map_factor;
+  shape.depth_noise_k = settings.depth_noise_k;
+  // The virtual baseline only scales the close/far split and the virtual right coordinate;
+  // ORB-SLAM's TUM settings use about 8 cm.
+  shape.virtual_baseline = settings.stereo_baseline_m.value_or(0.08);
+  return shape;
+}
+
 RigSetup MakeRig(const Settings& settings, Sensor sensor) {
   settings.Check();
-  RigSetup setup;
-  auto rig = std::make_shared<CameraRig>();
-  rig->sensor = sensor;
-  rig->fps = settings.fps > 0 ? settings.fps : 20.0;
-  rig->pyramid = ScalePyramid(settings.orb.n_levels, settings.orb.scale_factor);
-  const SE3d body_from_cam0 = settings.body_from_cam0.value_or(SE3d());
-
-  if (IsInertial(sensor)) {
-    if (!settings.imu || !settings.body_from_cam0) {
-      throw OptionError(
-          fmt::format("sensor {} needs IMU calibration (IMU.* keys)", SensorName(sensor)));
-    }
-    rig->imu = settings.imu;
-  }
-
-  if (IsStereo(sensor)) {
-    if (!settings.IsStereo()) {
-      throw OptionError(
-          "stereo sensor needs a stereo calibration (Camera2.* and Stereo.T_c1_c2, "
-          "or Camera.type Rectified with Stereo.b)");
-    }
-    if (settings.rectified_stereo) {
-      rig->camera = settings.camera1;
-      rig->baseline = settings.BaselineM();
-      rig->body_from_camera = body_from_cam0;
-    } else {
-      setup.rectification.emplace(settings.camera1, *settings.camera2, *settings.right_from_left);
-      rig->camera = setup.rectification->rectified_camera();
-      rig->baseline = setup.rectification->baseline();
-      rig->body_from_camera = setup.rectification->BodyFromRectLeft(body_from_cam0);
-    }
-  } else {
-    rig->camera = settings.camera1;
-    rig->body_from_camera = body_from_cam0;
-    if (IsRgbd(sensor)) {
-      if (!settings.depth_map_factor) {
-        throw OptionError("RGB-D sensor needs RGBD.DepthMapFactor in the settings");
-      }
-      rig->depth_factor = *settings.depth_map_factor;
-      if (settings.depth_noise_k) rig->depth_noise_k = *settings.depth_noise_k;
-      // The virtual baseline only scales the close/far split and the virtual right
-      // coordinate; ORB-SLAM's TUM settings use about 8 cm.
-      rig->baseline = settings.stereo_baseline_m.value_or(0.08);
-    }
-  }
-  if (rig->camera.type() != CameraType::kPinhole) {
-    // Tracking, matching and BA work on undistorted keypoints of an ideal pinhole; a fisheye
-    // image cannot be undistorted to one beyond 90 degrees.
+  if (IsInertial(sensor) && (!settings.imu || !settings.body_from_cam0)) {
     throw OptionError(
-        "the SLAM pipeline supports pinhole (radial-tangential) cameras; "
-        "Kannala-Brandt fisheye is supported by the camera model only");
+        fmt::format("sensor {} needs IMU calibration (IMU.* keys)", SensorName(sensor)));
   }
-  rig->UpdateDerived();
-  rig->bf = rig->fx * rig->baseline;
-  rig->th_depth = settings.th_depth * rig->baseline;
-  setup.rig = std::move(rig);
-  return setup;
+  if (IsStereo(sensor) && !settings.IsStereo()) {
+    throw OptionError(
+        "stereo sensor needs a stereo calibration (Camera2.* and Stereo.T_c1_c2, "
+        "or Camera.type Rectified with Stereo.b)");
+  }
+  if (IsRgbd(sensor) && !settings.depth_map_factor) {
+    throw OptionError("RGB-D sensor needs RGBD.DepthMapFactor in the settings");
+  }
+  return BuildRig(CalibrationFromSettings(settings, sensor), ShapeFromSettings(settings, sensor));
 }
 
 }  // namespace pkslam

@@ -1,21 +1,22 @@
 // Builds the CameraRig tracking works with from run Settings and the sensor (rectifying
-// unrectified stereo pairs).
+// unrectified stereo pairs): the settings' calibration (core/sensor/rig_calibration.h) and the
+// rest of the rig, checked against what the sensor needs.
 #pragma once
 
 #include <memory>
 #include <optional>
 
-#include "core/camera/stereo_rectification.h"
-#include "core/sensor/camera_rig.h"
+#include "core/sensor/rig_calibration.h"
 #include "io/settings.h"
 
 namespace pkslam {
 
-struct RigSetup {
-  std::shared_ptr<const CameraRig> rig;
-  // Set when stereo images must be rectified before tracking.
-  std::optional<StereoRectification> rectification;
-};
+// The calibration the settings state (cameras, extrinsics; time offset IMU.TimeOffset, 0 when
+// absent). A rectified stereo pair (Camera.type Rectified) becomes two identical pinholes
+// Stereo.b apart.
+RigCalibration CalibrationFromSettings(const Settings& settings, Sensor sensor);
+// Everything else of the rig.
+RigShape ShapeFromSettings(const Settings& settings, Sensor sensor);
 
 // Throws OptionError when the settings do not support the sensor (e.g. stereo without a
 // second camera, inertial without IMU calibration, RGB-D without a depth factor).

@@ -35,21 +35,22 @@ bool ProjectIdealPinhole(const double* params, const T* p_camera, T* uv) {
 
 // Pinhole with OpenCV's radial-tangential distortion (k1, k2, p1, p2, k3). Returns false when
 // z <= kMinDepth. Unlike CameraModel::Project it does not reject points beyond the radius where
-// the distortion polynomial folds back; keep such points out of the optimisation.
-template <typename T>
-bool ProjectRadTan(const double* params, const T* p_camera, T* uv) {
+// the distortion polynomial folds back; keep such points out of the optimisation. The
+// parameters may be Jets too (P = T: calibration, estimators/calibration).
+template <typename P, typename T>
+bool ProjectRadTan(const P* params, const T* p_camera, T* uv) {
   if (!(p_camera[2] > T(kMinDepth))) return false;
   const T inv_z = T(1) / p_camera[2];
   const T x = p_camera[0] * inv_z;
   const T y = p_camera[1] * inv_z;
-  const double k1 = params[4], k2 = params[5], p1 = params[6], p2 = params[7], k3 = params[8];
+  const P k1 = params[4], k2 = params[5], p1 = params[6], p2 = params[7], k3 = params[8];
   const T x2 = x * x;
   const T y2 = y * y;
   const T xy = x * y;
   const T r2 = x2 + y2;
   const T radial = T(1) + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const T xd = x * radial + T(2 * p1) * xy + p2 * (r2 + T(2) * x2);
-  const T yd = y * radial + p1 * (r2 + T(2) * y2) + T(2 * p2) * xy;
+  const T xd = x * radial + T(2.0 * p1) * xy + p2 * (r2 + T(2) * x2);
+  const T yd = y * radial + p1 * (r2 + T(2) * y2) + T(2.0 * p2) * xy;
   uv[0] = params[0] * xd + params[2];
   uv[1] = params[1] * yd + params[3];
   return true;

@@ -91,4 +91,14 @@ std::optional<Eigen::Vector2d> StereoRectification::RectifyRightPixel(
   return rectified_.Project(rect_right_from_right_ * right_.Unproject(uv_right));
 }
 
+std::optional<Eigen::Vector2d> StereoRectification::UnrectifyLeftPixel(
+    const Eigen::Vector2d& uv_rect) const {
+  return left_.Project(rect_left_from_left_.Inverse() * rectified_.Unproject(uv_rect));
+}
+
+std::optional<Eigen::Vector2d> StereoRectification::UnrectifyRightPixel(
+    const Eigen::Vector2d& uv_rect) const {
+  return right_.Project(rect_right_from_right_.Inverse() * rectified_.Unproject(uv_rect));
+}
+
 }  // namespace pkslam

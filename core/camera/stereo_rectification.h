@@ -63,6 +63,12 @@ class StereoRectification {
   // rays that end up behind the rectified camera (never for a normal stereo rig's image).
   std::optional<Eigen::Vector2d> RectifyLeftPixel(const Eigen::Vector2d& uv_left) const;
   std::optional<Eigen::Vector2d> RectifyRightPixel(const Eigen::Vector2d& uv_right) const;
+  // The raw pixel of a rectified pixel (inverse of Rectify*Pixel): where a keypoint found in a
+  // rectified image was measured by the physical camera. Online calibration (issue 36) moves
+  // keypoints from one rectification to the next through these. nullopt when the raw model
+  // cannot image the ray (never inside a normal rig's rectified image).
+  std::optional<Eigen::Vector2d> UnrectifyLeftPixel(const Eigen::Vector2d& uv_rect) const;
+  std::optional<Eigen::Vector2d> UnrectifyRightPixel(const Eigen::Vector2d& uv_rect) const;
 
  private:
   CameraModel left_;

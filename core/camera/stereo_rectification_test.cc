@@ -109,6 +109,26 @@ TEST(StereoRectificationTest, PixelFunctionAgreesWithTheRemapTables) {
   EXPECT_EQ(rect.right_map_y().size(), cv::Size(752, 480));
 }
 
+TEST(StereoRectificationTest, UnrectifyInvertsRectifyAndMatchesTheRemapTables) {
+  const StereoRectification rect = EurocRectification();
+  for (int v = 10; v < 480; v += 47) {
+    for (int u = 10; u < 752; u += 53) {
+      const Eigen::Vector2d uv(u, v);
+      const auto raw_left = rect.UnrectifyLeftPixel(uv);
+      const auto raw_right = rect.UnrectifyRightPixel(uv);
+      ASSERT_TRUE(raw_left && raw_right);
+      // The remap tables hold the same raw pixel (as floats).
+      EXPECT_NEAR(raw_left->x(), rect.left_map_x().at<float>(v, u), 2e-3);
+      EXPECT_NEAR(raw_right->y(), rect.right_map_y().at<float>(v, u), 2e-3);
+      const auto back_left = rect.RectifyLeftPixel(*raw_left);
+      const auto back_right = rect.RectifyRightPixel(*raw_right);
+      ASSERT_TRUE(back_left && back_right);
+      EXPECT_LT((*back_left - uv).norm(), 1e-6);
+      EXPECT_LT((*back_right - uv).norm(), 1e-6);
+    }
+  }
+}
+
 TEST(StereoRectificationTest, RejectsUnsupportedInput) {
   const CameraModel left = testing::EurocCam0();
   EXPECT_THROW(StereoRectification(left, testing::TumViKb8(), testing::EurocCam1FromCam0()),

@@ -1,0 +1,167 @@
+#include "core/sensor/rig_calibration.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/util/error.h"
+
+namespace pkslam {
+namespace {
+
+// Whether a stereo calibration is still the ideal pair a Rectified settings file describes:
+// two identical undistorted pinholes, parallel, the right one on the x axis.
+bool IsIdealPair(const RigCalibration& c) {
+  const CameraModel& a = c.cameras[0];
+  const CameraModel& b = c.cameras[1];
+  if (a.HasDistortion() || b.HasDistortion()) return false;
+  if (a.fx() != b.fx() || a.fy() != b.fy() || a.cx() != b.cx() || a.cy() != b.cy()) return false;
+  const Eigen::Vector3d t = c.cam1_from_cam0.translation();
+  return c.cam1_from_cam0.so3().Log().norm() == 0.0 && t.y() == 0.0 && t.z() == 0.0 && t.x() < 0;
+}
+
+// An ideal pinhole's pixel of a raw pixel of `camera` and back.
+Eigen::Vector2d Undistorted(const CameraModel& camera, const Eigen::Vector2d& raw) {
+  return camera.HasDistortion() ? camera.UndistortPixel(raw) : raw;
+}
+
+std::optional<Eigen::Vector2d> Distorted(const CameraModel& camera, const Eigen::Vector2d& uv) {
+  if (!camera.HasDistortion()) return uv;
+  const Eigen::Vector3d ray((uv.x() - camera.cx()) / camera.fx(),
+                            (uv.y() - camera.cy()) / camera.fy(), 1.0);
+  return camera.Project(ray);
+}
+
+}  // namespace
+
+RigSetup BuildRig(const RigCalibration& calibration, const RigShape& shape) {
+  PKSLAM_CHECK_OPTION(!calibration.cameras.empty(), "calibration", "no camera");
+  RigSetup setup;
+  auto rig = std::make_shared<CameraRig>();
+  rig->sensor = shape.sensor;
+  rig->fps = shape.fps;
+  rig->pyramid = shape.pyramid;
+  rig->imu = shape.imu;
+  const SE3d& body_from_cam0 = calibration.body_from_cam0;
+  if (IsStereo(shape.sensor)) {
+    PKSLAM_CHECK_OPTION(calibration.stereo(), "calibration", "stereo sensor without a cam1");
+    if (shape.rectified_input && IsIdealPair(calibration)) {
+      rig->camera = calibration.cameras[0];
+      rig->baseline = -calibration.cam1_from_cam0.translation().x();
+      rig->body_from_camera = body_from_cam0;
+    } else {
+      setup.rectification.emplace(calibration.cameras[0], calibration.cameras[1],
+                                  calibration.cam1_from_cam0);
+      rig->camera = setup.rectification->rectified_camera();
+      rig->baseline = setup.rectification->baseline();
+      rig->body_from_camera = setup.rectification->BodyFromRectLeft(body_from_cam0);
+    }
+  } else {
+    rig->camera = calibration.cameras[0];
+    rig->body_from_camera = body_from_cam0;
+    if (IsRgbd(shape.sensor)) {
+      rig->depth_factor = shape.depth_factor;
+      if (shape.depth_noise_k) rig->depth_noise_k = *shape.depth_noise_k;
+      rig->baseline = shape.virtual_baseline;
+    }
+  }
+  if (rig->camera.type() != CameraType::kPinhole) {
+    // Tracking, matching and BA work on undistorted keypoints of an ideal pinhole; a fisheye
+    // image cannot be undistorted to one beyond 90 degrees.
+    throw OptionError(
+        "the SLAM pipeline supports pinhole (radial-tangential) cameras; "
+        "Kannala-Brandt fisheye is supported by the camera model only");
+  }
+  rig->UpdateDerived();
+  rig->bf = rig->fx * rig->baseline;
+  rig->th_depth = shape.th_depth_baselines * rig->baseline;
+  setup.rig = std::move(rig);
+  return setup;
+}
+
+std::optional<Eigen::Vector2d> RawLeftPixel(const RigSetup& setup, const Eigen::Vector2d& uv) {
+  if (setup.rectification) return setup.rectification->UnrectifyLeftPixel(uv);
+  return Distorted(setup.rig->camera, uv);
+}
+
+std::optional<Eigen::Vector2d> RawRightPixel(const RigSetup& setup, const Eigen::Vector2d& uv) {
+  if (setup.rectification) return setup.rectification->UnrectifyRightPixel(uv);
+  return uv;
+}
+
+std::optional<Eigen::Vector2d> TrackingLeftPixel(const RigSetup& setup,
+                                                 const Eigen::Vector2d& raw) {
+  if (setup.rectification) return setup.rectification->RectifyLeftPixel(raw);
+  return Undistorted(setup.rig->camera, raw);
+}
+
+std::optional<Eigen::Vector2d> TrackingRightPixel(const RigSetup& setup,
+                                                  const Eigen::Vector2d& raw) {
+  if (setup.rectification) return setup.rectification->RectifyRightPixel(raw);
+  return raw;
+}
+
+std::optional<Eigen::Vector2d> RigWarp::Left(const Eigen::Vector2d& uv) const {
+  const auto raw = RawLeftPixel(from_, uv);
+  if (!raw) return std::nullopt;
+  return TrackingLeftPixel(to_, *raw);
+}
+
+std::optional<Eigen::Vector2d> RigWarp::Right(const Eigen::Vector2d& uv) const {
+  const auto raw = RawRightPixel(from_, uv);
+  if (!raw) return std::nullopt;
+  return TrackingRightPixel(to_, *raw);
+}
+
+namespace {
+
+// d(tracking pixel)/d(raw pixel) at `raw`, by central differences of the mapping (rectification
+// or undistortion: smooth, so 1e-3 px steps give ~1e-7 accuracy).
+template <typename F>
+std::optional<Eigen::Matrix2d> TrackingJacobian(const F& to_tracking, const Eigen::Vector2d& raw) {
+  constexpr double kStep = 1e-3;
+  Eigen::Matrix2d j;
+  for (int c = 0; c < 2; ++c) {
+    Eigen::Vector2d d = Eigen::Vector2d::Zero();
+    d[c] = kStep;
+    const auto plus = to_tracking(raw + d);
+    const auto minus = to_tracking(raw - d);
+    if (!plus || !minus) return std::nullopt;
+    j.col(c) = (*plus - *minus) / (2 * kStep);
+  }
+  return j;
+}
+
+}  // namespace
+
+std::optional<RawMeasurement> MakeRawMeasurement(const RigSetup& setup, const Eigen::Vector2d& uv,
+                                                 double u_right, double inv_sigma2,
+                                                 const Eigen::Vector2d& raw_keypoint) {
+  RawMeasurement m;
+  const double sqrt_info = std::sqrt(inv_sigma2);
+  if (setup.rectification) {
+    const auto raw = RawLeftPixel(setup, uv);
+    if (!raw) return std::nullopt;
+    const auto j = TrackingJacobian(
+        [&](const Eigen::Vector2d& p) { return TrackingLeftPixel(setup, p); }, *raw);
+    if (!j) return std::nullopt;
+    m.left = *raw;
+    m.left_whitening = sqrt_info * *j;
+  } else {
+    m.left = raw_keypoint;
+    m.left_whitening = sqrt_info * Eigen::Matrix2d::Identity();
+  }
+  if (u_right >= 0 && IsStereo(setup.rig->sensor)) {
+    const auto raw = RawRightPixel(setup, Eigen::Vector2d(u_right, uv.y()));
+    if (!raw) return std::nullopt;
+    const auto j = TrackingJacobian(
+        [&](const Eigen::Vector2d& p) { return TrackingRightPixel(setup, p); }, *raw);
+    if (!j) return std::nullopt;
+    m.has_right = true;
+    m.right = *raw;
+    m.right_whitening = sqrt_info * j->row(0);
+  }
+  return m;
+}
+
+}  // namespace pkslam

@@ -1,0 +1,160 @@
+// Calibration bundle adjustment: a full (visual or visual-inertial) bundle adjustment that also
+// estimates the rig's calibration (docs/calibration.md): each camera's intrinsics (fx, fy, cx,
+// cy, k1, k2), the stereo extrinsic cam1_from_cam0, the camera-IMU extrinsic cam0_from_body and
+// the camera-IMU time offset, each held to the calibration file's value by a Gaussian prior.
+//
+// Why a separate, whole-map adjustment rather than free calibration blocks in local BA: a
+// 10-keyframe window barely sees a camera-IMU rotation or a time offset (they need the motion of
+// many seconds), and a sliding window that re-estimates them from overlapping windows counts the
+// same observations again and again, so its uncertainty shrinks without new information. Here
+// every observation counts once and the file's prior once; local BA, tracking and loop closing
+// use the latest estimate (mapping/calibration_refinement.h applies it).
+//
+// Measurements are the physical pixels. Keypoints are found in rectified (stereo) or raw
+// (monocular) images; the map side gives each observation's raw cam0 pixel and, for a stereo
+// match, the raw cam1 pixel of its rectified right coordinate, with the whitening that maps a
+// raw-pixel error back to the image the keypoint was measured in: the 2x2 Jacobian of the
+// rectification for the left keypoint, and for the right only the row of it along the rectified
+// u (the stereo matcher measures u_right; the row it searched comes from the rectification
+// itself, so the vertical offset of the right image is not a measurement). Residuals:
+//   left:  W_l (pi(intrinsics0, cam0_from_body * body_from_world(t) * p) - raw_left)
+//   right: w_r (pi(intrinsics1, cam1_from_cam0 * cam0_from_body * body_from_world(t) * p)
+//                - raw_right)
+// where pi is the radial-tangential projection and body_from_world(t) the body pose at the
+// image's IMU time: the keyframe's state was placed at stamp + the offset then applied
+// (time_offset_applied), so with the offset estimate td the image lies delta = td - applied
+// later: world_from_body(t) = (R Exp(omega delta), p + v delta), omega the body's angular
+// velocity and v its velocity at the keyframe.
+//
+// Visual-only rigs use the same problem without inertial edges; the body is whatever frame the
+// keyframes' poses refer to (cam0_from_body then stays at its value: it is not observable).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <atomic>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/sensor/rig_calibration.h"
+#include "estimators/inertial/inertial_bundle.h"
+
+namespace pkslam {
+
+// 1-sigma uncertainty of a calibration file's values: the prior of the estimate. Defaults: the
+// upper end of the documented spread of EuRoC calibrations (docs/calibration.md, sources in
+// docs/realism.md): Kalibr's formal sigmas are 5-30x smaller than the differences between
+// published re-calibrations, and a prior must cover the latter.
+struct CalibrationPriorOptions {
+  double focal_px = 2.0;              // fx, fy
+  double principal_point_px = 2.0;    // cx, cy
+  double k1 = 0.01;                   // radial distortion
+  double k2 = 0.01;
+  double stereo_rotation_deg = 0.1;   // cam1_from_cam0, per axis
+  double stereo_translation_mm = 0.5;
+  double imu_rotation_deg = 0.35;     // cam0_from_body, per axis
+  double imu_translation_mm = 8.0;
+  double time_offset_ms = 2.0;
+
+  void Check() const;
+};
+
+// Which parts of the calibration a solve estimates (the others stay at their current value).
+struct CalibrationFreedom {
+  std::array<bool, 2> intrinsics = {false, false};  // per camera
+  bool stereo_extrinsic = false;
+  bool imu_rotation = false;
+  bool imu_translation = false;
+  bool time_offset = false;
+
+  bool Any() const {
+    return intrinsics[0] || intrinsics[1] || stereo_extrinsic || imu_rotation || imu_translation ||
+           time_offset;
+  }
+};
+
+struct CalibrationBundleOptions {
+  // Robust pass, then a pass without the outliers (0 skips it).
+  int iterations_first = 15;
+  int iterations_second = 10;
+  // chi2 thresholds of a left keypoint (2 DoF) and of a right coordinate (1 DoF), 95%.
+  double chi2_left = 5.991;
+  double chi2_right = 3.841;
+  int num_threads = 1;
+  double gravity_magnitude = 9.81;
+  // Compute the marginal covariance of the calibration (sigma in the report).
+  bool covariance = true;
+  CalibrationPriorOptions prior;
+
+  void Check() const;
+};
+
+struct CalibrationBundleProblem {
+  // Keyframes (camera_from_world of the tracking camera), points, observations and, for inertial
+  // maps, the chain's edges, velocities and biases. visual.observations' pixels are not used:
+  // `raw` holds each observation's physical measurement. camera_from_body: the tracking
+  // camera's (rectified left) extrinsic in the calibration being refined, so keyframe poses
+  // convert to body poses.
+  InertialBundleProblem bundle;
+  bool inertial = false;
+  struct RawObservation {
+    Eigen::Vector2d left = Eigen::Vector2d::Zero();  // raw cam0 pixel
+    Eigen::Matrix2d left_whitening = Eigen::Matrix2d::Identity();
+    bool has_right = false;
+    Eigen::Vector2d right = Eigen::Vector2d::Zero();  // raw cam1 pixel
+    Eigen::RowVector2d right_whitening = Eigen::RowVector2d::Zero();
+  };
+  std::vector<RawObservation> raw;  // parallel to bundle.visual.observations
+  // Per keyframe (inertial maps): the body's angular velocity at the keyframe (body frame,
+  // bias-corrected) and the time offset its stamp was shifted by.
+  std::vector<Eigen::Vector3d> angular_velocity;
+  std::vector<double> time_offset_applied;
+  // The calibration the keyframes' measurements were taken with (the starting point) and the
+  // calibration file's (the prior's mean).
+  RigCalibration initial;
+  RigCalibration prior;
+  CalibrationFreedom free;
+
+  bool empty() const { return bundle.visual.observations.empty(); }
+};
+
+// One estimated scalar of the calibration, for reports. Extrinsic entries are components of the
+// tangent of the change from the prior (left perturbation: rotation in deg, translation in mm,
+// in cam0 coordinates for the IMU extrinsic, cam1 coordinates for the stereo one).
+struct CalibrationParameter {
+  std::string name;  // cam0.fx, cam1.k1, stereo.rx, imu.tz, time_offset_ms, ...
+  std::string unit;  // px, "", deg, mm, ms
+  double file = 0;   // the prior's mean
+  double estimate = 0;
+  double sigma = 0;        // posterior 1-sigma (0 when not computed or not free)
+  double prior_sigma = 0;  // the prior's 1-sigma
+  bool free = false;
+};
+
+struct CalibrationBundleResult {
+  // Points, velocities, biases, outliers and solver statistics; bundle.visual.camera_from_world
+  // is left empty: the tracking camera of `estimate` is a new rectified camera, so the keyframes
+  // come as body poses and the map side turns them into camera poses of its new rig.
+  InertialBundleResult bundle;
+  std::vector<SE3d> world_from_body;  // per problem keyframe
+  RigCalibration estimate;
+  std::vector<CalibrationParameter> parameters;
+  bool covariance_ok = false;
+  int outliers = 0;
+};
+
+// The scalar parameters of `estimate` against `prior` (sigma left 0).
+std::vector<CalibrationParameter> CalibrationParameters(const RigCalibration& prior,
+                                                        const RigCalibration& estimate,
+                                                        const CalibrationFreedom& free,
+                                                        const CalibrationPriorOptions& sigmas,
+                                                        bool inertial);
+
+// Pure computation; `abort` (may be null) is polled between iterations (the best iterate so far
+// is returned).
+CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& problem,
+                                               const CalibrationBundleOptions& options,
+                                               const std::atomic<bool>* abort = nullptr);
+
+}  // namespace pkslam

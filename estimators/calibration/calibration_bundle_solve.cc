@@ -1,0 +1,437 @@
+// Solve phase of the calibration bundle adjustment: Ceres on a copy of the collected state.
+#include <ceres/covariance.h>
+#include <ceres/loss_function.h>
+#include <ceres/ordered_groups.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "estimators/calibration/calibration_bundle.h"
+#include "estimators/calibration/calibration_residuals.h"
+#include "estimators/optim/ceres_setup.h"
+#include "estimators/optim/se3_manifold.h"
+#include "imu/imu_factors.h"
+#include "imu/imu_manifolds.h"
+
+namespace pkslam {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+// Every block in one buffer, so Ceres' ordering of an elimination group (by address) does not
+// depend on where malloc put separate vectors (as in inertial_bundle_solve.cc).
+class State {
+ public:
+  State(int num_kf, int num_points)
+      : kf_(num_kf),
+        points_(num_points),
+        data_(static_cast<std::size_t>((kBodyPoseBlockSize + 9) * num_kf + 3 * num_points +
+                                       2 * kCalibIntrinsicsSize + 2 * kCalibExtrinsicSize + 1 + 3),
+              0.0) {}
+  double* pose(int i) { return data_.data() + kBodyPoseBlockSize * i; }
+  double* v(int i) { return data_.data() + kBodyPoseBlockSize * kf_ + 3 * i; }
+  double* bg(int i) { return data_.data() + (kBodyPoseBlockSize + 3) * kf_ + 3 * i; }
+  double* ba(int i) { return data_.data() + (kBodyPoseBlockSize + 6) * kf_ + 3 * i; }
+  double* point(int i) { return data_.data() + (kBodyPoseBlockSize + 9) * kf_ + 3 * i; }
+  double* calibration() { return point(points_); }
+  double* intrinsics(int camera) { return calibration() + kCalibIntrinsicsSize * camera; }
+  double* cam0_from_body() { return calibration() + 2 * kCalibIntrinsicsSize; }
+  double* cam1_from_cam0() { return cam0_from_body() + kCalibExtrinsicSize; }
+  double* offset() { return cam1_from_cam0() + kCalibExtrinsicSize; }
+  // A constant zero velocity for keyframes without inertial blocks.
+  double* no_velocity() { return offset() + 1; }
+
+ private:
+  int kf_;
+  int points_;
+  std::vector<double> data_;
+};
+
+void CopyArray(const std::array<double, kCalibIntrinsicsSize>& a, double* out) {
+  std::copy(a.begin(), a.end(), out);
+}
+
+// The marginal covariance of the free calibration blocks (tangent space), written into the
+// parameters' sigmas. False when Ceres cannot compute it (rank-deficient Jacobian).
+bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundleProblem& problem,
+                int num_threads, std::vector<CalibrationParameter>* parameters) {
+  struct Entry {
+    double* block;
+    int size;            // tangent size
+    int first;           // index of its first scalar in `parameters`
+    std::vector<int> map;  // tangent component -> offset from `first`
+    std::vector<double> scale;
+  };
+  std::vector<Entry> entries;
+  int index = 0;
+  for (int c = 0; c < static_cast<int>(problem.initial.cameras.size()) && c < 2; ++c) {
+    if (problem.free.intrinsics[c]) {
+      entries.push_back({s->intrinsics(c), kCalibIntrinsicsSize, index, {0, 1, 2, 3, 4, 5},
+                         {1, 1, 1, 1, 1, 1}});
+    }
+    index += kCalibIntrinsicsSize;
+  }
+  // Extrinsic tangents are [translation; rotation]; the report lists rotation first.
+  const std::vector<int> extrinsic_map = {3, 4, 5, 0, 1, 2};
+  const std::vector<double> extrinsic_scale = {1e3, 1e3, 1e3, kRadToDeg, kRadToDeg, kRadToDeg};
+  if (problem.initial.stereo()) {
+    if (problem.free.stereo_extrinsic) {
+      entries.push_back({s->cam1_from_cam0(), 6, index, extrinsic_map, extrinsic_scale});
+    }
+    index += 6;
+  }
+  if (problem.inertial) {
+    if (problem.free.imu_rotation || problem.free.imu_translation) {
+      entries.push_back({s->cam0_from_body(), 6, index, extrinsic_map, extrinsic_scale});
+    }
+    index += 6;
+    if (problem.free.time_offset) entries.push_back({s->offset(), 1, index, {0}, {1e3}});
+  }
+  if (entries.empty()) return true;
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = num_threads;
+  options.apply_loss_function = true;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (const Entry& e : entries) pairs.emplace_back(e.block, e.block);
+  if (!covariance.Compute(pairs, ceres_problem)) return false;
+  for (const Entry& e : entries) {
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(e.size, e.size);
+    if (!covariance.GetCovarianceMatrixInTangentSpace({e.block}, m.data())) return false;
+    for (int i = 0; i < e.size; ++i) {
+      CalibrationParameter& p = (*parameters)[static_cast<std::size_t>(e.first + e.map[i])];
+      if (p.free) p.sigma = std::sqrt(std::max(0.0, m(i, i))) * e.scale[i];
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& problem,
+                                               const CalibrationBundleOptions& options,
+                                               const std::atomic<bool>* abort) {
+  options.Check();
+  const BundleProblem& visual = problem.bundle.visual;
+  PKSLAM_CHECK(problem.raw.size() == visual.observations.size(),
+               "calibration BA: {} raw observations for {} observations", problem.raw.size(),
+               visual.observations.size());
+  PKSLAM_CHECK(!problem.initial.cameras.empty() &&
+                   problem.prior.cameras.size() == problem.initial.cameras.size(),
+               "calibration BA: cameras of the estimate and the prior differ");
+  const int num_kf = static_cast<int>(visual.keyframes.size());
+  const int num_points = static_cast<int>(visual.points.size());
+  const bool stereo = problem.initial.stereo();
+  State s(num_kf, num_points);
+  for (int i = 0; i < num_kf; ++i) {
+    BodyPoseToBlock(visual.keyframes[i].camera_from_world.Inverse() * problem.bundle.camera_from_body,
+                    s.pose(i));
+    if (problem.inertial && i < static_cast<int>(problem.bundle.velocities.size())) {
+      Eigen::Map<Eigen::Vector3d>(s.v(i)) = problem.bundle.velocities[i];
+      Eigen::Map<Eigen::Vector3d>(s.bg(i)) = problem.bundle.biases[i].gyro;
+      Eigen::Map<Eigen::Vector3d>(s.ba(i)) = problem.bundle.biases[i].accel;
+    }
+  }
+  for (int i = 0; i < num_points; ++i) {
+    Eigen::Map<Eigen::Vector3d>(s.point(i)) = visual.points[i].position_world;
+  }
+  for (std::size_t c = 0; c < problem.initial.cameras.size() && c < 2; ++c) {
+    CopyArray(IntrinsicsBlock(problem.initial.cameras[c]), s.intrinsics(static_cast<int>(c)));
+  }
+  PoseToBlock(problem.initial.body_from_cam0.Inverse(), s.cam0_from_body());
+  PoseToBlock(problem.initial.cam1_from_cam0, s.cam1_from_cam0());
+  *s.offset() = problem.initial.time_offset_s;
+
+  CalibrationBundleResult result;
+  result.estimate = problem.initial;
+  auto write_result = [&]() {
+    result.world_from_body.clear();
+    result.bundle.velocities.clear();
+    result.bundle.biases.clear();
+    result.bundle.visual.points_world.clear();
+    for (int i = 0; i < num_kf; ++i) {
+      result.world_from_body.push_back(BodyPoseFromBlock(s.pose(i)));
+      result.bundle.velocities.emplace_back(Eigen::Map<const Eigen::Vector3d>(s.v(i)));
+      result.bundle.biases.emplace_back(Eigen::Map<const Eigen::Vector3d>(s.bg(i)),
+                                        Eigen::Map<const Eigen::Vector3d>(s.ba(i)));
+    }
+    for (int i = 0; i < num_points; ++i) {
+      result.bundle.visual.points_world.emplace_back(Eigen::Map<const Eigen::Vector3d>(s.point(i)));
+    }
+    for (std::size_t c = 0; c < result.estimate.cameras.size() && c < 2; ++c) {
+      result.estimate.cameras[c] = CameraFromIntrinsicsBlock(problem.initial.cameras[c],
+                                                             s.intrinsics(static_cast<int>(c)));
+    }
+    result.estimate.body_from_cam0 = PoseFromBlock(s.cam0_from_body()).Inverse();
+    result.estimate.cam1_from_cam0 = PoseFromBlock(s.cam1_from_cam0());
+    result.estimate.time_offset_s = *s.offset();
+    result.parameters = CalibrationParameters(problem.prior, result.estimate, problem.free,
+                                              options.prior, problem.inertial);
+  };
+  if (problem.empty() || (abort != nullptr && abort->load())) {
+    result.bundle.visual.aborted = !problem.empty();
+    write_result();
+    return result;
+  }
+
+  ceres::Problem ceres_problem(ProblemOptions({.loss_functions = true, .fast_removal = true}));
+  BodyPoseManifold pose_manifold;
+  SE3LeftManifold extrinsic_manifold;
+  ceres::HuberLoss huber_left(std::sqrt(options.chi2_left));
+  ceres::HuberLoss huber_right(std::sqrt(options.chi2_right));
+  ceres::LossFunctionWrapper loss_left(&huber_left, ceres::DO_NOT_TAKE_OWNERSHIP);
+  ceres::LossFunctionWrapper loss_right(&huber_right, ceres::DO_NOT_TAKE_OWNERSHIP);
+
+  // Calibration blocks and their priors.
+  const CalibrationPriorOptions& sig = options.prior;
+  for (std::size_t c = 0; c < problem.initial.cameras.size() && c < 2; ++c) {
+    double* block = s.intrinsics(static_cast<int>(c));
+    ceres_problem.AddParameterBlock(block, kCalibIntrinsicsSize);
+    const auto mean = IntrinsicsBlock(problem.prior.cameras[c]);
+    Eigen::VectorXd sigma(kCalibIntrinsicsSize);
+    sigma << sig.focal_px, sig.focal_px, sig.principal_point_px, sig.principal_point_px, sig.k1,
+        sig.k2;
+    ceres_problem.AddResidualBlock(
+        new EuclideanPriorError(Eigen::Map<const Eigen::VectorXd>(mean.data(), kCalibIntrinsicsSize),
+                                sigma),
+        nullptr, block);
+    if (!problem.free.intrinsics[c]) ceres_problem.SetParameterBlockConstant(block);
+  }
+  ceres_problem.AddParameterBlock(s.cam0_from_body(), kCalibExtrinsicSize, &extrinsic_manifold);
+  ceres_problem.AddParameterBlock(s.cam1_from_cam0(), kCalibExtrinsicSize, &extrinsic_manifold);
+  ceres_problem.AddParameterBlock(s.offset(), 1);
+  ceres_problem.AddParameterBlock(s.no_velocity(), 3);
+  ceres_problem.SetParameterBlockConstant(s.no_velocity());
+  const bool imu_free =
+      problem.inertial && (problem.free.imu_rotation || problem.free.imu_translation);
+  if (imu_free) {
+    // A rotation-only (translation-only) freedom holds the other part at the prior through a
+    // prior 1000 times tighter (one block, one manifold; tight enough to keep it, loose enough
+    // to keep the system well conditioned).
+    // The frozen part is held where it is now, the free part drawn to the file's value.
+    const double frozen = 1e-3;
+    const SE3d file = problem.prior.body_from_cam0.Inverse();
+    const SE3d now = problem.initial.body_from_cam0.Inverse();
+    const SE3d mean(problem.free.imu_rotation ? file.so3() : now.so3(),
+                    problem.free.imu_translation ? file.translation() : now.translation());
+    ceres_problem.AddResidualBlock(
+        new ExtrinsicPriorError(
+            mean,
+            sig.imu_translation_mm * 1e-3 * (problem.free.imu_translation ? 1.0 : frozen),
+            sig.imu_rotation_deg / kRadToDeg * (problem.free.imu_rotation ? 1.0 : frozen)),
+        nullptr, s.cam0_from_body());
+  } else {
+    ceres_problem.SetParameterBlockConstant(s.cam0_from_body());
+  }
+  if (stereo && problem.free.stereo_extrinsic) {
+    ceres_problem.AddResidualBlock(
+        new ExtrinsicPriorError(problem.prior.cam1_from_cam0, sig.stereo_translation_mm * 1e-3,
+                                sig.stereo_rotation_deg / kRadToDeg),
+        nullptr, s.cam1_from_cam0());
+  } else {
+    ceres_problem.SetParameterBlockConstant(s.cam1_from_cam0());
+  }
+  if (problem.inertial && problem.free.time_offset) {
+    ceres_problem.AddResidualBlock(
+        new EuclideanPriorError(Eigen::VectorXd::Constant(1, problem.prior.time_offset_s),
+                                Eigen::VectorXd::Constant(1, sig.time_offset_ms * 1e-3)),
+        nullptr, s.offset());
+  } else {
+    ceres_problem.SetParameterBlockConstant(s.offset());
+  }
+
+  // Keyframes and the inertial chain.
+  std::vector<std::uint8_t> pose_added(static_cast<std::size_t>(num_kf), 0);
+  auto add_pose = [&](int i) {
+    if (pose_added[i]) return;
+    ceres_problem.AddParameterBlock(s.pose(i), kBodyPoseBlockSize, &pose_manifold);
+    if (visual.keyframes[i].fixed) ceres_problem.SetParameterBlockConstant(s.pose(i));
+    pose_added[i] = 1;
+  };
+  std::vector<std::uint8_t> inertial_added(static_cast<std::size_t>(num_kf), 0);
+  auto add_inertial = [&](int i) {
+    add_pose(i);
+    if (inertial_added[i]) return;
+    inertial_added[i] = 1;
+    ceres_problem.AddParameterBlock(s.v(i), 3);
+    ceres_problem.AddParameterBlock(s.bg(i), 3);
+    ceres_problem.AddParameterBlock(s.ba(i), 3);
+  };
+  if (problem.inertial) {
+    for (const auto& e : problem.bundle.edges) {
+      add_inertial(e.from);
+      add_inertial(e.to);
+      ceres_problem.AddResidualBlock(
+          new InertialError(e.preintegration, problem.bundle.gravity_world), nullptr,
+          {s.pose(e.from), s.v(e.from), s.bg(e.from), s.ba(e.from), s.pose(e.to), s.v(e.to)});
+      ceres_problem.AddResidualBlock(BiasRandomWalkError::Gyro(e.preintegration).release(),
+                                     nullptr, s.bg(e.from), s.bg(e.to));
+      ceres_problem.AddResidualBlock(BiasRandomWalkError::Accel(e.preintegration).release(),
+                                     nullptr, s.ba(e.from), s.ba(e.to));
+    }
+  }
+
+  // Observations: points need at least three residuals (a monocular point seen once has no
+  // depth, which would make the covariance rank-deficient).
+  const int num_obs = static_cast<int>(visual.observations.size());
+  std::vector<int> rows(static_cast<std::size_t>(num_points), 0);
+  for (int i = 0; i < num_obs; ++i) {
+    rows[visual.observations[i].point_index] += 2 + (problem.raw[i].has_right && stereo ? 1 : 0);
+  }
+  struct ObsBlocks {
+    ceres::ResidualBlockId left = nullptr;
+    ceres::ResidualBlockId right = nullptr;
+    const CalibratedLeftError* left_cost = nullptr;
+  };
+  std::vector<ObsBlocks> blocks(static_cast<std::size_t>(num_obs));
+  std::vector<std::uint8_t> point_added(static_cast<std::size_t>(num_points), 0);
+  for (int i = 0; i < num_obs; ++i) {
+    const BundleProblem::ObservationState& o = visual.observations[i];
+    const CalibrationBundleProblem::RawObservation& raw = problem.raw[i];
+    if (rows[o.point_index] < 3) continue;
+    const int k = o.keyframe_index;
+    ImageTiming timing;
+    if (problem.inertial && inertial_added[k]) {
+      if (k < static_cast<int>(problem.angular_velocity.size())) {
+        timing.angular_velocity = problem.angular_velocity[k];
+      }
+      if (k < static_cast<int>(problem.time_offset_applied.size())) {
+        timing.offset_applied = problem.time_offset_applied[k];
+      }
+    } else {
+      timing.offset_applied = problem.initial.time_offset_s;
+    }
+    double* velocity = problem.inertial && inertial_added[k] ? s.v(k) : s.no_velocity();
+    auto* left = new CalibratedLeftError(raw.left, raw.left_whitening,
+                                         FixedDistortionOf(problem.initial.cameras[0]), timing);
+    const double* params[6] = {s.pose(k), s.point(o.point_index), s.intrinsics(0),
+                               s.cam0_from_body(), s.offset(), velocity};
+    Eigen::Vector2d error;
+    if (!left->PixelError(params, &error)) {  // behind the camera at the start: an outlier
+      delete left;
+      continue;
+    }
+    add_pose(k);
+    point_added[o.point_index] = 1;
+    blocks[i].left_cost = left;
+    blocks[i].left = ceres_problem.AddResidualBlock(
+        left, &loss_left,
+        {s.pose(k), s.point(o.point_index), s.intrinsics(0), s.cam0_from_body(), s.offset(),
+         velocity});
+    if (raw.has_right && stereo) {
+      blocks[i].right = ceres_problem.AddResidualBlock(
+          new CalibratedRightError(raw.right, raw.right_whitening,
+                                   FixedDistortionOf(problem.initial.cameras[1]), timing),
+          &loss_right,
+          {s.pose(k), s.point(o.point_index), s.intrinsics(1), s.cam0_from_body(),
+           s.cam1_from_cam0(), s.offset(), velocity});
+    }
+  }
+  // The gauge: the problem's fixed keyframes; with none (a hand-made problem), the first.
+  bool any_fixed = false;
+  for (int i = 0; i < num_kf; ++i) any_fixed = any_fixed || (pose_added[i] && visual.keyframes[i].fixed);
+  if (!any_fixed) {
+    for (int i = 0; i < num_kf; ++i) {
+      if (pose_added[i]) {
+        ceres_problem.SetParameterBlockConstant(s.pose(i));
+        break;
+      }
+    }
+  }
+
+  int free_poses = 0;
+  for (int i = 0; i < num_kf; ++i) free_poses += pose_added[i] && !visual.keyframes[i].fixed;
+  ceres::Solver::Options solver_options =
+      SolverOptions(SchurSolverFor(free_poses), 0, options.num_threads);
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (int i = 0; i < num_points; ++i) {
+    if (point_added[i]) ordering->AddElementToGroup(s.point(i), 0);
+  }
+  for (int i = 0; i < num_kf; ++i) {
+    if (pose_added[i]) ordering->AddElementToGroup(s.pose(i), 1);
+    if (inertial_added[i]) {
+      ordering->AddElementToGroup(s.v(i), 1);
+      ordering->AddElementToGroup(s.bg(i), 1);
+      ordering->AddElementToGroup(s.ba(i), 1);
+    }
+  }
+  for (std::size_t c = 0; c < problem.initial.cameras.size() && c < 2; ++c) {
+    ordering->AddElementToGroup(s.intrinsics(static_cast<int>(c)), 1);
+  }
+  for (double* block : {s.cam0_from_body(), s.cam1_from_cam0(), s.offset(), s.no_velocity()}) {
+    ordering->AddElementToGroup(block, 1);
+  }
+  solver_options.linear_solver_ordering = ordering;
+  AbortCallback abort_callback(abort);
+  solver_options.callbacks.push_back(&abort_callback);
+
+  bool first = true;
+  auto solve = [&](int iterations) {
+    if (ceres_problem.NumResidualBlocks() == 0) return;
+    solver_options.max_num_iterations = iterations;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &ceres_problem, &summary);
+    if (first) result.bundle.visual.initial_cost = summary.initial_cost;
+    first = false;
+    result.bundle.visual.final_cost = summary.final_cost;
+    result.bundle.visual.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
+    result.bundle.visual.aborted = abort_callback.fired();
+    if (summary.termination_type == ceres::FAILURE) {
+      PKSLAM_LOG_WARN("calibration bundle adjustment: solver failure: {}", summary.message);
+    }
+  };
+
+  solve(options.iterations_first);
+  // Outliers after the robust pass: whitened chi2 of the left keypoint or the right coordinate.
+  for (int i = 0; i < num_obs; ++i) {
+    ObsBlocks& b = blocks[i];
+    if (b.left == nullptr) {
+      result.bundle.visual.outlier_observations.push_back(i);
+      continue;
+    }
+    double cost = 0;
+    bool outlier = false;
+    for (ceres::ResidualBlockId id : {b.left, b.right}) {
+      if (id == nullptr) continue;
+      double r[2] = {0, 0};
+      if (!ceres_problem.EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, r,
+                                              nullptr)) {
+        outlier = true;
+        continue;
+      }
+      const double chi2 = r[0] * r[0] + (id == b.left ? r[1] * r[1] : 0.0);
+      outlier = outlier || chi2 > (id == b.left ? options.chi2_left : options.chi2_right);
+    }
+    if (!outlier) continue;
+    result.bundle.visual.outlier_observations.push_back(i);
+    if (options.iterations_second > 0) {
+      ceres_problem.RemoveResidualBlock(b.left);
+      if (b.right != nullptr) ceres_problem.RemoveResidualBlock(b.right);
+      b = {};
+    }
+  }
+  result.outliers = static_cast<int>(result.bundle.visual.outlier_observations.size());
+  if (!result.bundle.visual.aborted && options.iterations_second > 0) {
+    loss_left.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+    loss_right.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+    solve(options.iterations_second);
+  }
+  write_result();
+  if (options.covariance && !result.bundle.visual.aborted && problem.free.Any()) {
+    result.covariance_ok =
+        FillSigmas(&ceres_problem, &s, problem, options.num_threads, &result.parameters);
+    if (!result.covariance_ok) {
+      PKSLAM_LOG_DEBUG("calibration bundle adjustment: covariance not computable");
+    }
+  }
+  return result;
+}
+
+}  // namespace pkslam
