@@ -126,6 +126,16 @@ void RegisterRunCommand(CLI::App& app) {
       [args](std::int64_t) { args->options.system.mapping.inertial.gravity_refinement = false; },
       "Inertial sensors: keep gravity fixed after the 15 s visual-inertial BA, as ORB-SLAM3 "
       "(for experiments)");
+  cmd->add_option_function<std::string>(
+         "--calibrate",
+         [args](const std::string& mode) {
+           args->options.system.mapping.calibration.enabled = mode == "online";
+         },
+         "online: estimate the rig's calibration while mapping (intrinsics, stereo and "
+         "camera-IMU extrinsics, time offset; docs/calibration.md) | off: take the settings' "
+         "calibration as exact")
+      ->check(CLI::IsMember({"online", "off"}))
+      ->default_str("off");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_option("--mapping-sync", args->options.mapping_sync,
                   "How tracking meets local mapping: live (offline default: local mapping as a "

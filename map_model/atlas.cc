@@ -26,6 +26,12 @@ Map* Atlas::CreateNewMap() {
 
 void Atlas::SetCurrentMap(Map* map) { current_ = map; }
 
+void Atlas::SetCalibration(RigCalibration calibration, RigSetup setup) {
+  calibration_ = std::move(calibration);
+  rig_setup_ = std::move(setup);
+  calibration_version_.fetch_add(1);
+}
+
 void Atlas::RemoveMap(const Map* map) {
   std::erase_if(maps_, [map](const std::unique_ptr<Map>& m) { return m.get() == map; });
   if (current_ == map) current_ = maps_.empty() ? nullptr : maps_.back().get();

@@ -9,6 +9,7 @@
 #include <shared_mutex>
 #include <vector>
 
+#include "core/sensor/rig_calibration.h"
 #include "core/util/annotated_mutex.h"
 #include "map_model/ids.h"
 #include "map_model/keyframe_database.h"
@@ -49,6 +50,15 @@ class Atlas {
   KeyFrameId NextKeyFrameId() { return next_kf_id_.fetch_add(1); }
   MapPointId NextMapPointId() { return next_point_id_.fetch_add(1); }
 
+  // The calibration every keyframe's keypoints are in, and the rig built from it (online
+  // calibration, mapping/calibration_refinement.h): each keyframe's rig() is rig_setup().rig.
+  // Read under the shared lock, set under the exclusive one; calibration_version() (bumped by
+  // every set) needs no lock, so tracking can poll it per frame.
+  const RigCalibration& calibration() const { return calibration_; }
+  const RigSetup& rig_setup() const { return rig_setup_; }
+  void SetCalibration(RigCalibration calibration, RigSetup setup);
+  int calibration_version() const { return calibration_version_.load(); }
+
   // Exclusive holds of the map lock so far, per kind of change (thread-safe; no lock needed).
   MapEditTable EditStats() const;
 
@@ -68,6 +78,9 @@ class Atlas {
   std::vector<std::unique_ptr<Map>> maps_;
   Map* current_ = nullptr;
   MapId next_map_id_ = 0;
+  RigCalibration calibration_;
+  RigSetup rig_setup_;
+  std::atomic<int> calibration_version_{0};
   std::atomic<FrameId> next_frame_id_{0};
   std::atomic<KeyFrameId> next_kf_id_{0};
   std::atomic<MapPointId> next_point_id_{0};

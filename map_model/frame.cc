@@ -4,6 +4,7 @@
 #include "core/sensor/depth_uncertainty.h"
 #include "core/util/error.h"
 #include "map_model/map_point.h"
+#include "map_model/recalibrate_features.h"
 
 namespace pkslam {
 
@@ -50,6 +51,15 @@ Frame::Frame(FrameId id, std::int64_t t_ns, std::shared_ptr<const CameraRig> rig
   grid_ = FeatureGrid(keypoints_un_, rig_->bounds);
   map_points.assign(n, nullptr);
   outliers.assign(n, 0);
+}
+
+void Frame::Recalibrate(std::shared_ptr<const CameraRig> rig, const RigWarp& warp,
+                        const SE3d& new_from_old) {
+  if (camera_from_world_) SetPose(new_from_old * *camera_from_world_);
+  rig_ = std::move(rig);
+  if (keypoints_un_.empty()) return;
+  RecalibrateFeatures(*rig_, warp, &keypoints_, &keypoints_un_, &right_u_, &depth_);
+  grid_ = FeatureGrid(keypoints_un_, rig_->bounds);
 }
 
 void Frame::ComputeBoW(const Vocabulary& vocabulary) {

@@ -15,6 +15,7 @@
 #include "core/features/descriptor.h"
 #include "core/geometry/se3.h"
 #include "core/sensor/camera_rig.h"
+#include "core/sensor/rig_calibration.h"
 #include "map_model/feature_grid.h"
 #include "map_model/ids.h"
 #include "map_model/inertial_state.h"
@@ -98,6 +99,11 @@ class Frame {
   FrameImu imu;                         // inertial sensors: preintegration and state
 
   int NumTrackedMapPoints() const;  // non-null, non-outlier matches
+
+  // Moves the frame to a new calibration of its rig (as KeyFrame::Recalibrate): keypoints
+  // through `warp`, the pose (if any) by new_from_old.
+  void Recalibrate(std::shared_ptr<const CameraRig> rig, const RigWarp& warp,
+                   const SE3d& new_from_old);
 
  private:
   FrameId id_ = kInvalidId;

@@ -21,6 +21,8 @@ namespace pkslam {
 struct FrameImu {
   std::optional<PreintegratedImu> from_last_frame;
   InertialState state;
+  // The camera-IMU time offset (s) the frame's stamp was shifted by (KeyFrameImu::time_offset_s).
+  double time_offset_s = 0.0;
 };
 
 // A keyframe's IMU data: the preintegration from the previous keyframe of the chain and the
@@ -31,6 +33,9 @@ struct KeyFrameImu {
   KeyFrame* next = nullptr;
   InertialState state;
   std::optional<InertialStatePrior> prior;  // see InertialStatePrior
+  // The camera-IMU time offset (s) the keyframe's stamp was shifted by when it was tracked
+  // (online calibration: its state sits at image stamp + this offset on the IMU clock).
+  double time_offset_s = 0.0;
 };
 
 }  // namespace pkslam

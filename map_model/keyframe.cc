@@ -6,6 +6,7 @@
 #include "map_model/frame.h"
 #include "map_model/map.h"
 #include "map_model/map_point.h"
+#include "map_model/recalibrate_features.h"
 
 namespace pkslam {
 namespace {
@@ -38,11 +39,24 @@ KeyFrame::KeyFrame(KeyFrameId id, const Frame& frame, Map* map)
       feature_vector_(frame.feature_vector()),
       map_points_(frame.map_points) {
   if (frame.HasPose()) SetPose(frame.camera_from_world());
+  imu.time_offset_s = frame.imu.time_offset_s;
 }
 
 KeyFrame::KeyFrame(KeyFrameId id, FrameId frame_id, std::int64_t t_ns,
                    std::shared_ptr<const CameraRig> rig, Map* map)
     : id_(id), frame_id_(frame_id), t_ns_(t_ns), rig_(std::move(rig)), map_(map) {}
+
+void KeyFrame::Recalibrate(std::shared_ptr<const CameraRig> rig, const RigWarp& warp,
+                           const SE3d& new_from_old) {
+  if (bad_) {
+    camera_from_parent_ = new_from_old * camera_from_parent_ * new_from_old.Inverse();
+  }
+  SetPose(new_from_old * camera_from_world_);
+  rig_ = std::move(rig);
+  if (bad_ || keypoints_un_.empty()) return;
+  RecalibrateFeatures(*rig_, warp, &keypoints_, &keypoints_un_, &right_u_, &depth_);
+  grid_ = FeatureGrid(keypoints_un_, rig_->bounds);
+}
 
 double KeyFrame::DisparityInformation(int i) const {
   if (depth_sigma_.empty() || !HasDepth(i)) return 0.0;

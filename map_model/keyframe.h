@@ -19,6 +19,7 @@
 #include "core/features/descriptor.h"
 #include "core/geometry/se3.h"
 #include "core/sensor/camera_rig.h"
+#include "core/sensor/rig_calibration.h"
 #include "map_model/feature_grid.h"
 #include "map_model/ids.h"
 #include "map_model/inertial_state.h"
@@ -119,6 +120,16 @@ class KeyFrame {
   bool IsBad() const { return bad_; }
   // For a retired keyframe: camera_from_parent at retirement.
   const SE3d& camera_from_parent() const { return camera_from_parent_; }
+
+  // --- online calibration (mapping/calibration_apply.h; Atlas mutex exclusive) ---
+  // Moves the keyframe to a new calibration of its rig: `rig` becomes its rig; a live keyframe's
+  // keypoints move through `warp` (stereo: re-rectified; monocular: re-undistorted from the raw
+  // keypoint) and its stereo depths are recomputed with the new bf; its pose and, if retired,
+  // its pose relative to its parent are expressed in the new tracking camera,
+  // new_from_old = (new camera_from_body) * (old camera_from_body)^-1, so the body keeps its
+  // place. A keypoint the warp cannot map keeps its coordinates and loses its stereo match.
+  void Recalibrate(std::shared_ptr<const CameraRig> rig, const RigWarp& warp,
+                   const SE3d& new_from_old);
 
   // --- inertial sensors (guarded by the Atlas mutex; map_model/inertial_state.h) ---
   KeyFrameImu imu;

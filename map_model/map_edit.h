@@ -20,6 +20,7 @@ enum class MapEdit : std::uint8_t {
   kApplyBundle,             // local mapping: a local BA result written back
   kApplyInertialBundle,     // local mapping: an inertial BA result (poses, velocities, biases)
   kInertialInitialisation,  // local mapping: IMU initialisation / scale and gravity refinement
+  kCalibration,             // local mapping / system: a calibration estimate applied to the map
   kLoopCorrection,          // loop closing: a loop's correction and the essential graph
   kMergeMaps,               // loop closing: two maps merged
   kGlobalBundle,            // loop closing: a global BA result merged in

@@ -28,6 +28,8 @@ std::string_view MapEditName(MapEdit edit) {
       return "apply_inertial_bundle";
     case MapEdit::kInertialInitialisation:
       return "inertial_initialisation";
+    case MapEdit::kCalibration:
+      return "calibration";
     case MapEdit::kLoopCorrection:
       return "loop_correction";
     case MapEdit::kMergeMaps:

@@ -7,8 +7,9 @@
 // Who writes what (threads as ORB-SLAM3's):
 //   tracking       kInitialise, kInsertKeyFrame, kReset
 //   local mapping  kProcessKeyFrame, kCullPoints, kCreatePoints, kFuse, kCullKeyFrames,
-//                  kApplyBundle, kApplyInertialBundle, kInertialInitialisation
+//                  kApplyBundle, kApplyInertialBundle, kInertialInitialisation, kCalibration
 //   loop closing   kLoopCorrection, kMergeMaps, kGlobalBundle
+//   system         kLoadMap, kCalibration (the file's calibration before the first frame)
 //   tests          kFixture (maps built by hand)
 #pragma once
 

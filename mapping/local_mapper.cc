@@ -21,6 +21,7 @@ void LocalMappingOptions::Check() const {
                       "{}", min_found_ratio);
   ba.Check();
   inertial.Check();
+  calibration.Check();
 }
 
 LocalMapper::LocalMapper(Atlas* atlas, std::shared_ptr<const CameraRig> rig,
@@ -33,6 +34,11 @@ LocalMapper::~LocalMapper() { Finish(); }
 
 void LocalMapper::SetKeyFrameConsumer(std::function<void(const KeyFramePtr&)> consumer) {
   consumer_ = std::move(consumer);
+}
+
+void LocalMapper::SetCalibrationPrior(RigCalibration file, RigShape shape) {
+  calibration_prior_ = std::move(file);
+  rig_shape_ = std::move(shape);
 }
 
 void LocalMapper::Start() {

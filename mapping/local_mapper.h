@@ -25,10 +25,12 @@
 
 #include "core/imu/imu_types.h"
 #include "core/sensor/camera_rig.h"
+#include "core/sensor/rig_calibration.h"
 #include "core/util/annotated_mutex.h"
 #include "map_model/atlas.h"
 #include "map_model/estimation/bundle_collect.h"
 #include "map_model/mapping_backend.h"
+#include "mapping/calibration_refinement.h"
 #include "mapping/inertial_mapping.h"
 
 namespace pkslam {
@@ -47,6 +49,8 @@ struct LocalMappingOptions {
   BundleAdjustmentOptions ba;
   // Inertial sensors: IMU initialisation stages and local inertial BA.
   InertialMappingOptions inertial;
+  // Online calibration (mapping/calibration_refinement.h); off by default.
+  OnlineCalibrationOptions calibration;
 
   void Check() const;
 };
@@ -89,6 +93,7 @@ struct LocalMappingStats {
   std::vector<ImuStageSnapshot> imu_stages;
   std::vector<GravityRefinementStat> gravity_refinements;
   int gravity_refinements_dropped = 0;  // results dropped: the map moved meanwhile
+  std::vector<CalibrationRefinementStat> calibration_refinements;
 };
 
 class LocalMapper : public MappingBackend {
@@ -105,6 +110,9 @@ class LocalMapper : public MappingBackend {
 
   // Where processed keyframes go (loop closing); set before Start().
   void SetKeyFrameConsumer(std::function<void(const KeyFramePtr&)> consumer);
+  // Online calibration (options.calibration.enabled): the calibration file's values (the prior)
+  // and the rest of the rig, to build rigs of new estimates; set before Start().
+  void SetCalibrationPrior(RigCalibration file, RigShape shape);
 
   // MappingBackend.
   void InsertKeyFrame(const KeyFramePtr& kf) override;
@@ -163,6 +171,9 @@ class LocalMapper : public MappingBackend {
   bool LocalInertialBundleAdjustment(const KeyFramePtr& kf);
   // Gravity refinement when due (InertialMappingOptions::gravity_refinement).
   void RefineGravity(const KeyFramePtr& kf);
+  // --- online calibration (mapping/local_mapper_calibration.cc) ---
+  // A calibration bundle adjustment of kf's map when due (OnlineCalibrationOptions).
+  void RefineCalibration(const KeyFramePtr& kf);
 
   Atlas* atlas_;
   std::shared_ptr<const CameraRig> rig_;
@@ -209,6 +220,14 @@ class LocalMapper : public MappingBackend {
   // Owned by the mapping thread: ORB-SLAM3 v0.3's mTinit, the keyframe intervals since the IMU
   // initialisation of moving_map_ over which the body travelled more than 5 cm in two steps.
   double two_step_motion_s_ = 0;
+
+  // Online calibration: set before Start(), read-only afterwards.
+  RigCalibration calibration_prior_;
+  RigShape rig_shape_;
+  // Owned by the mapping thread: the map the calibration schedule follows and the span (s) at
+  // which its next adjustment is due.
+  const Map* calibration_map_ = nullptr;
+  double calibration_due_s_ = 0;
 
   std::thread thread_;
 };

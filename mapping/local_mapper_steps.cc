@@ -63,6 +63,7 @@ void LocalMapper::ProcessNext() {
     if (options_.cull_keyframes) CullKeyFrames(kf);
   }
   if (IsInertial(rig_->sensor) && !IsStoppedOrStopRequested()) InertialStep(kf);
+  if (options_.calibration.enabled && !IsStoppedOrStopRequested()) RefineCalibration(kf);
   {
     MutexLock lock(mutex_);
     stats_.keyframe_ms.push_back(MsSince(start));

@@ -23,6 +23,29 @@ RigCalibration CalibrationFromSettings(const Settings& settings, Sensor sensor) 
   return c;
 }
 
+Settings SettingsWithCalibration(Settings settings, const RigCalibration& calibration) {
+  settings.camera1 = calibration.cameras.at(0);
+  if (settings.body_from_cam0) settings.body_from_cam0 = calibration.body_from_cam0;
+  settings.time_offset_s = settings.imu ? calibration.time_offset_s : 0.0;
+  if (calibration.stereo() && settings.IsStereo()) {
+    const bool still_rectified =
+        settings.rectified_stereo && !calibration.cameras[1].HasDistortion() &&
+        SameCalibration(calibration.cameras[0], calibration.cameras[1]) &&
+        calibration.cam1_from_cam0.so3().Log().norm() == 0.0 &&
+        calibration.cam1_from_cam0.translation().y() == 0.0 &&
+        calibration.cam1_from_cam0.translation().z() == 0.0;
+    if (still_rectified) {
+      settings.stereo_baseline_m = -calibration.cam1_from_cam0.translation().x();
+    } else {
+      settings.rectified_stereo = false;
+      settings.stereo_baseline_m.reset();
+      settings.camera2 = calibration.cameras[1];
+      settings.right_from_left = calibration.cam1_from_cam0;
+    }
+  }
+  return settings;
+}
+
 RigShape ShapeFromSettings(const Settings& settings, Sensor sensor) {
   RigShape shape;
   shape.sensor = sensor;

@@ -15,6 +15,10 @@ namespace pkslam {
 // absent). A rectified stereo pair (Camera.type Rectified) becomes two identical pinholes
 // Stereo.b apart.
 RigCalibration CalibrationFromSettings(const Settings& settings, Sensor sensor);
+// `settings` with the cameras, extrinsics and time offset of `calibration` (an estimate): what
+// OUT/calibration/settings.yaml holds. A rectified pair whose estimate is no longer the ideal pair
+// becomes a two-camera rig.
+Settings SettingsWithCalibration(Settings settings, const RigCalibration& calibration);
 // Everything else of the rig.
 RigShape ShapeFromSettings(const Settings& settings, Sensor sensor);
 

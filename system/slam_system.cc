@@ -1,6 +1,8 @@
 #include "system/slam_system.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <mutex>
@@ -17,6 +19,7 @@
 #include "map_model/map_point.h"
 #include "map_model/storage/atlas_storage.h"
 #include "map_model/storage/map_file.h"
+#include "mapping/calibration_collect.h"
 
 namespace pkslam {
 
@@ -36,6 +39,7 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
                        SystemOptions options)
     : options_(std::move(options)),
       setup_(MakeRig(settings, options_.sensor)),
+      file_calibration_(CalibrationFromSettings(settings, options_.sensor)),
       vocabulary_(std::move(vocabulary)) {
   PKSLAM_CHECK(vocabulary_ != nullptr, "no vocabulary");
   if (options_.deterministic) {
@@ -55,7 +59,13 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   auto selector = MakeKeyframeSelector(options_.selector, selector_parameters);
 
   atlas_.SetDatabase(std::make_unique<KeyFrameDatabase>(*vocabulary_));
+  {
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
+    atlas_.SetCalibration(file_calibration_, setup_);
+  }
+  calibration_version_ = atlas_.calibration_version();
   mapper_ = std::make_unique<LocalMapper>(&atlas_, setup_.rig, options_.mapping);
+  mapper_->SetCalibrationPrior(file_calibration_, ShapeFromSettings(settings, options_.sensor));
   OrbOptions orb;
   orb.n_features = settings.orb.n_features;
   orb.scale_factor = settings.orb.scale_factor;
@@ -65,6 +75,8 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   tracker_ = std::make_unique<Tracker>(&atlas_, vocabulary_.get(), setup_.rig, std::move(selector),
                                        mapper_.get(), options_.tracking, orb);
   tracker_->EnableTrace(options_.trace);
+  time_offset_s_ = IsInertial(options_.sensor) ? file_calibration_.time_offset_s : 0.0;
+  tracker_->SetTimeOffset(time_offset_s_);
   tracker_->EnableFrameTracks(options_.frame_tracks);
   if (!options_.no_loop) {
     LocalMapper* mapper = mapper_.get();
@@ -159,20 +171,69 @@ SlamSystem::MapFileInfo SlamSystem::LoadMap(const std::filesystem::path& file) {
   return info;
 }
 
+std::int64_t SlamSystem::ImuClock(std::int64_t t_ns) const {
+  // Inertial sensors only: without an IMU there is no other clock.
+  if (!IsInertial(options_.sensor)) return t_ns;
+  return t_ns + static_cast<std::int64_t>(std::llround(time_offset_s_ * 1e9));
+}
+
+void SlamSystem::SyncCalibration() {
+  if (atlas_.calibration_version() == calibration_version_) return;
+  RigSetup setup;
+  RigCalibration calibration;
+  {
+    auto lock = MapReader(atlas_).Lock();
+    setup = atlas_.rig_setup();
+    calibration = atlas_.calibration();
+    calibration_version_ = atlas_.calibration_version();
+  }
+  tracker_->SetRig(setup, setup_);
+  setup_ = std::move(setup);
+  time_offset_s_ = IsInertial(options_.sensor) ? calibration.time_offset_s : 0.0;
+  tracker_->SetTimeOffset(time_offset_s_);
+}
+
 TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
+  SyncCalibration();
   if (setup_.rectification) {
     const auto [l, r] = setup_.rectification->Rectify(left, right);
-    return tracker_->TrackStereo(l, r, t_ns);
+    return tracker_->TrackStereo(l, r, ImuClock(t_ns));
   }
-  return tracker_->TrackStereo(left, right, t_ns);
+  return tracker_->TrackStereo(left, right, ImuClock(t_ns));
 }
 
 TrackResult SlamSystem::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns) {
-  return tracker_->TrackRgbd(image, depth, t_ns);
+  SyncCalibration();
+  return tracker_->TrackRgbd(image, depth, ImuClock(t_ns));
 }
 
 TrackResult SlamSystem::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
-  return tracker_->TrackMonocular(image, t_ns);
+  SyncCalibration();
+  return tracker_->TrackMonocular(image, ImuClock(t_ns));
+}
+
+std::int64_t SlamSystem::ImuLookaheadNs() const {
+  // The preintegration needs a sample at or after the frame's IMU time.
+  constexpr std::int64_t kMarginNs = 20'000'000;
+  return kMarginNs + std::max<std::int64_t>(0, ImuClock(0));
+}
+
+CalibrationBundleResult SlamSystem::RefineCalibration(const CalibrationFreedom& free,
+                                                      const CalibrationBundleOptions& options,
+                                                      int max_observations_per_keyframe) const {
+  CalibrationBundleProblem problem;
+  {
+    auto lock = MapReader(atlas_).Lock();
+    const Map* map = LargestMap();
+    if (map == nullptr || map->keyframes().empty()) return {};
+    KeyFrame* newest = map->keyframes().rbegin()->second.get();
+    CalibrationCollectOptions collect;
+    collect.max_observations_per_keyframe = max_observations_per_keyframe;
+    problem = CollectCalibrationBundle(newest, IsInertial(options_.sensor), setup_,
+                                       file_calibration_, file_calibration_, collect);
+  }
+  problem.free = free;
+  return SolveCalibrationBundle(problem, options);
 }
 
 const Map* SlamSystem::LargestMap() const {

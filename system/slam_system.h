@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/bow/vocabulary.h"
+#include "estimators/calibration/calibration_bundle.h"
 #include "io/settings.h"
 #include "io/trajectory.h"
 #include "loopclosing/loop_closing.h"
@@ -63,12 +64,17 @@ class SlamSystem {
   SlamSystem(const SlamSystem&) = delete;
   SlamSystem& operator=(const SlamSystem&) = delete;
 
-  // Raw (unrectified) or rectified stereo pair, as the settings describe the rig.
+  // Raw (unrectified) or rectified stereo pair, as the settings describe the rig. Inertial
+  // sensors: `t_ns` is the image stamp; the frame is tracked (and written out) at
+  // stamp + the camera-IMU time offset, on the IMU clock (IMU.TimeOffset, or its online
+  // estimate), so IMU samples must reach past it (ImuLookaheadNs).
   TrackResult TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns);
   TrackResult TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns);
   TrackResult TrackMonocular(const cv::Mat& image, std::int64_t t_ns);
   // Inertial sensors: IMU samples (time-ordered) up to at least the next frame's time.
   void AddImu(const std::vector<ImuMeasurement>& samples) { tracker_->AddImu(samples); }
+  // How far past an image stamp IMU samples must have been given before the image is tracked.
+  std::int64_t ImuLookaheadNs() const;
 
   // Lets local mapping finish its queue and stops the threads (idempotent).
   void Shutdown();
@@ -97,6 +103,13 @@ class SlamSystem {
   void WriteMapPly(const std::filesystem::path& file) const;
 
   const CameraRig& rig() const { return *setup_.rig; }
+  // The calibration the settings state (the prior of online calibration).
+  const RigCalibration& file_calibration() const { return file_calibration_; }
+  // Batch calibration refinement over the largest map (call after Shutdown): the calibration
+  // bundle adjustment with `free` parameters, prior from the settings.
+  CalibrationBundleResult RefineCalibration(const CalibrationFreedom& free,
+                                            const CalibrationBundleOptions& options,
+                                            int max_observations_per_keyframe) const;
   const Tracker& tracker() const { return *tracker_; }
   LocalMappingStats mapping_stats() const { return mapper_->stats(); }
   // Empty stats with --no-loop.
@@ -115,6 +128,15 @@ class SlamSystem {
  private:
   SystemOptions options_;
   RigSetup setup_;
+  RigCalibration file_calibration_;
+  // The camera-IMU time offset applied to frame stamps (inertial sensors): frames are tracked on
+  // the IMU clock, stamp + offset.
+  double time_offset_s_ = 0.0;
+  std::int64_t ImuClock(std::int64_t t_ns) const;
+  // Online calibration: the Atlas calibration version setup_ and the tracker follow; before each
+  // frame SyncCalibration takes a newer one (tracking thread).
+  int calibration_version_ = 0;
+  void SyncCalibration();
   std::shared_ptr<const Vocabulary> vocabulary_;
   Atlas atlas_;
   std::unique_ptr<LocalMapper> mapper_;

@@ -17,6 +17,9 @@ class FrameBuilder {
   FrameBuilder(std::shared_ptr<const CameraRig> rig, const OrbOptions& orb,
                StereoMatcherOptions stereo = {});
 
+  // Frames built from now on use `rig` (a new calibration estimate).
+  void SetRig(std::shared_ptr<const CameraRig> rig) { rig_ = std::move(rig); }
+
   // Rectified grey pair.
   Frame BuildStereo(FrameId id, std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right) const;
   // Grey image + registered depth (CV_16U scaled by rig.depth_factor, or CV_32F metres).

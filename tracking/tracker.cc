@@ -112,7 +112,25 @@ TrackResult Tracker::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
   return Track(std::move(frame));
 }
 
+void Tracker::SetRig(const RigSetup& setup, const RigSetup& old_setup) {
+  const SE3d new_from_old = setup.rig->body_from_camera.Inverse() * rig_->body_from_camera;
+  const SE3d old_from_new = new_from_old.Inverse();
+  const RigWarp warp(old_setup, setup);
+  rig_ = setup.rig;
+  builder_.SetRig(rig_);
+  if (last_.size() > 0 || last_.HasPose()) last_.Recalibrate(rig_, warp, new_from_old);
+  if (init_frame_) init_frame_->Recalibrate(rig_, warp, new_from_old);
+  if (velocity_) velocity_ = new_from_old * *velocity_ * old_from_new;
+  for (FrameRecord& r : records_) {
+    r.camera_from_reference = new_from_old * r.camera_from_reference * old_from_new;
+    if (r.camera_from_world_online) {
+      r.camera_from_world_online = new_from_old * *r.camera_from_world_online;
+    }
+  }
+}
+
 TrackResult Tracker::Track(Frame frame) {
+  frame.imu.time_offset_s = time_offset_s_;
   const auto start = std::chrono::steady_clock::now();
   double frame_wait_ms = 0;
   const double cpu_start = ThreadCpuSeconds();

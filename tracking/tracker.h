@@ -12,6 +12,7 @@
 
 #include "keyframe/keyframe_selector.h"
 #include "map_model/atlas.h"
+#include "core/sensor/rig_calibration.h"
 #include "map_model/frame.h"
 #include "map_model/mapping_backend.h"
 #include "tracking/frame_builder.h"
@@ -106,6 +107,14 @@ class Tracker {
 
   // Drops the current map (a reset) and starts again from NOT_INITIALIZED.
   void Reset();
+  // The camera-IMU time offset the caller shifted the next frames' stamps by (recorded in their
+  // FrameImu / KeyFrameImu for the calibration BA).
+  void SetTimeOffset(double seconds) { time_offset_s_ = seconds; }
+  // A new calibration estimate (online calibration) moved the map's keyframes to `setup`'s rig:
+  // frames are built with it from now on, and what tracking keeps of earlier frames (the last
+  // frame, the monocular initialisation frame, the motion model, the records' poses relative to
+  // their keyframes) moves with the keyframes, the body keeping its place.
+  void SetRig(const RigSetup& setup, const RigSetup& old_setup);
 
  private:
   TrackResult Track(Frame frame);
@@ -184,6 +193,7 @@ class Tracker {
 
   std::vector<FrameRecord> records_;
   bool trace_enabled_ = false;
+  double time_offset_s_ = 0.0;
   bool frame_tracks_enabled_ = false;
   std::vector<TraceRow> trace_;
   SelectorDecision last_decision_;

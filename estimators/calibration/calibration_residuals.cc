@@ -48,29 +48,11 @@ void WriteJacobians(const J* residuals, int num_residuals,
 template <typename T>
 using Vec3T = Eigen::Matrix<T, 3, 1>;
 
-// world_from_body block * Exp(d) (BodyPoseManifold's right perturbation).
-template <typename T>
-SE3<T> PerturbedBodyPose(const double* block, const T* d) {
-  const Eigen::Matrix<T, 6, 1> delta(d[0], d[1], d[2], d[3], d[4], d[5]);
-  return BodyPoseFromBlock(block).cast<T>() * SE3<T>::Exp(delta);
-}
-
 // Exp(d) * block (SE3LeftManifold's left perturbation).
 template <typename T>
 SE3<T> PerturbedLeftPose(const double* block, const T* d) {
   const Eigen::Matrix<T, 6, 1> delta(d[0], d[1], d[2], d[3], d[4], d[5]);
   return SE3<T>::Exp(delta) * PoseFromBlock(block).cast<T>();
-}
-
-// The point in the body frame at the image's IMU time (calibration_bundle.h).
-template <typename T>
-Vec3T<T> PointInBodyAtImage(const SE3<T>& world_from_body, const Vec3T<T>& p_world,
-                            const T& offset, const Vec3T<T>& velocity, const ImageTiming& timing) {
-  const T delta = offset - T(timing.offset_applied);
-  const Vec3T<T> turn = timing.angular_velocity.cast<T>() * delta;
-  const SO3<T> rotation = world_from_body.so3() * SO3<T>::Exp(turn);
-  const Vec3T<T> position = world_from_body.translation() + velocity * delta;
-  return rotation.Inverse() * (p_world - position);
 }
 
 // Full radial-tangential parameters (fx fy cx cy k1 k2 p1 p2 k3) from the estimated six and the
@@ -88,22 +70,89 @@ bool ProjectCalibrated(const T* intrinsics, const FixedDistortion& fixed, const 
   return projection::ProjectRadTan(params.data(), p_cam.data(), uv);
 }
 
-// Blocks of the left residual.
-constexpr int kLeftJetSize = 6 + 3 + kCalibIntrinsicsSize + 6 + 1 + 3;
-constexpr std::array<BlockLayout, 6> kLeftLayout = {{{0, 6, 7},
-                                                     {6, 3, 3},
-                                                     {9, kCalibIntrinsicsSize, 6},
-                                                     {15, 6, 7},
-                                                     {21, 1, 1},
-                                                     {22, 3, 3}}};
-constexpr int kRightJetSize = 6 + 3 + kCalibIntrinsicsSize + 6 + 6 + 1 + 3;
-constexpr std::array<BlockLayout, 7> kRightLayout = {{{0, 6, 7},
-                                                      {6, 3, 3},
-                                                      {9, kCalibIntrinsicsSize, 6},
-                                                      {15, 6, 7},
-                                                      {21, 6, 7},
-                                                      {27, 1, 1},
-                                                      {28, 3, 3}}};
+// A point in cam0 at the image of a keyframe, and its derivatives with respect to every block's
+// tangent (calibration_bundle.h for the model):
+//   R_d = Exp(omega * d), d = offset - applied;  q = R^T (X - p - v d);  p_b = R_d^T q;
+//   p_c0 = R_cb p_b + t_cb.
+// Right perturbations of the body pose (R Exp(phi), p + R rho) give dq = -rho + [q]x phi; the
+// left perturbation of cam0_from_body gives dp_c0 = rho_e - [p_c0]x phi_e.
+struct CameraPoint {
+  Eigen::Vector3d p_c0;
+  Eigen::Matrix<double, 3, 6> d_pose;
+  Eigen::Matrix3d d_point;
+  Eigen::Matrix<double, 3, 6> d_extrinsic;
+  Eigen::Vector3d d_offset;
+  Eigen::Matrix3d d_velocity;
+};
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+void ComputeCameraPoint(double const* const* parameters, int extrinsic_index, int offset_index,
+                        int velocity_index, const ImageTiming& timing, bool jacobians,
+                        CameraPoint* out) {
+  const SE3d world_from_body = BodyPoseFromBlock(parameters[0]);
+  const Eigen::Map<const Eigen::Vector3d> x(parameters[1]);
+  const SE3d cam0_from_body = PoseFromBlock(parameters[extrinsic_index]);
+  const Eigen::Map<const Eigen::Vector3d> v(parameters[velocity_index]);
+  const double d = parameters[offset_index][0] - timing.offset_applied;
+  const Eigen::Matrix3d r_wb = world_from_body.RotationMatrix();
+  const Eigen::Matrix3d r_d = SO3d::Exp(timing.angular_velocity * d).Matrix();
+  const Eigen::Vector3d q = r_wb.transpose() * (x - world_from_body.translation() - v * d);
+  const Eigen::Vector3d p_b = r_d.transpose() * q;
+  const Eigen::Matrix3d r_cb = cam0_from_body.RotationMatrix();
+  out->p_c0 = r_cb * p_b + cam0_from_body.translation();
+  if (!jacobians) return;
+  const Eigen::Matrix3d a = r_cb * r_d.transpose();  // d p_c0 / d q
+  out->d_pose.leftCols<3>() = -a;
+  out->d_pose.rightCols<3>() = a * Skew(q);
+  out->d_point = a * r_wb.transpose();
+  out->d_extrinsic.leftCols<3>().setIdentity();
+  out->d_extrinsic.rightCols<3>() = -Skew(out->p_c0);
+  out->d_offset = r_cb * (-timing.angular_velocity.cross(p_b) - r_d.transpose() * r_wb.transpose() * v);
+  out->d_velocity = -d * out->d_point;
+}
+
+// Radial-tangential projection of p_cam with the estimated intrinsics, and its derivatives
+// (forward-mode Jets: 3 for the point, 6 for the intrinsics).
+bool Project(const double* intrinsics, const FixedDistortion& fixed, const Eigen::Vector3d& p_cam,
+             bool jacobians, Eigen::Vector2d* uv, Eigen::Matrix<double, 2, 3>* d_point,
+             Eigen::Matrix<double, 2, kCalibIntrinsicsSize>* d_intrinsics) {
+  if (!jacobians) {
+    double out[2];
+    if (!ProjectCalibrated(intrinsics, fixed, p_cam, out)) return false;
+    *uv = Eigen::Vector2d(out[0], out[1]);
+    return true;
+  }
+  using J = ceres::Jet<double, 3 + kCalibIntrinsicsSize>;
+  J k[kCalibIntrinsicsSize];
+  Seed(intrinsics, kCalibIntrinsicsSize, 3, k);
+  J p[3];
+  Seed(p_cam.data(), 3, 0, p);
+  J out[2];
+  if (!ProjectCalibrated(k, fixed, Vec3T<J>(p[0], p[1], p[2]), out)) return false;
+  for (int r = 0; r < 2; ++r) {
+    (*uv)[r] = out[r].a;
+    for (int c = 0; c < 3; ++c) (*d_point)(r, c) = out[r].v[c];
+    for (int c = 0; c < kCalibIntrinsicsSize; ++c) (*d_intrinsics)(r, c) = out[r].v[3 + c];
+  }
+  return true;
+}
+
+// Row-major writes of a residual Jacobian block (tangent columns, zeros in the rest).
+template <int R, int C>
+void Put(const Eigen::Matrix<double, R, C>& m, int ambient, double* out) {
+  if (out == nullptr) return;
+  for (int r = 0; r < R; ++r) {
+    for (int c = 0; c < ambient; ++c) out[r * ambient + c] = c < C ? m(r, c) : 0.0;
+  }
+}
+
+constexpr int kLeftBlocks[6] = {7, 3, kCalibIntrinsicsSize, 7, 1, 3};
+constexpr int kRightBlocks[7] = {7, 3, kCalibIntrinsicsSize, 7, 7, 1, 3};
 
 }  // namespace
 
@@ -112,50 +161,38 @@ CalibratedLeftError::CalibratedLeftError(const Eigen::Vector2d& raw,
                                          const FixedDistortion& fixed, const ImageTiming& timing)
     : raw_(raw), whitening_(whitening), fixed_(fixed), timing_(timing) {
   set_num_residuals(2);
-  for (const BlockLayout& l : kLeftLayout) mutable_parameter_block_sizes()->push_back(l.ambient);
+  for (int size : kLeftBlocks) mutable_parameter_block_sizes()->push_back(size);
 }
 
 bool CalibratedLeftError::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
-  using J = ceres::Jet<double, kLeftJetSize>;
-  J d_pose[6], point[3], intrinsics[kCalibIntrinsicsSize], d_extrinsic[6], offset[1], velocity[3];
-  SeedZero(6, kLeftLayout[0].offset, d_pose);
-  Seed(parameters[1], 3, kLeftLayout[1].offset, point);
-  Seed(parameters[2], kCalibIntrinsicsSize, kLeftLayout[2].offset, intrinsics);
-  SeedZero(6, kLeftLayout[3].offset, d_extrinsic);
-  Seed(parameters[4], 1, kLeftLayout[4].offset, offset);
-  Seed(parameters[5], 3, kLeftLayout[5].offset, velocity);
-  const SE3<J> world_from_body = PerturbedBodyPose(parameters[0], d_pose);
-  const SE3<J> cam0_from_body = PerturbedLeftPose(parameters[3], d_extrinsic);
-  const Vec3T<J> p_body =
-      PointInBodyAtImage(world_from_body, Vec3T<J>(point[0], point[1], point[2]), offset[0],
-                         Vec3T<J>(velocity[0], velocity[1], velocity[2]), timing_);
-  J uv[2];
-  if (!ProjectCalibrated(intrinsics, fixed_, Vec3T<J>(cam0_from_body * p_body), uv)) return false;
-  const J e0 = uv[0] - raw_.x();
-  const J e1 = uv[1] - raw_.y();
-  const J r[2] = {whitening_(0, 0) * e0 + whitening_(0, 1) * e1,
-                  whitening_(1, 0) * e0 + whitening_(1, 1) * e1};
-  residuals[0] = r[0].a;
-  residuals[1] = r[1].a;
-  WriteJacobians(r, 2, kLeftLayout, jacobians);
+  const bool want = jacobians != nullptr;
+  CameraPoint cp;
+  ComputeCameraPoint(parameters, 3, 4, 5, timing_, want, &cp);
+  Eigen::Vector2d uv;
+  Eigen::Matrix<double, 2, 3> d_uv_d_p;
+  Eigen::Matrix<double, 2, kCalibIntrinsicsSize> d_uv_d_k;
+  if (!Project(parameters[2], fixed_, cp.p_c0, want, &uv, &d_uv_d_p, &d_uv_d_k)) return false;
+  Eigen::Map<Eigen::Vector2d> r(residuals);
+  r = whitening_ * (uv - raw_);
+  if (!want) return true;
+  const Eigen::Matrix<double, 2, 3> a = whitening_ * d_uv_d_p;
+  Put<2, 6>(a * cp.d_pose, 7, jacobians[0]);
+  Put<2, 3>(a * cp.d_point, 3, jacobians[1]);
+  Put<2, kCalibIntrinsicsSize>(whitening_ * d_uv_d_k, kCalibIntrinsicsSize, jacobians[2]);
+  Put<2, 6>(a * cp.d_extrinsic, 7, jacobians[3]);
+  Put<2, 1>(a * cp.d_offset, 1, jacobians[4]);
+  Put<2, 3>(a * cp.d_velocity, 3, jacobians[5]);
   return true;
 }
 
 bool CalibratedLeftError::PixelError(double const* const* parameters,
                                      Eigen::Vector2d* error) const {
-  const double zero[6] = {0, 0, 0, 0, 0, 0};
-  const SE3d world_from_body = PerturbedBodyPose(parameters[0], zero);
-  const SE3d cam0_from_body = PerturbedLeftPose(parameters[3], zero);
-  const Eigen::Vector3d p_body = PointInBodyAtImage(
-      world_from_body, Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(parameters[1])),
-      parameters[4][0], Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(parameters[5])),
-      timing_);
-  double uv[2];
-  if (!ProjectCalibrated(parameters[2], fixed_, Eigen::Vector3d(cam0_from_body * p_body), uv)) {
-    return false;
-  }
-  *error = Eigen::Vector2d(uv[0], uv[1]) - raw_;
+  CameraPoint cp;
+  ComputeCameraPoint(parameters, 3, 4, 5, timing_, false, &cp);
+  Eigen::Vector2d uv;
+  if (!Project(parameters[2], fixed_, cp.p_c0, false, &uv, nullptr, nullptr)) return false;
+  *error = uv - raw_;
   return true;
 }
 
@@ -165,35 +202,34 @@ CalibratedRightError::CalibratedRightError(const Eigen::Vector2d& raw,
                                            const ImageTiming& timing)
     : raw_(raw), whitening_(whitening), fixed_(fixed), timing_(timing) {
   set_num_residuals(1);
-  for (const BlockLayout& l : kRightLayout) mutable_parameter_block_sizes()->push_back(l.ambient);
+  for (int size : kRightBlocks) mutable_parameter_block_sizes()->push_back(size);
 }
 
 bool CalibratedRightError::Evaluate(double const* const* parameters, double* residuals,
                                     double** jacobians) const {
-  using J = ceres::Jet<double, kRightJetSize>;
-  J d_pose[6], point[3], intrinsics[kCalibIntrinsicsSize], d_imu[6], d_stereo[6], offset[1],
-      velocity[3];
-  SeedZero(6, kRightLayout[0].offset, d_pose);
-  Seed(parameters[1], 3, kRightLayout[1].offset, point);
-  Seed(parameters[2], kCalibIntrinsicsSize, kRightLayout[2].offset, intrinsics);
-  SeedZero(6, kRightLayout[3].offset, d_imu);
-  SeedZero(6, kRightLayout[4].offset, d_stereo);
-  Seed(parameters[5], 1, kRightLayout[5].offset, offset);
-  Seed(parameters[6], 3, kRightLayout[6].offset, velocity);
-  const SE3<J> world_from_body = PerturbedBodyPose(parameters[0], d_pose);
-  const SE3<J> cam0_from_body = PerturbedLeftPose(parameters[3], d_imu);
-  const SE3<J> cam1_from_cam0 = PerturbedLeftPose(parameters[4], d_stereo);
-  const Vec3T<J> p_body =
-      PointInBodyAtImage(world_from_body, Vec3T<J>(point[0], point[1], point[2]), offset[0],
-                         Vec3T<J>(velocity[0], velocity[1], velocity[2]), timing_);
-  J uv[2];
-  if (!ProjectCalibrated(intrinsics, fixed_, Vec3T<J>(cam1_from_cam0 * (cam0_from_body * p_body)),
-                         uv)) {
-    return false;
-  }
-  const J r[1] = {whitening_(0) * (uv[0] - raw_.x()) + whitening_(1) * (uv[1] - raw_.y())};
-  residuals[0] = r[0].a;
-  WriteJacobians(r, 1, kRightLayout, jacobians);
+  const bool want = jacobians != nullptr;
+  CameraPoint cp;
+  ComputeCameraPoint(parameters, 3, 5, 6, timing_, want, &cp);
+  const SE3d cam1_from_cam0 = PoseFromBlock(parameters[4]);
+  const Eigen::Vector3d p_c1 = cam1_from_cam0 * cp.p_c0;
+  Eigen::Vector2d uv;
+  Eigen::Matrix<double, 2, 3> d_uv_d_p;
+  Eigen::Matrix<double, 2, kCalibIntrinsicsSize> d_uv_d_k;
+  if (!Project(parameters[2], fixed_, p_c1, want, &uv, &d_uv_d_p, &d_uv_d_k)) return false;
+  residuals[0] = whitening_ * (uv - raw_);
+  if (!want) return true;
+  const Eigen::Matrix<double, 1, 3> a = whitening_ * d_uv_d_p;
+  const Eigen::Matrix<double, 1, 3> b = a * cam1_from_cam0.RotationMatrix();  // through p_c0
+  Put<1, 6>(b * cp.d_pose, 7, jacobians[0]);
+  Put<1, 3>(b * cp.d_point, 3, jacobians[1]);
+  Put<1, kCalibIntrinsicsSize>(whitening_ * d_uv_d_k, kCalibIntrinsicsSize, jacobians[2]);
+  Put<1, 6>(b * cp.d_extrinsic, 7, jacobians[3]);
+  Eigen::Matrix<double, 3, 6> d_stereo;
+  d_stereo.leftCols<3>().setIdentity();
+  d_stereo.rightCols<3>() = -Skew(p_c1);
+  Put<1, 6>(a * d_stereo, 7, jacobians[4]);
+  Put<1, 1>(b * cp.d_offset, 1, jacobians[5]);
+  Put<1, 3>(b * cp.d_velocity, 3, jacobians[6]);
   return true;
 }
 

@@ -1,0 +1,58 @@
+#include "mapping/calibration_apply.h"
+
+#include "core/util/error.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "mapping/global_bundle.h"
+#include "mapping/inertial_bundle.h"
+
+namespace pkslam {
+
+void MoveToCalibration(Atlas* atlas, const RigCalibration& calibration, const RigSetup& setup) {
+  const RigSetup old = atlas->rig_setup();
+  if (old.rig != nullptr) {
+    // The body keeps its place: the tracking camera moves by new_from_old.
+    const SE3d new_from_old = setup.rig->body_from_camera.Inverse() * old.rig->body_from_camera;
+    const RigWarp warp(old, setup);
+    for (Map* map : atlas->maps()) {
+      for (const auto& [id, kf] : map->keyframes()) kf->Recalibrate(setup.rig, warp, new_from_old);
+      for (const auto& [id, kf] : map->retired_keyframes()) {
+        kf->Recalibrate(setup.rig, warp, new_from_old);
+      }
+    }
+  }
+  atlas->SetCalibration(calibration, setup);
+}
+
+void ApplyCalibration(Atlas* atlas, Map* map, const CalibrationBundleProblem& problem,
+                      const CalibrationBundleResult& result, const RigSetup& setup) {
+  MoveToCalibration(atlas, result.estimate, setup);
+  if (map == nullptr) return;
+  const InertialBundleProblem& bundle = problem.bundle;
+  PKSLAM_CHECK(result.world_from_body.size() == bundle.visual.keyframes.size(),
+               "calibration result ({} keyframes) does not match the problem ({})",
+               result.world_from_body.size(), bundle.visual.keyframes.size());
+  InertialBundleResult written;
+  written.visual = result.bundle.visual;
+  written.visual.outlier_observations.clear();
+  written.visual.camera_from_world.clear();
+  const SE3d body_from_camera = setup.rig->body_from_camera;
+  for (const SE3d& world_from_body : result.world_from_body) {
+    written.visual.camera_from_world.push_back((world_from_body * body_from_camera).Inverse());
+  }
+  written.velocities = result.bundle.velocities;
+  written.biases = result.bundle.biases;
+  MergeGlobalBundle(
+      map, bundle.visual,
+      [&] {
+        if (problem.inertial) {
+          ApplyInertialBundle(map, bundle, written);
+        } else {
+          ApplyBundle(map, bundle.visual, written.visual);
+        }
+      },
+      /*apply_sets_velocities=*/problem.inertial);
+  map->RecordWorldChange({});
+}
+
+}  // namespace pkslam

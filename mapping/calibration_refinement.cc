@@ -1,0 +1,149 @@
+#include "mapping/calibration_refinement.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/util/error.h"
+
+namespace pkslam {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+}  // namespace
+
+void OnlineCalibrationOptions::Check() const {
+  prior.Check();
+  PKSLAM_CHECK_OPTION(max_observations_per_keyframe >= 0,
+                      "calibration.max_observations_per_keyframe", "{}",
+                      max_observations_per_keyframe);
+  PKSLAM_CHECK_OPTION(iterations_first >= 1 && iterations_second >= 0, "calibration.iterations",
+                      "{} / {}", iterations_first, iterations_second);
+  PKSLAM_CHECK_OPTION(first_after_s > 0, "calibration.first_after_s", "{}", first_after_s);
+  PKSLAM_CHECK_OPTION(growth > 1, "calibration.growth", "{} (> 1)", growth);
+  PKSLAM_CHECK_OPTION(min_keyframes >= 2, "calibration.min_keyframes", "{}", min_keyframes);
+  PKSLAM_CHECK_OPTION(min_rotation_rate >= 0 && min_lever_rotation_rate >= 0 &&
+                          min_turn_rate >= 0 && min_speed >= 0,
+                      "calibration gates", "rates must not be negative");
+  PKSLAM_CHECK_OPTION(min_covered_cells >= 0 && min_covered_cells <= 16,
+                      "calibration.min_covered_cells", "{} (of 16)", min_covered_cells);
+  PKSLAM_CHECK_OPTION(min_cell_observations >= 0 && min_stereo_observations >= 0,
+                      "calibration gates", "counts must not be negative");
+}
+
+CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor sensor,
+                               const OnlineCalibrationOptions& options) {
+  CalibrationGates g;
+  const auto freeze_all = [&](const std::string& reason) {
+    for (const char* group : {"intrinsics", "stereo", "imu_rotation", "imu_translation",
+                              "time_offset"}) {
+      g.frozen[group] = reason;
+    }
+    g.free = {};
+  };
+  if (IsRgbd(sensor)) {
+    freeze_all("RGB-D: the depth image's registration is taken as given");
+    return g;
+  }
+  if (IsMonocular(sensor) && !IsInertial(sensor)) {
+    freeze_all("monocular without IMU: no metric scale to hold the intrinsics against");
+    return g;
+  }
+  const BundleProblem& visual = problem.bundle.visual;
+  const int num_kf = static_cast<int>(visual.keyframes.size());
+  if (num_kf < options.min_keyframes) {
+    freeze_all(fmt::format("{} keyframes (at least {})", num_kf, options.min_keyframes));
+    return g;
+  }
+
+  // Coverage of the image and stereo matches.
+  constexpr int kCells = 4;
+  std::array<int, kCells * kCells> cells{};
+  const CameraModel& cam0 = problem.initial.cameras.front();
+  for (std::size_t i = 0; i < problem.raw.size(); ++i) {
+    const Eigen::Vector2d& uv = problem.raw[i].left;
+    const int cx = std::clamp(static_cast<int>(uv.x() / cam0.width() * kCells), 0, kCells - 1);
+    const int cy = std::clamp(static_cast<int>(uv.y() / cam0.height() * kCells), 0, kCells - 1);
+    ++cells[static_cast<std::size_t>(cy * kCells + cx)];
+    g.stereo_observations += problem.raw[i].has_right ? 1 : 0;
+  }
+  for (int c : cells) g.covered_cells += c >= options.min_cell_observations ? 1 : 0;
+  const bool stereo = IsStereo(sensor) && problem.initial.stereo();
+  if (g.covered_cells >= options.min_covered_cells) {
+    g.free.intrinsics = {true, stereo};
+  } else {
+    g.frozen["intrinsics"] = fmt::format("observations cover {} of 16 image cells (at least {})",
+                                         g.covered_cells, options.min_covered_cells);
+  }
+  if (stereo) {
+    if (g.stereo_observations >= options.min_stereo_observations) {
+      g.free.stereo_extrinsic = true;
+    } else {
+      g.frozen["stereo"] = fmt::format("{} stereo matches (at least {})", g.stereo_observations,
+                                       options.min_stereo_observations);
+    }
+  }
+
+  if (!IsInertial(sensor) || !problem.inertial) {
+    if (IsInertial(sensor)) {
+      for (const char* group : {"imu_rotation", "imu_translation", "time_offset"}) {
+        g.frozen[group] = "the map's IMU is not initialised";
+      }
+    }
+    return g;
+  }
+  // Motion: angular rates and speeds at the keyframes of the chain.
+  std::vector<double> rates;
+  std::vector<double> speeds;
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  int n = 0;
+  for (int i = 0; i < num_kf; ++i) {
+    if (i >= static_cast<int>(problem.bundle.inertial.size()) || problem.bundle.inertial[i] == 0) {
+      continue;
+    }
+    const Eigen::Vector3d& w = problem.angular_velocity[static_cast<std::size_t>(i)];
+    m += w * w.transpose();
+    rates.push_back(w.norm());
+    speeds.push_back(problem.bundle.velocities[static_cast<std::size_t>(i)].norm());
+    ++n;
+  }
+  if (n > 0) m /= n;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(m);
+  g.second_axis_rate = std::sqrt(std::max(0.0, eigen.eigenvalues()[1]));  // ascending order
+  g.median_turn_rate = Median(rates);
+  g.median_speed = Median(speeds);
+  if (g.second_axis_rate >= options.min_rotation_rate) {
+    g.free.imu_rotation = true;
+  } else {
+    g.frozen["imu_rotation"] =
+        fmt::format("rotation about one axis only (second axis {:.3f} rad/s, at least {})",
+                    g.second_axis_rate, options.min_rotation_rate);
+  }
+  if (g.second_axis_rate >= options.min_lever_rotation_rate) {
+    g.free.imu_translation = true;
+  } else {
+    g.frozen["imu_translation"] =
+        fmt::format("too little rotation to see the lever arm (second axis {:.3f} rad/s, at "
+                    "least {})",
+                    g.second_axis_rate, options.min_lever_rotation_rate);
+  }
+  if (g.median_turn_rate >= options.min_turn_rate || g.median_speed >= options.min_speed) {
+    g.free.time_offset = true;
+  } else {
+    g.frozen["time_offset"] =
+        fmt::format("the images barely move (median {:.3f} rad/s, {:.3f} m/s)",
+                    g.median_turn_rate, g.median_speed);
+  }
+  return g;
+}
+
+}  // namespace pkslam

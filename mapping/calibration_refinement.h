@@ -1,0 +1,87 @@
+// Online calibration's policy (docs/calibration.md): when local mapping runs a calibration
+// bundle adjustment (calibration_collect.h -> estimators/calibration -> calibration_apply.h),
+// which parameters the motion so far makes observable, and what each run leaves in the stats.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/sensor/sensor.h"
+#include "estimators/calibration/calibration_bundle.h"
+
+namespace pkslam {
+
+struct OnlineCalibrationOptions {
+  // --calibrate online (true) | off.
+  bool enabled = false;
+  CalibrationPriorOptions prior;
+  // Observations per keyframe in an adjustment (evenly over the image; 0: all).
+  int max_observations_per_keyframe = 150;
+  // Solver iterations of the robust pass and of the refinement without outliers.
+  int iterations_first = 8;
+  int iterations_second = 4;
+  // The first adjustment once the map spans this much data time (s); the next whenever the span
+  // grew by `growth` (8, 12, 18, 27, ... s), so a flight of T seconds gets about log(T/8)/log(1.5)
+  // of them, most of them early, when the estimate moves most.
+  double first_after_s = 8.0;
+  double growth = 1.5;
+  // Too few keyframes tell too little.
+  int min_keyframes = 10;
+  // Observability gates (DecideFreedom). Camera-IMU rotation: the angular rate about the
+  // keyframes' second-most-excited axis (rms, rad/s): rotation about a single axis leaves the
+  // rotation about it unobservable. Camera-IMU translation (a lever arm seen only through
+  // rotation): the same rate, higher.
+  double min_rotation_rate = 0.05;
+  double min_lever_rotation_rate = 0.1;
+  // Time offset: the image must move, through rotation (median |omega|, rad/s) or translation
+  // (median speed, m/s).
+  double min_turn_rate = 0.05;
+  double min_speed = 0.1;
+  // Intrinsics: observations in at least this many cells of a 4x4 grid over the image (each with
+  // at least `min_cell_observations`).
+  int min_covered_cells = 12;
+  int min_cell_observations = 10;
+  // Stereo extrinsic: at least this many stereo matches.
+  int min_stereo_observations = 500;
+
+  void Check() const;
+};
+
+// The parameter groups a refinement frees, and why the others stay frozen.
+struct CalibrationGates {
+  CalibrationFreedom free;
+  // group ("intrinsics", "stereo", "imu_rotation", "imu_translation", "time_offset") -> reason
+  std::map<std::string, std::string> frozen;
+  // The measured motion and coverage the gates compared.
+  double second_axis_rate = 0;  // rad/s
+  double median_turn_rate = 0;  // rad/s
+  double median_speed = 0;      // m/s
+  int covered_cells = 0;
+  int stereo_observations = 0;
+};
+
+// Which parameters `problem` (collected from a map of `sensor`) can estimate. Monocular without
+// an IMU and RGB-D freeze everything: a monocular map has no metric scale to hold the intrinsics
+// against, and the RGB-D pipeline takes the depth image's registration as given.
+CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor sensor,
+                               const OnlineCalibrationOptions& options);
+
+// One calibration adjustment of a run (stats.json "calibration.history").
+struct CalibrationRefinementStat {
+  std::int64_t t_ns = 0;  // the keyframe that triggered it
+  double span_s = 0;      // data time the map spanned
+  int keyframes = 0;
+  int observations = 0;
+  int iterations = 0;
+  double initial_cost = 0;
+  double final_cost = 0;
+  double ms = 0;
+  bool applied = false;
+  std::string note;  // why it was not applied
+  CalibrationGates gates;
+  std::vector<CalibrationParameter> parameters;  // the estimate it ended with
+};
+
+}  // namespace pkslam
