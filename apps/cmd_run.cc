@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdlib>
 #include <memory>
 #include <optional>
 
@@ -193,6 +194,11 @@ void RegisterRunCommand(CLI::App& app) {
     if (!args->vocabulary.empty()) o.vocabulary = args->vocabulary;
     o.out = args->out;
     o.system.selector_parameters = ParseParams(args->params);
+    if (const char* v = std::getenv("PKSLAM_CALIB_MAXOBS")) o.system.mapping.calibration.max_observations_per_keyframe = std::atoi(v);  // TEMPORARY
+    if (const char* v = std::getenv("PKSLAM_CALIB_IT1")) o.system.mapping.calibration.iterations_first = std::atoi(v);  // TEMPORARY
+    if (const char* v = std::getenv("PKSLAM_CALIB_IT2")) o.system.mapping.calibration.iterations_second = std::atoi(v);  // TEMPORARY
+    if (const char* v = std::getenv("PKSLAM_CALIB_FIRST")) o.system.mapping.calibration.first_after_s = std::atof(v);  // TEMPORARY
+    if (const char* v = std::getenv("PKSLAM_CALIB_GROWTH")) o.system.mapping.calibration.growth = std::atof(v);  // TEMPORARY
     RunControl control;
     control.interrupt = &interrupted;
     // Until the first frame a signal takes its default action: reading a dataset polls no flag

@@ -43,6 +43,12 @@ EurocCameraSensor ReadEurocCameraSensor(const std::filesystem::path& sensor_yaml
   if (!(intrinsics[0] > 0 && intrinsics[1] > 0)) {
     yaml.Fail("intrinsics", "focal lengths fu, fv must be positive");
   }
+  if (const auto shift = yaml.OptionalDouble("timeshift_cam_imu")) {
+    if (!(std::abs(*shift) <= 1.0)) {
+      yaml.Fail("timeshift_cam_imu", fmt::format("must be within [-1, 1] s, found {}", *shift));
+    }
+    camera.timeshift_cam_imu = *shift;
+  }
   camera.distortion_model = yaml.String("distortion_model");
   camera.distortion_coefficients = yaml.DoubleSequence("distortion_coefficients");
   const std::size_t n = camera.distortion_coefficients.size();
@@ -62,6 +68,52 @@ EurocCameraSensor ReadEurocCameraSensor(const std::filesystem::path& sensor_yaml
                           camera.distortion_model));
   }
   return camera;
+}
+
+namespace {
+
+// Shortest text that reads back to the same double, always spelled as a real.
+std::string Real(double v) {
+  std::string s = fmt::format("{}", v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string Join(const std::vector<double>& values) {
+  std::string s;
+  for (std::size_t i = 0; i < values.size(); ++i) s += (i > 0 ? ", " : "") + Real(values[i]);
+  return s;
+}
+
+}  // namespace
+
+std::string EurocCameraSensorYaml(const EurocCameraSensor& c, const std::string& comment) {
+  // EuRoC's layout: T_BS rows continued under the opening bracket.
+  const Eigen::Matrix4d m = c.body_from_camera.Matrix();
+  std::string t_bs = "T_BS:\n  cols: 4\n  rows: 4\n  data: [";
+  for (int r = 0; r < 4; ++r) {
+    if (r > 0) t_bs += ",\n         ";
+    for (int col = 0; col < 4; ++col) t_bs += (col > 0 ? ", " : "") + Real(m(r, col));
+  }
+  t_bs += "]\n";
+  const std::vector<double> distortion =
+      c.distortion_coefficients.empty() ? std::vector<double>{0.0, 0.0, 0.0, 0.0}
+                                        : c.distortion_coefficients;
+  std::string text = fmt::format(
+      "%YAML:1.0\n# General sensor definitions.\nsensor_type: camera\ncomment: {}\n\n"
+      "# Sensor extrinsics wrt. the body-frame.\n{}\n"
+      "# Camera specific definitions.\nrate_hz: {}\nresolution: [{}, {}]\n"
+      "camera_model: {}\nintrinsics: [{}, {}, {}, {}] #fu, fv, cu, cv\n"
+      "distortion_model: {}\ndistortion_coefficients: [{}]\n",
+      comment, t_bs, c.rate_hz, c.width, c.height, c.camera_model, Real(c.intrinsics[0]),
+      Real(c.intrinsics[1]), Real(c.intrinsics[2]), Real(c.intrinsics[3]), c.distortion_model,
+      Join(distortion));
+  if (c.timeshift_cam_imu != 0.0) {
+    text += fmt::format("# t_imu = t_cam + timeshift_cam_imu [s] (Kalibr's convention)\n"
+                        "timeshift_cam_imu: {}\n",
+                        Real(c.timeshift_cam_imu));
+  }
+  return text + "\n";
 }
 
 EurocImuSensor ReadEurocImuSensor(const std::filesystem::path& sensor_yaml) {

@@ -20,6 +20,9 @@ struct EurocCameraSensor {
   std::array<double, 4> intrinsics{};           // fu, fv, cu, cv
   std::string distortion_model;                 // "radial-tangential" | "equidistant"
   std::vector<double> distortion_coefficients;  // radtan: k1 k2 p1 p2 [k3]; equidistant: k1..k4
+  // Kalibr's camera-IMU time shift (t_imu = t_cam + shift, seconds): not in EuRoC's files
+  // (0), written by pkslam's calibration estimates (OUT/calibration/cam0/sensor.yaml).
+  double timeshift_cam_imu = 0;
 };
 
 struct EurocImuSensor {
@@ -35,5 +38,9 @@ struct EurocImuSensor {
 // Throws InputError naming the file and key.
 EurocCameraSensor ReadEurocCameraSensor(const std::filesystem::path& sensor_yaml);
 EurocImuSensor ReadEurocImuSensor(const std::filesystem::path& sensor_yaml);
+
+// A camera's sensor.yaml in EuRoC's layout (%YAML:1.0 header, T_BS rows under the bracket);
+// timeshift_cam_imu only when not 0. Doubles are written with every digit.
+std::string EurocCameraSensorYaml(const EurocCameraSensor& camera, const std::string& comment);
 
 }  // namespace pkslam

@@ -62,6 +62,8 @@ Settings SettingsFromEuroc(const EurocDataset& dataset) {
     s.imu = noise;
     // The camera's T_BS is relative to the body frame; the IMU may be offset from it.
     s.body_from_cam0 = imu.body_from_imu.Inverse() * cam0.body_from_camera;
+    // Kalibr's timeshift_cam_imu when cam0's file has it (pkslam's calibration estimates).
+    s.time_offset_s = cam0.timeshift_cam_imu;
   }
   s.th_depth = 60;
   s.orb = OrbExtractorSettings{};  // 1200 features, 1.2, 8 levels, FAST 20 / 7

@@ -1,7 +1,11 @@
 #include "mapping/calibration_apply.h"
 
 #include "core/util/error.h"
+#include "estimators/optim/point_refinement.h"
+#include "map_model/estimation/bundle_collect.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
+#include "map_model/map_point.h"
 #include "map_model/map.h"
 #include "mapping/global_bundle.h"
 #include "mapping/inertial_bundle.h"
@@ -22,6 +26,34 @@ void MoveToCalibration(Atlas* atlas, const RigCalibration& calibration, const Ri
     }
   }
   atlas->SetCalibration(calibration, setup);
+}
+
+int RefinePointsToCalibration(Atlas* atlas, MapId map_id) {
+  BundleProblem problem;
+  std::vector<Eigen::Vector3d> refined;
+  {
+    auto lock = MapReader(*atlas).Lock();
+    const Map* map = atlas->FindMap(map_id);
+    if (map == nullptr) return 0;
+    problem = CollectGlobalBundle(*map);
+    refined = RefinePoints(problem);
+  }
+  auto lock = MapEditor(atlas).Write(MapEdit::kCalibration);
+  Map* map = atlas->FindMap(map_id);
+  if (map == nullptr) return 0;
+  int moved = 0;
+  for (std::size_t i = 0; i < problem.points.size(); ++i) {
+    if (refined[i] == problem.points[i].position_world) continue;
+    const MapPointPtr point = map->MapPointById(problem.points[i].point_id);
+    // A point changed meanwhile (local BA, fusion) keeps its newer position.
+    if (point == nullptr || point->IsBad() || point->position() != problem.points[i].position_world) {
+      continue;
+    }
+    point->SetPosition(refined[i]);
+    point->UpdateNormalAndDepth();
+    ++moved;
+  }
+  return moved;
 }
 
 void ApplyCalibration(Atlas* atlas, Map* map, const CalibrationBundleProblem& problem,

@@ -20,6 +20,12 @@ namespace pkslam {
 void ApplyCalibration(Atlas* atlas, Map* map, const CalibrationBundleProblem& problem,
                       const CalibrationBundleResult& result, const RigSetup& setup);
 
+// Every point of map `map_id` refined with the keyframe poses held (structure-only,
+// estimators/optim/point_refinement.h), so points the thinned calibration adjustment left out
+// move to the new calibration too. Takes the Atlas lock itself: shared to collect and solve,
+// exclusive (kCalibration) to write. Returns the points moved.
+int RefinePointsToCalibration(Atlas* atlas, MapId map_id);
+
 // Only the calibration: every keyframe moves to `setup` as above, poses and points stay (a
 // calibration read from a file or a map, before or between adjustments). Exclusive lock.
 void MoveToCalibration(Atlas* atlas, const RigCalibration& calibration, const RigSetup& setup);

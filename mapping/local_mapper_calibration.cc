@@ -103,6 +103,7 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
     ApplyCalibration(atlas_, map, problem, result, next);
   }
   rig_ = next.rig;
+  RefinePointsToCalibration(atlas_, problem.bundle.visual.map_id);
   stat.applied = true;
   finish("");
   PKSLAM_LOG_INFO(

@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/util/error.h"
+#include "io/euroc_sensor.h"
 
 namespace pkslam::sim {
 
@@ -97,21 +98,17 @@ std::string MatrixYaml(const Eigen::Matrix4d& m) {
 
 std::string CameraYaml(const CameraRig& c) {
   const CameraModel& cam = c.camera;
-  std::string dist;
-  for (std::size_t i = 0; i < cam.distortion().size(); ++i) {
-    dist += (i > 0 ? ", " : "") + FormatDouble(cam.distortion()[i]);
-  }
-  if (cam.distortion().empty()) dist = "0.0, 0.0, 0.0, 0.0";
-  return fmt::format(
-      "%YAML:1.0\n# General sensor definitions.\nsensor_type: camera\n"
-      "comment: pkslam simulated {} (EuRoC VI-Sensor geometry)\n\n"
-      "# Sensor extrinsics wrt. the body-frame.\n{}\n"
-      "# Camera specific definitions.\nrate_hz: {}\nresolution: [{}, {}]\n"
-      "camera_model: pinhole\nintrinsics: [{}, {}, {}, {}] #fu, fv, cu, cv\n"
-      "distortion_model: radial-tangential\ndistortion_coefficients: [{}]\n\n",
-      c.name, MatrixYaml(c.body_from_camera.Matrix()), fmt::format("{}", c.rate_hz), cam.width(),
-      cam.height(), FormatDouble(cam.fx()), FormatDouble(cam.fy()), FormatDouble(cam.cx()),
-      FormatDouble(cam.cy()), dist);
+  EurocCameraSensor sensor;
+  sensor.body_from_camera = c.body_from_camera;
+  sensor.rate_hz = c.rate_hz;
+  sensor.width = cam.width();
+  sensor.height = cam.height();
+  sensor.camera_model = "pinhole";
+  sensor.intrinsics = {cam.fx(), cam.fy(), cam.cx(), cam.cy()};
+  sensor.distortion_model = "radial-tangential";
+  sensor.distortion_coefficients = cam.distortion();
+  return EurocCameraSensorYaml(
+      sensor, fmt::format("pkslam simulated {} (EuRoC VI-Sensor geometry)", c.name));
 }
 
 std::string ImuYaml(const ImuOptions& imu) {

@@ -357,25 +357,7 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   WriteTrajectoryOutputs(system, options);
   if (control.trajectory_written) control.trajectory_written();
   system.Shutdown();
-  if (std::getenv("PKSLAM_CALIB_PROTO") != nullptr) {  // TEMPORARY prototype
-    CalibrationFreedom free;
-    const bool st = IsStereo(sensor), in = IsInertial(sensor);
-    free.intrinsics = {true, st};
-    free.stereo_extrinsic = st;
-    free.imu_rotation = in;
-    free.imu_translation = in;
-    free.time_offset = in;
-    const int cap = std::atoi(std::getenv("PKSLAM_CALIB_PROTO"));
-    const auto t_start = std::chrono::steady_clock::now();
-    CalibrationBundleOptions copts; copts.covariance = std::getenv("PKSLAM_NOCOV") == nullptr;
-    const CalibrationBundleResult res = system.RefineCalibration(free, copts, cap);
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-    for (const auto& p : res.parameters) {
-      fmt::print("CALIB {:16s} file {:12.6f} est {:12.6f} sigma {:10.6f} prior {:8.4f}\n", p.name, p.file, p.estimate, p.sigma, p.prior_sigma);
-    }
-    WriteOrbSlam3Settings(SettingsWithCalibration(settings, res.estimate), options.out / "calibration_proto.yaml");
-    fmt::print("CALIB obs-outliers {} iterations {} cost {} -> {} time {:.2f} s cov {}\n", res.outliers, res.bundle.visual.iterations, res.bundle.visual.initial_cost, res.bundle.visual.final_cost, secs, res.covariance_ok);
-  }
+
   // Saved also after an interruption: the map of the frames processed.
   if (options.save_map) summary.map_saved = system.SaveMap(*options.save_map);
   summary.wall_s =

@@ -278,6 +278,16 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   for (const std::string& w : summary->estimate.warnings)
     PKSLAM_LOG_WARN("suspect estimate: {}", w);
 
+  const CalibrationReport calibration = system.calibration_report();
+  const CalibrationSources sources =
+      options.settings ? SourcesFromSettingsFile(*options.settings)
+      : std::filesystem::exists(options.dataset / "mav0")
+          ? SourcesFromEurocDataset(options.dataset)
+          : SourcesFromSettingsFile(options.dataset / "settings.yaml");
+  const std::vector<std::string> calibration_warnings = CalibrationWarnings(calibration, sources);
+  for (const std::string& w : calibration_warnings) PKSLAM_LOG_WARN("{}", w);
+  WriteCalibrationFiles(calibration, system.settings(), out);
+
   JsonWriter json;
   json.BeginObject();
   json.Member("dataset", options.dataset.string());
@@ -380,6 +390,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   }
   json.EndObject();
   WriteLoopClosing(system, options, loop_stats, summary->estimate.lost_for_good_s, &json);
+  WriteCalibrationJson(calibration, calibration_warnings, &json);
   WriteArray(&json, "tracking_ms", tracking_ms);
   WriteArray(&json, "local_mapping_ms", mapping.keyframe_ms);
   WriteArray(&json, "local_ba_ms", mapping.ba_ms);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <mutex>
@@ -19,6 +20,7 @@
 #include "map_model/map_point.h"
 #include "map_model/storage/atlas_storage.h"
 #include "map_model/storage/map_file.h"
+#include "mapping/calibration_apply.h"
 #include "mapping/calibration_collect.h"
 
 namespace pkslam {
@@ -38,6 +40,7 @@ void SystemOptions::Check() const {
 SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabulary> vocabulary,
                        SystemOptions options)
     : options_(std::move(options)),
+      settings_(settings),
       setup_(MakeRig(settings, options_.sensor)),
       file_calibration_(CalibrationFromSettings(settings, options_.sensor)),
       vocabulary_(std::move(vocabulary)) {
@@ -106,6 +109,78 @@ void SlamSystem::Shutdown() {
   mapper_->Finish();
   mapper_finished_.store(true);
   if (loop_) loop_->Finish();
+  if (options_.mapping.calibration.enabled) FinishCalibration();
+}
+
+void SlamSystem::FinishCalibration() {
+  const OnlineCalibrationOptions& o = options_.mapping.calibration;
+  CalibrationBundleProblem problem;
+  RigSetup setup;
+  const Map* collected_from = nullptr;
+  {
+    auto lock = MapReader(atlas_).Lock();
+    const Map* map = LargestMap();
+    if (map == nullptr || map->keyframes().empty()) return;
+    KeyFrame* newest = map->keyframes().rbegin()->second.get();
+    const bool inertial =
+        IsInertial(options_.sensor) && map->imu_status().inertial_ba1_done;
+    CalibrationCollectOptions collect;
+    collect.max_observations_per_keyframe = o.max_observations_per_keyframe;
+    setup = atlas_.rig_setup();
+    problem = CollectCalibrationBundle(newest, inertial, setup, atlas_.calibration(),
+                                       file_calibration_, collect);
+    collected_from = map;
+  }
+  final_gates_ = DecideFreedom(problem, options_.sensor, o);
+  problem.free = final_gates_.free;
+  if (!problem.free.Any() || problem.empty()) return;
+  CalibrationBundleOptions ba;
+  ba.iterations_first = o.iterations_first;
+  ba.iterations_second = o.iterations_second;
+  ba.num_threads = options_.mapping.ba.num_threads;
+  ba.prior = o.prior;
+  CalibrationBundleResult result = SolveCalibrationBundle(problem, ba);
+  if (result.bundle.visual.iterations == 0) return;
+  RigSetup next;
+  try {
+    next = BuildRig(result.estimate, ShapeFromSettings(settings_, options_.sensor));
+  } catch (const OptionError& e) {
+    PKSLAM_LOG_WARN("final calibration estimate rejected: {}", e.what());
+    return;
+  }
+  if (std::getenv("PKSLAM_FINAL_NOAPPLY") == nullptr) {  // TEMPORARY experiment
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
+    Map* map = atlas_.FindMap(collected_from->id());
+    ApplyCalibration(&atlas_, map, problem, result, next);
+  }
+  RefinePointsToCalibration(&atlas_, problem.bundle.visual.map_id);
+  // Tracking has ended: its records follow the keyframes here.
+  SyncCalibration();
+  final_calibration_ = std::move(result);
+}
+
+CalibrationReport SlamSystem::calibration_report() const {
+  CalibrationReport report;
+  report.online = options_.mapping.calibration.enabled;
+  report.sensor = options_.sensor;
+  report.file = file_calibration_;
+  {
+    auto lock = MapReader(atlas_).Lock();
+    report.estimate = atlas_.calibration();
+  }
+  report.history = mapper_->stats().calibration_refinements;
+  if (final_calibration_) {
+    report.parameters = final_calibration_->parameters;
+    report.covariance_ok = final_calibration_->covariance_ok;
+    report.frozen = final_gates_.frozen;
+  } else {
+    CalibrationFreedom none;
+    report.parameters =
+        CalibrationParameters(file_calibration_, report.estimate, none,
+                              options_.mapping.calibration.prior, IsInertial(options_.sensor));
+    if (!report.history.empty()) report.frozen = report.history.back().gates.frozen;
+  }
+  return report;
 }
 
 namespace {

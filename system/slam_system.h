@@ -12,6 +12,7 @@
 
 #include "core/bow/vocabulary.h"
 #include "estimators/calibration/calibration_bundle.h"
+#include "system/calibration_outputs.h"
 #include "io/settings.h"
 #include "io/trajectory.h"
 #include "loopclosing/loop_closing.h"
@@ -105,6 +106,10 @@ class SlamSystem {
   const CameraRig& rig() const { return *setup_.rig; }
   // The calibration the settings state (the prior of online calibration).
   const RigCalibration& file_calibration() const { return file_calibration_; }
+  const Settings& settings() const { return settings_; }
+  // The run's calibration: the file's, the estimate at the end, every online adjustment, and
+  // (online) the final whole-map adjustment's sigmas and gates (after Shutdown).
+  CalibrationReport calibration_report() const;
   // Batch calibration refinement over the largest map (call after Shutdown): the calibration
   // bundle adjustment with `free` parameters, prior from the settings.
   CalibrationBundleResult RefineCalibration(const CalibrationFreedom& free,
@@ -127,8 +132,13 @@ class SlamSystem {
 
  private:
   SystemOptions options_;
+  Settings settings_;
   RigSetup setup_;
   RigCalibration file_calibration_;
+  // Online calibration: the final whole-map adjustment (FinishCalibration, at Shutdown).
+  std::optional<CalibrationBundleResult> final_calibration_;
+  CalibrationGates final_gates_;
+  void FinishCalibration();
   // The camera-IMU time offset applied to frame stamps (inertial sensors): frames are tracked on
   // the IMU clock, stamp + offset.
   double time_offset_s_ = 0.0;

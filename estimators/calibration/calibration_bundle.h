@@ -1,7 +1,8 @@
 // Calibration bundle adjustment: a full (visual or visual-inertial) bundle adjustment that also
 // estimates the rig's calibration (docs/calibration.md): each camera's intrinsics (fx, fy, cx,
-// cy, k1, k2), the stereo extrinsic cam1_from_cam0, the camera-IMU extrinsic cam0_from_body and
-// the camera-IMU time offset, each held to the calibration file's value by a Gaussian prior.
+// cy, k1, k2; the right camera's fy and cy stay, as its vertical coordinate is not measured),
+// the stereo extrinsic cam1_from_cam0, the camera-IMU extrinsic cam0_from_body and the
+// camera-IMU time offset, each held to the calibration file's value by a Gaussian prior.
 //
 // Why a separate, whole-map adjustment rather than free calibration blocks in local BA: a
 // 10-keyframe window barely sees a camera-IMU rotation or a time offset (they need the motion of

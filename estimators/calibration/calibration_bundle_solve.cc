@@ -1,6 +1,7 @@
 // Solve phase of the calibration bundle adjustment: Ceres on a copy of the collected state.
 #include <ceres/covariance.h>
 #include <ceres/loss_function.h>
+#include <ceres/manifold.h>
 #include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
@@ -69,13 +70,14 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
     int first;           // index of its first scalar in `parameters`
     std::vector<int> map;  // tangent component -> offset from `first`
     std::vector<double> scale;
+    bool intrinsics = false;  // covariance in ambient coordinates (frozen ones have none)
   };
   std::vector<Entry> entries;
   int index = 0;
   for (int c = 0; c < static_cast<int>(problem.initial.cameras.size()) && c < 2; ++c) {
     if (problem.free.intrinsics[c]) {
       entries.push_back({s->intrinsics(c), kCalibIntrinsicsSize, index, {0, 1, 2, 3, 4, 5},
-                         {1, 1, 1, 1, 1, 1}});
+                         {1, 1, 1, 1, 1, 1}, true});
     }
     index += kCalibIntrinsicsSize;
   }
@@ -105,8 +107,13 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
   for (const Entry& e : entries) pairs.emplace_back(e.block, e.block);
   if (!covariance.Compute(pairs, ceres_problem)) return false;
   for (const Entry& e : entries) {
+    // Intrinsics in ambient coordinates (a frozen coordinate has zero variance there); the
+    // extrinsics in their 6-D tangent.
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(e.size, e.size);
-    if (!covariance.GetCovarianceMatrixInTangentSpace({e.block}, m.data())) return false;
+    if (!(e.intrinsics ? covariance.GetCovarianceMatrix({e.block}, m.data())
+                  : covariance.GetCovarianceMatrixInTangentSpace({e.block}, m.data()))) {
+      return false;
+    }
     for (int i = 0; i < e.size; ++i) {
       CalibrationParameter& p = (*parameters)[static_cast<std::size_t>(e.first + e.map[i])];
       if (p.free) p.sigma = std::sqrt(std::max(0.0, m(i, i))) * e.scale[i];
@@ -186,6 +193,8 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
   ceres::Problem ceres_problem(ProblemOptions({.loss_functions = true, .fast_removal = true}));
   BodyPoseManifold pose_manifold;
   SE3LeftManifold extrinsic_manifold;
+  // The right camera's fy and cy stay: the stereo matcher measures only its u coordinate.
+  ceres::SubsetManifold right_intrinsics_manifold(kCalibIntrinsicsSize, {1, 3});
   ceres::HuberLoss huber_left(std::sqrt(options.chi2_left));
   ceres::HuberLoss huber_right(std::sqrt(options.chi2_right));
   ceres::LossFunctionWrapper loss_left(&huber_left, ceres::DO_NOT_TAKE_OWNERSHIP);
@@ -195,7 +204,8 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
   const CalibrationPriorOptions& sig = options.prior;
   for (std::size_t c = 0; c < problem.initial.cameras.size() && c < 2; ++c) {
     double* block = s.intrinsics(static_cast<int>(c));
-    ceres_problem.AddParameterBlock(block, kCalibIntrinsicsSize);
+    ceres_problem.AddParameterBlock(block, kCalibIntrinsicsSize,
+                                    c == 1 ? &right_intrinsics_manifold : nullptr);
     const auto mean = IntrinsicsBlock(problem.prior.cameras[c]);
     Eigen::VectorXd sigma(kCalibIntrinsicsSize);
     sigma << sig.focal_px, sig.focal_px, sig.principal_point_px, sig.principal_point_px, sig.k1,

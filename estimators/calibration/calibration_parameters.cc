@@ -21,8 +21,10 @@ void AddCamera(int index, const CameraModel& prior, const CameraModel& estimate,
   const double sigmas[kCalibIntrinsicsSize] = {s.focal_px,           s.focal_px, s.principal_point_px,
                                                s.principal_point_px, s.k1,       s.k2};
   for (int i = 0; i < kCalibIntrinsicsSize; ++i) {
+    // cam1's fy and cy are never estimated (calibration_bundle.h).
+    const bool estimated = free && !(index == 1 && (i == 1 || i == 3));
     out->push_back({fmt::format("cam{}.{}", index, names[i]), i < 4 ? "px" : "", p[i], e[i], 0.0,
-                    sigmas[i], free});
+                    sigmas[i], estimated});
   }
 }
 

@@ -1,0 +1,139 @@
+#include "system/calibration_outputs.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/util/output_file.h"
+#include "io/euroc_sensor.h"
+#include "system/rig_factory.h"
+
+namespace pkslam {
+namespace {
+
+// The group a parameter name belongs to, and the file it came from.
+const std::string& SourceOf(const std::string& name, const CalibrationSources& s) {
+  if (name.rfind("cam1.", 0) == 0 || name.rfind("stereo.", 0) == 0) return s.cam1;
+  if (name.rfind("imu.", 0) == 0) return s.imu;
+  if (name == "time_offset") return s.time_offset;
+  return s.cam0;
+}
+
+EurocCameraSensor SensorOf(const CameraModel& camera, const SE3d& body_from_camera, double rate_hz,
+                           double timeshift) {
+  EurocCameraSensor s;
+  s.body_from_camera = body_from_camera;
+  s.rate_hz = rate_hz;
+  s.width = camera.width();
+  s.height = camera.height();
+  s.camera_model = "pinhole";
+  s.intrinsics = {camera.fx(), camera.fy(), camera.cx(), camera.cy()};
+  s.distortion_model = "radial-tangential";
+  s.distortion_coefficients = camera.distortion();
+  s.timeshift_cam_imu = timeshift;
+  return s;
+}
+
+}  // namespace
+
+CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings) {
+  const std::string f = settings.string();
+  return {f, f, f, f};
+}
+
+CalibrationSources SourcesFromEurocDataset(const std::filesystem::path& dataset) {
+  const std::string cam0 = (dataset / "mav0" / "cam0" / "sensor.yaml").string();
+  const std::string cam1 = (dataset / "mav0" / "cam1" / "sensor.yaml").string();
+  return {cam0, cam1, cam0 + " (T_BS)", cam0 + " (timeshift_cam_imu; absent: 0)"};
+}
+
+std::vector<std::string> CalibrationWarnings(const CalibrationReport& report,
+                                             const CalibrationSources& sources,
+                                             double threshold) {
+  std::vector<std::string> out;
+  if (!report.online || !report.covariance_ok) return out;
+  for (const CalibrationParameter& p : report.parameters) {
+    if (!p.free || !(p.sigma > 0)) continue;
+    const double off = p.file - p.estimate;
+    const double n = std::abs(off) / p.sigma;
+    if (n <= threshold) continue;
+    const std::string unit = p.unit.empty() ? "" : " " + p.unit;
+    out.push_back(fmt::format(
+        "calibration: {} in {} is {:.3g}{} off the estimate ({:.1f} sigma; file {:.6g}, estimate "
+        "{:.6g} +- {:.2g})",
+        p.name, SourceOf(p.name, sources), off, unit, n, p.file, p.estimate, p.sigma));
+  }
+  return out;
+}
+
+void WriteCalibrationJson(const CalibrationReport& report,
+                          const std::vector<std::string>& warnings, JsonWriter* json) {
+  json->Key("calibration").BeginObject();
+  json->Member("mode", report.online ? "online" : "off");
+  json->Member("covariance", report.covariance_ok);
+  json->Key("parameters").BeginArray();
+  for (const CalibrationParameter& p : report.parameters) {
+    json->BeginObject();
+    json->Member("name", p.name);
+    json->Member("unit", p.unit);
+    json->Member("file", p.file);
+    json->Member("estimate", p.estimate);
+    json->Member("sigma", p.sigma);
+    json->Member("prior_sigma", p.prior_sigma);
+    json->Member("free", p.free);
+    json->EndObject();
+  }
+  json->EndArray();
+  json->Key("frozen").BeginObject();
+  for (const auto& [group, reason] : report.frozen) json->Member(group, reason);
+  json->EndObject();
+  json->Key("warnings").BeginArray();
+  for (const std::string& w : warnings) json->Value(w);
+  json->EndArray();
+  json->Key("history").BeginArray();
+  for (const CalibrationRefinementStat& h : report.history) {
+    json->BeginObject();
+    json->Member("t_s", static_cast<double>(h.t_ns) * 1e-9);
+    json->Member("span_s", h.span_s);
+    json->Member("keyframes", h.keyframes);
+    json->Member("observations", h.observations);
+    json->Member("iterations", h.iterations);
+    json->Member("ms", h.ms);
+    json->Member("applied", h.applied);
+    json->Member("note", h.note);
+    json->Key("estimate").BeginObject();
+    for (const CalibrationParameter& p : h.parameters) json->Member(p.name, p.estimate);
+    json->EndObject();
+    json->Key("free").BeginArray();
+    for (const CalibrationParameter& p : h.parameters) {
+      if (p.free) json->Value(p.name);
+    }
+    json->EndArray();
+    json->EndObject();
+  }
+  json->EndArray();
+  json->EndObject();
+}
+
+void WriteCalibrationFiles(const CalibrationReport& report, const Settings& settings,
+                           const std::filesystem::path& out_dir) {
+  const std::filesystem::path dir = out_dir / "calibration";
+  const RigCalibration& e = report.estimate;
+  const double rate = settings.fps > 0 ? settings.fps : 20.0;
+  const double shift = IsInertial(report.sensor) ? e.time_offset_s : 0.0;
+  const std::string comment = fmt::format(
+      "pkslam calibration estimate ({}; the calibration file's values {})",
+      report.online ? "--calibrate online" : "--calibrate off",
+      report.online ? "refined while mapping" : "as read");
+  for (std::size_t c = 0; c < e.cameras.size() && c < 2; ++c) {
+    const SE3d body_from_camera = c == 0 ? e.body_from_cam0 : e.body_from_cam1();
+    std::filesystem::create_directories(dir / fmt::format("cam{}", c));
+    WriteFileAtomically(dir / fmt::format("cam{}", c) / "sensor.yaml",
+                        EurocCameraSensorYaml(SensorOf(e.cameras[c], body_from_camera, rate,
+                                                       c == 0 ? shift : 0.0),
+                                              comment + fmt::format(", cam{}", c)));
+  }
+  WriteOrbSlam3Settings(SettingsWithCalibration(settings, e), dir / "settings.yaml");
+}
+
+}  // namespace pkslam

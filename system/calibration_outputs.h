@@ -1,0 +1,54 @@
+// What a run reports about its calibration (docs/calibration.md): the stats.json "calibration"
+// section (each parameter's file value, estimate, sigma and whether it was freed; why the others
+// stayed frozen; every adjustment of the run), one warning line per file value the estimate
+// contradicts, and OUT/calibration/ with the estimate as EuRoC sensor.yaml files and an
+// ORB-SLAM3 settings file, to feed back to pkslam or to another system.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/util/json_writer.h"
+#include "io/settings.h"
+#include "mapping/calibration_refinement.h"
+
+namespace pkslam {
+
+struct CalibrationReport {
+  bool online = false;
+  Sensor sensor = Sensor::kStereo;
+  RigCalibration file;
+  RigCalibration estimate;
+  // The final estimate's parameters (sigmas when covariance_ok) and the gates of the final
+  // adjustment (empty without one).
+  std::vector<CalibrationParameter> parameters;
+  bool covariance_ok = false;
+  std::map<std::string, std::string> frozen;
+  std::vector<CalibrationRefinementStat> history;
+};
+
+// Where each parameter group came from, for the warnings: the settings file, or a EuRoC
+// dataset's sensor.yaml files.
+struct CalibrationSources {
+  std::string cam0, cam1, imu, time_offset;
+};
+CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings);
+CalibrationSources SourcesFromEurocDataset(const std::filesystem::path& dataset);
+
+// A warning per free parameter whose file value is more than `threshold` sigmas from the
+// estimate (needs sigmas), naming the parameter, the size and the file.
+std::vector<std::string> CalibrationWarnings(const CalibrationReport& report,
+                                             const CalibrationSources& sources,
+                                             double threshold = 3.0);
+
+void WriteCalibrationJson(const CalibrationReport& report,
+                          const std::vector<std::string>& warnings, JsonWriter* json);
+
+// OUT/calibration/{cam0,cam1}/sensor.yaml (EuRoC; cam0's with timeshift_cam_imu for inertial
+// sensors) and OUT/calibration/settings.yaml (ORB-SLAM3 v1.0, `settings` with the estimate).
+void WriteCalibrationFiles(const CalibrationReport& report, const Settings& settings,
+                           const std::filesystem::path& out_dir);
+
+}  // namespace pkslam
