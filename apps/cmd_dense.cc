@@ -24,6 +24,7 @@ struct DenseArgs {
   std::string run;
   std::string dataset;
   std::string settings;
+  bool file_calibration = false;
   std::string out;
   std::string json;
   std::string mesh;
@@ -41,9 +42,16 @@ void RunDense(const DenseArgs& args) {
     throw InputError(keyframes_file, "no keyframes.txt (is this a `pkslam run` output?)");
   }
   const Trajectory keyframes = ReadTrajectory(keyframes_file, TrajectoryFormat::kTum);
-  const auto source = dense::KeyframeImageSource::Open(
-      args.dataset, args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings),
-      args.options.full_view);
+  // The keyframe poses are poses of the run's rectified camera, built from the calibration the
+  // run ended with (RUN/calibration/settings.yaml: the file's, or its online estimate).
+  std::optional<fs::path> settings;
+  if (!args.settings.empty()) {
+    settings = args.settings;
+  } else if (!args.file_calibration && fs::exists(fs::path(args.run) / "calibration" / "settings.yaml")) {
+    settings = fs::path(args.run) / "calibration" / "settings.yaml";
+  }
+  const auto source =
+      dense::KeyframeImageSource::Open(args.dataset, settings, args.options.full_view);
   RequireRunOfDataset(args.run, args.dataset);
   std::optional<dense::MeshStats> mesh;
   dense::DenseStats stats;
@@ -186,7 +194,11 @@ void RegisterDenseCommand(CLI::App& app) {
   cmd->add_option("--mesh-truncation", args->mesh_options.truncation_m,
                   "TSDF truncation distance (m)")
       ->capture_default_str();
-  cmd->add_option("--settings", args->settings, "The settings file the run used (if any)");
+  cmd->add_option("--settings", args->settings,
+                  "Settings for the images (default: RUN/calibration/settings.yaml, the "
+                  "calibration the run ended with; else as `pkslam run`)");
+  cmd->add_flag("--file-calibration", args->file_calibration,
+                "Rectify with the dataset's calibration files even if the run estimated its own");
   dense::DenseOptions& o = args->options;
   cmd->add_option("--voxel", o.voxel_m, "Voxel side (m)")->capture_default_str();
   cmd->add_option("--max-depth", o.max_depth_m, "Largest depth used (m; 0: 4 m)")

@@ -23,6 +23,7 @@ struct CommandExit {
 void RegisterEvalCommand(CLI::App& app);
 void RegisterInfoCommand(CLI::App& app);
 void RegisterRunCommand(CLI::App& app);
+void RegisterCalibrateCommand(CLI::App& app);
 void RegisterMapCommand(CLI::App& app);
 void RegisterTracksCommand(CLI::App& app);
 void RegisterViewCommand(CLI::App& app);

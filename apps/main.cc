@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterEvalCommand(app);
   pkslam::apps::RegisterInfoCommand(app);
   pkslam::apps::RegisterRunCommand(app);
+  pkslam::apps::RegisterCalibrateCommand(app);
   pkslam::apps::RegisterMapCommand(app);
   pkslam::apps::RegisterTracksCommand(app);
   pkslam::apps::RegisterViewCommand(app);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -154,8 +155,25 @@ CameraModel KeyframeImageSource::PinholeCamera() const {
 
 std::optional<std::size_t> KeyframeImageSource::FindFrame(std::int64_t t_ns) const {
   const auto it = std::lower_bound(timestamps_.begin(), timestamps_.end(), t_ns);
-  if (it == timestamps_.end() || *it != t_ns) return std::nullopt;
-  return static_cast<std::size_t>(it - timestamps_.begin());
+  if (it != timestamps_.end() && *it == t_ns) {
+    return static_cast<std::size_t>(it - timestamps_.begin());
+  }
+  // Inertial runs with a camera-IMU time offset stamp their poses on the IMU clock (image stamp
+  // + offset, a few ms): the nearest image within a quarter of the frame interval is the one.
+  if (timestamps_.size() < 2) return std::nullopt;
+  const std::int64_t tolerance = (timestamps_.back() - timestamps_.front()) /
+                                 static_cast<std::int64_t>(timestamps_.size() - 1) / 4;
+  std::optional<std::size_t> best;
+  std::int64_t best_gap = tolerance + 1;
+  for (auto candidate : {it, it == timestamps_.begin() ? it : it - 1}) {
+    if (candidate == timestamps_.end()) continue;
+    const std::int64_t gap = std::abs(*candidate - t_ns);
+    if (gap < best_gap) {
+      best_gap = gap;
+      best = static_cast<std::size_t>(candidate - timestamps_.begin());
+    }
+  }
+  return best;
 }
 
 KeyframeImages KeyframeImageSource::Load(std::size_t index) const {

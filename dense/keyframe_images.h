@@ -66,7 +66,8 @@ class KeyframeImageSource {
 
   // Frame timestamps (t_ns) in dataset order.
   const std::vector<std::int64_t>& timestamps() const { return timestamps_; }
-  // Index of the frame with exactly this timestamp.
+  // Index of the frame with this timestamp, or the nearest within a quarter of the frame
+  // interval (a pose stamped on the IMU clock: image stamp + the camera-IMU time offset).
   std::optional<std::size_t> FindFrame(std::int64_t t_ns) const;
   // Loads frame `index` (throws InputError for missing/corrupt image files).
   KeyframeImages Load(std::size_t index) const;

@@ -28,6 +28,11 @@ void OnlineCalibrationOptions::Check() const {
                       max_observations_per_keyframe);
   PKSLAM_CHECK_OPTION(iterations_first >= 1 && iterations_second >= 0, "calibration.iterations",
                       "{} / {}", iterations_first, iterations_second);
+  PKSLAM_CHECK_OPTION(final_max_observations_per_keyframe >= 0 && final_iterations_first >= 1 &&
+                          final_iterations_second >= 0,
+                      "calibration.final", "{} observations, {} / {} iterations",
+                      final_max_observations_per_keyframe, final_iterations_first,
+                      final_iterations_second);
   PKSLAM_CHECK_OPTION(first_after_s > 0, "calibration.first_after_s", "{}", first_after_s);
   PKSLAM_CHECK_OPTION(growth > 1, "calibration.growth", "{} (> 1)", growth);
   PKSLAM_CHECK_OPTION(min_keyframes >= 2, "calibration.min_keyframes", "{}", min_keyframes);

@@ -27,6 +27,11 @@ struct OnlineCalibrationOptions {
   // of them, most of them early, when the estimate moves most.
   double first_after_s = 8.0;
   double growth = 1.5;
+  // The final whole-map adjustment when the run ends (its sigmas are what the run reports):
+  // observations per keyframe (0: all; `pkslam calibrate`) and iterations.
+  int final_max_observations_per_keyframe = 150;
+  int final_iterations_first = 8;
+  int final_iterations_second = 4;
   // Too few keyframes tell too little.
   int min_keyframes = 10;
   // Observability gates (DecideFreedom). Camera-IMU rotation: the angular rate about the

@@ -91,6 +91,9 @@ struct RunSummary {
   // What the run's own signals say about its trajectory (suspect() when tracking was lost for
   // good or maps stayed apart).
   EstimateHealth estimate;
+  // The run's calibration (file, estimate, sigmas, adjustments) and its warnings.
+  CalibrationReport calibration;
+  std::vector<std::string> calibration_warnings;
 
   // Adds one tracked frame: frames, tracked, keyframe reasons, selector decisions, criteria.
   void Count(const TrackResult& result);

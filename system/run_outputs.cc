@@ -287,6 +287,8 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   const std::vector<std::string> calibration_warnings = CalibrationWarnings(calibration, sources);
   for (const std::string& w : calibration_warnings) PKSLAM_LOG_WARN("{}", w);
   WriteCalibrationFiles(calibration, system.settings(), out);
+  summary->calibration = calibration;
+  summary->calibration_warnings = calibration_warnings;
 
   JsonWriter json;
   json.BeginObject();

@@ -125,7 +125,7 @@ void SlamSystem::FinishCalibration() {
     const bool inertial =
         IsInertial(options_.sensor) && map->imu_status().inertial_ba1_done;
     CalibrationCollectOptions collect;
-    collect.max_observations_per_keyframe = o.max_observations_per_keyframe;
+    collect.max_observations_per_keyframe = o.final_max_observations_per_keyframe;
     setup = atlas_.rig_setup();
     problem = CollectCalibrationBundle(newest, inertial, setup, atlas_.calibration(),
                                        file_calibration_, collect);
@@ -135,8 +135,8 @@ void SlamSystem::FinishCalibration() {
   problem.free = final_gates_.free;
   if (!problem.free.Any() || problem.empty()) return;
   CalibrationBundleOptions ba;
-  ba.iterations_first = o.iterations_first;
-  ba.iterations_second = o.iterations_second;
+  ba.iterations_first = o.final_iterations_first;
+  ba.iterations_second = o.final_iterations_second;
   ba.num_threads = options_.mapping.ba.num_threads;
   ba.prior = o.prior;
   CalibrationBundleResult result = SolveCalibrationBundle(problem, ba);
@@ -217,12 +217,26 @@ SlamSystem::MapFileInfo SlamSystem::SaveMap(const std::filesystem::path& file) c
 SlamSystem::MapFileInfo SlamSystem::LoadMap(const std::filesystem::path& file) {
   const auto start = std::chrono::steady_clock::now();
   const AtlasRecord record = ReadMapFile(file);
-  CheckCompatible(file, record, vocabulary_->Fingerprint(), *setup_.rig);
+  // A map whose calibration was estimated online is in that calibration: the session continues
+  // in it (the settings' values stay the prior), provided it is the same rig.
+  RigCalibration calibration = file_calibration_;
+  RigSetup setup = setup_;
+  if (record.calibration) {
+    try {
+      calibration = FromCalibrationRecord(*record.calibration);
+      CheckSameRig(file_calibration_, calibration);
+      setup = BuildRig(calibration, ShapeFromSettings(settings_, options_.sensor));
+    } catch (const OptionError& e) {
+      throw InputError(file, fmt::format("map built with another camera: {}", e.what()));
+    }
+  }
+  CheckCompatible(file, record, vocabulary_->Fingerprint(), *setup.rig);
   if (record.maps.empty()) throw InputError(file, "the map file holds no map");
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kLoadMap);
+    atlas_.SetCalibration(calibration, setup);
     try {
-      AtlasStorage::Restore(record, setup_.rig, &atlas_);
+      AtlasStorage::Restore(record, setup.rig, &atlas_);
     } catch (const InputError&) {
       throw;
     } catch (const Error& e) {
@@ -235,6 +249,7 @@ SlamSystem::MapFileInfo SlamSystem::LoadMap(const std::filesystem::path& file) {
       atlas_.CreateNewMap();  // this session's map; loop closing merges it when it recognises one
     }
   }
+  SyncCalibration();
   session_first_keyframe_id_ = record.next_keyframe_id;
   if (options_.tracking.localise_only) tracker_->StartLocalisation();
   MapFileInfo info = CountMaps(record);

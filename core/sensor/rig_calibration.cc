@@ -34,6 +34,37 @@ std::optional<Eigen::Vector2d> Distorted(const CameraModel& camera, const Eigen:
 
 }  // namespace
 
+void CheckSameRig(const RigCalibration& file, const RigCalibration& estimate) {
+  PKSLAM_CHECK_OPTION(file.cameras.size() == estimate.cameras.size(), "calibration",
+                      "{} cameras, expected {}", estimate.cameras.size(), file.cameras.size());
+  for (std::size_t c = 0; c < file.cameras.size(); ++c) {
+    const CameraModel& a = file.cameras[c];
+    const CameraModel& b = estimate.cameras[c];
+    PKSLAM_CHECK_OPTION(a.width() == b.width() && a.height() == b.height(), "calibration",
+                        "cam{} is {}x{}, expected {}x{}", c, b.width(), b.height(), a.width(),
+                        a.height());
+    PKSLAM_CHECK_OPTION(std::abs(b.fx() / a.fx() - 1) <= 0.03 && std::abs(b.fy() / a.fy() - 1) <= 0.03,
+                        "calibration", "cam{} focal length {} / {}, expected {} / {} (within 3%)",
+                        c, b.fx(), b.fy(), a.fx(), a.fy());
+    PKSLAM_CHECK_OPTION(std::abs(b.cx() - a.cx()) <= 20 && std::abs(b.cy() - a.cy()) <= 20,
+                        "calibration", "cam{} principal point ({}, {}), expected ({}, {}) (within "
+                        "20 px)",
+                        c, b.cx(), b.cy(), a.cx(), a.cy());
+  }
+  const auto check_extrinsic = [](const char* name, const SE3d& a, const SE3d& b) {
+    const SE3d d = a.Inverse() * b;
+    PKSLAM_CHECK_OPTION(d.so3().Log().norm() <= 3.0 * M_PI / 180.0 && d.translation().norm() <= 0.03,
+                        "calibration", "{} differs by {:.2f} deg and {:.1f} mm (within 3 deg, 30 "
+                        "mm)",
+                        name, d.so3().Log().norm() * 180.0 / M_PI, d.translation().norm() * 1e3);
+  };
+  check_extrinsic("body_from_cam0", file.body_from_cam0, estimate.body_from_cam0);
+  if (file.stereo()) check_extrinsic("cam1_from_cam0", file.cam1_from_cam0, estimate.cam1_from_cam0);
+  PKSLAM_CHECK_OPTION(std::abs(file.time_offset_s - estimate.time_offset_s) <= 0.05, "calibration",
+                      "time offset {} s, expected {} s (within 50 ms)", estimate.time_offset_s,
+                      file.time_offset_s);
+}
+
 RigSetup BuildRig(const RigCalibration& calibration, const RigShape& shape) {
   PKSLAM_CHECK_OPTION(!calibration.cameras.empty(), "calibration", "no camera");
   RigSetup setup;

@@ -67,6 +67,13 @@ struct RigSetup {
   std::optional<StereoRectification> rectification;
 };
 
+// Whether `estimate` can be a calibration of the rig `file` describes, not of another camera:
+// same cameras and image sizes, focal lengths within 3%, principal points within 20 px,
+// extrinsics within 3 deg and 3 cm, time offsets within 50 ms (several times the error of a
+// bad calibration, far below the difference between two rigs). Throws OptionError naming the
+// first difference.
+void CheckSameRig(const RigCalibration& file, const RigCalibration& estimate);
+
 // Throws OptionError for calibrations the pipeline cannot track with (fisheye tracking camera,
 // stereo without a second camera, a vertical or swapped stereo pair).
 RigSetup BuildRig(const RigCalibration& calibration, const RigShape& shape);

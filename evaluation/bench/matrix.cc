@@ -17,13 +17,14 @@ struct Config {
   bool dense = false;
   std::vector<std::string> peer_command;
   std::vector<std::string> peer_sensors;  // empty: all
+  std::vector<std::string> run_args;
 };
 
 // The configurations run on `dataset`: the suite's selectors, then the sweep points.
 std::vector<Config> Configurations(const Suite& suite, const std::string& dataset) {
   std::vector<Config> out;
   for (const auto& sel : suite.selectors) {
-    Config c{sel.label, sel.name, suite.params, "", 0.0, suite.dense, {}, {}};
+    Config c{sel.label, sel.name, suite.params, "", 0.0, suite.dense, {}, {}, sel.args};
     for (const auto& [k, v] : sel.params) c.params[k] = v;
     out.push_back(c);
   }
@@ -45,7 +46,8 @@ std::vector<Config> Configurations(const Suite& suite, const std::string& datase
                v,
                suite.dense || sw.dense,
                {},
-               {}};
+               {},
+               base->args};
       for (const auto& [k, x] : base->params) c.params[k] = x;
       c.params[sw.param] = v;
       out.push_back(c);
@@ -102,6 +104,7 @@ std::vector<RunSpec> ExpandSuite(const Suite& suite) {
           r.sweep_value = c.sweep_value;
           r.dense = c.dense;
           r.peer_command = c.peer_command;
+          r.run_args = c.run_args;
           r.run = k;
           r.seed = suite.seed + static_cast<std::uint64_t>(k);
           if (d.sim) {

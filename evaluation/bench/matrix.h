@@ -22,6 +22,7 @@ struct RunSpec {
   std::string config;    // selector label, plus @PARAM=VALUE for sweep points
   std::string selector;  // selector factory name
   std::map<std::string, double> params;  // suite params, then selector params, then sweep
+  std::vector<std::string> run_args;     // the configuration's further `pkslam run` options
   std::string sweep_param;               // empty unless a sweep point
   double sweep_value = 0.0;
   bool dense = false;  // build the run's dense cloud after it

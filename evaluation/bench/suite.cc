@@ -178,11 +178,15 @@ SelectorSpec ParseSelector(const Context& c, const YAML::Node& node) {
   if (node.IsScalar()) {
     s.name = String(c, node, "selectors");
   } else {
-    CheckKeys(c, node, "a selector", {"name", "label", "params"});
+    CheckKeys(c, node, "a selector", {"name", "label", "params", "args"});
     if (!node["name"]) c.Fail(node, "selector without 'name'");
     s.name = String(c, node["name"], "name");
     if (node["label"]) s.label = String(c, node["label"], "label");
     if (node["params"]) s.params = Params(c, node["params"]);
+    if (node["args"]) {
+      if (!node["args"].IsSequence()) c.Fail(node["args"], "'args' must be a list of strings");
+      for (const YAML::Node& a : node["args"]) s.args.push_back(String(c, a, "args"));
+    }
   }
   if (s.label.empty()) s.label = s.name;
   if (s.name.empty() || s.label.find_first_of("/\\ \t@") != std::string::npos) {

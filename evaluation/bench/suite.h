@@ -9,7 +9,8 @@
 //   baseline: orbslam3          # selector label relative improvements are measured against
 //   alignment: auto             # headline ATE: se3 | sim3 | auto (sim3 for mono sensors)
 //   sensors: [stereo, mono]     # passed through to `pkslam run --sensor`
-//   selectors: [orbslam3, pks, {name: pks, label: pks-strict, params: {tau: 0.3}}]
+//   selectors: [orbslam3, pks, {name: pks, label: pks-strict, params: {tau: 0.3}},
+//               {name: orbslam3, label: online, args: [--calibrate, online]}]
 //   params: {name: value}       # overrides for every run (pkslam run --param)
 //   dense: false                # build a dense cloud of every run (pkslam dense)
 //   sweeps: [{selector: pks, param: delta, values: [10, 20, 30, 40], datasets: [V101],
@@ -73,6 +74,8 @@ struct SelectorSpec {
   std::string name;   // selector_factory name (orbslam3, pks, ...)
   std::string label;  // unique label in tables; default: the name
   std::map<std::string, double> params;
+  // Further `pkslam run` options of this configuration, verbatim (e.g. [--calibrate, online]).
+  std::vector<std::string> args;
 };
 
 // One parameter swept over values for one selector; each value is its own configuration.

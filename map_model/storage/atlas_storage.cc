@@ -53,6 +53,9 @@ AtlasRecord AtlasStorage::Snapshot(const Atlas& atlas, const CameraRig& rig,
   out.camera.cy = rig.cy;
   out.camera.bf = rig.bf;
   out.camera.body_from_camera = rig.body_from_camera;
+  if (!atlas.calibration().cameras.empty()) {
+    out.calibration = ToCalibrationRecord(atlas.calibration());
+  }
   out.current_map = atlas.current_ != nullptr ? atlas.current_->id() : -1;
   out.next_map_id = atlas.next_map_id_;
   out.next_frame_id = atlas.next_frame_id_.load();
@@ -111,6 +114,9 @@ AtlasRecord AtlasStorage::Snapshot(const Atlas& atlas, const CameraRig& rig,
       k.imu_next = Saved(kf->imu.next, map.get()) ? kf->imu.next->id() : kInvalidId;
       k.imu_state = kf->imu.state;
       k.imu_prior = kf->imu.prior;
+      if (kf->imu.time_offset_s != 0.0 && out.calibration) {
+        out.calibration->keyframe_time_offsets.emplace_back(kf->id(), kf->imu.time_offset_s);
+      }
     }
     for (const auto& [id, point] : map->map_points_) {
       if (point->IsBad()) continue;
@@ -136,6 +142,12 @@ AtlasRecord AtlasStorage::Snapshot(const Atlas& atlas, const CameraRig& rig,
 
 void AtlasStorage::Restore(const AtlasRecord& record, std::shared_ptr<const CameraRig> rig,
                            Atlas* atlas) {
+  std::map<KeyFrameId, double> time_offsets;
+  if (record.calibration) {
+    for (const auto& [id, offset] : record.calibration->keyframe_time_offsets) {
+      time_offsets[id] = offset;
+    }
+  }
   for (const auto& map : atlas->maps_) {
     PKSLAM_CHECK(map->keyframes_.empty() && map->map_points_.empty(),
                  "a map file loads into a new system only (map {} is not empty)", map->id_);
@@ -172,6 +184,7 @@ void AtlasStorage::Restore(const AtlasRecord& record, std::shared_ptr<const Came
       kf->imu.from_previous = k.imu_from_previous;
       kf->imu.state = k.imu_state;
       kf->imu.prior = k.imu_prior;
+      kf->imu.time_offset_s = time_offsets.count(k.id) > 0 ? time_offsets.at(k.id) : 0.0;
       keyframes[k.id] = kf.get();
       map->keyframes_[k.id] = kf;
     }
@@ -253,6 +266,33 @@ void AtlasStorage::Restore(const AtlasRecord& record, std::shared_ptr<const Came
       atlas->current_ = atlas->maps_.back().get();
     }
   }
+}
+
+}  // namespace pkslam
+
+namespace pkslam {
+
+CalibrationRecord ToCalibrationRecord(const RigCalibration& calibration) {
+  CalibrationRecord r;
+  for (const CameraModel& c : calibration.cameras) {
+    r.cameras.push_back({c.width(), c.height(), c.fx(), c.fy(), c.cx(), c.cy(), c.distortion()});
+  }
+  r.body_from_cam0 = calibration.body_from_cam0;
+  r.cam1_from_cam0 = calibration.cam1_from_cam0;
+  r.time_offset_s = calibration.time_offset_s;
+  return r;
+}
+
+RigCalibration FromCalibrationRecord(const CalibrationRecord& record) {
+  RigCalibration c;
+  for (const CalibrationRecord::Camera& r : record.cameras) {
+    c.cameras.push_back(
+        CameraModel::Pinhole(r.width, r.height, r.fx, r.fy, r.cx, r.cy, r.distortion));
+  }
+  c.body_from_cam0 = record.body_from_cam0;
+  c.cam1_from_cam0 = record.cam1_from_cam0;
+  c.time_offset_s = record.time_offset_s;
+  return c;
 }
 
 }  // namespace pkslam

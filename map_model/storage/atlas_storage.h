@@ -28,4 +28,9 @@ class AtlasStorage {
                       Atlas* atlas);
 };
 
+// The calibration of a map file and back (AtlasRecord::calibration).
+CalibrationRecord ToCalibrationRecord(const RigCalibration& calibration);
+// Throws OptionError when a recorded camera is not a valid pinhole.
+RigCalibration FromCalibrationRecord(const CalibrationRecord& record);
+
 }  // namespace pkslam

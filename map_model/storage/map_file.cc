@@ -131,6 +131,14 @@ void serialize(Archive& ar, AtlasRecord& a) {
   ar(a.vocabulary_fingerprint, a.camera, a.current_map, a.next_map_id, a.next_frame_id,
      a.next_keyframe_id, a.next_point_id, a.maps);
 }
+template <class Archive>
+void serialize(Archive& ar, CalibrationRecord::Camera& c) {
+  ar(c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.distortion);
+}
+template <class Archive>
+void serialize(Archive& ar, CalibrationRecord& c) {
+  ar(c.cameras, c.body_from_cam0, c.cam1_from_cam0, c.time_offset_s, c.keyframe_time_offsets);
+}
 
 namespace {
 
@@ -173,6 +181,7 @@ void WriteMapFile(const std::filesystem::path& file, const AtlasRecord& record) 
   {
     cereal::PortableBinaryOutputArchive archive(payload_stream);
     archive(record);
+    archive(record.calibration);  // version 2
   }
   const std::string payload = payload_stream.str();
   std::string out;
@@ -193,9 +202,10 @@ AtlasRecord ReadMapFile(const std::filesystem::path& file) {
     throw InputError(file, "not a pkslam map file (no PKSLAMAP header)");
   }
   const auto version = GetLittleEndian<std::uint32_t>(bytes, 8);
-  if (version != kMapFileVersion) {
-    throw InputError(file, fmt::format("map file format version {}, this pkslam reads version {}",
-                                       version, kMapFileVersion));
+  if (version < kOldestMapFileVersion || version > kMapFileVersion) {
+    throw InputError(file, fmt::format("map file format version {}, this pkslam reads versions "
+                                       "{}-{}",
+                                       version, kOldestMapFileVersion, kMapFileVersion));
   }
   const auto size = GetLittleEndian<std::uint64_t>(bytes, 12);
   const auto crc = GetLittleEndian<std::uint32_t>(bytes, 20);
@@ -213,6 +223,7 @@ AtlasRecord ReadMapFile(const std::filesystem::path& file) {
     std::istringstream payload_stream(std::string(payload), std::ios::binary);
     cereal::PortableBinaryInputArchive archive(payload_stream);
     archive(record);
+    if (version >= 2) archive(record.calibration);
   } catch (const std::exception& e) {
     throw InputError(file, fmt::format("map file payload does not decode: {}", e.what()));
   }

@@ -21,7 +21,10 @@
 
 namespace pkslam {
 
-inline constexpr std::uint32_t kMapFileVersion = 1;
+// Version 2 appends the map's calibration (AtlasRecord::calibration) to version 1's payload;
+// version 1 files still read (without one).
+inline constexpr std::uint32_t kMapFileVersion = 2;
+inline constexpr std::uint32_t kOldestMapFileVersion = 1;
 
 // Writes atomically (a partial file never replaces a good one). Throws OutputError.
 void WriteMapFile(const std::filesystem::path& file, const AtlasRecord& record);

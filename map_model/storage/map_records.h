@@ -6,7 +6,7 @@
 // features, descriptors, BoW and feature vectors, poses, point-keyframe observations, the
 // covisibility graph with its weights, the spanning tree, loop edges, the inertial chain with
 // its preintegrations, states and marginalisation priors, each map's IMU status and world-change
-// log, the id counters, and the camera the map was built with.
+// log, the id counters, the camera the map was built with and its calibration.
 #pragma once
 
 #include <Eigen/Core>
@@ -103,9 +103,27 @@ struct CameraRecord {
   SE3d body_from_camera;
 };
 
+// The calibration the map's keypoints are in (online calibration: an estimate, not the file's;
+// map file version 2). Cameras as CameraModel::Pinhole arguments.
+struct CalibrationRecord {
+  struct Camera {
+    std::int32_t width = 0, height = 0;
+    double fx = 0, fy = 0, cx = 0, cy = 0;
+    std::vector<double> distortion;
+  };
+  std::vector<Camera> cameras;
+  SE3d body_from_cam0;
+  SE3d cam1_from_cam0;
+  double time_offset_s = 0;
+  // Keyframes tracked with a non-zero time offset (KeyFrameImu::time_offset_s).
+  std::vector<std::pair<KeyFrameId, double>> keyframe_time_offsets;
+};
+
 struct AtlasRecord {
   std::uint64_t vocabulary_fingerprint = 0;
   CameraRecord camera;
+  // Version 2 files; absent in version 1 files (the rig's calibration was the settings').
+  std::optional<CalibrationRecord> calibration;
   MapId current_map = -1;
   MapId next_map_id = 0;
   FrameId next_frame_id = 0;
