@@ -137,6 +137,9 @@ void RegisterRunCommand(CLI::App& app) {
          "calibration as exact")
       ->check(CLI::IsMember({"online", "off"}))
       ->default_str("off");
+  cmd->add_flag("--calibrate-lever-arm", args->options.system.mapping.calibration.imu_translation,
+                "--calibrate online: estimate the camera-IMU translation too (held at the file's "
+                "value by default; docs/calibration.md)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_option("--mapping-sync", args->options.mapping_sync,
                   "How tracking meets local mapping: live (offline default: local mapping as a "
@@ -198,6 +201,14 @@ void RegisterRunCommand(CLI::App& app) {
     if (const char* v = std::getenv("PKSLAM_CALIB_IT1")) o.system.mapping.calibration.iterations_first = std::atoi(v);  // TEMPORARY
     if (const char* v = std::getenv("PKSLAM_CALIB_IT2")) o.system.mapping.calibration.iterations_second = std::atoi(v);  // TEMPORARY
     if (const char* v = std::getenv("PKSLAM_CALIB_FIRST")) o.system.mapping.calibration.first_after_s = std::atof(v);  // TEMPORARY
+    if (const char* v = std::getenv("PKSLAM_CALIB_LEVER")) o.system.mapping.calibration.min_lever_rotation_rate = std::atof(v);  // TEMPORARY
+    if (std::getenv("PKSLAM_CALIB_NOINTR")) o.system.mapping.calibration.min_covered_cells = 16, o.system.mapping.calibration.min_cell_observations = 1000000;  // TEMPORARY
+    if (std::getenv("PKSLAM_CALIB_NOSTEREO")) o.system.mapping.calibration.min_stereo_observations = 100000000;  // TEMPORARY
+    if (std::getenv("PKSLAM_CALIB_NOROT")) o.system.mapping.calibration.min_rotation_rate = 1000;  // TEMPORARY
+    if (std::getenv("PKSLAM_CALIB_NOTD")) o.system.mapping.calibration.min_turn_rate = 1000, o.system.mapping.calibration.min_speed = 1000;  // TEMPORARY
+    if (const char* v = std::getenv("PKSLAM_CALIB_FINALOBS")) o.system.mapping.calibration.final_max_observations_per_keyframe = std::atoi(v);  // TEMPORARY
+    if (const char* v = std::getenv("PKSLAM_CALIB_FOCAL")) o.system.mapping.calibration.prior.focal_px = std::atof(v);  // TEMPORARY
+    if (const char* v = std::getenv("PKSLAM_CALIB_PP")) o.system.mapping.calibration.prior.principal_point_px = std::atof(v);  // TEMPORARY
     if (const char* v = std::getenv("PKSLAM_CALIB_GROWTH")) o.system.mapping.calibration.growth = std::atof(v);  // TEMPORARY
     RunControl control;
     control.interrupt = &interrupted;

@@ -99,8 +99,22 @@ CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertia
   if (newest == nullptr || newest->IsBad() || newest->map() == nullptr) return problem;
   const Map& map = *newest->map();
   if (inertial) {
+    // The chain ends at the newest keyframe joined to its predecessor: the very last keyframes
+    // of a sequence may have no preintegration (the IMU log ends with the images).
+    KeyFrame* end = newest;
+    std::size_t longest = 0;
+    int tried = 0;
+    for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend() && tried < 10;
+         ++it, ++tried) {
+      if (it->second->IsBad() || it->second->id() > newest->id()) continue;
+      const std::size_t length = InertialChain(it->second.get(), 0).size();
+      if (length > longest) {
+        longest = length;
+        end = it->second.get();
+      }
+    }
     InertialBundleOptions ba;
-    problem.bundle = CollectFullInertialBundle(newest, ba, /*free_tilt=*/false);
+    problem.bundle = CollectFullInertialBundle(end, ba, /*free_tilt=*/false);
     problem.inertial = !problem.bundle.edges.empty();
   }
   if (!problem.inertial) {

@@ -20,8 +20,9 @@ struct CalibrationCollectOptions {
 };
 
 // Requires the Atlas mutex (shared). Inertial maps (`inertial` and an initialised chain ending
-// at `newest`): the chain as a full visual-inertial BA (first keyframe fixed; keyframes off the
-// chain fixed, visual only); otherwise every live keyframe of newest's map (the first fixed).
+// at `newest`, or at the one of the ten keyframes before it with the longest chain): the chain
+// as a full visual-inertial BA (first keyframe fixed; keyframes off the chain fixed, visual
+// only); otherwise every live keyframe of newest's map (the first fixed).
 // `setup` is the rig the map's keypoints are in (all keyframes share it); `current` its
 // calibration, `file` the calibration file's (the prior). The problem's freedom is left empty.
 CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertial,

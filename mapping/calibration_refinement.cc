@@ -33,6 +33,7 @@ void OnlineCalibrationOptions::Check() const {
                       "calibration.final", "{} observations, {} / {} iterations",
                       final_max_observations_per_keyframe, final_iterations_first,
                       final_iterations_second);
+  PKSLAM_CHECK_OPTION(min_iterations >= 0, "calibration.min_iterations", "{}", min_iterations);
   PKSLAM_CHECK_OPTION(first_after_s > 0, "calibration.first_after_s", "{}", first_after_s);
   PKSLAM_CHECK_OPTION(growth > 1, "calibration.growth", "{} (> 1)", growth);
   PKSLAM_CHECK_OPTION(min_keyframes >= 2, "calibration.min_keyframes", "{}", min_keyframes);
@@ -133,7 +134,9 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
         fmt::format("rotation about one axis only (second axis {:.3f} rad/s, at least {})",
                     g.second_axis_rate, options.min_rotation_rate);
   }
-  if (g.second_axis_rate >= options.min_lever_rotation_rate) {
+  if (!options.imu_translation) {
+    g.frozen["imu_translation"] = "held at the file's value (--calibrate-lever-arm estimates it)";
+  } else if (g.second_axis_rate >= options.min_lever_rotation_rate) {
     g.free.imu_translation = true;
   } else {
     g.frozen["imu_translation"] =

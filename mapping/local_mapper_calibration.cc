@@ -71,6 +71,7 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
   ba.iterations_second = o.iterations_second;
   ba.num_threads = options_.ba.num_threads;
   ba.covariance = false;
+  ba.min_iterations_before_abort = o.min_iterations;
   ba.prior = o.prior;
   const CalibrationBundleResult result = SolveCalibrationBundle(problem, ba, &abort_ba_);
   stat.iterations = result.bundle.visual.iterations;

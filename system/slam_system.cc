@@ -131,6 +131,9 @@ void SlamSystem::FinishCalibration() {
                                        file_calibration_, collect);
     collected_from = map;
   }
+  PKSLAM_LOG_INFO("final calibration adjustment: {} keyframes, {} observations, {} inertial edges{}",
+                  problem.bundle.visual.keyframes.size(), problem.raw.size(),
+                  problem.bundle.edges.size(), problem.inertial ? "" : " (visual only)");
   final_gates_ = DecideFreedom(problem, options_.sensor, o);
   problem.free = final_gates_.free;
   if (!problem.free.Any() || problem.empty()) return;

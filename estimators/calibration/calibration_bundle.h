@@ -1,8 +1,10 @@
 // Calibration bundle adjustment: a full (visual or visual-inertial) bundle adjustment that also
 // estimates the rig's calibration (docs/calibration.md): each camera's intrinsics (fx, fy, cx,
 // cy, k1, k2; the right camera's fy and cy stay, as its vertical coordinate is not measured),
-// the stereo extrinsic cam1_from_cam0, the camera-IMU extrinsic cam0_from_body and the
-// camera-IMU time offset, each held to the calibration file's value by a Gaussian prior.
+// the stereo extrinsic's rotation about the y and z axes (its translation is the map's scale
+// and its rotation about x moves only rows: both stay), the camera-IMU extrinsic cam0_from_body
+// and the camera-IMU time offset, each held to the calibration file's value by a Gaussian
+// prior.
 //
 // Why a separate, whole-map adjustment rather than free calibration blocks in local BA: a
 // 10-keyframe window barely sees a camera-IMU rotation or a time offset (they need the motion of
@@ -86,6 +88,9 @@ struct CalibrationBundleOptions {
   double gravity_magnitude = 9.81;
   // Compute the marginal covariance of the calibration (sigma in the report).
   bool covariance = true;
+  // An abort request is obeyed from this iteration on: an adjustment interrupted by every new
+  // keyframe would otherwise never move the calibration on a busy map.
+  int min_iterations_before_abort = 0;
   CalibrationPriorOptions prior;
 
   void Check() const;
@@ -120,9 +125,11 @@ struct CalibrationBundleProblem {
   bool empty() const { return bundle.visual.observations.empty(); }
 };
 
-// One estimated scalar of the calibration, for reports. Extrinsic entries are components of the
-// tangent of the change from the prior (left perturbation: rotation in deg, translation in mm,
-// in cam0 coordinates for the IMU extrinsic, cam1 coordinates for the stereo one).
+// One estimated scalar of the calibration, for reports. Extrinsic entries are the change of the
+// transform a calibration file holds, as a user would edit it: imu.* of body_from_cam0 (EuRoC's
+// cam0 T_BS, ORB-SLAM3's IMU.T_b_c1), stereo.* of cam0_from_cam1 (ORB-SLAM3's Stereo.T_c1_c2,
+// cam1's position in cam0): r* the rotation vector of R_estimate R_file^T (deg), t* the
+// translation difference (mm), both in the parent frame's axes (body, cam0).
 struct CalibrationParameter {
   std::string name;  // cam0.fx, cam1.k1, stereo.rx, imu.tz, time_offset_ms, ...
   std::string unit;  // px, "", deg, mm, ms

@@ -64,38 +64,48 @@ void CopyArray(const std::array<double, kCalibIntrinsicsSize>& a, double* out) {
 // parameters' sigmas. False when Ceres cannot compute it (rank-deficient Jacobian).
 bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundleProblem& problem,
                 int num_threads, std::vector<CalibrationParameter>* parameters) {
+  // A block's tangent covariance C maps to the reported scalars as J C J^T (report-ordered J).
   struct Entry {
     double* block;
-    int size;            // tangent size
-    int first;           // index of its first scalar in `parameters`
-    std::vector<int> map;  // tangent component -> offset from `first`
-    std::vector<double> scale;
-    bool intrinsics = false;  // covariance in ambient coordinates (frozen ones have none)
+    int first;          // index of its first scalar in `parameters`
+    Eigen::MatrixXd j;  // reported scalars x block tangent (units included)
+    bool ambient = false;  // intrinsics: Ceres' ambient covariance (frozen coordinates: 0)
   };
   std::vector<Entry> entries;
   int index = 0;
   for (int c = 0; c < static_cast<int>(problem.initial.cameras.size()) && c < 2; ++c) {
     if (problem.free.intrinsics[c]) {
-      entries.push_back({s->intrinsics(c), kCalibIntrinsicsSize, index, {0, 1, 2, 3, 4, 5},
-                         {1, 1, 1, 1, 1, 1}, true});
+      entries.push_back({s->intrinsics(c), index,
+                         Eigen::MatrixXd::Identity(kCalibIntrinsicsSize, kCalibIntrinsicsSize),
+                         true});
     }
     index += kCalibIntrinsicsSize;
   }
-  // Extrinsic tangents are [translation; rotation]; the report lists rotation first.
-  const std::vector<int> extrinsic_map = {3, 4, 5, 0, 1, 2};
-  const std::vector<double> extrinsic_scale = {1e3, 1e3, 1e3, kRadToDeg, kRadToDeg, kRadToDeg};
+  // The block B = X^-1 of the reported X = parent_from_child moves as Exp(e) B, so X moves as
+  // X Exp(-e): rotation vector -R_X phi, translation -R_X rho (first order).
+  const auto extrinsic_j = [](const SE3d& parent_from_child) {
+    Eigen::MatrixXd j = Eigen::MatrixXd::Zero(6, 6);
+    const Eigen::Matrix3d r = parent_from_child.RotationMatrix();
+    j.block<3, 3>(0, 3) = -r * kRadToDeg;
+    j.block<3, 3>(3, 0) = -r * 1e3;
+    return j;
+  };
   if (problem.initial.stereo()) {
     if (problem.free.stereo_extrinsic) {
-      entries.push_back({s->cam1_from_cam0(), 6, index, extrinsic_map, extrinsic_scale});
+      entries.push_back({s->cam1_from_cam0(), index,
+                         extrinsic_j(PoseFromBlock(s->cam1_from_cam0()).Inverse())});
     }
     index += 6;
   }
   if (problem.inertial) {
     if (problem.free.imu_rotation || problem.free.imu_translation) {
-      entries.push_back({s->cam0_from_body(), 6, index, extrinsic_map, extrinsic_scale});
+      entries.push_back({s->cam0_from_body(), index,
+                         extrinsic_j(PoseFromBlock(s->cam0_from_body()).Inverse())});
     }
     index += 6;
-    if (problem.free.time_offset) entries.push_back({s->offset(), 1, index, {0}, {1e3}});
+    if (problem.free.time_offset) {
+      entries.push_back({s->offset(), index, Eigen::MatrixXd::Constant(1, 1, 1e3)});
+    }
   }
   if (entries.empty()) return true;
   ceres::Covariance::Options options;
@@ -107,16 +117,16 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
   for (const Entry& e : entries) pairs.emplace_back(e.block, e.block);
   if (!covariance.Compute(pairs, ceres_problem)) return false;
   for (const Entry& e : entries) {
-    // Intrinsics in ambient coordinates (a frozen coordinate has zero variance there); the
-    // extrinsics in their 6-D tangent.
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(e.size, e.size);
-    if (!(e.intrinsics ? covariance.GetCovarianceMatrix({e.block}, m.data())
-                  : covariance.GetCovarianceMatrixInTangentSpace({e.block}, m.data()))) {
+    const int n = static_cast<int>(e.j.cols());
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(n, n);
+    if (!(e.ambient ? covariance.GetCovarianceMatrix({e.block}, m.data())
+                    : covariance.GetCovarianceMatrixInTangentSpace({e.block}, m.data()))) {
       return false;
     }
-    for (int i = 0; i < e.size; ++i) {
-      CalibrationParameter& p = (*parameters)[static_cast<std::size_t>(e.first + e.map[i])];
-      if (p.free) p.sigma = std::sqrt(std::max(0.0, m(i, i))) * e.scale[i];
+    const Eigen::MatrixXd reported = e.j * m * e.j.transpose();
+    for (int i = 0; i < reported.rows(); ++i) {
+      CalibrationParameter& p = (*parameters)[static_cast<std::size_t>(e.first + i)];
+      if (p.free) p.sigma = std::sqrt(std::max(0.0, reported(i, i)));
     }
   }
   return true;
@@ -158,6 +168,11 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
   PoseToBlock(problem.initial.cam1_from_cam0, s.cam1_from_cam0());
   *s.offset() = problem.initial.time_offset_s;
 
+  // cam1's fy and cy follow cam0's at the file's differences (CalibratedRightError).
+  const Eigen::Vector2d vertical_offset =
+      stereo ? Eigen::Vector2d(problem.prior.cameras[1].fy() - problem.prior.cameras[0].fy(),
+                               problem.prior.cameras[1].cy() - problem.prior.cameras[0].cy())
+             : Eigen::Vector2d::Zero();
   CalibrationBundleResult result;
   result.estimate = problem.initial;
   auto write_result = [&]() {
@@ -175,8 +190,14 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
       result.bundle.visual.points_world.emplace_back(Eigen::Map<const Eigen::Vector3d>(s.point(i)));
     }
     for (std::size_t c = 0; c < result.estimate.cameras.size() && c < 2; ++c) {
-      result.estimate.cameras[c] = CameraFromIntrinsicsBlock(problem.initial.cameras[c],
-                                                             s.intrinsics(static_cast<int>(c)));
+      double block[kCalibIntrinsicsSize];
+      std::copy(s.intrinsics(static_cast<int>(c)),
+                s.intrinsics(static_cast<int>(c)) + kCalibIntrinsicsSize, block);
+      if (c == 1) {
+        block[1] = s.intrinsics(0)[1] + vertical_offset[0];
+        block[3] = s.intrinsics(0)[3] + vertical_offset[1];
+      }
+      result.estimate.cameras[c] = CameraFromIntrinsicsBlock(problem.initial.cameras[c], block);
     }
     result.estimate.body_from_cam0 = PoseFromBlock(s.cam0_from_body()).Inverse();
     result.estimate.cam1_from_cam0 = PoseFromBlock(s.cam1_from_cam0());
@@ -243,9 +264,16 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
     ceres_problem.SetParameterBlockConstant(s.cam0_from_body());
   }
   if (stereo && problem.free.stereo_extrinsic) {
+    // Only the rotation about the cameras' y and z axes: the baseline is the map's scale (with an
+    // IMU, the accelerometers' scale factors pull it; the file's baseline is the better-known),
+    // and the rotation about x moves the right image's rows, which the matcher does not measure.
+    // Those are held at the file's value by a prior 1000 times tighter.
+    const double frozen = 1e-3;
+    const double t = sig.stereo_translation_mm * 1e-3 * frozen;
+    const double r = sig.stereo_rotation_deg / kRadToDeg;
     ceres_problem.AddResidualBlock(
-        new ExtrinsicPriorError(problem.prior.cam1_from_cam0, sig.stereo_translation_mm * 1e-3,
-                                sig.stereo_rotation_deg / kRadToDeg),
+        new ExtrinsicPriorError(problem.prior.cam1_from_cam0,
+                                (Eigen::Matrix<double, 6, 1>() << t, t, t, r * frozen, r, r).finished()),
         nullptr, s.cam1_from_cam0());
   } else {
     ceres_problem.SetParameterBlockConstant(s.cam1_from_cam0());
@@ -340,10 +368,11 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
     if (raw.has_right && stereo) {
       blocks[i].right = ceres_problem.AddResidualBlock(
           new CalibratedRightError(raw.right, raw.right_whitening,
-                                   FixedDistortionOf(problem.initial.cameras[1]), timing),
+                                   FixedDistortionOf(problem.initial.cameras[1]), timing,
+                                   vertical_offset),
           &loss_right,
-          {s.pose(k), s.point(o.point_index), s.intrinsics(1), s.cam0_from_body(),
-           s.cam1_from_cam0(), s.offset(), velocity});
+          {s.pose(k), s.point(o.point_index), s.intrinsics(1), s.intrinsics(0),
+           s.cam0_from_body(), s.cam1_from_cam0(), s.offset(), velocity});
     }
   }
   // The gauge: the problem's fixed keyframes; with none (a hand-made problem), the first.
@@ -381,7 +410,7 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
     ordering->AddElementToGroup(block, 1);
   }
   solver_options.linear_solver_ordering = ordering;
-  AbortCallback abort_callback(abort);
+  AbortCallback abort_callback(abort, options.min_iterations_before_abort);
   solver_options.callbacks.push_back(&abort_callback);
 
   bool first = true;

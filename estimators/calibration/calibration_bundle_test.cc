@@ -229,13 +229,16 @@ TEST(CalibrationBundleTest, StereoInertialRecoversTheRigFromAMiscalibratedFile) 
   const double depth_error_file = StereoDepthError(f, t);
   EXPECT_GT(depth_error_file, 2e-3);
   EXPECT_LT(StereoDepthError(e, t), depth_error_file / 3);
-  // Sigmas are reported for every free parameter (all but cam1's fy and cy); the data shrinks
-  // those it observes below the prior's.
+  // Sigmas are reported for every free parameter (all but cam1's fy and cy, the stereo
+  // translation and its rotation about x); the data shrinks those it observes below the prior's.
   for (const CalibrationParameter& p : result.parameters) {
-    ASSERT_EQ(p.free, p.name != "cam1.fy" && p.name != "cam1.cy") << p.name;
+    const bool held = p.name == "cam1.fy" || p.name == "cam1.cy" || p.name == "stereo.rx" ||
+                      p.name.rfind("stereo.t", 0) == 0;
+    ASSERT_EQ(p.free, !held) << p.name;
     EXPECT_LE(p.sigma, p.prior_sigma) << p.name;
   }
-  // The keyframes come back as body poses near the truth.
+  // The keyframes come back as body poses near the truth (within the 0.1% scale error of the
+  // file's baseline, which is held: some 5 m from the origin).
   ASSERT_EQ(result.world_from_body.size(), scene.true_world_from_body.size());
   double worst = 0;
   for (std::size_t k = 0; k < result.world_from_body.size(); ++k) {
@@ -243,7 +246,7 @@ TEST(CalibrationBundleTest, StereoInertialRecoversTheRigFromAMiscalibratedFile) 
                              scene.true_world_from_body[k].translation())
                                 .norm());
   }
-  EXPECT_LT(worst, 5e-3);
+  EXPECT_LT(worst, 8e-3);
 }
 
 TEST(CalibrationBundleTest, FrozenParametersStayAtTheirValue) {

@@ -28,20 +28,21 @@ void AddCamera(int index, const CameraModel& prior, const CameraModel& estimate,
   }
 }
 
-// Six tangent components of estimate * prior^-1 (left perturbation): translation mm, rotation
-// deg.
+// A parent_from_child transform's change from the file, as a user would edit it: the rotation
+// vector of R_estimate R_file^T (deg, parent axes), then t_estimate - t_file (mm, parent axes).
 void AddExtrinsic(const std::string& prefix, const SE3d& prior, const SE3d& estimate,
                   bool free_rotation, bool free_translation, double sigma_rotation_deg,
                   double sigma_translation_mm, std::vector<CalibrationParameter>* out) {
-  const Eigen::Matrix<double, 6, 1> d = (estimate * prior.Inverse()).Log();
+  const Eigen::Vector3d rotation = (estimate.so3() * prior.so3().Inverse()).Log();
+  const Eigen::Vector3d translation = estimate.translation() - prior.translation();
   const char* axes[3] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
-    out->push_back({prefix + ".r" + axes[i], "deg", 0.0, d[3 + i] * kDeg, 0.0, sigma_rotation_deg,
-                    free_rotation});
+    out->push_back({prefix + ".r" + axes[i], "deg", 0.0, rotation[i] * kDeg, 0.0,
+                    sigma_rotation_deg, free_rotation});
   }
   for (int i = 0; i < 3; ++i) {
-    out->push_back({prefix + ".t" + axes[i], "mm", 0.0, d[i] * 1e3, 0.0, sigma_translation_mm,
-                    free_translation});
+    out->push_back({prefix + ".t" + axes[i], "mm", 0.0, translation[i] * 1e3, 0.0,
+                    sigma_translation_mm, free_translation});
   }
 }
 
@@ -67,6 +68,8 @@ void CalibrationBundleOptions::Check() const {
   PKSLAM_CHECK_OPTION(chi2_left > 0 && chi2_right > 0, "calibration_ba.chi2", "{} / {}", chi2_left,
                       chi2_right);
   PKSLAM_CHECK_OPTION(num_threads >= 1, "calibration_ba.num_threads", "{}", num_threads);
+  PKSLAM_CHECK_OPTION(min_iterations_before_abort >= 0, "calibration_ba.min_iterations_before_abort",
+                      "{}", min_iterations_before_abort);
   PKSLAM_CHECK_OPTION(gravity_magnitude > 0, "calibration_ba.gravity_magnitude", "{}",
                       gravity_magnitude);
   prior.Check();
@@ -83,14 +86,15 @@ std::vector<CalibrationParameter> CalibrationParameters(const RigCalibration& pr
               sigmas, &out);
   }
   if (estimate.stereo()) {
-    AddExtrinsic("stereo", prior.cam1_from_cam0, estimate.cam1_from_cam0, free.stereo_extrinsic,
-                 free.stereo_extrinsic, sigmas.stereo_rotation_deg, sigmas.stereo_translation_mm,
-                 &out);
+    const std::size_t first = out.size();
+    AddExtrinsic("stereo", prior.cam1_from_cam0.Inverse(), estimate.cam1_from_cam0.Inverse(),
+                 free.stereo_extrinsic, false, sigmas.stereo_rotation_deg,
+                 sigmas.stereo_translation_mm, &out);
+    out[first].free = false;  // stereo.rx: held (calibration_bundle.h)
   }
   if (inertial) {
-    AddExtrinsic("imu", prior.body_from_cam0.Inverse(), estimate.body_from_cam0.Inverse(),
-                 free.imu_rotation, free.imu_translation, sigmas.imu_rotation_deg,
-                 sigmas.imu_translation_mm, &out);
+    AddExtrinsic("imu", prior.body_from_cam0, estimate.body_from_cam0, free.imu_rotation,
+                 free.imu_translation, sigmas.imu_rotation_deg, sigmas.imu_translation_mm, &out);
     out.push_back({"time_offset", "ms", prior.time_offset_s * 1e3, estimate.time_offset_s * 1e3,
                    0.0, sigmas.time_offset_ms, free.time_offset});
   }

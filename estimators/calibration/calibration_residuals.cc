@@ -152,7 +152,7 @@ void Put(const Eigen::Matrix<double, R, C>& m, int ambient, double* out) {
 }
 
 constexpr int kLeftBlocks[6] = {7, 3, kCalibIntrinsicsSize, 7, 1, 3};
-constexpr int kRightBlocks[7] = {7, 3, kCalibIntrinsicsSize, 7, 7, 1, 3};
+constexpr int kRightBlocks[8] = {7, 3, kCalibIntrinsicsSize, kCalibIntrinsicsSize, 7, 7, 1, 3};
 
 }  // namespace
 
@@ -199,8 +199,13 @@ bool CalibratedLeftError::PixelError(double const* const* parameters,
 CalibratedRightError::CalibratedRightError(const Eigen::Vector2d& raw,
                                            const Eigen::RowVector2d& whitening,
                                            const FixedDistortion& fixed,
-                                           const ImageTiming& timing)
-    : raw_(raw), whitening_(whitening), fixed_(fixed), timing_(timing) {
+                                           const ImageTiming& timing,
+                                           const Eigen::Vector2d& vertical_offset)
+    : raw_(raw),
+      whitening_(whitening),
+      fixed_(fixed),
+      timing_(timing),
+      vertical_offset_(vertical_offset) {
   set_num_residuals(1);
   for (int size : kRightBlocks) mutable_parameter_block_sizes()->push_back(size);
 }
@@ -209,27 +214,40 @@ bool CalibratedRightError::Evaluate(double const* const* parameters, double* res
                                     double** jacobians) const {
   const bool want = jacobians != nullptr;
   CameraPoint cp;
-  ComputeCameraPoint(parameters, 3, 5, 6, timing_, want, &cp);
-  const SE3d cam1_from_cam0 = PoseFromBlock(parameters[4]);
+  ComputeCameraPoint(parameters, 4, 6, 7, timing_, want, &cp);
+  const SE3d cam1_from_cam0 = PoseFromBlock(parameters[5]);
   const Eigen::Vector3d p_c1 = cam1_from_cam0 * cp.p_c0;
+  // cam1's fy and cy follow cam0's (calibration_residuals.h).
+  const double intrinsics[kCalibIntrinsicsSize] = {
+      parameters[2][0], parameters[3][1] + vertical_offset_[0],
+      parameters[2][2], parameters[3][3] + vertical_offset_[1],
+      parameters[2][4], parameters[2][5]};
   Eigen::Vector2d uv;
   Eigen::Matrix<double, 2, 3> d_uv_d_p;
   Eigen::Matrix<double, 2, kCalibIntrinsicsSize> d_uv_d_k;
-  if (!Project(parameters[2], fixed_, p_c1, want, &uv, &d_uv_d_p, &d_uv_d_k)) return false;
+  if (!Project(intrinsics, fixed_, p_c1, want, &uv, &d_uv_d_p, &d_uv_d_k)) return false;
   residuals[0] = whitening_ * (uv - raw_);
   if (!want) return true;
   const Eigen::Matrix<double, 1, 3> a = whitening_ * d_uv_d_p;
   const Eigen::Matrix<double, 1, 3> b = a * cam1_from_cam0.RotationMatrix();  // through p_c0
+  const Eigen::Matrix<double, 1, kCalibIntrinsicsSize> k = whitening_ * d_uv_d_k;
+  Eigen::Matrix<double, 1, kCalibIntrinsicsSize> k1 = k;
+  Eigen::Matrix<double, 1, kCalibIntrinsicsSize> k0 = Eigen::Matrix<double, 1, 6>::Zero();
+  for (int c : {1, 3}) {
+    k0(c) = k(c);
+    k1(c) = 0.0;
+  }
   Put<1, 6>(b * cp.d_pose, 7, jacobians[0]);
   Put<1, 3>(b * cp.d_point, 3, jacobians[1]);
-  Put<1, kCalibIntrinsicsSize>(whitening_ * d_uv_d_k, kCalibIntrinsicsSize, jacobians[2]);
-  Put<1, 6>(b * cp.d_extrinsic, 7, jacobians[3]);
+  Put<1, kCalibIntrinsicsSize>(k1, kCalibIntrinsicsSize, jacobians[2]);
+  Put<1, kCalibIntrinsicsSize>(k0, kCalibIntrinsicsSize, jacobians[3]);
+  Put<1, 6>(b * cp.d_extrinsic, 7, jacobians[4]);
   Eigen::Matrix<double, 3, 6> d_stereo;
   d_stereo.leftCols<3>().setIdentity();
   d_stereo.rightCols<3>() = -Skew(p_c1);
-  Put<1, 6>(a * d_stereo, 7, jacobians[4]);
-  Put<1, 1>(b * cp.d_offset, 1, jacobians[5]);
-  Put<1, 3>(b * cp.d_velocity, 3, jacobians[6]);
+  Put<1, 6>(a * d_stereo, 7, jacobians[5]);
+  Put<1, 1>(b * cp.d_offset, 1, jacobians[6]);
+  Put<1, 3>(b * cp.d_velocity, 3, jacobians[7]);
   return true;
 }
 
@@ -251,14 +269,18 @@ bool EuclideanPriorError::Evaluate(double const* const* parameters, double* resi
   return true;
 }
 
-ExtrinsicPriorError::ExtrinsicPriorError(const SE3d& mean, double sigma_translation,
-                                         double sigma_rotation)
-    : mean_inverse_(mean.Inverse()),
-      inv_sigma_translation_(1.0 / sigma_translation),
-      inv_sigma_rotation_(1.0 / sigma_rotation) {
+ExtrinsicPriorError::ExtrinsicPriorError(const SE3d& mean, const Eigen::Matrix<double, 6, 1>& sigma)
+    : mean_inverse_(mean.Inverse()), inv_sigma_(sigma.cwiseInverse()) {
   set_num_residuals(6);
   mutable_parameter_block_sizes()->push_back(kCalibExtrinsicSize);
 }
+
+ExtrinsicPriorError::ExtrinsicPriorError(const SE3d& mean, double sigma_translation,
+                                         double sigma_rotation)
+    : ExtrinsicPriorError(mean, (Eigen::Matrix<double, 6, 1>() << sigma_translation,
+                                 sigma_translation, sigma_translation, sigma_rotation,
+                                 sigma_rotation, sigma_rotation)
+                                    .finished()) {}
 
 bool ExtrinsicPriorError::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
@@ -269,7 +291,7 @@ bool ExtrinsicPriorError::Evaluate(double const* const* parameters, double* resi
       (PerturbedLeftPose(parameters[0], d) * mean_inverse_.cast<J>()).Log();
   J r[6];
   for (int i = 0; i < 6; ++i) {
-    r[i] = log[i] * (i < 3 ? inv_sigma_translation_ : inv_sigma_rotation_);
+    r[i] = log[i] * inv_sigma_[i];
     residuals[i] = r[i].a;
   }
   WriteJacobians(r, 6, std::array<BlockLayout, 1>{{{0, 6, 7}}}, jacobians);

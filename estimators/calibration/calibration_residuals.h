@@ -60,12 +60,17 @@ class CalibratedLeftError final : public ceres::CostFunction {
 };
 
 // Right coordinate of a stereo match. Parameters {pose[7], point[3], intrinsics1[6],
-// cam0_from_body[7], cam1_from_cam0[7], offset[1], velocity[3]}; residual 1:
-// whitening * (projection - raw).
+// intrinsics0[6], cam0_from_body[7], cam1_from_cam0[7], offset[1], velocity[3]}; residual 1:
+// whitening * (projection - raw). Only the right image's column is measured, so cam1's fy and
+// cy are not parameters of their own: they follow cam0's, fy1 = fy0 + vertical_offset[0],
+// cy1 = cy0 + vertical_offset[1] (the file's differences), which keeps the pair's rows as
+// aligned as the file had them while cam0's vertical parameters move (intrinsics1's fy and cy
+// entries are not read).
 class CalibratedRightError final : public ceres::CostFunction {
  public:
   CalibratedRightError(const Eigen::Vector2d& raw, const Eigen::RowVector2d& whitening,
-                       const FixedDistortion& fixed, const ImageTiming& timing);
+                       const FixedDistortion& fixed, const ImageTiming& timing,
+                       const Eigen::Vector2d& vertical_offset);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
@@ -74,6 +79,7 @@ class CalibratedRightError final : public ceres::CostFunction {
   Eigen::RowVector2d whitening_;
   FixedDistortion fixed_;
   ImageTiming timing_;
+  Eigen::Vector2d vertical_offset_;
 };
 
 // (x - mean) / sigma per component. Parameters {block[n]}; residual n.
@@ -88,18 +94,18 @@ class EuclideanPriorError final : public ceres::CostFunction {
   Eigen::VectorXd inv_sigma_;
 };
 
-// Log(T * mean^-1) (translation part, rotation part) divided by the sigmas, on an SE3LeftManifold
-// block. Parameters {T[7]}; residual 6.
+// Log(T * mean^-1) (translation part, rotation part) divided by per-component sigmas, on an
+// SE3LeftManifold block. Parameters {T[7]}; residual 6.
 class ExtrinsicPriorError final : public ceres::CostFunction {
  public:
+  ExtrinsicPriorError(const SE3d& mean, const Eigen::Matrix<double, 6, 1>& sigma);
   ExtrinsicPriorError(const SE3d& mean, double sigma_translation, double sigma_rotation);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
   SE3d mean_inverse_;
-  double inv_sigma_translation_;
-  double inv_sigma_rotation_;
+  Eigen::Matrix<double, 6, 1> inv_sigma_;
 };
 
 // Fills / reads the 6-double intrinsics block of a radial-tangential camera.

@@ -64,16 +64,16 @@ TEST(CalibrationResidualsTest, RightJacobiansMatchNumericDifferentiation) {
   const Keyframe s;
   const CameraModel cam1 = testing::EurocCam1();
   const CalibratedRightError cost(Eigen::Vector2d(380, 240), Eigen::RowVector2d(0.9, 0.05),
-                                  FixedDistortionOf(cam1), s.timing);
+                                  FixedDistortionOf(cam1), s.timing, Eigen::Vector2d(-1.1, 6.9));
   const BodyPoseManifold body;
   const SE3LeftManifold left;
   const Eigen::Vector3d x = s.point();
   ExpectJacobiansMatch(testing::CompareJacobians(
       cost,
       {Block(s.world_from_body, true), {x.x(), x.y(), x.z()}, Intrinsics(cam1),
-       Block(s.cam0_from_body, false), Block(s.cam1_from_cam0, false), {1.5e-3},
-       {0.8, -0.3, 0.2}},
-      {&body, nullptr, nullptr, &left, &left, nullptr, nullptr}));
+       Intrinsics(testing::EurocCam0()), Block(s.cam0_from_body, false),
+       Block(s.cam1_from_cam0, false), {1.5e-3}, {0.8, -0.3, 0.2}},
+      {&body, nullptr, nullptr, nullptr, &left, &left, nullptr, nullptr}));
 }
 
 TEST(CalibrationResidualsTest, ResidualIsZeroAtTheTrueProjectionOfTheImageTime) {

@@ -4,8 +4,9 @@
 
 namespace pkslam {
 
-ceres::CallbackReturnType AbortCallback::operator()(const ceres::IterationSummary& /*summary*/) {
+ceres::CallbackReturnType AbortCallback::operator()(const ceres::IterationSummary& summary) {
   if (abort_ == nullptr || !abort_->load(std::memory_order_relaxed)) return ceres::SOLVER_CONTINUE;
+  if (summary.iteration < min_iterations_) return ceres::SOLVER_CONTINUE;
   fired_ = true;
   return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
 }

@@ -21,12 +21,16 @@ namespace pkslam {
 // (Ceres 2.1).
 class AbortCallback final : public ceres::IterationCallback {
  public:
-  explicit AbortCallback(const std::atomic<bool>* abort) : abort_(abort) {}
+  // `min_iterations`: the flag is obeyed only from this iteration on (a solve that would never
+  // finish between two interruptions still makes that much progress).
+  explicit AbortCallback(const std::atomic<bool>* abort, int min_iterations = 0)
+      : abort_(abort), min_iterations_(min_iterations) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override;
   bool fired() const { return fired_; }
 
  private:
   const std::atomic<bool>* abort_;
+  int min_iterations_ = 0;
   bool fired_ = false;
 };
 

@@ -6,8 +6,8 @@
 RUN is a `pkslam run` / `pkslam calibrate` output folder (its stats.json "calibration" section),
 SEQ the `pkslam simulate` folder it ran on: SEQ/truth/ holds the rendering calibration and
 SEQ/truth/realism_draw.yaml the errors written into the sequence's files. The parameters are
-those of docs/calibration.md (intrinsics in px; extrinsic changes as rotation deg / translation mm
-in the tangent of estimate * file^-1; time offset in ms). Prints, per parameter: file - truth,
+those of docs/calibration.md (intrinsics in px; the changes of body_from_cam0 and cam0_from_cam1
+from the file as rotation vector in deg and translation in mm; time offset in ms). Prints, per parameter: file - truth,
 estimate - truth, the estimate's sigma, and whether it was freed. With several runs, the median
 over them of |estimate - truth|.
 """
@@ -76,24 +76,26 @@ def truth_parameters(seq):
             out[f"{name}.{key}"] = float(v)
         cams.append(t_bs(s))
     draw = load_yaml(f"{seq}/truth/realism_draw.yaml")
-    # Written body_from_cam0 = Exp(rig_error) * true, so for cam0_from_body the file differs from
-    # the truth by estimate * file^-1 = true^-1 * Exp(-e) * true in the truth's terms:
-    # truth's tangent = Log(T_true_cb * T_file_cb^-1).
+    # The files hold body_from_cam0 = Exp(rig_error) * true and cam0_from_cam1 (of the written
+    # T_BS) = true * Exp(stereo_error) for cam1_from_cam0; the parameters are the changes of
+    # body_from_cam0 and cam0_from_cam1 from the file (docs/calibration.md): rotation vector of
+    # R_x R_file^T (deg), translation t_x - t_file (mm).
     rig_error = np.array(draw.get("rig_error", [0] * 6), float)
     stereo_error = np.array(draw.get("stereo_error", [0] * 6), float)
+
+    def change(prefix, true, file):
+        rot = log_se3(np.block([[true[:3, :3] @ file[:3, :3].T, np.zeros((3, 1))],
+                                [np.zeros((1, 3)), np.ones((1, 1))]]))[3:]
+        for i, a in enumerate("xyz"):
+            out[f"{prefix}.r{a}"] = math.degrees(rot[i])
+            out[f"{prefix}.t{a}"] = (true[i, 3] - file[i, 3]) * 1e3
+
     t_bc0 = cams[0]
-    t_bc0_file = exp_se3(rig_error) @ t_bc0
-    d = log_se3(np.linalg.inv(t_bc0) @ t_bc0_file)  # cam0_from_body_true * (cam0_from_body_file)^-1
-    for i, a in enumerate("xyz"):
-        out[f"imu.r{a}"] = math.degrees(d[3 + i])
-        out[f"imu.t{a}"] = d[i] * 1e3
+    change("imu", t_bc0, exp_se3(rig_error) @ t_bc0)
     if len(cams) > 1:
         t_c1c0 = np.linalg.inv(cams[1]) @ cams[0]
         t_c1c0_file = t_c1c0 @ exp_se3(stereo_error)
-        d = log_se3(t_c1c0 @ np.linalg.inv(t_c1c0_file))
-        for i, a in enumerate("xyz"):
-            out[f"stereo.r{a}"] = math.degrees(d[3 + i])
-            out[f"stereo.t{a}"] = d[i] * 1e3
+        change("stereo", np.linalg.inv(t_c1c0), np.linalg.inv(t_c1c0_file))
     out["time_offset"] = float(draw.get("camera_imu_offset_ms", 0.0))
     return out
 

@@ -1,0 +1,190 @@
+// End-to-end: online calibration (docs/calibration.md). A replay whose calibration files carry
+// the realism preset's errors (calibration and timing sources on, the others off so it renders
+// fast) is run with --calibrate online and off; what the run reports (stats.json "calibration",
+// OUT/calibration/) is read back as a user would, fed back to pkslam, and `pkslam calibrate`
+// writes its report.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "io/euroc_sensor.h"
+#include "io/json_file.h"
+#include "io/settings.h"
+#include "tests/support/test_data.h"
+
+namespace pkslam {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using testing::RunPkslam;
+
+// One rendering shared by the tests of this file (rendered once per process).
+class CalibrationCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const auto shared = testing::SharedDataDir();
+    if (!shared) return;
+    dir_ = new fs::path(testing::MakeTempDir("calibration_cli"));
+    const auto sim = RunPkslam(fmt::format(
+        "--log-level warn simulate --out '{}' --trajectory '{}' --start 3 --duration 22 "
+        "--quality fast --quiet --no-cloud --realism euroc --realism-off "
+        "appearance,motion,imu,ground-truth",
+        Seq().string(), (*shared / "euroc/groundtruth/V1_02_medium.txt").string()));
+    rendered_ = sim.exit_code == 0;
+    if (!rendered_) ADD_FAILURE() << sim.output;
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  void SetUp() override {
+    PKSLAM_REQUIRE_SHARED_DATA(shared);
+    ASSERT_TRUE(rendered_);
+  }
+  static fs::path Seq() { return *dir_ / "seq"; }
+  static fs::path Dir() { return *dir_; }
+  // `pkslam run` stereo-inertial into Dir()/name (once per name).
+  static testing::CommandResult Run(const std::string& name, const std::string& extra) {
+    return RunPkslam(fmt::format(
+        "--log-level info run --dataset '{}' --sensor stereo-inertial --out '{}' --quiet "
+        "--deterministic {}",
+        Seq().string(), (Dir() / name).string(), extra));
+  }
+
+  static fs::path* dir_;
+  static bool rendered_;
+};
+
+fs::path* CalibrationCli::dir_ = nullptr;
+bool CalibrationCli::rendered_ = false;
+
+const YAML::Node* FindParameter(const YAML::Node& parameters, const std::string& name,
+                                YAML::Node* storage) {
+  for (const YAML::Node& p : parameters) {
+    if (p["name"].as<std::string>() == name) {
+      *storage = p;
+      return storage;
+    }
+  }
+  return nullptr;
+}
+
+TEST_F(CalibrationCli, OnlineRunReportsAndWritesTheEstimate) {
+  const auto run = Run("online", "--calibrate online");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const fs::path out = Dir() / "online";
+  const YAML::Node c = ReadJsonFile(out / "stats.json")["calibration"];
+  ASSERT_TRUE(c.IsMap());
+  EXPECT_EQ(c["mode"].as<std::string>(), "online");
+  // Adjustments ran while mapping and at least one moved the map to its estimate.
+  ASSERT_GE(c["history"].size(), 1u);
+  bool applied = false;
+  for (const YAML::Node& h : c["history"]) applied = applied || h["applied"].as<bool>();
+  EXPECT_TRUE(applied);
+  // The final estimate carries sigmas; the time offset (file 0, rendered +1 ms) was freed and
+  // moved towards the truth, further than its sigma.
+  EXPECT_TRUE(c["covariance"].as<bool>());
+  YAML::Node offset;
+  ASSERT_NE(FindParameter(c["parameters"], "time_offset", &offset), nullptr);
+  EXPECT_TRUE(offset["free"].as<bool>());
+  EXPECT_EQ(offset["file"].as<double>(), 0.0);
+  const double estimate_ms = offset["estimate"].as<double>();
+  const double sigma_ms = offset["sigma"].as<double>();
+  EXPECT_GT(sigma_ms, 0.0);
+  EXPECT_LT(std::abs(estimate_ms - 1.0), 0.5) << estimate_ms;
+  EXPECT_GT(estimate_ms, 3 * sigma_ms);
+  // The estimate's files read back as EuRoC sensor files and as settings, with the same values.
+  const EurocCameraSensor cam0 = ReadEurocCameraSensor(out / "calibration/cam0/sensor.yaml");
+  EXPECT_NEAR(cam0.timeshift_cam_imu * 1e3, estimate_ms, 1e-9);
+  const Settings settings = ReadOrbSlam3Settings(out / "calibration/settings.yaml");
+  EXPECT_NEAR(settings.time_offset_s * 1e3, estimate_ms, 1e-9);
+  YAML::Node fx;
+  ASSERT_NE(FindParameter(c["parameters"], "cam0.fx", &fx), nullptr);
+  EXPECT_DOUBLE_EQ(settings.camera1.fx(), fx["estimate"].as<double>());
+  EXPECT_DOUBLE_EQ(cam0.intrinsics[0], fx["estimate"].as<double>());
+  // A warning line names the time offset and the file it is missing from.
+  EXPECT_THAT(run.output, HasSubstr("calibration: time_offset in"));
+  EXPECT_THAT(run.output, HasSubstr("cam0/sensor.yaml"));
+}
+
+TEST_F(CalibrationCli, DeterministicOnlineRunsAreIdentical) {
+  for (const char* name : {"det_a", "det_b"}) {
+    const auto run = Run(name, "--calibrate online");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+  }
+  EXPECT_EQ(testing::ReadFileBytes(Dir() / "det_a/trajectory.txt"),
+            testing::ReadFileBytes(Dir() / "det_b/trajectory.txt"));
+  EXPECT_EQ(testing::ReadFileBytes(Dir() / "det_a/calibration/settings.yaml"),
+            testing::ReadFileBytes(Dir() / "det_b/calibration/settings.yaml"));
+}
+
+TEST_F(CalibrationCli, OffReportsTheFileAndWritesItBack) {
+  const auto run = Run("off", "");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const YAML::Node c = ReadJsonFile(Dir() / "off/stats.json")["calibration"];
+  EXPECT_EQ(c["mode"].as<std::string>(), "off");
+  EXPECT_EQ(c["history"].size(), 0u);
+  for (const YAML::Node& p : c["parameters"]) {
+    EXPECT_FALSE(p["free"].as<bool>());
+    // Extrinsic entries are Log(estimate * file^-1): zero up to rounding.
+    EXPECT_NEAR(p["file"].as<double>(), p["estimate"].as<double>(), 1e-9)
+        << p["name"].as<std::string>();
+  }
+  // The written file is the dataset's calibration.
+  const EurocCameraSensor written = ReadEurocCameraSensor(Dir() / "off/calibration/cam1/sensor.yaml");
+  const EurocCameraSensor dataset = ReadEurocCameraSensor(Seq() / "mav0/cam1/sensor.yaml");
+  EXPECT_EQ(written.intrinsics, dataset.intrinsics);
+  EXPECT_EQ(written.distortion_coefficients, dataset.distortion_coefficients);
+  EXPECT_LT((written.body_from_camera.Inverse() * dataset.body_from_camera).Log().norm(), 1e-12);
+}
+
+TEST_F(CalibrationCli, TheEstimateFedBackRunsAndAMapCarriesItsCalibration) {
+  const auto online = Run("saved", fmt::format("--calibrate online --save-map '{}'",
+                                               (Dir() / "saved.map").string()));
+  ASSERT_EQ(online.exit_code, 0) << online.output;
+  const auto fed_back = Run("fed_back", fmt::format("--settings '{}'",
+                                                    (Dir() / "saved/calibration/settings.yaml").string()));
+  EXPECT_EQ(fed_back.exit_code, 0) << fed_back.output;
+  // A later session with the file's calibration loads the map and continues in its estimate.
+  const auto loaded = Run("loaded", fmt::format("--load-map '{}' --max-frames 60",
+                                                (Dir() / "saved.map").string()));
+  ASSERT_EQ(loaded.exit_code, 0) << loaded.output;
+  const YAML::Node c = ReadJsonFile(Dir() / "loaded/stats.json")["calibration"];
+  YAML::Node offset;
+  ASSERT_NE(FindParameter(c["parameters"], "time_offset", &offset), nullptr);
+  const YAML::Node saved = ReadJsonFile(Dir() / "saved/stats.json")["calibration"];
+  YAML::Node saved_offset;
+  ASSERT_NE(FindParameter(saved["parameters"], "time_offset", &saved_offset), nullptr);
+  EXPECT_DOUBLE_EQ(offset["estimate"].as<double>(), saved_offset["estimate"].as<double>());
+}
+
+TEST_F(CalibrationCli, CalibrateWritesFilesAndAReport) {
+  const fs::path out = Dir() / "calibrate";
+  const auto r = RunPkslam(fmt::format(
+      "--log-level warn calibrate --dataset '{}' --sensor stereo-inertial --out '{}' --quiet "
+      "--deterministic --no-verify",
+      Seq().string(), out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(out / "calibration/cam0/sensor.yaml"));
+  EXPECT_TRUE(fs::exists(out / "calibration/settings.yaml"));
+  const std::string report = testing::ReadFileBytes(out / "report.md");
+  EXPECT_THAT(report, HasSubstr("| time_offset | ms |"));
+  EXPECT_THAT(r.output, HasSubstr("parameters estimated"));
+}
+
+TEST(CalibrationCliOptions, RejectsAnUnknownModeAndMonocularCalibrate) {
+  const auto bad = RunPkslam("run --dataset nowhere --calibrate sometimes");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_THAT(bad.output, HasSubstr("--calibrate"));
+  const auto mono = RunPkslam("calibrate --dataset nowhere --sensor mono");
+  EXPECT_NE(mono.exit_code, 0);
+  EXPECT_THAT(mono.output, HasSubstr("stereo rig or an IMU"));
+}
+
+}  // namespace
+}  // namespace pkslam
