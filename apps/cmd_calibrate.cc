@@ -33,6 +33,8 @@ struct CalibrateArgs {
   std::uint64_t seed = 0;
   bool deterministic = false;
   bool no_verify = false;
+  bool lever_arm = false;
+  bool mono_intrinsics = false;
   bool quiet = false;
   std::string python = "/usr/bin/python3";
 };
@@ -136,6 +138,8 @@ void RunCalibrate(const CalibrateArgs& args) {
   calibrate.out = out / "run";
   OnlineCalibrationOptions& c = calibrate.system.mapping.calibration;
   c.enabled = true;
+  c.imu_translation = args.lever_arm;
+  c.monocular_intrinsics = args.mono_intrinsics;
   c.final_max_observations_per_keyframe = 0;
   c.final_iterations_first = 30;
   c.final_iterations_second = 15;
@@ -209,6 +213,10 @@ void RegisterCalibrateCommand(CLI::App& app) {
                 "Local mapping in lock-step: identical output run to run");
   cmd->add_flag("--no-verify", args->no_verify,
                 "Skip the two runs that measure ATE with the file's and the refined calibration");
+  cmd->add_flag("--calibrate-lever-arm", args->lever_arm,
+                "Estimate the camera-IMU translation too (held at the file's value by default)");
+  cmd->add_flag("--calibrate-mono-intrinsics", args->mono_intrinsics,
+                "mono-inertial: estimate the camera's intrinsics too (held by default)");
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
   cmd->add_option("--python", args->python, "Python with matplotlib, for the plot")
       ->capture_default_str();

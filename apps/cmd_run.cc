@@ -3,7 +3,6 @@
 
 #include <atomic>
 #include <csignal>
-#include <cstdlib>
 #include <memory>
 #include <optional>
 
@@ -140,6 +139,10 @@ void RegisterRunCommand(CLI::App& app) {
   cmd->add_flag("--calibrate-lever-arm", args->options.system.mapping.calibration.imu_translation,
                 "--calibrate online: estimate the camera-IMU translation too (held at the file's "
                 "value by default; docs/calibration.md)");
+  cmd->add_flag("--calibrate-mono-intrinsics",
+                args->options.system.mapping.calibration.monocular_intrinsics,
+                "--calibrate online, monocular-inertial: estimate the camera's intrinsics too "
+                "(held at the file's values by default; docs/calibration.md)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_option("--mapping-sync", args->options.mapping_sync,
                   "How tracking meets local mapping: live (offline default: local mapping as a "
@@ -197,19 +200,6 @@ void RegisterRunCommand(CLI::App& app) {
     if (!args->vocabulary.empty()) o.vocabulary = args->vocabulary;
     o.out = args->out;
     o.system.selector_parameters = ParseParams(args->params);
-    if (const char* v = std::getenv("PKSLAM_CALIB_MAXOBS")) o.system.mapping.calibration.max_observations_per_keyframe = std::atoi(v);  // TEMPORARY
-    if (const char* v = std::getenv("PKSLAM_CALIB_IT1")) o.system.mapping.calibration.iterations_first = std::atoi(v);  // TEMPORARY
-    if (const char* v = std::getenv("PKSLAM_CALIB_IT2")) o.system.mapping.calibration.iterations_second = std::atoi(v);  // TEMPORARY
-    if (const char* v = std::getenv("PKSLAM_CALIB_FIRST")) o.system.mapping.calibration.first_after_s = std::atof(v);  // TEMPORARY
-    if (const char* v = std::getenv("PKSLAM_CALIB_LEVER")) o.system.mapping.calibration.min_lever_rotation_rate = std::atof(v);  // TEMPORARY
-    if (std::getenv("PKSLAM_CALIB_NOINTR")) o.system.mapping.calibration.min_covered_cells = 16, o.system.mapping.calibration.min_cell_observations = 1000000;  // TEMPORARY
-    if (std::getenv("PKSLAM_CALIB_NOSTEREO")) o.system.mapping.calibration.min_stereo_observations = 100000000;  // TEMPORARY
-    if (std::getenv("PKSLAM_CALIB_NOROT")) o.system.mapping.calibration.min_rotation_rate = 1000;  // TEMPORARY
-    if (std::getenv("PKSLAM_CALIB_NOTD")) o.system.mapping.calibration.min_turn_rate = 1000, o.system.mapping.calibration.min_speed = 1000;  // TEMPORARY
-    if (const char* v = std::getenv("PKSLAM_CALIB_FINALOBS")) o.system.mapping.calibration.final_max_observations_per_keyframe = std::atoi(v);  // TEMPORARY
-    if (const char* v = std::getenv("PKSLAM_CALIB_FOCAL")) o.system.mapping.calibration.prior.focal_px = std::atof(v);  // TEMPORARY
-    if (const char* v = std::getenv("PKSLAM_CALIB_PP")) o.system.mapping.calibration.prior.principal_point_px = std::atof(v);  // TEMPORARY
-    if (const char* v = std::getenv("PKSLAM_CALIB_GROWTH")) o.system.mapping.calibration.growth = std::atof(v);  // TEMPORARY
     RunControl control;
     control.interrupt = &interrupted;
     // Until the first frame a signal takes its default action: reading a dataset polls no flag

@@ -10,6 +10,7 @@ plot_keyframes.csv (written by the harness), writes PNGs into --out and an index
 
 import argparse
 import csv
+import json
 import math
 import os
 import sys
@@ -221,6 +222,57 @@ def trajectories(index, rows, roots):
         index.save(fig, f"traj_{safe(dataset)}_{safe(sensor)}.png", "trajectories",
                    f"{dataset}, {sensor}: ground truth (black) and estimates; circles are "
                    "keyframe positions")
+
+
+def online_calibration(index, rows, roots):
+    """Per dataset and sensor, every online-calibration run's estimates over the flight
+    (stats.json calibration.history, applied adjustments): time offset, camera-IMU rotation change,
+    cam0 fx change and the disparity offset change (cam0.cx - cam1.cx) against the file."""
+    panels = [("time_offset", "time offset [ms]", None),
+              ("imu_rotation", "camera-IMU rotation change [deg]", None),
+              ("cam0.fx", "cam0 fx - file [px]", None),
+              ("disparity", "(cam0.cx - cam1.cx) - file [px]", None)]
+    for dataset, sensor, sub, configs in run_groups(rows):
+        series = []
+        for r in sub:
+            d = find_run(roots, r["run_id"])
+            if d is None or not os.path.exists(os.path.join(d, "stats.json")):
+                continue
+            with open(os.path.join(d, "stats.json")) as f:
+                c = json.load(f).get("calibration") or {}
+            if c.get("mode") != "online":
+                continue
+            file = {p["name"]: p["file"] for p in c.get("parameters", [])}
+            steps = [h for h in c.get("history", []) if h.get("applied")]
+            if not steps:
+                continue
+            t = [h["span_s"] for h in steps]
+
+            def value(e, key):
+                if key == "imu_rotation":
+                    return math.sqrt(sum(e.get(f"imu.r{a}", 0.0) ** 2 for a in "xyz"))
+                if key == "disparity":
+                    if "cam1.cx" not in e:
+                        return float("nan")
+                    return (e["cam0.cx"] - e["cam1.cx"]) - (file["cam0.cx"] - file["cam1.cx"])
+                if key == "cam0.fx":
+                    return e.get(key, float("nan")) - file.get(key, 0.0)
+                return e.get(key, float("nan"))
+            series.append((f"{r['config']} seed {r['seed']}",
+                           t, {k: [value(h["estimate"], k) for h in steps] for k, _, _ in panels}))
+        if not series:
+            continue
+        fig, axes = plt.subplots(1, len(panels), figsize=(15, 3.4))
+        for ax, (key, label, _) in zip(axes, panels):
+            for name, t, values in series:
+                ax.plot(t, values[key], marker="o", ms=3, label=name)
+            ax.set_title(label, fontsize=9)
+            ax.set_xlabel("map span at the adjustment [s]")
+            ax.grid(alpha=0.3)
+        axes[0].legend(fontsize=7)
+        index.save(fig, f"calibration_{safe(dataset)}_{safe(sensor)}.png", "calibration",
+                   f"{dataset}, {sensor}: the online calibration estimates of each run over the "
+                   "flight (applied adjustments)")
 
 
 def sweeps(index, rows):
@@ -481,6 +533,7 @@ def main():
                         "tracking_time.png", "keyframes",
                         "Median per-frame tracking time (mean ± std over runs)")
         sweeps(index, rows)
+        online_calibration(index, rows, a.runs)
         equal_budget(index, rows)
         statistics_fragments(a.out, a.results)
     index.write()

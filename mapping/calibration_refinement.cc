@@ -44,6 +44,10 @@ void OnlineCalibrationOptions::Check() const {
                       "calibration.min_covered_cells", "{} (of 16)", min_covered_cells);
   PKSLAM_CHECK_OPTION(min_cell_observations >= 0 && min_stereo_observations >= 0,
                       "calibration gates", "counts must not be negative");
+  PKSLAM_CHECK_OPTION(max_prior_sigmas > 0 && max_step_prior_sigmas > 0 &&
+                          final_max_step_prior_sigmas > 0,
+                      "calibration.max_prior_sigmas", "{} / {} / {}", max_prior_sigmas,
+                      max_step_prior_sigmas, final_max_step_prior_sigmas);
 }
 
 CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor sensor,
@@ -84,7 +88,10 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
   }
   for (int c : cells) g.covered_cells += c >= options.min_cell_observations ? 1 : 0;
   const bool stereo = IsStereo(sensor) && problem.initial.stereo();
-  if (g.covered_cells >= options.min_covered_cells) {
+  if (IsMonocular(sensor) && !options.monocular_intrinsics) {
+    g.frozen["intrinsics"] =
+        "held at the file's values for a monocular rig (the focal length trades against depth)";
+  } else if (g.covered_cells >= options.min_covered_cells) {
     g.free.intrinsics = {true, stereo};
   } else {
     g.frozen["intrinsics"] = fmt::format("observations cover {} of 16 image cells (at least {})",
@@ -152,6 +159,26 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
                     g.median_turn_rate, g.median_speed);
   }
   return g;
+}
+
+std::optional<std::string> ImplausibleEstimate(const CalibrationBundleProblem& problem,
+                                               const RigCalibration& estimate,
+                                               const OnlineCalibrationOptions& options) {
+  const auto check = [&](const RigCalibration& from, double limit,
+                         const char* what) -> std::optional<std::string> {
+    for (const CalibrationParameter& p :
+         CalibrationParameters(from, estimate, problem.free, options.prior, problem.inertial)) {
+      if (!p.free) continue;
+      const double n = std::abs(p.estimate - p.file) / p.prior_sigma;
+      if (n > limit) {
+        return fmt::format("{} would move {:.3g} {} {} ({:.0f} prior sigmas, at most {:.0f})",
+                           p.name, p.estimate - p.file, p.unit, what, n, limit);
+      }
+    }
+    return std::nullopt;
+  };
+  if (auto why = check(problem.prior, options.max_prior_sigmas, "from the file")) return why;
+  return check(problem.initial, options.max_step_prior_sigmas, "in one adjustment");
 }
 
 }  // namespace pkslam

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,11 @@ struct OnlineCalibrationOptions {
   // factors, axis misalignment and g-sensitivity, bias it) and freeing it raised stereo-inertial
   // ATE (docs/calibration.md, "Parameters left at the file's value").
   bool imu_translation = false;
+  // Estimate the intrinsics of a monocular rig too. Off by default: with one camera the focal
+  // length trades against the map's depth, held only by the IMU's scale, and on the V2_01 replay
+  // freeing them moved cam0's fx and cx further from the truth (0.6 -> 0.9-1.4 px) and raised
+  // mono-inertial ATE (docs/calibration.md, "Parameters left at the file's value").
+  bool monocular_intrinsics = false;
   // Observability gates (DecideFreedom). Camera-IMU rotation: the angular rate about the
   // keyframes' second-most-excited axis (rms, rad/s): rotation about a single axis leaves the
   // rotation about it unobservable. Camera-IMU translation (a lever arm seen only through
@@ -58,6 +64,18 @@ struct OnlineCalibrationOptions {
   int min_cell_observations = 10;
   // Stereo extrinsic: at least this many stereo matches.
   int min_stereo_observations = 500;
+  // An adjustment is not applied when a parameter ends more than `max_prior_sigmas` of its
+  // prior's sigmas from the file's value, or moved more than `max_step_prior_sigmas` of them in
+  // this one adjustment: a diverged solve (a monocular map that lost its scale pulled cam0's fx
+  // 34 px, 17 sigma, in one step on a V2_01 replay), not a calibration. A gross file error (2 deg,
+  // 11 ms, 5 px: 4-6 sigma), corrected in one step, stays within both.
+  double max_prior_sigmas = 10.0;
+  double max_step_prior_sigmas = 8.0;
+  // The final whole-map adjustment refines what mapping converged to; a step beyond this many
+  // prior sigmas from it is drift along a weakly observed direction (mono-inertial V2_01 replay:
+  // cam0's fx 9 px in the final adjustment after holding within 0.5 px over 6 adjustments), and
+  // the run keeps mapping's estimate.
+  double final_max_step_prior_sigmas = 3.0;
 
   void Check() const;
 };
@@ -80,6 +98,12 @@ struct CalibrationGates {
 // against, and the RGB-D pipeline takes the depth image's registration as given.
 CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor sensor,
                                const OnlineCalibrationOptions& options);
+
+// Why the estimate `result` of an adjustment that started from `problem.initial` must not be
+// applied (OnlineCalibrationOptions::max_prior_sigmas, max_step_prior_sigmas), or nullopt.
+std::optional<std::string> ImplausibleEstimate(const CalibrationBundleProblem& problem,
+                                               const RigCalibration& estimate,
+                                               const OnlineCalibrationOptions& options);
 
 // One calibration adjustment of a run (stats.json "calibration.history").
 struct CalibrationRefinementStat {

@@ -82,6 +82,11 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
     finish("interrupted before its first step");
     return;
   }
+  if (const auto why = ImplausibleEstimate(problem, result.estimate, o)) {
+    PKSLAM_LOG_WARN("calibration adjustment at t = {:.1f} s not applied: {}", stat.span_s, *why);
+    finish("rejected: " + *why);
+    return;
+  }
   // The new rig (rectification maps) is built outside the lock.
   RigSetup next;
   try {

@@ -58,10 +58,16 @@ std::vector<std::string> CalibrationWarnings(const CalibrationReport& report,
     const double n = std::abs(off) / p.sigma;
     if (n <= threshold) continue;
     const std::string unit = p.unit.empty() ? "" : " " + p.unit;
+    // Beyond 5 of the prior's sigmas the file is not slightly off but wrong for this rig.
+    const bool gross = p.prior_sigma > 0 && std::abs(off) > 5 * p.prior_sigma;
     out.push_back(fmt::format(
         "calibration: {} in {} is {:.3g}{} off the estimate ({:.1f} sigma; file {:.6g}, estimate "
-        "{:.6g} +- {:.2g})",
-        p.name, SourceOf(p.name, sources), off, unit, n, p.file, p.estimate, p.sigma));
+        "{:.6g} +- {:.2g}){}",
+        p.name, SourceOf(p.name, sources), off, unit, n, p.file, p.estimate, p.sigma,
+        gross ? fmt::format("; {:.0f} times a calibration file's usual error: the file is wrong "
+                            "for this rig (the estimate is in OUT/calibration/)",
+                            std::abs(off) / p.prior_sigma)
+              : ""));
   }
   return out;
 }
@@ -71,6 +77,7 @@ void WriteCalibrationJson(const CalibrationReport& report,
   json->Key("calibration").BeginObject();
   json->Member("mode", report.online ? "online" : "off");
   json->Member("covariance", report.covariance_ok);
+  json->Member("note", report.note);
   json->Key("parameters").BeginArray();
   for (const CalibrationParameter& p : report.parameters) {
     json->BeginObject();

@@ -27,6 +27,7 @@ struct CalibrationReport {
   bool covariance_ok = false;
   std::map<std::string, std::string> frozen;
   std::vector<CalibrationRefinementStat> history;
+  std::string note;  // why the final adjustment was not applied ("" when it was, or off)
 };
 
 // Where each parameter group came from, for the warnings: the settings file, or a EuRoC
@@ -38,7 +39,8 @@ CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings
 CalibrationSources SourcesFromEurocDataset(const std::filesystem::path& dataset);
 
 // A warning per free parameter whose file value is more than `threshold` sigmas from the
-// estimate (needs sigmas), naming the parameter, the size and the file.
+// estimate (needs sigmas), naming the parameter, the size and the file; one more than 5 prior
+// sigmas off says the file is wrong for the rig.
 std::vector<std::string> CalibrationWarnings(const CalibrationReport& report,
                                              const CalibrationSources& sources,
                                              double threshold = 3.0);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <mutex>
@@ -144,6 +143,15 @@ void SlamSystem::FinishCalibration() {
   ba.prior = o.prior;
   CalibrationBundleResult result = SolveCalibrationBundle(problem, ba);
   if (result.bundle.visual.iterations == 0) return;
+  OnlineCalibrationOptions final_limits = o;
+  final_limits.max_step_prior_sigmas = o.final_max_step_prior_sigmas;
+  if (const auto why = ImplausibleEstimate(problem, result.estimate, final_limits)) {
+    PKSLAM_LOG_WARN("final calibration adjustment not applied (the run keeps mapping's estimate, "
+                    "without sigmas): {}",
+                    *why);
+    final_note_ = "final adjustment not applied: " + *why;
+    return;
+  }
   RigSetup next;
   try {
     next = BuildRig(result.estimate, ShapeFromSettings(settings_, options_.sensor));
@@ -151,7 +159,7 @@ void SlamSystem::FinishCalibration() {
     PKSLAM_LOG_WARN("final calibration estimate rejected: {}", e.what());
     return;
   }
-  if (std::getenv("PKSLAM_FINAL_NOAPPLY") == nullptr) {  // TEMPORARY experiment
+  {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
     Map* map = atlas_.FindMap(collected_from->id());
     ApplyCalibration(&atlas_, map, problem, result, next);
@@ -183,6 +191,7 @@ CalibrationReport SlamSystem::calibration_report() const {
                               options_.mapping.calibration.prior, IsInertial(options_.sensor));
     if (!report.history.empty()) report.frozen = report.history.back().gates.frozen;
   }
+  report.note = final_note_;
   return report;
 }
 

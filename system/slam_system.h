@@ -138,6 +138,7 @@ class SlamSystem {
   // Online calibration: the final whole-map adjustment (FinishCalibration, at Shutdown).
   std::optional<CalibrationBundleResult> final_calibration_;
   CalibrationGates final_gates_;
+  std::string final_note_;  // why the final adjustment was not applied (reported)
   void FinishCalibration();
   // The camera-IMU time offset applied to frame stamps (inertial sensors): frames are tracked on
   // the IMU clock, stamp + offset.

@@ -64,7 +64,7 @@ std::vector<std::string> RunWarnings(const fs::path& stats) {
   std::vector<std::string> out;
   if (!fs::exists(stats)) return out;
   const YAML::Node root = ReadJsonFile(stats);
-  for (const char* section : {"input", "estimate"}) {
+  for (const char* section : {"input", "estimate", "calibration"}) {
     const YAML::Node node = root[section];
     if (!node || !node.IsMap() || !node["warnings"] || !node["warnings"].IsSequence()) continue;
     for (const YAML::Node& w : node["warnings"]) {
@@ -72,6 +72,25 @@ std::vector<std::string> RunWarnings(const fs::path& stats) {
     }
   }
   return out;
+}
+
+// stats.json's online calibration: applied adjustments and the file's values.
+void ReadCalibration(const fs::path& stats, ViewData* data) {
+  if (!fs::exists(stats)) return;
+  const YAML::Node c = ReadJsonFile(stats)["calibration"];
+  if (!c || !c.IsMap() || c["mode"].as<std::string>("") != "online") return;
+  for (const YAML::Node& p : c["parameters"]) {
+    data->calibration_file[p["name"].as<std::string>("")] = p["file"].as<double>(0.0);
+  }
+  for (const YAML::Node& h : c["history"]) {
+    if (!h["applied"].as<bool>(false)) continue;
+    ViewCalibrationStep step;
+    step.t_s = h["t_s"].as<double>(0.0);
+    for (const auto& kv : h["estimate"]) {
+      step.estimate[kv.first.as<std::string>()] = kv.second.as<double>(0.0);
+    }
+    data->calibration.push_back(std::move(step));
+  }
 }
 
 }  // namespace
@@ -219,6 +238,7 @@ ViewData LoadViewData(const ViewOptions& options) {
     });
   }
   data.warnings = RunWarnings(run / "stats.json");
+  ReadCalibration(run / "stats.json", &data);
   return data;
 }
 
@@ -282,6 +302,19 @@ std::string ViewDataJson(const ViewData& data) {
     for (int i = 0; i < 3; ++i) json.Value(static_cast<int>(c[static_cast<std::size_t>(i)]));
   }
   json.EndArray();
+  json.Key("calibration").BeginArray();
+  for (const ViewCalibrationStep& s : data.calibration) {
+    json.BeginObject();
+    json.Member("t", s.t_s);
+    json.Key("e").BeginObject();
+    for (const auto& [k, v] : s.estimate) json.Member(k, v);
+    json.EndObject();
+    json.EndObject();
+  }
+  json.EndArray();
+  json.Key("calibration_file").BeginObject();
+  for (const auto& [k, v] : data.calibration_file) json.Member(k, v);
+  json.EndObject();
   json.Key("timeline").BeginArray();
   for (const ViewTimelineRow& r : data.timeline) {
     json.BeginObject();

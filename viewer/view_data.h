@@ -51,6 +51,13 @@ struct ViewTimelineRow {
   std::map<std::string, double> quantities;  // selector trace values of the frame
 };
 
+// One applied online-calibration adjustment (stats.json calibration.history): when, and the
+// estimate it ended with (parameter name -> value, docs/calibration.md).
+struct ViewCalibrationStep {
+  double t_s = 0;
+  std::map<std::string, double> estimate;
+};
+
 struct ViewData {
   std::string title;
   std::string alignment;  // "se3", "sim3" or "none"
@@ -65,6 +72,10 @@ struct ViewData {
   // The run's own warnings from stats.json: "input: ..." (degraded input) and "estimate: ..."
   // (suspect estimate, system/estimate_health.h); the page shows them above everything else.
   std::vector<std::string> warnings;
+  // Online calibration: the applied adjustments and the file's values (empty for --calibrate
+  // off or older runs).
+  std::vector<ViewCalibrationStep> calibration;
+  std::map<std::string, double> calibration_file;
 };
 
 // Reads the run (InputError naming the missing or malformed file).

@@ -34,6 +34,25 @@ TEST(LoadViewData, CarriesTheRunsWarnings) {
   EXPECT_THAT(ViewDataJson(data), HasSubstr(R"("warnings":["input: 2 frames skipped",)"));
 }
 
+// Online calibration: its warning leads the page, its applied adjustments reach the timeline.
+TEST(LoadViewData, CarriesTheOnlineCalibration) {
+  ViewOptions options;
+  options.run = RunFolder("view_calibration", R"({"calibration": {"mode": "online",
+      "parameters": [{"name": "time_offset", "file": 0.0, "estimate": 1.01}],
+      "warnings": ["time_offset in seq/mav0/cam0/sensor.yaml is -1.01 ms off the estimate"],
+      "history": [{"t_s": 8.0, "applied": true, "estimate": {"time_offset": 0.7}},
+                  {"t_s": 12.0, "applied": false, "estimate": {"time_offset": 0.7}},
+                  {"t_s": 18.0, "applied": true, "estimate": {"time_offset": 1.0}}]}})");
+  const ViewData data = LoadViewData(options);
+  EXPECT_THAT(data.warnings, ElementsAre("calibration: time_offset in seq/mav0/cam0/sensor.yaml "
+                                         "is -1.01 ms off the estimate"));
+  ASSERT_EQ(data.calibration.size(), 2u);  // the applied ones
+  EXPECT_DOUBLE_EQ(data.calibration[1].t_s, 18.0);
+  EXPECT_DOUBLE_EQ(data.calibration[1].estimate.at("time_offset"), 1.0);
+  EXPECT_DOUBLE_EQ(data.calibration_file.at("time_offset"), 0.0);
+  EXPECT_THAT(ViewDataJson(data), HasSubstr(R"("calibration":[{"t":8,"e":{"time_offset":0.7}})"));
+}
+
 TEST(LoadViewData, NoStatsNoWarningsAndBadStatsNamed) {
   ViewOptions options;
   options.run = RunFolder("view_no_stats", "");

@@ -202,6 +202,13 @@
     if (lo > 0 && Math.abs(poses[lo - 1].t - t) < Math.abs(poses[lo].t - t)) lo -= 1;
     return Math.abs(poses[lo].t - t) < 0.05 ? poses[lo] : null;
   }
+  // The online calibration estimate in use at time t (the last adjustment applied before it).
+  const steps = (D.calibration || []).slice().sort((a, b) => a.t - b.t);
+  function calibrationAt(t) {
+    let found = null;
+    for (const s of steps) { if (s.t <= t) found = s; }
+    return found;
+  }
   function showRow(i) {
     const r = rows[i];
     if (!r) return;
@@ -213,6 +220,22 @@
     if (r.kf) text += ' · <b>keyframe</b>';
     if (r.reason) text += ` · decision: ${esc(r.reason)}`;
     if (p && p.ate >= 0) text += ` · ATE ${p.ate.toFixed(3)} m`;
+    const c = calibrationAt(r.t);
+    if (c) {
+      const e = c.e;
+      const parts = [];
+      if (e.time_offset !== undefined) parts.push(`time offset ${e.time_offset.toFixed(2)} ms`);
+      const rot = ['imu.rx', 'imu.ry', 'imu.rz'].map((k) => e[k] || 0);
+      if (e['imu.rx'] !== undefined) {
+        parts.push(`camera-IMU rotation ${Math.hypot(...rot).toFixed(3)} deg off the file`);
+      }
+      for (const k of ['cam0.fx', 'cam0.cx', 'cam1.cx']) {
+        if (e[k] !== undefined && D.calibration_file[k] !== undefined) {
+          parts.push(`${k} ${(e[k] - D.calibration_file[k]) >= 0 ? '+' : ''}${(e[k] - D.calibration_file[k]).toFixed(2)} px`);
+        }
+      }
+      text += ` · calibration (since t ${(c.t - rows[0].t).toFixed(1)} s): ${parts.join(', ')}`;
+    }
     if (r.q) {
       const order = ['M_c', 'D_c', 'Th_adaptive', 'A_c', 'E_c', 'criterion1', 'criterion2',
                      'M_r', 'D_r'];
@@ -226,7 +249,9 @@
   }
   // The timeline strip: tracked points (grey), keyframes (red ticks), and when the trace has
   // them PKS's D_c (blue) against its adaptive threshold Th_adaptive (orange), each scaled to
-  // its own maximum; a black line marks the current frame.
+  // its own maximum; with online calibration its time-offset estimate (purple steps, scaled to
+  // its largest value, labelled) and a purple tick at each adjustment; a black line marks the
+  // current frame.
   const strip = document.getElementById('strip');
   function drawStrip(current) {
     const w = strip.clientWidth, h = strip.clientHeight;
@@ -254,6 +279,21 @@
     series((r) => r.tracked, '#999999');
     series((r) => (r.q ? r.q.D_c : undefined), '#1f77b4');
     series((r) => (r.q ? r.q.Th_adaptive : undefined), '#ff7f0e');
+    if (steps.length) {
+      series((r) => { const c = calibrationAt(r.t); return c ? c.e.time_offset : undefined; },
+             '#9467bd');
+      g.fillStyle = '#9467bd';
+      let last = -1;
+      rows.forEach((r, i) => {
+        const c = calibrationAt(r.t);
+        if (c && c !== last) { g.fillRect(x(i), h - 6, 1, 6); last = c; }
+      });
+      const top = Math.max(...steps.map((s) => s.e.time_offset || 0));
+      if (top > 0) {
+        g.font = '10px sans-serif';
+        g.fillText(`time offset estimate (top ${top.toFixed(2)} ms)`, 4, 11);
+      }
+    }
     g.fillStyle = '#d62728';
     rows.forEach((r, i) => { if (r.kf) g.fillRect(x(i), 0, 1, 6); });
     g.fillStyle = '#000000';

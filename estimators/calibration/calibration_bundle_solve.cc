@@ -8,8 +8,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <vector>
 
@@ -427,7 +425,6 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
     if (summary.termination_type == ceres::FAILURE) {
       PKSLAM_LOG_WARN("calibration bundle adjustment: solver failure: {}", summary.message);
     }
-    if (std::getenv("PKSLAM_CERES_REPORT")) fprintf(stderr, "%s\n", summary.FullReport().c_str());
   };
 
   solve(options.iterations_first);

@@ -303,6 +303,14 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
     for (const auto& t : sweeps) doc.AddTable(t);
     doc.Images(plots, "sweeps");
   }
+  if (std::any_of(plots.begin(), plots.end(),
+                  [](const Plot& p) { return p.section == "calibration"; })) {
+    doc.Heading(2, "Online calibration");
+    doc.Paragraph(
+        "The calibration estimates of runs with --calibrate online over the flight "
+        "(docs/calibration.md); each run's final estimate with sigmas is in its stats.json.");
+    doc.Images(plots, "calibration");
+  }
   const Table failures = FailureTable(results);
   if (!failures.rows.empty()) {
     doc.Heading(2, "Failed runs");
