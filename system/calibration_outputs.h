@@ -39,8 +39,9 @@ CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings
 CalibrationSources SourcesFromEurocDataset(const std::filesystem::path& dataset);
 
 // A warning per free parameter whose file value is more than `threshold` sigmas from the
-// estimate (needs sigmas), naming the parameter, the size and the file; one more than 5 prior
-// sigmas off says the file is wrong for the rig.
+// estimate, with the sigma at least a third of the prior's (the prior's third alone when the
+// covariance failed), naming the parameter, the size and the file; one more than 5 prior sigmas
+// off says the file is wrong for the rig.
 std::vector<std::string> CalibrationWarnings(const CalibrationReport& report,
                                              const CalibrationSources& sources,
                                              double threshold = 3.0);

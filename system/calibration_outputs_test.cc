@@ -22,11 +22,13 @@ CalibrationReport Report() {
   r.file.body_from_cam0 = testing::EurocBodyFromCam0();
   r.file.cam1_from_cam0 = testing::EurocCam1FromCam0();
   r.estimate = r.file;
-  r.estimate.time_offset_s = 1.0e-3;
-  // cx 0.4 px off at sigma 0.2 (2 sigma: no warning), the time offset 1 ms at 0.15 (6.7 sigma),
-  // fx 12 px at 0.3 (a gross error: 6 prior sigmas).
+  r.estimate.time_offset_s = 3.0e-3;
+  // cx 0.4 px off at sigma 0.2 (but at least 2/3 px, a third of the prior: no warning), the time
+  // offset 3 ms at 0.15 (sigma 2/3 ms: 4.5 sigma), fx 12 px at 0.3 (a gross error: 6 prior
+  // sigmas), cy 1.2 px at 0.1 (warned at the floor only: 1.8 sigma, none).
   r.parameters = {{"cam0.cx", "px", 367.215, 367.615, 0.2, 2.0, true},
-                  {"time_offset", "ms", 0.0, 1.0, 0.15, 2.0, true},
+                  {"cam0.cy", "px", 248.0, 249.2, 0.1, 2.0, true},
+                  {"time_offset", "ms", 0.0, 3.0, 0.15, 2.0, true},
                   {"cam1.fx", "px", 469.587, 457.587, 0.3, 2.0, true},
                   {"cam1.fy", "px", 456.134, 456.134, 0.0, 2.0, false}};
   return r;
@@ -37,15 +39,18 @@ TEST(CalibrationWarnings, NameTheParameterTheSizeAndTheFile) {
   const auto w = CalibrationWarnings(r, SourcesFromEurocDataset("seq"));
   ASSERT_THAT(w, SizeIs(2));
   EXPECT_THAT(w[0], HasSubstr("time_offset in seq/mav0/cam0/sensor.yaml (timeshift_cam_imu"));
-  EXPECT_THAT(w[0], HasSubstr("-1 ms off the estimate (6.7 sigma"));
+  EXPECT_THAT(w[0], HasSubstr("-3 ms off the estimate (4.5 sigma, a third of the prior's;"));
   EXPECT_THAT(w[0], ::testing::Not(HasSubstr("wrong for this rig")));
   EXPECT_THAT(w[1], HasSubstr("cam1.fx in seq/mav0/cam1/sensor.yaml is 12 px off"));
   EXPECT_THAT(w[1], HasSubstr("6 times a calibration file's usual error"));
-  // A settings file names itself; without sigmas (or with --calibrate off) nothing is claimed.
+  // A settings file names itself; without the covariance the prior's third still finds gross
+  // errors; with --calibrate off nothing is claimed.
   EXPECT_THAT(CalibrationWarnings(r, SourcesFromSettingsFile("s.yaml"))[0], HasSubstr("in s.yaml"));
   CalibrationReport no_sigma = r;
   no_sigma.covariance_ok = false;
-  EXPECT_TRUE(CalibrationWarnings(no_sigma, SourcesFromEurocDataset("seq")).empty());
+  const auto nw = CalibrationWarnings(no_sigma, SourcesFromEurocDataset("seq"));
+  ASSERT_THAT(nw, SizeIs(2));
+  EXPECT_THAT(nw[0], HasSubstr("a third of the prior's: no covariance"));
   CalibrationReport off = r;
   off.online = false;
   EXPECT_TRUE(CalibrationWarnings(off, SourcesFromEurocDataset("seq")).empty());
@@ -64,12 +69,12 @@ TEST(CalibrationFiles, ReadBackAsEurocSensorsAndSettings) {
   WriteCalibrationFiles(r, settings, dir);
   const EurocCameraSensor cam0 = ReadEurocCameraSensor(dir / "calibration/cam0/sensor.yaml");
   const EurocCameraSensor cam1 = ReadEurocCameraSensor(dir / "calibration/cam1/sensor.yaml");
-  EXPECT_DOUBLE_EQ(cam0.timeshift_cam_imu, 1.0e-3);
+  EXPECT_DOUBLE_EQ(cam0.timeshift_cam_imu, 3.0e-3);
   EXPECT_DOUBLE_EQ(cam1.timeshift_cam_imu, 0.0);
   EXPECT_LT((cam1.body_from_camera.Inverse() * r.estimate.body_from_cam1()).Log().norm(), 1e-12);
   EXPECT_EQ(cam0.intrinsics[0], r.estimate.cameras[0].fx());
   const Settings back = ReadOrbSlam3Settings(dir / "calibration/settings.yaml");
-  EXPECT_DOUBLE_EQ(back.time_offset_s, 1.0e-3);
+  EXPECT_DOUBLE_EQ(back.time_offset_s, 3.0e-3);
   EXPECT_LT((*back.right_from_left * r.estimate.cam1_from_cam0.Inverse()).Log().norm(), 1e-12);
 }
 

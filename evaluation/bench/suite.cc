@@ -228,7 +228,7 @@ SweepSpec ParseSweep(const Context& c, const YAML::Node& node) {
 
 void Validate(const Context& c, const YAML::Node& root, Suite& s) {
   if (s.datasets.empty()) c.Fail(root, "the suite lists no datasets");
-  if (s.selectors.empty()) c.Fail(root, "the suite lists no selectors");
+  if (s.selectors.empty() && s.peers.empty()) c.Fail(root, "the suite lists no selectors or peers");
   std::set<std::string> names;
   for (const auto& d : s.datasets) {
     if (!names.insert(d.name).second)

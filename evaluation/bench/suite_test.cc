@@ -220,6 +220,24 @@ datasets:
   EXPECT_EQ(runs[2].id, "a/rgbd/orbslam3/seed1");
 }
 
+// A suite of peers only (another system's runs beside a pkslam suite's, in their own folder).
+TEST(Suite, APeerWithoutSelectorsIsASuite) {
+  const std::string head = R"(runs: 2
+sensors: [stereo-inertial]
+selectors: []
+)";
+  const Suite s = ParseSuite(head + R"(peers:
+  - {label: p, command: [x]}
+datasets:
+  - {name: a, path: /data/a}
+)",
+                             "suite.yaml");
+  const auto runs = ExpandSuite(s);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[1].id, "a/stereo-inertial/p/seed2");
+  ExpectError(head + "datasets:\n  - {name: a, path: /data/a}\n", 1, "no selectors or peers");
+}
+
 // A simulated dataset's own settings.yaml lives in its cache folder, known only at run time:
 // "{dataset}" in `settings` is left for the executor to fill in.
 TEST(Suite, SettingsInsideTheDatasetFolder) {
