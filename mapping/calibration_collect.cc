@@ -99,8 +99,9 @@ CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertia
   if (newest == nullptr || newest->IsBad() || newest->map() == nullptr) return problem;
   const Map& map = *newest->map();
   if (inertial) {
-    // The chain ends at the newest keyframe joined to its predecessor: the very last keyframes
-    // of a sequence may have no preintegration (the IMU log ends with the images).
+    // The chain ends at whichever of the last 10 keyframes has the longest chain behind it: the
+    // very last keyframes of a sequence may have no preintegration (the IMU log ends with the
+    // images), and a chain from one of them would leave the adjustment visual-only.
     KeyFrame* end = newest;
     std::size_t longest = 0;
     int tried = 0;

@@ -163,7 +163,8 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
 
 std::optional<std::string> ImplausibleEstimate(const CalibrationBundleProblem& problem,
                                                const RigCalibration& estimate,
-                                               const OnlineCalibrationOptions& options) {
+                                               const OnlineCalibrationOptions& options,
+                                               double max_step_prior_sigmas) {
   const auto check = [&](const RigCalibration& from, double limit,
                          const char* what) -> std::optional<std::string> {
     for (const CalibrationParameter& p :
@@ -178,7 +179,7 @@ std::optional<std::string> ImplausibleEstimate(const CalibrationBundleProblem& p
     return std::nullopt;
   };
   if (auto why = check(problem.prior, options.max_prior_sigmas, "from the file")) return why;
-  return check(problem.initial, options.max_step_prior_sigmas, "in one adjustment");
+  return check(problem.initial, max_step_prior_sigmas, "in one adjustment");
 }
 
 }  // namespace pkslam

@@ -99,11 +99,14 @@ struct CalibrationGates {
 CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor sensor,
                                const OnlineCalibrationOptions& options);
 
-// Why the estimate `result` of an adjustment that started from `problem.initial` must not be
-// applied (OnlineCalibrationOptions::max_prior_sigmas, max_step_prior_sigmas), or nullopt.
+// Why the estimate of an adjustment that started from `problem.initial` must not be applied:
+// more than options.max_prior_sigmas from the file, or more than `max_step_prior_sigmas` from
+// where it started (mapping's adjustments: options.max_step_prior_sigmas; the final one:
+// options.final_max_step_prior_sigmas), or nullopt.
 std::optional<std::string> ImplausibleEstimate(const CalibrationBundleProblem& problem,
                                                const RigCalibration& estimate,
-                                               const OnlineCalibrationOptions& options);
+                                               const OnlineCalibrationOptions& options,
+                                               double max_step_prior_sigmas);
 
 // One calibration adjustment of a run (stats.json "calibration.history").
 struct CalibrationRefinementStat {

@@ -110,17 +110,19 @@ TEST(ImplausibleEstimateTest, RejectsJumpsAndEstimatesFarFromTheFile) {
     return e;
   };
   const OnlineCalibrationOptions o;  // priors: 2 px focal, 2 ms offset
-  EXPECT_FALSE(ImplausibleEstimate(p, shifted(p.initial, 5.0, 9.0), o));  // a gross file error
-  const auto jump = ImplausibleEstimate(p, shifted(p.initial, 34.0, 0.0), o);
+  const double max_step = o.max_step_prior_sigmas;
+  // A gross file error.
+  EXPECT_FALSE(ImplausibleEstimate(p, shifted(p.initial, 5.0, 9.0), o, max_step));
+  const auto jump = ImplausibleEstimate(p, shifted(p.initial, 34.0, 0.0), o, max_step);
   ASSERT_TRUE(jump.has_value());
   EXPECT_NE(jump->find("cam0.fx would move 34 px from the file (17 prior sigmas"), std::string::npos)
       << *jump;
   // Far from the file in small steps is still far from the file; a big step from a good start
   // is still a jump.
   p.initial = shifted(p.prior, 19.0, 0.0);
-  EXPECT_TRUE(ImplausibleEstimate(p, shifted(p.initial, 3.0, 0.0), o).has_value());
+  EXPECT_TRUE(ImplausibleEstimate(p, shifted(p.initial, 3.0, 0.0), o, max_step).has_value());
   p.initial = shifted(p.prior, 0.0, -8.0);
-  const auto step = ImplausibleEstimate(p, shifted(p.initial, 0.0, 17.0), o);
+  const auto step = ImplausibleEstimate(p, shifted(p.initial, 0.0, 17.0), o, max_step);
   ASSERT_TRUE(step.has_value());
   EXPECT_NE(step->find("in one adjustment"), std::string::npos) << *step;
 }

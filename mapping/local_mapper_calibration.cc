@@ -82,7 +82,7 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
     finish("interrupted before its first step");
     return;
   }
-  if (const auto why = ImplausibleEstimate(problem, result.estimate, o)) {
+  if (const auto why = ImplausibleEstimate(problem, result.estimate, o, o.max_step_prior_sigmas)) {
     PKSLAM_LOG_WARN("calibration adjustment at t = {:.1f} s not applied: {}", stat.span_s, *why);
     finish("rejected: " + *why);
     return;

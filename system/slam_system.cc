@@ -143,9 +143,8 @@ void SlamSystem::FinishCalibration() {
   ba.prior = o.prior;
   CalibrationBundleResult result = SolveCalibrationBundle(problem, ba);
   if (result.bundle.visual.iterations == 0) return;
-  OnlineCalibrationOptions final_limits = o;
-  final_limits.max_step_prior_sigmas = o.final_max_step_prior_sigmas;
-  if (const auto why = ImplausibleEstimate(problem, result.estimate, final_limits)) {
+  if (const auto why = ImplausibleEstimate(problem, result.estimate, o,
+                                           o.final_max_step_prior_sigmas)) {
     PKSLAM_LOG_WARN("final calibration adjustment not applied (the run keeps mapping's estimate, "
                     "without sigmas): {}",
                     *why);
