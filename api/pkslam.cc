@@ -1,11 +1,16 @@
 // The public API (api/include/pkslam/pkslam.h) over SlamSystem.
 #include "pkslam/pkslam.h"
 
+#include <fmt/format.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 #include "core/sensor/sensor.h"
 #include "core/util/error.h"
 #include "evaluation/evaluate.h"
+#include "io/rigid_transform_file.h"
 #include "io/settings.h"
 #include "map_model/keyframe.h"
 #include "system/run_dataset.h"
@@ -45,6 +50,51 @@ auto Guard(F&& f) -> decltype(f()) {
   }
 }
 
+SE3d ToSE3(const Eigen::Matrix4d& m, const char* what) {
+  if (!m.allFinite()) throw std::invalid_argument(fmt::format("{}: not finite", what));
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  if (!(r.transpose() * r).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || r.determinant() < 0 ||
+      !m.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1))) {
+    throw std::invalid_argument(fmt::format("{}: not a rigid transform (rotation block not "
+                                            "orthonormal, or bottom row not 0 0 0 1)",
+                                            what));
+  }
+  return SE3d(SO3d(r), m.topRightCorner<3, 1>());
+}
+
+// An 8-bit image of the settings' size as the grey image tracking reads (BGR converted).
+cv::Mat GreyImage(const cv::Mat& image, const char* what, const CameraModel& camera) {
+  if (image.empty()) throw std::invalid_argument(fmt::format("{}: empty image", what));
+  if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
+    throw std::invalid_argument(fmt::format(
+        "{}: expected 8-bit grey or BGR, got {} channel(s) of {}", what, image.channels(),
+        image.depth() == CV_16U ? "16-bit" : image.depth() == CV_32F ? "float" : "another type"));
+  }
+  if (image.cols != camera.width() || image.rows != camera.height()) {
+    throw std::invalid_argument(fmt::format("{}: {}x{} image, but the settings' camera is {}x{}",
+                                            what, image.cols, image.rows, camera.width(),
+                                            camera.height()));
+  }
+  if (image.channels() == 1) return image;
+  cv::Mat grey;
+  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+cv::Mat DepthImage(const cv::Mat& depth, const CameraModel& camera) {
+  if (depth.empty()) throw std::invalid_argument("depth: empty image");
+  if (depth.channels() != 1 || (depth.depth() != CV_16U && depth.depth() != CV_32F)) {
+    throw std::invalid_argument("depth: expected one channel of uint16 (scaled by the settings' "
+                                "depth factor) or float32 metres");
+  }
+  if (depth.cols != camera.width() || depth.rows != camera.height()) {
+    throw std::invalid_argument(fmt::format("depth: {}x{} image, but the settings' camera is {}x{}",
+                                            depth.cols, depth.rows, camera.width(),
+                                            camera.height()));
+  }
+  return depth;
+}
+
 }  // namespace
 
 const char* SlamStateName(SlamState state) {
@@ -63,7 +113,23 @@ const char* SlamStateName(SlamState state) {
 
 struct Slam::Impl {
   std::unique_ptr<SlamSystem> system;
+  Sensor sensor = Sensor::kStereo;
   TrackResult last;
+  bool shut_down = false;
+  std::optional<std::int64_t> last_frame_t_ns;
+  std::optional<std::int64_t> last_imu_t_ns;
+
+  const CameraModel& camera() const { return system->settings().camera1; }
+  // Before each frame: tracking is still open and time goes forward (a frame before the
+  // previous one came back as an unsorted trajectory).
+  void CheckFrame(std::int64_t t_ns) {
+    if (shut_down) throw std::invalid_argument("Slam: tracking after Shutdown()");
+    if (last_frame_t_ns && t_ns <= *last_frame_t_ns) {
+      throw std::invalid_argument(fmt::format(
+          "t_ns: {} is not after the previous frame's {}", t_ns, *last_frame_t_ns));
+    }
+    last_frame_t_ns = t_ns;
+  }
 };
 
 Slam::Slam(const SlamOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -81,6 +147,7 @@ Slam::Slam(const SlamOptions& options) : impl_(std::make_unique<Impl>()) {
     system.tracking.localise_only = options.localise_only;
     if (!options.deterministic) system.mapping_sync = "free";  // a live caller
     impl_->system = std::make_unique<SlamSystem>(settings, LoadRunVocabulary(run), system);
+    impl_->sensor = *sensor;
     return 0;
   });
 }
@@ -88,30 +155,53 @@ Slam::Slam(const SlamOptions& options) : impl_(std::make_unique<Impl>()) {
 Slam::~Slam() = default;
 
 SlamState Slam::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
+  const cv::Mat grey = GreyImage(image, "image", impl_->camera());
+  impl_->CheckFrame(t_ns);
   return Guard([&] {
-    impl_->last = impl_->system->TrackMonocular(image, t_ns);
+    impl_->last = impl_->system->TrackMonocular(grey, t_ns);
     return ToApi(impl_->last.state);
   });
 }
 
 SlamState Slam::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
+  const cv::Mat left_grey = GreyImage(left, "left", impl_->camera());
+  const cv::Mat right_grey = GreyImage(right, "right", impl_->camera());
+  impl_->CheckFrame(t_ns);
   return Guard([&] {
-    impl_->last = impl_->system->TrackStereo(left, right, t_ns);
+    impl_->last = impl_->system->TrackStereo(left_grey, right_grey, t_ns);
     return ToApi(impl_->last.state);
   });
 }
 
 SlamState Slam::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns) {
+  const cv::Mat grey = GreyImage(image, "image", impl_->camera());
+  const cv::Mat checked_depth = DepthImage(depth, impl_->camera());
+  impl_->CheckFrame(t_ns);
   return Guard([&] {
-    impl_->last = impl_->system->TrackRgbd(image, depth, t_ns);
+    impl_->last = impl_->system->TrackRgbd(grey, checked_depth, t_ns);
     return ToApi(impl_->last.state);
   });
 }
 
 void Slam::AddImu(const std::vector<ImuSample>& samples) {
+  if (impl_->shut_down) throw std::invalid_argument("Slam: AddImu after Shutdown()");
   std::vector<ImuMeasurement> m;
   m.reserve(samples.size());
-  for (const ImuSample& s : samples) m.push_back({s.t_ns, s.gyro, s.accel});
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const ImuSample& s = samples[i];
+    // Checked here, where the caller can see which sample: downstream a NaN failed only at the
+    // next frame's preintegration.
+    if (!s.gyro.allFinite() || !s.accel.allFinite()) {
+      throw std::invalid_argument(fmt::format("IMU sample {} (t_ns {}): not finite", i, s.t_ns));
+    }
+    if (impl_->last_imu_t_ns && s.t_ns <= *impl_->last_imu_t_ns) {
+      throw std::invalid_argument(fmt::format("IMU sample {}: t_ns {} is not after the previous "
+                                              "sample's {}",
+                                              i, s.t_ns, *impl_->last_imu_t_ns));
+    }
+    impl_->last_imu_t_ns = s.t_ns;
+    m.push_back({s.t_ns, s.gyro, s.accel});
+  }
   Guard([&] {
     impl_->system->AddImu(m);
     return 0;
@@ -136,10 +226,31 @@ void Slam::LoadMap(const std::string& file) {
   Guard([&] { return impl_->system->LoadMap(file); });
 }
 
-void Slam::Shutdown() { impl_->system->Shutdown(); }
+void Slam::Shutdown() {
+  impl_->system->Shutdown();
+  impl_->shut_down = true;
+}
 
-std::vector<StampedPose> Slam::Trajectory() const {
+std::vector<StampedPose> Slam::CameraTrajectory() const {
   return ToApi(impl_->system->FrameTrajectory());
+}
+
+std::vector<StampedBodyPose> Slam::BodyTrajectory() const {
+  if (impl_->sensor == Sensor::kMonocular) {
+    throw std::runtime_error(
+        "BodyTrajectory: a visual monocular map has no metric scale for the camera-body lever "
+        "arm; compare CameraTrajectory() with Evaluate(..., body_from_camera)");
+  }
+  const SE3d camera_from_body = impl_->system->rig().body_from_camera.Inverse();
+  std::vector<StampedBodyPose> out;
+  for (const pkslam::StampedPose& p : impl_->system->FrameTrajectory().poses) {
+    out.push_back({p.t_ns, (p.pose * camera_from_body).Matrix()});
+  }
+  return out;
+}
+
+Eigen::Matrix4d Slam::BodyFromCamera() const {
+  return impl_->system->rig().body_from_camera.Matrix();
 }
 
 std::vector<StampedPose> Slam::KeyFrameTrajectory() const {
@@ -148,11 +259,16 @@ std::vector<StampedPose> Slam::KeyFrameTrajectory() const {
 
 namespace {
 
+// As `pkslam eval` reads and pairs (repeated stamps kept, one-to-one association), so the two
+// agree to the last digit on the same files.
 Evaluation EvaluateAgainst(const std::string& ground_truth_file, const pkslam::Trajectory& est,
-                           const std::string& align) {
+                           const std::string& align,
+                           const std::optional<Eigen::Matrix4d>& body_from_camera) {
   EvaluationOptions options;
   options.alignment = ParseAlignmentMethod(align);
-  const pkslam::Trajectory gt = ReadTrajectory(ground_truth_file);
+  pkslam::Trajectory gt = ReadTrajectory(ground_truth_file, TrajectoryFormat::kAuto,
+                                         DuplicateTimestamps::kKeepAll);
+  if (body_from_camera) gt = ChangeSensorFrame(gt, ToSE3(*body_from_camera, "body_from_camera"));
   const EvaluationResult r = EvaluateTrajectories(gt, est, options);
   Evaluation out;
   out.pairs = r.pairs.size();
@@ -172,21 +288,35 @@ Evaluation EvaluateAgainst(const std::string& ground_truth_file, const pkslam::T
 }  // namespace
 
 Evaluation Evaluate(const std::string& ground_truth_file, const std::string& estimate_file,
-                    const std::string& align) {
-  return Guard(
-      [&] { return EvaluateAgainst(ground_truth_file, ReadTrajectory(estimate_file), align); });
+                    const std::string& align,
+                    const std::optional<Eigen::Matrix4d>& body_from_camera) {
+  return Guard([&] {
+    return EvaluateAgainst(ground_truth_file,
+                           ReadTrajectory(estimate_file, TrajectoryFormat::kAuto,
+                                          DuplicateTimestamps::kKeepAll),
+                           align, body_from_camera);
+  });
 }
 
 Evaluation Evaluate(const std::string& ground_truth_file, const std::vector<StampedPose>& estimate,
-                    const std::string& align) {
-  return Guard([&] {
-    pkslam::Trajectory est;
-    for (const StampedPose& p : estimate) {
-      const Eigen::Matrix3d r = p.world_from_camera.topLeftCorner<3, 3>();
-      est.poses.push_back({p.t_ns, SE3d(SO3d(r), p.world_from_camera.topRightCorner<3, 1>())});
-    }
-    return EvaluateAgainst(ground_truth_file, est, align);
-  });
+                    const std::string& align,
+                    const std::optional<Eigen::Matrix4d>& body_from_camera) {
+  pkslam::Trajectory est;
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    est.poses.push_back({estimate[i].t_ns, ToSE3(estimate[i].world_from_camera,
+                                                 fmt::format("estimate pose {}", i).c_str())});
+  }
+  return Guard([&] { return EvaluateAgainst(ground_truth_file, est, align, body_from_camera); });
+}
+
+Evaluation Evaluate(const std::string& ground_truth_file,
+                    const std::vector<StampedBodyPose>& estimate, const std::string& align) {
+  pkslam::Trajectory est;
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    est.poses.push_back({estimate[i].t_ns, ToSE3(estimate[i].world_from_body,
+                                                 fmt::format("estimate pose {}", i).c_str())});
+  }
+  return Guard([&] { return EvaluateAgainst(ground_truth_file, est, align, std::nullopt); });
 }
 
 }  // namespace pkslam::api

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "core/util/output_guard.h"
 #include "core/util/error.h"
 #include "evaluation/bench/bench.h"
 #include "evaluation/bench/report.h"
@@ -115,6 +116,9 @@ void Run(const BenchArgs& a) {
         e.slurm_script.string(), fs::absolute(h.out).string());
     return;
   }
+  // The report replaces OUT/plots at the end: refuse a folder the bench did not make now, not
+  // after hours of runs.
+  CheckOwnedDirectory(h.out / "plots", "index.tsv");
   bench::WriteBenchInfo(h.out, suite);
   std::signal(SIGINT, OnBenchSignal);
   std::signal(SIGTERM, OnBenchSignal);

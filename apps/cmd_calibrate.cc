@@ -10,7 +10,9 @@
 #include <optional>
 #include <string>
 
+#include "apps/cli_errors.h"
 #include "apps/commands.h"
+#include "core/util/output_guard.h"
 #include "core/util/error.h"
 #include "core/util/output_file.h"
 #include "core/util/project_file.h"
@@ -124,6 +126,7 @@ void RunCalibrate(const CalibrateArgs& args) {
         args.sensor));
   }
   const fs::path out = args.out;
+  CheckOwnedDirectory(out / "calibration", "settings.yaml");  // replaced at the end
   fs::create_directories(out);
   RunOptions base;
   base.dataset = args.dataset;
@@ -145,7 +148,7 @@ void RunCalibrate(const CalibrateArgs& args) {
   c.final_iterations_second = 15;
   fmt::print("calibrate: mapping with online calibration -> {}\n", calibrate.out.string());
   const RunSummary run = RunDataset(calibrate);
-  fs::remove_all(out / "calibration");
+  RemoveOwnedDirectory(out / "calibration", "settings.yaml");
   fs::copy(calibrate.out / "calibration", out / "calibration", fs::copy_options::recursive);
 
   const fs::path script = FindProjectFile("evaluation/calibration_plot.py");
@@ -202,7 +205,10 @@ void RegisterCalibrateCommand(CLI::App& app) {
       "Estimate the rig's calibration from an ordinary flight (no target): refined EuRoC and "
       "ORB-SLAM3 files, a report, and with ground truth the ATE before and after");
   cmd->add_option("--dataset", args->dataset, "EuRoC dataset folder")->required();
-  cmd->add_option("--sensor", args->sensor, "stereo | stereo-inertial | mono-inertial")
+  cmd->add_option("--sensor", args->sensor, "Sensor configuration")
+      ->check(OneOf({"stereo", "stereo-inertial", "mono-inertial"},
+                    "calibration needs a stereo rig or an IMU (a monocular map has no metric "
+                    "scale to hold the intrinsics against)"))
       ->capture_default_str();
   cmd->add_option("--settings", args->settings,
                   "ORB-SLAM3 v1.0 settings file (EuRoC: default from the sensor.yaml files)");

@@ -30,6 +30,7 @@ struct EvalArgs {
   bool rpe_consecutive = false;
   std::string json_file;
   std::string body_from_camera_file;
+  bool allow_frame_offset = false;
 };
 
 void RunEval(const EvalArgs& args) {
@@ -41,6 +42,7 @@ void RunEval(const EvalArgs& args) {
   options.rpe.delta = args.rpe_delta;
   options.rpe.unit = ParseRpeUnit(args.rpe_unit);
   options.rpe.all_pairs = !args.rpe_consecutive;
+  options.allow_frame_offset = args.allow_frame_offset;
   options.Check();
   const TrajectoryFormat gt_format = ParseTrajectoryFormat(args.gt_format);
   const TrajectoryFormat est_format = ParseTrajectoryFormat(args.est_format);
@@ -91,6 +93,10 @@ void RegisterEvalCommand(CLI::App& app) {
   cmd->add_flag("--rpe-consecutive", args->rpe_consecutive,
                 "RPE on non-overlapping consecutive pairs (evo's default) instead of all pairs");
   cmd->add_option("--json", args->json_file, "Also write the results as JSON to this file");
+  cmd->add_flag("--allow-frame-offset", args->allow_frame_offset,
+                "Measure although the aligned orientations differ by a near-constant rotation "
+                "over 5 deg (by default an error: estimate and truth describe different frames, "
+                "e.g. camera against body)");
   cmd->add_option("--body-from-camera", args->body_from_camera_file,
                   "Move the ground truth (body poses) into the camera with this rigid transform "
                   "(a run's body_from_camera.txt) and compare the camera trajectory.txt: needed "

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "apps/cli_errors.h"
 #include "apps/commands.h"
 #include "core/sensor/sensor.h"
 #include "core/util/error.h"
@@ -108,6 +109,8 @@ void RegisterMapCommand(CLI::App& app) {
                         "EuRoC dataset whose sensor.yaml files give the camera (or --settings)");
   roundtrip->add_option("--settings", args->settings, "ORB-SLAM3 settings file");
   roundtrip->add_option("--sensor", args->sensor, "Sensor the map was built with")
+      ->check(OneOf({"mono", "stereo", "rgbd", "mono-inertial", "stereo-inertial",
+                     "rgbd-inertial"}))
       ->capture_default_str();
   roundtrip->add_option("--vocabulary", args->vocabulary, "ORB vocabulary (default: shipped)");
   roundtrip->add_option("--out", args->out, "Where to write the re-saved map (FILE.roundtrip)");

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 
+#include "apps/cli_errors.h"
 #include "apps/commands.h"
 #include "core/util/error.h"
 #include "system/run_dataset.h"
@@ -44,7 +45,7 @@ void OnTrajectoryWritten() {
 
 struct RunArgs {
   RunOptions options;
-  std::string sensor = "stereo";
+  std::optional<std::string> sensor;  // default: stereo for --dataset, mono otherwise
   std::string settings;
   std::string vocabulary;
   std::string out = "out";
@@ -104,8 +105,10 @@ void RegisterRunCommand(CLI::App& app) {
                   "--images: one frame per line, 't_ns' (DIR/t_ns.png) or 't name' (t in s "
                   "with a decimal point, else ns)");
   cmd->add_option("--sensor", args->sensor,
-                  "mono | stereo | rgbd | mono-inertial | stereo-inertial | rgbd-inertial")
-      ->capture_default_str();
+                  "Sensor configuration (default: stereo for --dataset, mono for --video, "
+                  "--camera and --images)")
+      ->check(OneOf({"mono", "stereo", "rgbd", "mono-inertial", "stereo-inertial",
+                     "rgbd-inertial"}));
   cmd->add_option("--settings", args->settings,
                   "ORB-SLAM3 v1.0 settings file (EuRoC: default from the sensor.yaml files)");
   cmd->add_option("--vocabulary", args->vocabulary, "ORB vocabulary (DBoW2 .txt or pkslam .bin)");
@@ -134,7 +137,7 @@ void RegisterRunCommand(CLI::App& app) {
          "online: estimate the rig's calibration while mapping (intrinsics, stereo and "
          "camera-IMU extrinsics, time offset; docs/calibration.md) | off: take the settings' "
          "calibration as exact")
-      ->check(CLI::IsMember({"online", "off"}))
+      ->check(OneOf({"online", "off"}))
       ->default_str("off");
   cmd->add_flag("--calibrate-lever-arm", args->options.system.mapping.calibration.imu_translation,
                 "--calibrate online: estimate the camera-IMU translation too (held at the file's "
@@ -149,7 +152,7 @@ void RegisterRunCommand(CLI::App& app) {
                   "live run at real-time pace would see it, without sleeping), lockstep (each "
                   "keyframe mapped before the next frame; --deterministic), free (no coupling; "
                   "--realtime default)")
-      ->check(CLI::IsMember({"live", "lockstep", "free"}));
+      ->check(OneOf({"live", "lockstep", "free"}));
   cmd->add_option("--live-pace", args->options.system.live_pace,
                   "--mapping-sync live: playback speed of the emulated live run (2: as if frames "
                   "came twice as fast as their timestamps)")
@@ -158,7 +161,7 @@ void RegisterRunCommand(CLI::App& app) {
                   "--mapping-sync live: measure local mapping's work in its thread's CPU time "
                   "(cpu: the same emulated machine however loaded this one is) or in wall time "
                   "(wall: this machine under its present load)")
-      ->check(CLI::IsMember({"cpu", "wall"}))
+      ->check(OneOf({"cpu", "wall"}))
       ->capture_default_str();
   cmd->add_option("--max-frames", args->options.max_frames, "Stop after N frames (0: all)");
   cmd->add_option("--first-frame", args->options.first_frame,
@@ -193,8 +196,9 @@ void RegisterRunCommand(CLI::App& app) {
                 "see stats.json \"estimate\")");
   cmd->callback([args] {
     RunOptions& o = args->options;
-    const auto sensor = ParseSensor(args->sensor);
-    if (!sensor) throw OptionError(fmt::format("unknown --sensor '{}'", args->sensor));
+    const auto sensor =
+        ParseSensor(args->sensor.value_or(o.dataset.empty() ? "mono" : "stereo"));
+    if (!sensor) throw OptionError(fmt::format("unknown --sensor '{}'", *args->sensor));
     o.system.sensor = *sensor;
     if (!args->settings.empty()) o.settings = args->settings;
     if (!args->vocabulary.empty()) o.vocabulary = args->vocabulary;
@@ -228,14 +232,16 @@ void RegisterRunCommand(CLI::App& app) {
     fmt::print(
         "wall {:.2f} s for {:.2f} s of data ({:.2f}x real time), median tracking {:.2f} ms\n",
         s.wall_s, s.sequence_s, s.wall_s > 0 ? s.sequence_s / s.wall_s : 0.0, s.median_tracking_ms);
-    fmt::print(
-        "outputs: {}/{{trajectory.txt, keyframes.txt, map_points.ply, stats.json, run.log}}\n",
-        o.out.string());
+    // trajectory_body.txt (body = IMU frame, what EuRoC ground truth describes) is written for
+    // every metric run (system/run_outputs.cc); a visual monocular map has no metric lever arm.
+    fmt::print("outputs: {}/{{trajectory.txt, {}keyframes.txt, map_points.ply, stats.json, "
+               "run.log}} (docs/run.md lists all)\n",
+               o.out.string(), o.system.sensor == Sensor::kMonocular ? "" : "trajectory_body.txt, ");
     if (s.input.degraded()) {
       fmt::print("degraded input: {} warning(s), see {}/stats.json \"input\"\n",
                  s.input.warnings.size(), o.out.string());
     }
-    if (s.estimate.suspect()) {
+    if (!s.estimate.warnings.empty()) {
       fmt::print("suspect estimate: {}; see {}/stats.json \"estimate\"\n",
                  s.estimate.warnings.front(), o.out.string());
     }
@@ -245,6 +251,11 @@ void RegisterRunCommand(CLI::App& app) {
                         fmt::format("interrupted by {} after {} frames (outputs "
                                     "written for them)",
                                     signal == SIGTERM ? "SIGTERM" : "SIGINT", s.frames)};
+    }
+    if (!s.estimate.no_estimate.empty()) {
+      throw CommandExit{kExitNoEstimate,
+                        fmt::format("error: no estimate: {}; see {}/stats.json \"estimate\"",
+                                    s.estimate.no_estimate, o.out.string())};
     }
     if (args->strict && s.input.degraded()) {
       throw CommandExit{kExitDegraded, "--strict: the run finished on degraded input"};

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli_errors.h"
 #include "apps/commands.h"
 #include "core/util/error.h"
 #include "sim/scene_description.h"
@@ -199,7 +200,7 @@ void RegisterSimulateCommand(CLI::App& app) {
                   "odometry's 1241x376 pair, 0.537 m baseline, 10 Hz, settings.yaml with 2000 "
                   "ORB features), vga (640x480, 20 Hz, 1000 features); run with --settings "
                   "DATASET/settings.yaml to use its feature count")
-      ->check(CLI::IsMember({"euroc", "kitti", "vga"}))
+      ->check(OneOf({"euroc", "kitti", "vga"}))
       ->capture_default_str();
   cmd->add_option("--blackout", args->blackout, "Black images between T0 and T1 (s from start)")
       ->expected(2);

@@ -9,9 +9,11 @@ namespace pkslam::apps {
 
 // Exit codes (docs/run.md): 0 success, 1 error (bad input, failed write), 2 internal error,
 // 3 finished on degraded input under --strict, 4 finished with a suspect estimate under --strict
-// (system/estimate_health.h), 128 + signal when interrupted (outputs written).
+// (system/estimate_health.h), 5 the run has no estimate (too few frames with a pose; --strict or
+// not), 128 + signal when interrupted (outputs written).
 inline constexpr int kExitDegraded = 3;
 inline constexpr int kExitSuspect = 4;
+inline constexpr int kExitNoEstimate = 5;
 
 // Thrown by a command that finished its work but must exit with `code`; main() prints
 // `message` (when not empty) as one line.
@@ -35,5 +37,6 @@ void RegisterRgbdOdometryCommand(CLI::App& app);
 void RegisterPlanarCommand(CLI::App& app);
 void RegisterSimulateCommand(CLI::App& app);
 void RegisterBenchCommand(CLI::App& app);
+void RegisterSettingsCommand(CLI::App& app);
 
 }  // namespace pkslam::apps

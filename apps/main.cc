@@ -3,6 +3,8 @@
 #include <exception>
 #include <iostream>
 
+#include "apps/cli_errors.h"
+#include "apps/cli_outputs.h"
 #include "apps/commands.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -14,7 +16,11 @@ int main(int argc, char** argv) {
   std::string log_level = "info";
   app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off")
       ->capture_default_str();
-  app.parse_complete_callback([&log_level] { pkslam::SetLogLevel(log_level); });
+  // Runs once parsing is complete, before the subcommand's callback: nothing is written yet.
+  app.parse_complete_callback([&app, &log_level] {
+    pkslam::SetLogLevel(log_level);
+    pkslam::apps::CheckOutputsAgainstInputs(app);
+  });
 
   pkslam::apps::RegisterEvalCommand(app);
   pkslam::apps::RegisterInfoCommand(app);
@@ -31,11 +37,12 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterPlanarCommand(app);
   pkslam::apps::RegisterSimulateCommand(app);
   pkslam::apps::RegisterBenchCommand(app);
+  pkslam::apps::RegisterSettingsCommand(app);
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return pkslam::apps::ReportParseError(app, e, argc, argv);
   } catch (const pkslam::apps::CommandExit& e) {
     if (!e.message.empty()) std::cerr << "pkslam: " << e.message << '\n';
     return e.code;

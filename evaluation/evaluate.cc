@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
 #include <cmath>
 
 #include "core/util/error.h"
@@ -36,6 +39,79 @@ std::string StatisticsRow(std::string_view label, const ErrorStatistics& s) {
   return fmt::format(
       "{:<14} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>11.6f}\n", label,
       s.rmse, s.mean, s.median, s.std, s.min, s.max, s.sse);
+}
+
+// Matched poses must be numbers; for a Sim(3) alignment each side must also move: with all
+// positions in one place the scale is free (it shrinks the estimate onto the truth, or grows it
+// anywhere). A rigid alignment of a static side still measures the other side's spread.
+void CheckPosesUsable(const std::vector<SE3d>& poses, const std::vector<IndexPair>& pairs,
+                      bool estimate, bool need_spread, const std::filesystem::path& name) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const SE3d& pose = poses[k];
+    if (!pose.translation().allFinite() || !pose.so3().Matrix().allFinite()) {
+      throw InputError(name, fmt::format("pose {} of the file (matched pair {}) is not finite",
+                                         (estimate ? pairs[k].est : pairs[k].ref) + 1, k + 1));
+    }
+    mean += pose.translation();
+  }
+  if (!need_spread) return;
+  mean /= static_cast<double>(poses.size());
+  double spread_sq = 0;
+  for (const SE3d& pose : poses) spread_sq += (pose.translation() - mean).squaredNorm();
+  const double spread_m = std::sqrt(spread_sq / static_cast<double>(poses.size()));
+  if (spread_m < 1e-6) {
+    throw InputError(name, fmt::format("the {} matched {} poses all sit at one place (RMS spread "
+                                       "{:.2g} m): a Sim(3) alignment has no scale to find",
+                                       poses.size(), estimate ? "estimate" : "reference",
+                                       spread_m));
+  }
+}
+
+// After alignment the orientations of estimate and reference should agree up to drift. A large
+// rotation between them that is nearly the same at every pose means the two describe different
+// frames of the rig (ORB-SLAM3 and pkslam write camera poses; EuRoC's ground truth is the body,
+// whose camera sits at about 90 degrees): the numbers would measure the calibration, not the run.
+void CheckSameBodyFrame(const std::vector<SE3d>& ref, const std::vector<SE3d>& est,
+                        const std::filesystem::path& est_name) {
+  // Along a nearly straight path the alignment cannot fix the rotation about the path from
+  // positions alone, and an offset about it is the alignment's, not the files'.
+  Eigen::Vector3d mean_position = Eigen::Vector3d::Zero();
+  for (const SE3d& pose : ref) mean_position += pose.translation();
+  mean_position /= static_cast<double>(ref.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const SE3d& pose : ref) {
+    const Eigen::Vector3d d = pose.translation() - mean_position;
+    scatter += d * d.transpose();
+  }
+  const Eigen::Vector3d spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter)
+                                     .eigenvalues()
+                                     .cwiseMax(0.0)
+                                     .cwiseSqrt();  // ascending
+  if (spread(2) < 1e-6 || spread(1) < 0.1 * spread(2)) return;
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  std::vector<SO3d> offsets;
+  for (std::size_t k = 0; k < ref.size(); ++k) {
+    offsets.push_back(ref[k].so3().Inverse() * est[k].so3());
+    sum += offsets.back().Matrix();
+  }
+  const SO3d mean = SO3d::FitToMatrix(sum);  // chordal mean of the offsets
+  const double offset_deg = mean.Angle() * kRadToDeg;
+  if (offset_deg <= 5.0) return;
+  std::vector<double> residual_deg;
+  for (const SO3d& r : offsets) residual_deg.push_back((mean.Inverse() * r).Angle() * kRadToDeg);
+  std::nth_element(residual_deg.begin(), residual_deg.begin() + residual_deg.size() * 9 / 10,
+                   residual_deg.end());
+  const double p90_deg = residual_deg[residual_deg.size() * 9 / 10];
+  if (p90_deg > offset_deg / 3.0) return;  // not constant: drift or a failed run, measured as is
+  throw InputError(
+      est_name,
+      fmt::format("its orientation differs from the ground truth's by a near-constant {:.1f} deg "
+                  "(90% of poses within {:.1f} deg of it): the two describe different frames, "
+                  "e.g. camera poses against body (IMU) ground truth. Evaluate the run's "
+                  "trajectory_body.txt, or pass --body-from-camera RUN/body_from_camera.txt "
+                  "(Python: body_from_camera=); --allow-frame-offset measures anyway",
+                  offset_deg, p90_deg));
 }
 
 }  // namespace
@@ -92,6 +168,9 @@ EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& e
     ref_positions.push_back(ref_poses.back().translation());
     est_positions.push_back(est_poses.back().translation());
   }
+  const bool sim3 = options.alignment == AlignmentMethod::kSim3;
+  CheckPosesUsable(ref_poses, result.pairs, false, sim3, ref_name);
+  CheckPosesUsable(est_poses, result.pairs, true, sim3, est_name);
   result.ref_from_est = AlignPositions(est_positions, ref_positions, options.alignment);
 
   // The aligned estimate: rotated and translated, positions scaled (rotations have no scale).
@@ -99,6 +178,7 @@ EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& e
   for (SE3d& pose : est_poses) {
     pose = SE3d(t.so3() * pose.so3(), t * pose.translation());
   }
+  if (!options.allow_frame_offset) CheckSameBodyFrame(ref_poses, est_poses, est_name);
   for (std::size_t k = 0; k < est_poses.size(); ++k) {
     result.ate_translation_errors_m.push_back(
         (est_poses[k].translation() - ref_poses[k].translation()).norm());

@@ -28,6 +28,10 @@ struct EvaluationOptions {
   // Whether to compute the RPE, and how.
   bool compute_rpe = true;
   RpeOptions rpe;
+  // Measure even when the aligned estimate's orientation differs from the reference's by a
+  // near-constant rotation (CheckSameBodyFrame): by default that is an error, since it means
+  // the two trajectories describe different frames (a camera against body ground truth).
+  bool allow_frame_offset = false;
 
   void Check() const;
 };
@@ -49,8 +53,11 @@ struct EvaluationResult {
 };
 
 // Throws InputError naming the estimate's file when no pose pair falls within max_diff (the
-// message gives both time ranges) or when there are too few pairs for the alignment;
-// OptionError for bad options.
+// message gives both time ranges), when there are too few pairs for the alignment, when a
+// matched pose is not finite, when for a Sim(3) alignment either side's matched positions do not
+// move (identical or all-zero poses once gave a scale of 2.44 and an ATE as if valid),
+// or when the aligned orientations differ by a near-constant rotation of more than 5 degrees
+// on a path that is not a straight line (see allow_frame_offset); OptionError for bad options.
 EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& est,
                                       const EvaluationOptions& options);
 

@@ -38,6 +38,34 @@ std::vector<TimeGap> FindTimeGaps(const std::vector<std::int64_t>& t_ns, double 
   return gaps;
 }
 
+void CheckTimeBase(const std::vector<std::int64_t>& t_ns, double nominal_rate_hz,
+                   std::string_view rate_source, const std::filesystem::path& file,
+                   std::string_view what) {
+  if (nominal_rate_hz <= 0 || t_ns.size() < 3) return;
+  std::vector<std::int64_t> intervals;
+  intervals.reserve(t_ns.size() - 1);
+  for (std::size_t i = 1; i < t_ns.size(); ++i) intervals.push_back(t_ns[i] - t_ns[i - 1]);
+  std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
+  const double median_ns = static_cast<double>(intervals[intervals.size() / 2]);
+  const double nominal_ns = 1e9 / nominal_rate_hz;
+  const double ratio = nominal_ns / std::max(median_ns, 1.0);  // > 1: stamps too close
+  if (ratio <= 5.0 && ratio >= 0.2) return;
+  // The unit the stamps would be in if they were right (the ratio a power of 1000).
+  std::string hint;
+  for (const auto& [factor, unit] : {std::pair{1e3, "microseconds"}, std::pair{1e6, "milliseconds"},
+                                     std::pair{1e9, "seconds"}}) {
+    if (ratio > factor / 5.0 && ratio < factor * 5.0) {
+      hint = fmt::format(": the stamps look like {}, where nanoseconds belong", unit);
+    }
+  }
+  if (ratio < 1.0 && ratio > 1e-3 / 5.0 && ratio < 1e-3 * 5.0) {
+    hint = ": the stamps look 1000x too large (picoseconds, or nanoseconds scaled twice?)";
+  }
+  throw InputError(file, fmt::format(
+                             "{} {:.6g} ns apart (median), but {} says {} Hz ({:.6g} ns){}", what,
+                             median_ns, rate_source, nominal_rate_hz, nominal_ns, hint));
+}
+
 double MeasuredRateHz(std::int64_t first_ns, std::int64_t last_ns, std::size_t count) {
   if (count < 2 || last_ns <= first_ns) return 0.0;
   return static_cast<double>(count - 1) * 1e9 / static_cast<double>(last_ns - first_ns);
@@ -70,6 +98,10 @@ void FillImageStream(const std::vector<ImageEntry>& listed, double frame_gap_per
   std::vector<std::int64_t> t_ns;
   t_ns.reserve(stream->images.size());
   for (const ImageEntry& entry : stream->images) t_ns.push_back(entry.t_ns);
+  const std::string rate_source = stream->name == "rgb" || stream->name == "depth"
+                                      ? std::string("TUM RGB-D's nominal rate")
+                                      : stream->name + "/sensor.yaml";
+  CheckTimeBase(t_ns, stream->nominal_rate_hz, rate_source, stream->list_file, "images are");
   const double period_ns = stream->nominal_rate_hz > 0 ? 1e9 / stream->nominal_rate_hz : 0.0;
   stream->gaps = FindTimeGaps(t_ns, period_ns, frame_gap_periods);
 }

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/imu/imu_types.h"
@@ -45,6 +46,16 @@ using ImuSample = ImuMeasurement;
 // nominal_period_ns <= 0 uses the median interval. Fewer than 2 samples: no gaps.
 std::vector<TimeGap> FindTimeGaps(const std::vector<std::int64_t>& t_ns, double nominal_period_ns,
                                   double max_periods);
+
+// The time base of a list against its sensor description: throws InputError naming `file` when
+// the median interval between samples is more than 5x off the nominal period (nominal_rate_hz
+// > 0; fewer than 3 samples are not checked). Stamps in microseconds where nanoseconds belong
+// come out 1000x too fast, whole seconds read as nanoseconds 10^9x: the message says which unit
+// the stamps look like. Without this check such data ran as "0.00 s of data".
+// `rate_source` names where the nominal rate came from ("sensor.yaml", "Camera.fps").
+void CheckTimeBase(const std::vector<std::int64_t>& t_ns, double nominal_rate_hz,
+                   std::string_view rate_source, const std::filesystem::path& file,
+                   std::string_view what);
 
 // (n - 1) / (last - first) in Hz; 0 when fewer than 2 samples or zero span.
 double MeasuredRateHz(std::int64_t first_ns, std::int64_t last_ns, std::size_t count);

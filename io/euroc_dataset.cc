@@ -186,6 +186,8 @@ EurocDataset EurocDataset::Open(const fs::path& root, const EurocOptions& option
     std::vector<std::int64_t> t_ns;
     t_ns.reserve(d.imu_.size());
     for (const ImuSample& s : d.imu_) t_ns.push_back(s.t_ns);
+    CheckTimeBase(t_ns, d.imu_sensor_->rate_hz, "imu0/sensor.yaml", imu_dir / "data.csv",
+                  "IMU samples are");
     d.imu_gaps_ = FindTimeGaps(t_ns, 1e9 / d.imu_sensor_->rate_hz, options.imu_gap_periods);
     if (!d.imu_gaps_.empty()) {
       PKSLAM_LOG_WARN(

@@ -148,6 +148,11 @@ class ImageFolderSource : public FrameSource {
   }
   std::optional<std::size_t> Count() const override { return entries_.size(); }
   std::string Name() const override { return timestamps_.string(); }
+  std::vector<std::int64_t> ListedTimes() const override {
+    std::vector<std::int64_t> t_ns;
+    for (const Entry& e : entries_) t_ns.push_back(e.t_ns);
+    return t_ns;
+  }
 
  private:
   struct Entry {

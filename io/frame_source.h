@@ -12,6 +12,7 @@
 #include <opencv2/core/mat.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace pkslam {
 
@@ -30,6 +31,9 @@ class FrameSource {
   virtual std::optional<std::size_t> Count() const = 0;
   // For logs and stats.json: the file, folder or "camera N".
   virtual std::string Name() const = 0;
+  // Every frame's time when known before reading (a timestamp list): checked against the
+  // settings' Camera.fps before the run (io/dataset_common.h CheckTimeBase).
+  virtual std::vector<std::int64_t> ListedTimes() const { return {}; }
 };
 
 // `fps` > 0: stamps are frame_index / fps; otherwise the container's per-frame timestamps

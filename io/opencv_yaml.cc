@@ -5,6 +5,7 @@
 #include <Eigen/LU>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <opencv2/core.hpp>
 #include <regex>
 
@@ -34,6 +35,7 @@ OpenCvYamlFile::OpenCvYamlFile(const std::filesystem::path& file) : file_(file) 
     }
   }
   if (blank) throw InputError(file, "empty file");
+  CheckNoDuplicateKeys();
   if (lines_.front().rfind("%YAML", 0) != 0) {
     throw InputError(file, 1, "not an OpenCV YAML file (the first line must be '%YAML:1.0')");
   }
@@ -61,6 +63,25 @@ OpenCvYamlFile::OpenCvYamlFile(const std::filesystem::path& file) : file_(file) 
   }
   if (!storage_.isOpened()) throw InputError(file, "cannot parse as OpenCV YAML");
   if (!storage_.root().isMap()) throw InputError(file, "expected a map of keys at top level");
+}
+
+void OpenCvYamlFile::CheckNoDuplicateKeys() const {
+  // OpenCV keeps one of two equal keys without a word; a file with `intrinsics:` twice ran on
+  // whichever it kept. Top-level keys only (nested maps such as T_BS's rows/cols/data repeat
+  // legitimately across parents).
+  static const std::regex kTopLevelKey(R"(^([A-Za-z_][A-Za-z0-9_.\-]*)[ \t]*:)");
+  std::map<std::string, std::size_t> first_line;
+  for (std::size_t i = 0; i < lines_.size(); ++i) {
+    std::smatch match;
+    if (!std::regex_search(lines_[i], match, kTopLevelKey)) continue;
+    const auto [it, inserted] = first_line.emplace(match[1].str(), i + 1);
+    if (!inserted) {
+      throw InputError(file_, i + 1,
+                       fmt::format("key '{}' appears twice (first on line {}); OpenCV would "
+                                   "silently use one of them: delete the other",
+                                   match[1].str(), it->second));
+    }
+  }
 }
 
 bool OpenCvYamlFile::Has(const std::string& key) const {

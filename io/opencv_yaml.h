@@ -48,6 +48,7 @@ class OpenCvYamlFile {
   std::size_t LineOf(const std::string& key) const;
 
  private:
+  void CheckNoDuplicateKeys() const;  // throws InputError at the second occurrence
   cv::FileNode RequiredNode(const std::string& key) const;
   double NumberOf(const cv::FileNode& node, const std::string& key, const char* where) const;
 

@@ -2,7 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <optional>
+
+#include "core/camera/camera_plausibility.h"
 #include "core/util/error.h"
+#include "io/opencv_yaml.h"
 
 namespace pkslam {
 namespace {
@@ -10,15 +14,23 @@ namespace {
 CameraModel CameraOf(const EurocCameraSensor& sensor, const std::filesystem::path& yaml) {
   const auto& k = sensor.intrinsics;
   const auto& d = sensor.distortion_coefficients;
+  std::optional<CameraModel> camera;
   try {
-    if (sensor.distortion_model == "equidistant") {
-      return CameraModel::KannalaBrandt8(sensor.width, sensor.height, k[0], k[1], k[2], k[3],
-                                         {d[0], d[1], d[2], d[3]});
-    }
-    return CameraModel::Pinhole(sensor.width, sensor.height, k[0], k[1], k[2], k[3], d);
+    camera = sensor.distortion_model == "equidistant"
+                 ? CameraModel::KannalaBrandt8(sensor.width, sensor.height, k[0], k[1], k[2],
+                                               k[3], {d[0], d[1], d[2], d[3]})
+                 : CameraModel::Pinhole(sensor.width, sensor.height, k[0], k[1], k[2], k[3], d);
   } catch (const OptionError& e) {
     throw InputError(yaml, fmt::format("invalid camera calibration: {}", e.what()));
   }
+  if (const auto bad = FindImplausibleParameter(*camera)) {
+    const bool distortion = bad->parameter == "distortion";
+    const std::string key = distortion ? "distortion_coefficients" : "intrinsics";
+    throw InputError(yaml, OpenCvYamlFile(yaml).LineOf(key),
+                     fmt::format("implausible calibration ({}{}): {}", key,
+                                 distortion ? "" : " [fu, fv, cu, cv]", bad->what));
+  }
+  return *camera;
 }
 
 }  // namespace

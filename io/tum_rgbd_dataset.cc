@@ -175,6 +175,31 @@ void TumRgbdDataset::RequireValidDepth(std::size_t images) const {
                                n - 1));
 }
 
+void TumRgbdDataset::CheckDepthScale(double factor, const std::string& factor_source,
+                                     std::size_t images) const {
+  const std::size_t n = std::min(images, associations_.size());
+  std::vector<float> raw;
+  for (std::size_t k = 0; k < n; ++k) {
+    cv::Mat depth;
+    LoadDepthRaw(associations_[k].depth).convertTo(depth, CV_32F);
+    for (int r = 0; r < depth.rows; r += 4) {  // every 4th pixel: plenty for a median
+      const float* row = depth.ptr<float>(r);
+      for (int c = 0; c < depth.cols; c += 4) {
+        if (row[c] > 0) raw.push_back(row[c]);
+      }
+    }
+  }
+  if (raw.empty() || factor <= 0) return;  // RequireValidDepth's and the settings' business
+  std::nth_element(raw.begin(), raw.begin() + raw.size() / 2, raw.end());
+  const double median_m = raw[raw.size() / 2] / factor;
+  if (median_m >= 0.1 && median_m <= 50.0) return;
+  throw InputError(depth_.images[associations_.front().depth].path,
+                   fmt::format("median depth of the first {} depth images is {:.4g} m with {} "
+                               "{:g} (raw median {:g}): the depth factor is wrong (TUM RGB-D: "
+                               "5000 per metre; a sensor in millimetres: 1000)",
+                               n, median_m, factor_source, factor, raw[raw.size() / 2]));
+}
+
 cv::Mat TumRgbdDataset::LoadDepthMetres(std::size_t i) const {
   cv::Mat metres;
   LoadDepthRaw(i).convertTo(metres, CV_32F, 1.0 / depth_factor_);

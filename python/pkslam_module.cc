@@ -1,6 +1,8 @@
 // The Python module `pkslam` (its native part, pkslam._pkslam): the public C++ API
 // (api/include/pkslam/pkslam.h) with NumPy arrays in and out. Images are uint8 (H, W) or
-// (H, W, 3) arrays, depth uint16 or float32 (H, W), poses 4x4 float64 world_from_camera.
+// (H, W, 3) arrays, depth uint16 or float32 (H, W), poses 4x4 float64; camera_trajectory()
+// holds world_from_camera, body_trajectory() world_from_body. Bad arguments raise ValueError
+// naming the argument (std::invalid_argument in the C++ API).
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -8,7 +10,9 @@
 
 #include <opencv2/core/mat.hpp>
 #include <stdexcept>
+#include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "pkslam/pkslam.h"
@@ -42,7 +46,17 @@ cv::Mat View(const py::array& a, const char* what) {
                  CV_MAKETYPE(depth, channels), b.ptr);
 }
 
-py::tuple TrajectoryArrays(const std::vector<api::StampedPose>& poses) {
+template <typename Pose>
+const Eigen::Matrix4d& PoseMatrix(const Pose& p) {
+  if constexpr (std::is_same_v<Pose, api::StampedPose>) {
+    return p.world_from_camera;
+  } else {
+    return p.world_from_body;
+  }
+}
+
+template <typename Pose>
+py::tuple TrajectoryArrays(const std::vector<Pose>& poses) {
   py::array_t<std::int64_t> t(static_cast<py::ssize_t>(poses.size()));
   py::array_t<double> m({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}, py::ssize_t{4}});
   auto tv = t.mutable_unchecked<1>();
@@ -51,7 +65,7 @@ py::tuple TrajectoryArrays(const std::vector<api::StampedPose>& poses) {
     tv(static_cast<py::ssize_t>(i)) = poses[i].t_ns;
     for (int r = 0; r < 4; ++r) {
       for (int c = 0; c < 4; ++c)
-        mv(static_cast<py::ssize_t>(i), r, c) = poses[i].world_from_camera(r, c);
+        mv(static_cast<py::ssize_t>(i), r, c) = PoseMatrix(poses[i])(r, c);
     }
   }
   return py::make_tuple(t, m);
@@ -61,7 +75,7 @@ std::vector<api::StampedPose> PosesFromArrays(const py::array_t<std::int64_t>& t
                                               const py::array_t<double>& m) {
   if (m.ndim() != 3 || m.shape(1) != 4 || m.shape(2) != 4 || t.ndim() != 1 ||
       t.shape(0) != m.shape(0)) {
-    throw std::invalid_argument("estimate: expected (t_ns[N], poses[N, 4, 4])");
+    throw std::invalid_argument("est: expected (t_ns[N], poses[N, 4, 4])");
   }
   auto tv = t.unchecked<1>();
   auto mv = m.unchecked<3>();
@@ -164,25 +178,49 @@ PYBIND11_MODULE(_pkslam, m) {
       .def("load_map", &api::Slam::LoadMap, py::arg("file"))
       .def("shutdown", &api::Slam::Shutdown, py::call_guard<py::gil_scoped_release>())
       .def(
-          "trajectory", [](const api::Slam& s) { return TrajectoryArrays(s.Trajectory()); },
-          "(t_ns[N], world_from_camera[N, 4, 4]) of every tracked frame")
+          "camera_trajectory",
+          [](const api::Slam& s) { return TrajectoryArrays(s.CameraTrajectory()); },
+          "(t_ns[N], world_from_camera[N, 4, 4]) of every tracked frame (the left camera)")
+      .def(
+          "body_trajectory",
+          [](const api::Slam& s) { return TrajectoryArrays(s.BodyTrajectory()); },
+          "(t_ns[N], world_from_body[N, 4, 4]) of every tracked frame: the body (IMU) frame "
+          "that EuRoC ground truth describes (not for visual monocular maps)")
+      .def(
+          "trajectory",
+          [](const api::Slam&) -> py::tuple {
+            throw std::invalid_argument(
+                "Slam.trajectory() is ambiguous: use camera_trajectory() (world_from_camera) or "
+                "body_trajectory() (world_from_body, what EuRoC ground truth describes)");
+          },
+          "Removed: camera_trajectory() or body_trajectory()")
+      .def_property_readonly("body_from_camera", &api::Slam::BodyFromCamera,
+                             "The rig's camera-to-body transform (4x4)")
       .def("keyframe_trajectory",
-           [](const api::Slam& s) { return TrajectoryArrays(s.KeyFrameTrajectory()); });
+           [](const api::Slam& s) { return TrajectoryArrays(s.KeyFrameTrajectory()); },
+           "(t_ns[N], world_from_camera[N, 4, 4]) of the keyframes");
   m.def(
       "evaluate",
-      [](const std::string& gt, const py::object& est, const std::string& align) {
+      [](const std::string& gt, const py::object& est, const std::string& align,
+         const std::optional<Eigen::Matrix4d>& body_from_camera) {
         if (py::isinstance<py::str>(est)) {
-          return EvaluationDict(api::Evaluate(gt, est.cast<std::string>(), align));
+          return EvaluationDict(api::Evaluate(gt, est.cast<std::string>(), align, body_from_camera));
+        }
+        if (!py::isinstance<py::tuple>(est) || py::len(est) != 2) {
+          throw std::invalid_argument("est: a trajectory file or (t_ns, poses) arrays");
         }
         const auto pair = est.cast<py::tuple>();
-        if (pair.size() != 2) throw std::invalid_argument("estimate: a file or (t_ns, poses)");
         return EvaluationDict(
             api::Evaluate(gt,
                           PosesFromArrays(pair[0].cast<py::array_t<std::int64_t>>(),
                                           pair[1].cast<py::array_t<double>>()),
-                          align));
+                          align, body_from_camera));
       },
       py::arg("gt"), py::arg("est"), py::arg("align") = "se3",
-      "ATE/RPE of an estimate (a trajectory file, or Slam.trajectory()'s arrays) against a "
-      "ground-truth file");
+      py::arg("body_from_camera") = py::none(),
+      "ATE/RPE of an estimate against a ground-truth file, as `pkslam eval`. est: a trajectory "
+      "file or (t_ns, poses) arrays in the ground truth's frame (Slam.body_trajectory() against "
+      "EuRoC's body ground truth); camera poses (Slam.camera_trajectory()) with "
+      "body_from_camera=Slam.body_from_camera, which moves the truth into the camera. A camera "
+      "trajectory against body truth without it raises RuntimeError with that hint.");
 }

@@ -208,7 +208,32 @@ void WriteReferenceClouds(const Scene& scene, const SurfaceVisibility* visibilit
   }
 }
 
+// A render goes into an empty folder or replaces an earlier render (sim.yaml) there, entry by
+// entry, so a --no-images render never leaves older images beside new IMU and ground truth. Any
+// other folder is left alone: `--out` onto a recording would mix the two (docs/robustness.md).
+void ClearEarlierRender(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(dir, ec) || (fs::is_directory(dir, ec) && fs::is_empty(dir, ec))) return;
+  if (!fs::is_directory(dir, ec) || !fs::exists(dir / "sim.yaml", ec)) {
+    throw OptionError(fmt::format(
+        "--out {}: exists and is not a pkslam render (no sim.yaml); simulate writes into an empty "
+        "or new folder, or replaces an earlier render",
+        dir.string()));
+  }
+  static constexpr const char* kRenderEntries[] = {
+      "mav0",          "truth",           "rgb",        "depth",
+      "rgb.txt",       "depth.txt",       "associations.txt", "groundtruth.txt",
+      "settings.yaml", "timestamps.txt",  "reference_cloud.ply", "reference_observed.ply",
+      "sim.yaml"};
+  for (const char* name : kRenderEntries) {
+    fs::remove_all(dir / name, ec);
+    if (ec) throw OutputError(dir / name, ec.message());
+  }
+}
+
 }  // namespace
+
 
 SimulationSummary RunSimulation(const SimulationOptions& options) {
   options.Check();
@@ -305,6 +330,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     std::filesystem::create_directories(o.output_dir, ec);
     if (ec) throw Error(fmt::format("cannot create {}: {}", o.output_dir.string(), ec.message()));
   } else if (!o.bench) {
+    ClearEarlierRender(o.output_dir);
     std::error_code ec;
     std::filesystem::create_directories(o.output_dir, ec);
     if (ec) throw Error(fmt::format("cannot create {}: {}", o.output_dir.string(), ec.message()));

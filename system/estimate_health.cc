@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace pkslam {
 
@@ -54,6 +55,23 @@ EstimateHealth AssessEstimate(const std::vector<double>& lost_for_good_s,
                     maps_at_end));
   }
   return h;
+}
+
+std::string NoEstimateReason(int frames, int poses, bool never_initialised, bool monocular) {
+  if (frames <= 0) return "no frame was read";
+  const int needed = frames < 20 ? std::min(frames, 3)
+                                 : std::max(3, static_cast<int>(std::ceil(0.1 * frames)));
+  if (poses >= needed) return "";
+  std::string why =
+      never_initialised
+          ? monocular ? "the map never initialised (a monocular map needs two views with enough "
+                        "parallax and matches: move the camera sideways, or check the settings' "
+                        "intrinsics)"
+                      : "the map never initialised (a first frame needs 50 keypoints with a "
+                        "stereo or depth measurement: check the calibration and the images)"
+          : "tracking was lost for most of the run";
+  return fmt::format("only {} of {} frames have a pose (at least {} needed): {}", poses, frames,
+                     needed, why);
 }
 
 }  // namespace pkslam

@@ -22,9 +22,18 @@ struct EstimateHealth {
   int maps_at_end = 0;
   double largest_merge_correction_m = 0;  // how far a merge moved its query keyframe
   std::vector<std::string> warnings;
+  // Why the run has no estimate at all (too few frames with a pose; NoEstimateReason), or "".
+  // Such a run is an error whatever --strict says: `pkslam run` exits kExitNoEstimate.
+  std::string no_estimate;
 
-  bool suspect() const { return !warnings.empty(); }
+  bool suspect() const { return !warnings.empty() || !no_estimate.empty(); }
 };
+
+// "" when `poses` frames with a pose of `frames` read are an estimate; else why not. A run needs
+// min(frames, 3) poses below 20 frames and 10% of its frames (at least 3) from there: fewer
+// cannot even be aligned to ground truth (pkslam eval needs 3), and a tenth of a run is a
+// fragment, not a trajectory. `never_initialised`: no frame ever left NOT_INITIALIZED.
+std::string NoEstimateReason(int frames, int poses, bool never_initialised, bool monocular);
 
 // Times (s) at which tracking was lost for good in `records` (frame order).
 std::vector<double> LostForGoodTimes(const std::vector<FrameRecord>& records);

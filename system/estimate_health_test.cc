@@ -70,5 +70,25 @@ TEST(AssessEstimate, AMergeWithoutALossAloneIsNotSuspect) {
   EXPECT_DOUBLE_EQ(h.largest_merge_correction_m, 12.0);
 }
 
+TEST(NoEstimateReason, TooFewPosesAreNoEstimate) {
+  EXPECT_EQ(NoEstimateReason(40, 40, false, true), "");
+  EXPECT_EQ(NoEstimateReason(1, 1, false, false), "");  // a one-frame run (map load timing)
+  EXPECT_EQ(NoEstimateReason(200, 20, false, false), "");
+  const std::string never = NoEstimateReason(40, 0, true, true);
+  EXPECT_NE(never.find("only 0 of 40 frames have a pose (at least 4 needed)"), std::string::npos)
+      << never;
+  EXPECT_NE(never.find("monocular map needs two views"), std::string::npos) << never;
+  EXPECT_NE(NoEstimateReason(200, 19, false, false).find("lost for most"), std::string::npos);
+  EXPECT_NE(NoEstimateReason(10, 2, true, false).find("50 keypoints"), std::string::npos);
+  EXPECT_NE(NoEstimateReason(0, 0, true, false), "");
+}
+
+TEST(NoEstimateReason, MakesTheEstimateSuspect) {
+  EstimateHealth h;
+  EXPECT_FALSE(h.suspect());
+  h.no_estimate = NoEstimateReason(40, 0, true, true);
+  EXPECT_TRUE(h.suspect());
+}
+
 }  // namespace
 }  // namespace pkslam

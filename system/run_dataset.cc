@@ -9,6 +9,7 @@
 #include <future>
 #include <thread>
 
+#include "core/camera/stereo_rectification.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
@@ -154,6 +155,16 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
     }
     settings =
         options.settings ? ReadOrbSlam3Settings(*options.settings) : SettingsFromEuroc(*euroc);
+    if (IsStereo(sensor) && settings.camera2 && settings.right_from_left) {
+      // Rectified here once to name the file when the rig cannot be a rig (the system
+      // rectifies again; a few milliseconds).
+      try {
+        StereoRectification(settings.camera1, *settings.camera2, *settings.right_from_left);
+      } catch (const OptionError& e) {
+        throw InputError(options.settings.value_or(euroc->mav0() / "cam1" / "sensor.yaml"),
+                         e.what());
+      }
+    }
   } else if (TumRgbdDataset::LooksLikeTumRgbd(options.dataset)) {
     tum = TumRgbdDataset::Open(options.dataset);
     if (IsStereo(sensor)) throw OptionError("a TUM RGB-D dataset has no stereo pair");
@@ -180,6 +191,10 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
     }
     settings = ReadOrbSlam3Settings(options.settings.value_or(fallback));
     if (!settings.depth_map_factor) settings.depth_map_factor = tum->depth_factor();
+    if (IsRgbd(sensor)) {
+      tum->CheckDepthScale(*settings.depth_map_factor,
+                           "RGBD.DepthMapFactor of " + options.settings.value_or(fallback).string());
+    }
   } else {
     throw InputError(options.dataset,
                      "not a EuRoC (mav0/cam0/data.csv) or TUM RGB-D (rgb.txt, depth.txt) dataset");

@@ -166,6 +166,7 @@ void WriteEstimateHealth(const EstimateHealth& health, JsonWriter* json) {
   json->Member("lost_for_good", static_cast<int>(health.lost_for_good_s.size()));
   json->Member("maps_at_end", health.maps_at_end);
   json->Member("largest_merge_correction_m", health.largest_merge_correction_m);
+  json->Member("no_estimate", health.no_estimate);
   WriteStrings(json, "warnings", health.warnings);
   json->EndObject();
 }
@@ -277,6 +278,12 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   summary->estimate = AssessEstimate(LostForGoodTimes(records), loop_stats.merges, summary->maps);
   for (const std::string& w : summary->estimate.warnings)
     PKSLAM_LOG_WARN("suspect estimate: {}", w);
+  summary->estimate.no_estimate =
+      NoEstimateReason(static_cast<int>(records.size()), frames_in_trajectory, !initialised,
+                       IsMonocular(options.system.sensor));
+  if (!summary->estimate.no_estimate.empty()) {
+    PKSLAM_LOG_ERROR("no estimate: {}", summary->estimate.no_estimate);
+  }
 
   const CalibrationReport calibration = system.calibration_report();
   const CalibrationSources sources =

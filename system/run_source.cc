@@ -7,6 +7,7 @@
 #include "core/util/output_file.h"
 #include "core/util/progress.h"
 #include "io/rigid_transform_file.h"
+#include "io/dataset_common.h"
 #include "io/settings.h"
 #include "io/trajectory.h"
 #include "system/run_outputs.h"
@@ -38,6 +39,8 @@ RunSummary RunFrameSource(const RunOptions& options_in, FrameSource& source,
   } log_guard;
 
   const Settings settings = ReadOrbSlam3Settings(*options.settings);
+  CheckTimeBase(source.ListedTimes(), settings.fps, "the settings' Camera.fps", source.Name(),
+                "frames are");
   RunSummary summary;
   summary.dataset_fingerprint = source.Name();
   auto vocabulary = LoadRunVocabulary(options);

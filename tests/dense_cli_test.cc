@@ -22,7 +22,10 @@ testing::CommandResult Pkslam(const std::string& arguments) {
 
 class DenseCliTest : public ::testing::Test {
  protected:
-  void SetUp() override { dir_ = testing::MakeTempDir("dense_cli_test"); }
+  void SetUp() override {
+    dir_ = testing::MakeTempDir("dense_cli_test");
+    fs::create_directories(dir_ / "data");  // not a dataset; outputs go beside it
+  }
   void TearDown() override { fs::remove_all(dir_); }
 
   std::string Write(const std::string& name, const std::string& content) {
@@ -50,26 +53,26 @@ constexpr const char* kTinyPly =
 TEST_F(DenseCliTest, DenseBadInputIsOneLine) {
   const std::string out = (dir_ / "c.ply").string();
   EXPECT_NE(ExpectOneLineError(fmt::format("dense --run {}/nope --dataset {} --out {}",
-                                           dir_.string(), dir_.string(), out))
+                                           dir_.string(), (dir_ / "data").string(), out))
                 .find("run directory does not exist"),
             std::string::npos);
   fs::create_directories(dir_ / "run");
   EXPECT_NE(ExpectOneLineError(fmt::format("dense --run {}/run --dataset {} --out {}",
-                                           dir_.string(), dir_.string(), out))
+                                           dir_.string(), (dir_ / "data").string(), out))
                 .find("keyframes.txt"),
             std::string::npos);
   Write("run/keyframes.txt", "1.0 0 0 0 0 0 0 1\n1.5 0 0 zero 0 0 0 1\n");
   EXPECT_NE(ExpectOneLineError(fmt::format("dense --run {}/run --dataset {} --out {}",
-                                           dir_.string(), dir_.string(), out))
+                                           dir_.string(), (dir_ / "data").string(), out))
                 .find("keyframes.txt:2:"),
             std::string::npos);
   Write("run/keyframes.txt", "1.0 0 0 0 0 0 0 1\n");
   EXPECT_NE(ExpectOneLineError(fmt::format("dense --run {}/run --dataset {} --out {}",
-                                           dir_.string(), dir_.string(), out))
+                                           dir_.string(), (dir_ / "data").string(), out))
                 .find("not a EuRoC"),
             std::string::npos);
   ExpectOneLineError(fmt::format("dense --run {}/run --dataset {} --out {} --voxel 0",
-                                 dir_.string(), dir_.string(), out));
+                                 dir_.string(), (dir_ / "data").string(), out));
 }
 
 TEST_F(DenseCliTest, CloudCompareBadInputIsOneLine) {

@@ -1,5 +1,6 @@
 #include "core/camera/stereo_rectification.h"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -51,6 +52,18 @@ StereoRectification::StereoRectification(const CameraModel& left, const CameraMo
                       "the right camera is on the left of the left camera (baseline {} m); "
                       "swap the cameras",
                       baseline_);
+  // With alpha 0 the rectified view keeps only pixels both cameras see; implausible intrinsics
+  // or extrinsics shrink that to a sliver and the focal length to tens of thousands of pixels
+  // (0 frames tracked). A real rig stays near its cameras' focal length.
+  const double focal = p1.at<double>(0, 0);
+  const double camera_focal = std::min(left.fx(), right.fx());
+  if (!(focal >= 0.25 * camera_focal && focal <= 4.0 * camera_focal)) {
+    throw OptionError(fmt::format(
+        "implausible stereo calibration: rectification gives a focal length of {:.0f} px from "
+        "cameras of {:.0f} and {:.0f} px (the intrinsics, distortion or stereo extrinsic cannot "
+        "be a real rig)",
+        focal, left.fx(), right.fx()));
+  }
   rectified_ = CameraModel::Pinhole(left.width(), left.height(), p1.at<double>(0, 0),
                                     p1.at<double>(1, 1), p1.at<double>(0, 2), p1.at<double>(1, 2));
   rect_left_from_left_ = SO3d(ToEigen3x3(r1));

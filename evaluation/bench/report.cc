@@ -1,5 +1,7 @@
 #include "evaluation/bench/report.h"
 
+#include "core/util/output_guard.h"
+
 #include <algorithm>
 #include <cmath>
 #include <ctime>
@@ -10,6 +12,7 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/output_file.h"
+#include "core/util/output_guard.h"
 #include "core/util/project_file.h"
 #include "evaluation/bench/process.h"
 
@@ -52,8 +55,9 @@ std::vector<Plot> DrawPlots(const ReportOptions& o, const std::vector<fs::path>&
                             std::string* error) {
   const fs::path script = o.plots_script.empty() ? DefaultPlotsScript() : o.plots_script;
   const fs::path dir = o.out / "plots";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  // Only a plots folder the bench made is replaced (index.tsv: one from before the marker).
+  RemoveOwnedDirectory(dir, "index.tsv");
+  CreateOwnedDirectory(dir);
   if (!fs::exists(o.python)) {
     *error = "python not found: " + o.python.string();
     return {};

@@ -6,6 +6,8 @@
 // stereo settings file (e.g. the settings.yaml `pkslam simulate` writes).
 #include <pkslam/pkslam.h>
 
+#include <Eigen/Geometry>
+
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -44,13 +46,21 @@ int main(int argc, char** argv) {
       if (state == pkslam::api::SlamState::kOk) ++tracked;
     }
     slam.Shutdown();
-    const std::vector<pkslam::api::StampedPose> trajectory = slam.Trajectory();
+    // Body (IMU) poses: the frame EuRoC ground truth describes (CameraTrajectory() for the
+    // left camera's).
+    const std::vector<pkslam::api::StampedBodyPose> trajectory = slam.BodyTrajectory();
     std::printf("frames %d tracked %d keyframes %d map points %d trajectory %zu poses\n", frames,
                 tracked, slam.NumKeyFrames(), slam.NumMapPoints(), trajectory.size());
     if (argc > 3) {
+      // TUM format: t[s] x y z qx qy qz qw (pkslam eval, evo_ape tum).
       std::ofstream out(argv[3]);
+      out.precision(9);
       for (const auto& p : trajectory) {
-        out << p.t_ns << " " << p.world_from_camera.block<3, 1>(0, 3).transpose() << "\n";
+        const Eigen::Vector3d t = p.world_from_body.block<3, 1>(0, 3);
+        const Eigen::Quaterniond q(Eigen::Matrix3d(p.world_from_body.block<3, 3>(0, 0)));
+        out << std::fixed << 1e-9 * static_cast<double>(p.t_ns) << ' ' << t.x() << ' ' << t.y()
+            << ' ' << t.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w()
+            << '\n';
       }
     }
     return tracked > 0 ? 0 : 1;

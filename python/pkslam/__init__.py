@@ -5,8 +5,10 @@
     for t_ns, left, right in frames:          # uint8 numpy images
         slam.track_stereo(left, right, t_ns)
     slam.shutdown()
-    t_ns, poses = slam.trajectory()           # int64[N], float64[N, 4, 4] world_from_camera
+    t_ns, poses = slam.body_trajectory()      # int64[N], float64[N, 4, 4] world_from_body
     print(pkslam.evaluate("gt.csv", (t_ns, poses), align="se3")["ate_rmse_m"])
+    # camera poses: pkslam.evaluate("gt.csv", slam.camera_trajectory(),
+    #                               body_from_camera=slam.body_from_camera)
 
 `simulate()` renders an EuRoC-format sequence with exact ground truth (`pkslam simulate`).
 """

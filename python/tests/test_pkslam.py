@@ -1,11 +1,14 @@
 """The Python module end to end: simulate a 5 s sequence, run stereo SLAM on it through
 pkslam.Slam with NumPy images, evaluate the trajectory, and check inputs are refused cleanly."""
 import glob
+import json
 import os
+import subprocess
 
 import cv2
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 import pkslam
 
@@ -13,7 +16,8 @@ import pkslam
 @pytest.fixture(scope="module")
 def sequence(tmp_path_factory):
     out = tmp_path_factory.mktemp("seq") / "seq"
-    return pkslam.simulate(out, duration=5.0, seed=2, motion="medium", quality="fast",
+    # Difficult motion: a path that is not a straight line, so orientations tell frames apart.
+    return pkslam.simulate(out, duration=5.0, seed=2, motion="difficult", quality="fast",
                            extra=["--no-cloud"])
 
 
@@ -33,15 +37,37 @@ def test_stereo_slam_through_python_meets_the_ate_bar(sequence, tmp_path):
     pose = slam.pose()
     assert pose.shape == (4, 4) and np.allclose(pose[3], [0, 0, 0, 1])
     slam.shutdown()
-    t_ns, poses = slam.trajectory()
+    t_ns, poses = slam.camera_trajectory()
     assert t_ns.dtype == np.int64 and poses.shape == (len(t_ns), 4, 4)
+    assert np.all(np.diff(t_ns) > 0)
     assert slam.num_keyframes > 2 and slam.num_map_points > 100
-    # Camera trajectory against the body ground truth: compare positions only after an SE3
-    # alignment; the rig's 6 cm lever arm bounds the error from above.
     gt = os.path.join(sequence, "mav0/state_groundtruth_estimate0/data.csv")
-    result = pkslam.evaluate(gt, (t_ns, poses), align="se3")
-    assert result["pairs"] == len(t_ns)
-    assert result["ate_rmse_m"] < 0.05
+    body_t, body_poses = slam.body_trajectory()
+    body = pkslam.evaluate(gt, (body_t, body_poses), align="se3")
+    assert body["pairs"] == len(t_ns)
+    assert body["ate_rmse_m"] < 0.05 and body["ate_rot_rmse_deg"] < 2
+    # Camera poses need the extrinsic; without it they are refused with the hint, not measured.
+    camera = pkslam.evaluate(gt, (t_ns, poses), align="se3",
+                             body_from_camera=slam.body_from_camera)
+    assert camera["ate_rot_rmse_deg"] < 2
+    with pytest.raises(RuntimeError, match="body_from_camera"):
+        pkslam.evaluate(gt, (t_ns, poses), align="se3")
+    with pytest.raises(ValueError, match="ambiguous"):
+        slam.trajectory()
+    # The CLI on the same body trajectory: the same numbers.
+    est = tmp_path / "body.txt"
+    with open(est, "w") as f:
+        for t, m in zip(body_t, body_poses):
+            q = Rotation.from_matrix(m[:3, :3]).as_quat()  # x y z w
+            f.write(f"{t * 1e-9:.9f} {m[0, 3]:.12f} {m[1, 3]:.12f} {m[2, 3]:.12f} "
+                    f"{q[0]:.12f} {q[1]:.12f} {q[2]:.12f} {q[3]:.12f}\n")
+    cli = subprocess.run([pkslam._executable(), "eval", "--gt", gt, "--est", str(est), "--json",
+                          str(tmp_path / "eval.json")], capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    with open(tmp_path / "eval.json") as f:
+        cli_result = json.load(f)
+    assert abs(cli_result["ate"]["rmse"] - body["ate_rmse_m"]) < 1e-6
+    assert abs(cli_result["rpe"]["trans_m"]["rmse"] - body["rpe_trans_rmse_m"]) < 1e-6
     # Map files from Python.
     map_file = tmp_path / "map.pkmap"
     slam.save_map(str(map_file))
@@ -56,6 +82,40 @@ def test_bad_inputs_raise(sequence):
         slam.track_mono(np.zeros((480, 752), np.float64), 0)
     with pytest.raises(ValueError, match="C-contiguous"):
         slam.track_mono(np.zeros((752, 480), np.uint8).T, 0)
+    with pytest.raises(ValueError, match="image: 640x480 image, but the settings' camera is 752x480"):
+        slam.track_mono(np.zeros((480, 640), np.uint8), 0)
+    with pytest.raises(ValueError, match="image: expected 8-bit"):
+        slam.track_mono(np.zeros((480, 752), np.uint16), 0)
+    with pytest.raises(ValueError, match="image: empty"):
+        slam.track_mono(np.zeros((0, 0), np.uint8), 0)
+    # BGR images are converted.
+    assert slam.track_mono(np.full((480, 752, 3), 128, np.uint8), 10**9) == "NOT_INITIALIZED"
+    with pytest.raises(ValueError, match="not after the previous frame"):
+        slam.track_mono(np.zeros((480, 752), np.uint8), 10**9 - 1)
     slam.shutdown()
+    with pytest.raises(ValueError, match="after Shutdown"):
+        slam.track_mono(np.zeros((480, 752), np.uint8), 2 * 10**9)
     with pytest.raises(RuntimeError):
         pkslam.evaluate("/no_such_gt.csv", "/no_such_est.txt")
+    with pytest.raises(ValueError, match="est:"):
+        pkslam.evaluate("/no_such_gt.csv", [1, 2, 3])
+
+
+def test_bad_imu_and_poses_raise(sequence):
+    slam = pkslam.Slam(os.path.join(sequence, "settings.yaml"), pkslam.VOCABULARY,
+                       sensor="stereo-inertial")
+    t = np.array([1, 2, 3], np.int64)
+    gyro = np.zeros((3, 3))
+    gyro[1, 2] = np.nan
+    with pytest.raises(ValueError, match="IMU sample 1 .*not finite"):
+        slam.add_imu(t, gyro, np.zeros((3, 3)))
+    slam.shutdown()
+    gt = os.path.join(sequence, "mav0/state_groundtruth_estimate0/data.csv")
+    with open(gt) as f:
+        stamps = [int(line.split(",")[0]) for line in f if line[0].isdigit()][:50]
+    poses = np.tile(np.eye(4), (50, 1, 1))
+    with pytest.raises(RuntimeError, match="one place"):
+        pkslam.evaluate(gt, (np.array(stamps, np.int64), poses), align="sim3")
+    poses[3, 0, 3] = np.nan
+    with pytest.raises(ValueError, match="estimate pose 3: not finite"):
+        pkslam.evaluate(gt, (np.array(stamps, np.int64), poses))

@@ -4,12 +4,22 @@
 // tracking state, save and load maps, get the trajectories. Everything else in pkslam is
 // internal to the library (namespace pkslam::api keeps these names apart from it).
 //
-//   pkslam::api::Slam slam({.settings = "cam.yaml", .vocabulary = "ORBvoc.bin", .sensor =
-//   "stereo"}); for (...) slam.TrackStereo(left, right, t_ns); slam.Shutdown(); for (const
-//   pkslam::api::StampedPose& p : slam.Trajectory()) ...
+//   pkslam::api::SlamOptions options;
+//   options.settings = "cam.yaml";
+//   options.vocabulary = "ORBvoc.bin";
+//   options.sensor = "stereo";
+//   pkslam::api::Slam slam(options);
+//   for (...) slam.TrackStereo(left, right, t_ns);
+//   slam.Shutdown();
+//   for (const pkslam::api::StampedBodyPose& p : slam.BodyTrajectory()) ...
+//
+// Frames: camera trajectories hold world_from_camera (the left camera), body trajectories
+// world_from_body (the IMU: what EuRoC ground truth describes). Every name says which.
 //
 // Threads: one Slam per caller thread; it runs its own local-mapping and loop-closing threads.
-// Errors: std::runtime_error with a one-line message (bad files name the file).
+// Errors: std::invalid_argument for a bad argument (naming it: an image of the wrong size or
+// type, a frame time that does not increase, a non-finite IMU sample, a call after Shutdown),
+// std::runtime_error with a one-line message for everything else (bad files name the file).
 #pragma once
 
 #include <Eigen/Core>
@@ -22,7 +32,7 @@
 
 namespace pkslam::api {
 
-inline constexpr const char* kApiVersion = "0.1.0";
+inline constexpr const char* kApiVersion = "0.2.0";
 
 enum class SlamState { kNotInitialized, kOk, kRecentlyLost, kLost };
 const char* SlamStateName(SlamState state);
@@ -30,6 +40,11 @@ const char* SlamStateName(SlamState state);
 struct StampedPose {
   std::int64_t t_ns = 0;
   Eigen::Matrix4d world_from_camera = Eigen::Matrix4d::Identity();
+};
+
+struct StampedBodyPose {
+  std::int64_t t_ns = 0;
+  Eigen::Matrix4d world_from_body = Eigen::Matrix4d::Identity();
 };
 
 struct ImuSample {
@@ -56,9 +71,10 @@ class Slam {
   Slam(const Slam&) = delete;
   Slam& operator=(const Slam&) = delete;
 
-  // Images: 8-bit grey or BGR; depth: 16-bit (settings' depth factor) or 32-bit float metres.
-  // Stereo pairs raw or rectified, as the settings describe the rig. Inertial sensors: add
-  // the IMU samples up to (a little past) each frame's time first.
+  // Images: 8-bit grey or BGR (converted to grey), of the settings' size; depth: 16-bit
+  // (settings' depth factor) or 32-bit float metres. Stereo pairs raw or rectified, as the
+  // settings describe the rig. Frame times must increase. Inertial sensors: add the IMU samples
+  // up to (a little past) each frame's time first.
   SlamState TrackMonocular(const cv::Mat& image, std::int64_t t_ns);
   SlamState TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns);
   SlamState TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns);
@@ -75,11 +91,20 @@ class Slam {
   void SaveMap(const std::string& file) const;
   void LoadMap(const std::string& file);
 
-  // Finishes local mapping and loop closing (idempotent; the destructor calls it).
+  // Finishes local mapping and loop closing (idempotent; the destructor calls it). Tracking
+  // after it is an error.
   void Shutdown();
-  // Every tracked frame, re-expressed through its keyframe's final pose; the keyframes.
-  std::vector<StampedPose> Trajectory() const;
+  // Every tracked frame, re-expressed through its keyframe's final pose: as camera poses, and as
+  // body poses (camera poses moved by BodyFromCamera(); not for visual monocular maps, whose
+  // unknown scale does not fit the metric lever arm: compare their camera poses with
+  // Evaluate(..., body_from_camera)). The keyframes as camera poses.
+  std::vector<StampedPose> CameraTrajectory() const;
+  std::vector<StampedBodyPose> BodyTrajectory() const;
   std::vector<StampedPose> KeyFrameTrajectory() const;
+  [[deprecated("ambiguous frame: use CameraTrajectory() or BodyTrajectory()")]]
+  std::vector<StampedPose> Trajectory() const { return CameraTrajectory(); }
+  // The rig's camera-to-body transform (the settings' IMU.T_b_c1; identity without an IMU).
+  Eigen::Matrix4d BodyFromCamera() const;
 
  private:
   struct Impl;
@@ -89,6 +114,9 @@ class Slam {
 // ATE / RPE of an estimate against ground truth (`pkslam eval`, evo-compatible): associate by
 // time (max 10 ms), align ("se3", "sim3", "posyaw", "none"), RPE over 1-frame pairs. The ground
 // truth and the estimate are files (TUM, EuRoC csv or ORB-SLAM3 format, detected) or poses.
+// Camera poses against body ground truth need `body_from_camera` (the truth is moved into the
+// camera, as `pkslam eval --body-from-camera`); without it such a pair is refused with that hint
+// (a near-constant orientation offset), never measured as if the frames were the same.
 struct Evaluation {
   std::size_t pairs = 0;
   double scale = 1.0;  // of the alignment (1 unless sim3)
@@ -97,8 +125,12 @@ struct Evaluation {
   double rpe_trans_rmse_m = 0, rpe_rot_rmse_deg = 0;
 };
 Evaluation Evaluate(const std::string& ground_truth_file, const std::string& estimate_file,
-                    const std::string& align = "se3");
+                    const std::string& align = "se3",
+                    const std::optional<Eigen::Matrix4d>& body_from_camera = std::nullopt);
 Evaluation Evaluate(const std::string& ground_truth_file, const std::vector<StampedPose>& estimate,
-                    const std::string& align = "se3");
+                    const std::string& align = "se3",
+                    const std::optional<Eigen::Matrix4d>& body_from_camera = std::nullopt);
+Evaluation Evaluate(const std::string& ground_truth_file,
+                    const std::vector<StampedBodyPose>& estimate, const std::string& align = "se3");
 
 }  // namespace pkslam::api
