@@ -81,9 +81,11 @@ void RegisterEvalCommand(CLI::App& app) {
   cmd->add_option("--align", args->align, "Alignment: se3|sim3|posyaw|none")->capture_default_str();
   cmd->add_option("--max-diff", args->max_diff_s,
                   "Largest time difference of an associated pose pair (s)")
+      ->check(CLI::Range(1e-9, 1e3))
       ->capture_default_str();
   cmd->add_option("--t-offset", args->offset_s,
                   "Offset added to the estimate's timestamps before association (s)")
+      ->check(CLI::Range(-1e6, 1e6))
       ->capture_default_str();
   cmd->add_flag("--evo-association", args->evo_association,
                 "Keep evo's repeated matches instead of strictly one-to-one pairs");

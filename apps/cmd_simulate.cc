@@ -99,6 +99,11 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
   o.output_dir = a.out;
   o.trajectory = a.trajectory;
   o.motion.level = sim::ParseMotionLevel(a.motion);
+  if (a.trajectory.empty() && o.duration_s > 0 && o.duration_s <= o.motion.rest_s) {
+    throw OptionError(fmt::format("--duration {}: random motion starts with {} s at rest (as "
+                                  "EuRoC's flights before take-off); give more than that",
+                                  o.duration_s, o.motion.rest_s));
+  }
   o.quality = sim::ParseQuality(a.quality);
   if (!a.blackout.empty()) {
     o.blackout_begin_s = a.blackout.at(0);
@@ -168,6 +173,7 @@ void RegisterSimulateCommand(CLI::App& app) {
       ->excludes(traj);
   cmd->add_option("--duration", o.duration_s,
                   "Seconds to simulate (0: replay to the end / 60 s of random motion)")
+      ->check(CLI::Range(0.0, 3600.0))
       ->capture_default_str();
   cmd->add_option("--start", o.start_s, "Replay: start this many seconds into the file")
       ->capture_default_str();

@@ -132,8 +132,11 @@ void RegisterVocabCommand(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   train->add_option("--out", args->out, "Output file: .txt (DBoW2 text) or .bin/.pkvoc")
       ->required();
-  train->add_option("--k", args->train.branching, "Branching factor")->capture_default_str();
+  train->add_option("--k", args->train.branching, "Branching factor")
+      ->check(CLI::Range(2, 255))
+      ->capture_default_str();
   train->add_option("--L", args->train.levels, "Depth (levels below the root)")
+      ->check(CLI::Range(1, 32))
       ->capture_default_str();
   train
       ->add_option("--max-images", args->max_images,

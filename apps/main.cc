@@ -1,6 +1,7 @@
 // pkslam: one executable, one subcommand per capability (see README.md).
 #include <CLI/CLI.hpp>
 #include <exception>
+#include <filesystem>
 #include <iostream>
 
 #include "apps/cli_errors.h"
@@ -47,6 +48,11 @@ int main(int argc, char** argv) {
     if (!e.message.empty()) std::cerr << "pkslam: " << e.message << '\n';
     return e.code;
   } catch (const pkslam::Error& e) {
+    std::cerr << "pkslam: error: " << e.what() << '\n';
+    return 1;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path that cannot be created or read (an unwritable --out): the user's to fix, and
+    // the message names the path.
     std::cerr << "pkslam: error: " << e.what() << '\n';
     return 1;
   } catch (const std::exception& e) {

@@ -1,6 +1,7 @@
 #include "map_model/keyframe_database.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "core/bow/vocabulary.h"
 #include "core/util/error.h"
@@ -92,10 +93,11 @@ std::map<KeyFrameId, std::pair<KeyFrame*, int>> KeyFrameDatabase::CountCommonWor
 }
 
 std::vector<PlaceCandidate> KeyFrameDatabase::ScoreGroups(
-    const BowVector& bow, const std::map<KeyFrameId, std::pair<KeyFrame*, int>>& counts) const {
+    const BowVector& bow, const std::map<KeyFrameId, std::pair<KeyFrame*, int>>& counts,
+    double min_common_words_ratio) const {
   int max_common = 0;
   for (const auto& [id, entry] : counts) max_common = std::max(max_common, entry.second);
-  const double min_common = options_.min_common_words_ratio * max_common;
+  const double min_common = min_common_words_ratio * max_common;
 
   // Only keyframes above the common-words threshold get a score; the others count as 0 when
   // they appear in a group (ORB-SLAM would read a stale score left by an earlier query).
@@ -126,18 +128,26 @@ std::vector<PlaceCandidate> KeyFrameDatabase::ScoreGroups(
 
 std::vector<PlaceCandidate> KeyFrameDatabase::DetectRelocalisationCandidates(const Frame& frame,
                                                                              const Map* map) const {
+  return DetectRelocalisationCandidates(frame, map, options_,
+                                        std::numeric_limits<std::size_t>::max());
+}
+
+std::vector<PlaceCandidate> KeyFrameDatabase::DetectRelocalisationCandidates(
+    const Frame& frame, const Map* map, const KeyFrameDatabaseOptions& ratios,
+    std::size_t max_candidates) const {
   PKSLAM_CHECK(frame.HasBoW(), "frame {} has no BoW vector", frame.id());
   const auto counts = CountCommonWords(
       frame.bow(), [map](const KeyFrame* kf) { return map == nullptr || kf->map() == map; });
-  std::vector<PlaceCandidate> groups = ScoreGroups(frame.bow(), counts);
+  std::vector<PlaceCandidate> groups =
+      ScoreGroups(frame.bow(), counts, ratios.min_common_words_ratio);
   if (groups.empty()) return {};
 
   std::sort(groups.begin(), groups.end(), BetterGroup);
-  const double min_score = options_.min_group_score_ratio * groups.front().group_score;
+  const double min_score = ratios.min_group_score_ratio * groups.front().group_score;
   std::vector<PlaceCandidate> out;
   std::map<KeyFrameId, bool> added;
   for (const PlaceCandidate& g : groups) {
-    if (g.group_score <= min_score) break;
+    if (g.group_score <= min_score || out.size() >= max_candidates) break;
     if (!added.emplace(g.keyframe->id(), true).second) continue;
     out.push_back(g);
   }
@@ -153,7 +163,8 @@ LoopAndMergeCandidates KeyFrameDatabase::DetectLoopAndMergeCandidates(const KeyF
   const auto counts = CountCommonWords(keyframe->bow(), [&excluded](const KeyFrame* kf) {
     return kf->map() != nullptr && excluded.count(kf->id()) == 0;
   });
-  std::vector<PlaceCandidate> groups = ScoreGroups(keyframe->bow(), counts);
+  std::vector<PlaceCandidate> groups =
+      ScoreGroups(keyframe->bow(), counts, options_.min_common_words_ratio);
   std::sort(groups.begin(), groups.end(), BetterGroup);
 
   LoopAndMergeCandidates out;

@@ -82,6 +82,12 @@ class KeyFrameDatabase {
   // Requires the frame's BoW. Shared lock.
   std::vector<PlaceCandidate> DetectRelocalisationCandidates(const Frame& frame,
                                                              const Map* map) const;
+  // The same with `ratios`' two thresholds in place of the database's, at most max_candidates
+  // returned: the wider search after repeated failure (lower ratios keep keyframes that share
+  // fewer words, as a view seen from further off does).
+  std::vector<PlaceCandidate> DetectRelocalisationCandidates(const Frame& frame, const Map* map,
+                                                             const KeyFrameDatabaseOptions& ratios,
+                                                             std::size_t max_candidates) const;
 
   // ORB-SLAM3's DetectNBestCandidates: like the relocalisation query but excluding the query
   // keyframe and its covisibility neighbours; groups are ranked by accumulated score and the
@@ -99,10 +105,12 @@ class KeyFrameDatabase {
   template <typename Accept>
   std::map<KeyFrameId, std::pair<KeyFrame*, int>> CountCommonWords(const BowVector& bow,
                                                                    Accept accept) const;
-  // Scores the keyframes above the common-words threshold and accumulates group scores;
-  // returns one PlaceCandidate per scored keyframe (in id order of the scored keyframe).
+  // Scores the keyframes sharing more than min_common_words_ratio * the most common words and
+  // accumulates group scores; returns one PlaceCandidate per scored keyframe (in id order of the
+  // scored keyframe).
   std::vector<PlaceCandidate> ScoreGroups(
-      const BowVector& bow, const std::map<KeyFrameId, std::pair<KeyFrame*, int>>& counts) const;
+      const BowVector& bow, const std::map<KeyFrameId, std::pair<KeyFrame*, int>>& counts,
+      double min_common_words_ratio) const;
 
   const Vocabulary& vocabulary_;
   KeyFrameDatabaseOptions options_;

@@ -17,6 +17,13 @@ MapPoint::MapPoint(MapPointId id, const Eigen::Vector3d& position_world, KeyFram
       position_(position_world),
       reference_kf_(reference_kf) {}
 
+MapPointPtr MapPoint::Temporary(const Eigen::Vector3d& position_world,
+                                const Descriptor& descriptor) {
+  auto point = std::make_shared<MapPoint>(kInvalidId, position_world, nullptr, nullptr);
+  point->descriptor_ = descriptor;
+  return point;
+}
+
 void MapPoint::AddObservation(KeyFrame* kf, int index) {
   auto [it, inserted] = observations_.try_emplace(kf->id(), Observation{kf, index});
   if (!inserted) return;

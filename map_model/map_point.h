@@ -21,6 +21,10 @@ namespace pkslam {
 class MapPoint : public std::enable_shared_from_this<MapPoint> {
  public:
   MapPoint(MapPointId id, const Eigen::Vector3d& position_world, KeyFrame* reference_kf, Map* map);
+  // A point for one frame's visual odometry (localisation only, where the loaded map has no
+  // points to track): a stereo/RGB-D keypoint's position and descriptor, no id, no map, no
+  // observations. It never enters a map; tracking drops it after the frame.
+  static MapPointPtr Temporary(const Eigen::Vector3d& position_world, const Descriptor& descriptor);
   MapPoint(const MapPoint&) = delete;
   MapPoint& operator=(const MapPoint&) = delete;
 

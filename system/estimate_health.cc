@@ -57,6 +57,25 @@ EstimateHealth AssessEstimate(const std::vector<double>& lost_for_good_s,
   return h;
 }
 
+std::vector<LocalisationGap> LocalisationGaps(const std::vector<FrameRecord>& records) {
+  std::vector<LocalisationGap> gaps;
+  bool in_gap = false;
+  for (const FrameRecord& r : records) {
+    const double t = static_cast<double>(r.t_ns) * 1e-9;
+    const bool tracked = r.state == TrackingState::kOk;
+    if (!tracked && !in_gap) {
+      gaps.push_back({t, std::nullopt, 0});
+      in_gap = true;
+    }
+    if (!tracked) ++gaps.back().frames;
+    if (tracked && in_gap) {
+      gaps.back().relocalised_s = t;
+      in_gap = false;
+    }
+  }
+  return gaps;
+}
+
 std::string NoEstimateReason(int frames, int poses, bool never_initialised, bool monocular) {
   if (frames <= 0) return "no frame was read";
   const int needed = frames < 20 ? std::min(frames, 3)

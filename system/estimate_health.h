@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,5 +46,16 @@ EstimateHealth AssessEstimate(const std::vector<double>& lost_for_good_s,
                               const std::vector<LoopEvent>& merges, int maps_at_end);
 
 inline constexpr std::size_t kMaxLossWarnings = 5;
+
+// Localisation only (--localise-only): tracking never starts a map, so a loss is not "for good";
+// the frame after it relocalises against the loaded map or stays without a pose. One gap per
+// stretch without a pose: where it began (the first frame when the run starts lost, as
+// localisation does), where tracking came back (relocalised), and its length in frames.
+struct LocalisationGap {
+  double begin_s = 0;
+  std::optional<double> relocalised_s;  // none: not relocalised before the run ended
+  int frames = 0;
+};
+std::vector<LocalisationGap> LocalisationGaps(const std::vector<FrameRecord>& records);
 
 }  // namespace pkslam

@@ -70,6 +70,26 @@ TEST(AssessEstimate, AMergeWithoutALossAloneIsNotSuspect) {
   EXPECT_DOUBLE_EQ(h.largest_merge_correction_m, 12.0);
 }
 
+TEST(LocalisationGaps, OneGapPerStretchWithoutAPose) {
+  std::vector<FrameRecord> records(8);
+  const TrackingState states[] = {TrackingState::kLost, TrackingState::kLost, TrackingState::kOk,
+                                  TrackingState::kOk,   TrackingState::kLost, TrackingState::kOk,
+                                  TrackingState::kLost, TrackingState::kLost};
+  for (int i = 0; i < 8; ++i) {
+    records[i].t_ns = std::int64_t{1'000'000'000} * (i + 1);
+    records[i].state = states[i];
+  }
+  const auto gaps = LocalisationGaps(records);
+  ASSERT_EQ(gaps.size(), 3u);
+  EXPECT_EQ(gaps[0].begin_s, 1.0);
+  EXPECT_EQ(gaps[0].relocalised_s, 3.0);
+  EXPECT_EQ(gaps[0].frames, 2);
+  EXPECT_EQ(gaps[1].begin_s, 5.0);
+  EXPECT_EQ(gaps[1].relocalised_s, 6.0);
+  EXPECT_EQ(gaps[2].frames, 2);
+  EXPECT_FALSE(gaps[2].relocalised_s);
+}
+
 TEST(NoEstimateReason, TooFewPosesAreNoEstimate) {
   EXPECT_EQ(NoEstimateReason(40, 40, false, true), "");
   EXPECT_EQ(NoEstimateReason(1, 1, false, false), "");  // a one-frame run (map load timing)

@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <optional>
 #include <fstream>
 #include <numeric>
 #include <set>
@@ -171,6 +172,45 @@ void WriteEstimateHealth(const EstimateHealth& health, JsonWriter* json) {
   json->EndObject();
 }
 
+// Localisation only: how much of the run found itself in the loaded map, and each stretch
+// without a pose (the run starts in one, before the first relocalisation).
+void WriteLocalisation(const std::vector<FrameRecord>& records, JsonWriter* json) {
+  const std::vector<LocalisationGap> gaps = LocalisationGaps(records);
+  const int localised = static_cast<int>(std::count_if(
+      records.begin(), records.end(), [](const FrameRecord& r) { return r.state == TrackingState::kOk; }));
+  const double t0 = records.empty() ? 0.0 : static_cast<double>(records.front().t_ns) * 1e-9;
+  std::optional<double> first_localised_s;
+  for (const FrameRecord& r : records) {
+    if (r.state == TrackingState::kOk) {
+      first_localised_s = static_cast<double>(r.t_ns) * 1e-9 - t0;
+      break;
+    }
+  }
+  for (const LocalisationGap& g : gaps) {
+    if (g.relocalised_s) {
+      PKSLAM_LOG_INFO("localisation: no pose from t = {:.3f} s for {} frame(s), relocalised in "
+                      "the loaded map at t = {:.3f} s",
+                      g.begin_s, g.frames, *g.relocalised_s);
+    } else {
+      PKSLAM_LOG_WARN("localisation: no pose from t = {:.3f} s to the end ({} frame(s)): not "
+                      "relocalised in the loaded map",
+                      g.begin_s, g.frames);
+    }
+  }
+  json->Key("localisation").BeginObject();
+  json->Member("frames", static_cast<int>(records.size()));
+  json->Member("localised", localised);
+  // Of those, frames placed by visual odometry from the frame before (no map points in view).
+  json->Member("visual_odometry", static_cast<int>(std::count_if(
+                                      records.begin(), records.end(),
+                                      [](const FrameRecord& r) { return r.visual_odometry; })));
+  json->Member("first_localised_after_s", first_localised_s.value_or(-1.0));
+  json->Member("gaps", static_cast<int>(gaps.size()));
+  json->Member("unrecovered_frames",
+               gaps.empty() || gaps.back().relocalised_s ? 0 : gaps.back().frames);
+  json->EndObject();
+}
+
 // What the run found wrong with its input (system/input_report.h).
 void WriteInputReport(const InputReport& input, JsonWriter* json) {
   json->Key("input").BeginObject();
@@ -275,7 +315,12 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   summary->lost = lost;
   summary->median_tracking_ms = Median(tracking_ms);
   const LoopClosingStats loop_stats = system.loop_stats();
-  summary->estimate = AssessEstimate(LostForGoodTimes(records), loop_stats.merges, summary->maps);
+  // Localisation never starts or resets a map: its losses are gaps in one map's trajectory,
+  // reported as such (WriteLocalisation), not stitched maps.
+  const bool localise_only = options.system.tracking.localise_only;
+  summary->estimate =
+      AssessEstimate(localise_only ? std::vector<double>{} : LostForGoodTimes(records),
+                     loop_stats.merges, summary->maps);
   for (const std::string& w : summary->estimate.warnings)
     PKSLAM_LOG_WARN("suspect estimate: {}", w);
   summary->estimate.no_estimate =
@@ -323,6 +368,7 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   json.Member("degraded", summary->input.degraded());
   WriteInputReport(summary->input, &json);
   WriteEstimateHealth(summary->estimate, &json);
+  if (localise_only) WriteLocalisation(records, &json);
   json.Member("frames", summary->frames);
   json.Member("frames_in_trajectory", frames_in_trajectory);
   json.Member("lost_frames", lost);

@@ -52,7 +52,23 @@ bool Tracker::Relocalize() {
   KeyFrameDatabase* database = atlas_->database();
   if (database == nullptr) return false;
   current_.ComputeBoW(*vocabulary_);
-  const auto places = database->DetectRelocalisationCandidates(current_, atlas_->current_map());
+  // After repeated failure the view is likely further from every keyframe than the usual
+  // thresholds allow (a localisation map of 10 s seen from elsewhere in the room): widen.
+  const bool wide = failed_relocalisations_ >= options_.relocalisation_widen_after;
+  if (failed_relocalisations_ == options_.relocalisation_widen_after) {
+    PKSLAM_LOG_INFO("relocalisation: {} attempts in a row failed (t = {:.3f} s); widening the "
+                    "place search",
+                    failed_relocalisations_, current_.t_s());
+  }
+  KeyFrameDatabaseOptions wide_ratios;
+  wide_ratios.min_common_words_ratio = 0.5;
+  wide_ratios.min_group_score_ratio = 0.5;
+  const auto places =
+      wide ? database->DetectRelocalisationCandidates(
+                 current_, atlas_->current_map(), wide_ratios,
+                 static_cast<std::size_t>(options_.relocalisation_wide_candidates))
+           : database->DetectRelocalisationCandidates(current_, atlas_->current_map());
+  ++failed_relocalisations_;  // until the success below
   if (places.empty()) return false;
 
   const OrbMatcher bow_matcher(0.75, true);
@@ -115,10 +131,13 @@ bool Tracker::Relocalize() {
         PKSLAM_LOG_INFO("relocalised at t = {:.3f} s against keyframe {} ({} inliers)",
                         current_.t_s(), c.keyframe->id(), good);
         ++relocalisations_;
+        failed_relocalisations_ = 0;
         return true;
       }
     }
   }
+  PKSLAM_LOG_DEBUG("relocalisation failed at t = {:.3f} s: {} place(s), {} with 15+ BoW matches{}",
+                   current_.t_s(), places.size(), candidates.size(), wide ? " (wide)" : "");
   std::fill(current_.map_points.begin(), current_.map_points.end(), nullptr);
   return false;
 }

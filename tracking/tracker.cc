@@ -62,6 +62,9 @@ void TrackingOptions::Check() const {
   PKSLAM_CHECK_OPTION(motion_model_radius_stereo > 0 && motion_model_radius_mono > 0,
                       "Tracking.motion_model_radius", "{} / {}", motion_model_radius_stereo,
                       motion_model_radius_mono);
+  PKSLAM_CHECK_OPTION(relocalisation_widen_after >= 0 && relocalisation_wide_candidates > 0,
+                      "Tracking.relocalisation_widen_after", "{} / {}",
+                      relocalisation_widen_after, relocalisation_wide_candidates);
   pose.Check();
 }
 
@@ -188,8 +191,7 @@ TrackResult Tracker::Track(Frame frame) {
         if (ok) {
           state_ = TrackingState::kOk;
         } else if (state_ == TrackingState::kOk) {
-          const bool keep =
-              atlas_->current_map()->NumKeyFrames() > options_.min_keyframes_to_keep_map;
+          const bool keep = atlas_->current_map()->NumKeyFrames() > MinKeyFramesToKeepMap();
           state_ = keep ? TrackingState::kRecentlyLost : TrackingState::kLost;
           lost_since_t_ns_ = current_.t_ns();
         } else if (state_ == TrackingState::kRecentlyLost &&
@@ -254,6 +256,8 @@ TrackResult Tracker::Track(Frame frame) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() -
       frame_wait_ms;
   RecordFrame(new_keyframe, ms, 1e3 * (ThreadCpuSeconds() - cpu_start));
+  records_.back().visual_odometry =
+      options_.localise_only && visual_odometry_ && state_ == TrackingState::kOk;
   result.state = state_;
   result.new_keyframe = new_keyframe;
   result.inliers = inliers_;
@@ -363,13 +367,21 @@ void Tracker::StereoInitialization() {
   state_ = TrackingState::kOk;
 }
 
+int Tracker::MinKeyFramesToKeepMap() const {
+  // A monocular map of a few keyframes is mostly its two-view initialisation, with a scale of its
+  // own: ORB-SLAM3 resets it. A stereo or RGB-D map is metric from its first keyframe: it is
+  // kept, so a short loss (20 black frames) no longer drops the frames tracked before it, and the
+  // next map may be merged with it.
+  return IsMonocular(rig_->sensor) ? options_.min_keyframes_to_keep_map : 0;
+}
+
 void Tracker::HandleLost() {
   int keyframes = 0;
   {
     auto lock = MapReader(*atlas_).Lock();
     keyframes = atlas_->current_map()->NumKeyFrames();
   }
-  if (keyframes <= options_.min_keyframes_to_keep_map) {
+  if (keyframes <= MinKeyFramesToKeepMap()) {
     PKSLAM_LOG_WARN("tracking lost at t = {:.3f} s with {} keyframes: resetting the map",
                     current_.t_s(), keyframes);
     Reset();

@@ -39,6 +39,9 @@ struct FrameRecord {
   // optimisation does not move it): what a live user saw; inertial runs write it out.
   std::optional<SE3d> camera_from_world_online;
   bool keyframe = false;
+  // Localisation only: the pose came from visual odometry against the previous frame, not
+  // from the loaded map's points (TrackLocalisationOnly).
+  bool visual_odometry = false;
   // Wall time from image to pose: building the frame (ORB extraction, stereo matching) and
   // tracking it, as ORB-SLAM3's examples time Track*(); live-emulation waits excluded.
   double tracking_ms = 0;
@@ -130,6 +133,9 @@ class Tracker {
   // otherwise, then the local map; sets state_ (kOk or kLost). Atlas lock held (shared).
   bool TrackLocalisationOnly();
   void UpdateLastFrame();
+  // Localisation only (stereo/RGB-D): temporary points from the last frame's depth for the
+  // keypoints without a map point, so the motion model can track where the map has none.
+  void AddVisualOdometryPoints();
   void UpdateLocalKeyFrames();
   void UpdateLocalPoints();
   int SearchLocalPoints();
@@ -139,6 +145,8 @@ class Tracker {
   void CreateNewKeyFrame(const SelectorInput& input);
   // Finds the frame's pose in the current map from BoW candidates (tracking/relocalization.cc).
   bool Relocalize();
+  // Keyframes a lost map needs to be kept (else reset): options' for monocular maps, 0 else.
+  int MinKeyFramesToKeepMap() const;
   void HandleLost();
   // Back to NOT_INITIALIZED on the current (new or cleared) map.
   void StartOver();
@@ -184,12 +192,15 @@ class Tracker {
   int inliers_ = 0;
   std::int64_t lost_since_t_ns_ = 0;
   int relocalisations_ = 0;
+  int failed_relocalisations_ = 0;  // in a row; reset by a success (Relocalize)
 
   // Local map (rebuilt every frame).
   std::vector<KeyFrame*> local_keyframes_;
   std::vector<MapPointPtr> local_points_;
   // Temporal stereo points created for the last frame (not in the map).
-  std::vector<MapPointPtr> temporal_points_;
+  // Localisation only: the last frame was tracked by visual odometry (too few map points in
+  // view); tracking goes on from it while relocalisation is tried on every frame.
+  bool visual_odometry_ = false;
 
   std::vector<FrameRecord> records_;
   bool trace_enabled_ = false;

@@ -51,6 +51,30 @@ void Tracker::UpdateLastFrame() {
   if (record.reference && !record.reference->IsBad()) {
     last_.SetPose(record.camera_from_reference * record.reference->camera_from_world());
   }
+  if (options_.localise_only && !IsMonocular(rig_->sensor)) AddVisualOdometryPoints();
+}
+
+void Tracker::AddVisualOdometryPoints() {
+  // The closest keypoints with depth that have no map point: all closer than th_depth, and at
+  // least max_temporal_points of them (ORB-SLAM's UpdateLastFrame does the same in its
+  // localisation mode).
+  std::vector<std::pair<float, int>> by_depth;
+  for (int i = 0; i < last_.size(); ++i) {
+    if (!last_.HasDepth(i)) continue;
+    const auto& mp = last_.map_points[i];
+    if (mp && mp->NumObservations() > 0) continue;
+    by_depth.emplace_back(last_.depth()[i], i);
+  }
+  std::sort(by_depth.begin(), by_depth.end());
+  int added = 0;
+  for (const auto& [depth, i] : by_depth) {
+    if (depth > rig_->th_depth && added >= options_.max_temporal_points) break;
+    const auto world = last_.UnprojectStereo(i);
+    if (!world) continue;
+    last_.map_points[i] = MapPoint::Temporary(*world, last_.descriptors()[i]);
+    if (i < static_cast<int>(last_.outliers.size())) last_.outliers[i] = 0;
+    ++added;
+  }
 }
 
 bool Tracker::TrackWithMotionModel() {
@@ -69,7 +93,16 @@ bool Tracker::TrackWithMotionModel() {
   if (n < options_.min_matches_motion_model) return false;
   current_.outliers.assign(current_.size(), 0);
   OptimizePose(&current_, options_.pose);
-  return DiscardOutliers(&current_) >= 10;
+  const int in_map = DiscardOutliers(&current_);
+  if (options_.localise_only && !mono) {
+    // Localisation: temporary visual-odometry points count too (TrackLocalisationOnly decides
+    // whether the map or odometry placed the frame); ORB-SLAM asks for 20 matches in all.
+    const int all = static_cast<int>(std::count_if(current_.map_points.begin(),
+                                                   current_.map_points.end(),
+                                                   [](const MapPointPtr& p) { return p != nullptr; }));
+    return in_map >= 10 || all >= 20;
+  }
+  return in_map >= 10;
 }
 
 bool Tracker::TrackLocalMap() {

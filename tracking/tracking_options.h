@@ -43,8 +43,15 @@ struct TrackingOptions {
   int new_keyframe_min_close_points = 100;
   // Seconds in RECENTLY_LOST before declaring LOST (inertial).
   double recently_lost_timeout_s = 5.0;
-  // A lost map with at most this many keyframes is reset instead of kept in the Atlas.
+  // A lost monocular map with at most this many keyframes is reset instead of kept in the Atlas
+  // (stereo and RGB-D maps are always kept: metric from their first keyframe).
   int min_keyframes_to_keep_map = 10;
+  // Relocalisation widens its search after this many failed attempts in a row (localisation
+  // mode tries on every frame without a pose): the place query keeps keyframes sharing half the
+  // best one's words (ORB-SLAM: 80%) and groups scoring half the best group's (75%), at most
+  // relocalisation_wide_candidates of them.
+  int relocalisation_widen_after = 5;
+  int relocalisation_wide_candidates = 20;
   // Deterministic mode: wait for local mapping to finish each keyframe before going on.
   bool lockstep = false;
   // Localisation only (--localise-only, on a loaded map; ORB-SLAM3's localisation mode):

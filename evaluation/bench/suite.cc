@@ -308,7 +308,13 @@ Suite ParseSuite(const std::string& text, const fs::path& file) {
   Suite s;
   s.file = file;
   s.name = root["name"] ? String(c, root["name"], "name") : file.stem().string();
-  if (root["runs"]) s.runs = static_cast<int>(Integer(c, root["runs"], "runs", 1));
+  if (root["runs"]) {
+    // Every run is a result row and a folder: a typo such as 100000000 used to grow memory
+    // until std::bad_alloc instead of being named.
+    const long long runs = Integer(c, root["runs"], "runs", 1);
+    if (runs > 1000) c.Fail(root["runs"], fmt::format("'runs' must be <= 1000 (got {})", runs));
+    s.runs = static_cast<int>(runs);
+  }
   if (root["seed"]) s.seed = static_cast<std::uint64_t>(Integer(c, root["seed"], "seed", 0));
   if (root["deterministic"]) s.deterministic = Bool(c, root["deterministic"], "deterministic");
   if (root["dense"]) s.dense = Bool(c, root["dense"], "dense");

@@ -195,6 +195,12 @@ void WriteMapFile(const std::filesystem::path& file, const AtlasRecord& record) 
 }
 
 AtlasRecord ReadMapFile(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) {
+    throw InputError(file, std::filesystem::is_directory(file, ec)
+                               ? "is a folder, not a map file (pkslam run --save-map FILE)"
+                               : "map file not found");
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file, "cannot open map file");
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -10,8 +10,10 @@ Classes: clean (exit != 0, one "pkslam: error:" line naming the bad input, no st
 warned (exit 0, the expected warning, a stats.json flag), crashed (killed by a signal, abort,
 sanitizer report, or exit 2 = internal error), hung (timeout), silent (exit 0 without the
 warning, or an error run that left a stats.json), unnamed (exit != 0 without naming the
-input). Signal cases are clean when the trajectory left behind evaluates against the ground
-truth. `run` exits 1 unless every case is clean or warned.
+input), correct (a case that must work: exit 0, or 5 for a run allowed to find no estimate, and
+its outputs pass the case's check). "noestimate" cases are clean when the run exits 5 naming why
+and stats.json "estimate" says so. Signal cases are clean when the trajectory left behind
+evaluates against the ground truth. `run` exits 1 unless every case is clean, warned or correct.
 """
 import argparse
 import json
@@ -102,7 +104,8 @@ def keep_imu_fraction(seq, lo, hi):
 
 class Case:
     def __init__(self, name, base, mutate, args, expect, needles, stats_key=None, runner=None,
-                 limit_file_kb=None):
+                 limit_file_kb=None, check=None):
+        self.check = check  # expect "correct": check(out) -> (ok, detail) on the outputs
         self.name = name
         self.base = base
         self.mutate = mutate
@@ -307,6 +310,205 @@ CASES = [
 ]
 
 
+# ---- Round 2 (issue 37): inputs from outside the project's own corpus. -----------------------
+
+def m_blank_cam0(seq):
+    """Every cam0 image one flat grey: nothing to track."""
+    import numpy as np
+    for p in cam_images(seq, "cam0"):
+        rewrite_image(p, lambda im: np.full_like(im, 128))
+
+
+def m_black_stretch(seq):
+    """Frames 30-49 black in both cameras (a covered lens, a dropped exposure)."""
+    import numpy as np
+    for cam in ("cam0", "cam1"):
+        for p in cam_images(seq, cam)[30:50]:
+            rewrite_image(p, lambda im: np.zeros_like(im))
+
+
+def m_no_sim_yaml(seq):
+    """A recording, not a render: no sim.yaml."""
+    os.unlink(os.path.join(seq, "sim.yaml"))
+
+
+def m_users_plots(seq):
+    os.makedirs(os.path.join(seq, "plots"))
+    with open(os.path.join(seq, "plots", "my_figure.pdf"), "w") as f:
+        f.write("mine")
+
+
+def edit_yaml(path, pattern, replacement):
+    lines = [re.sub(pattern, replacement, l) for l in read_lines(path)]
+    write_lines(path, lines)
+
+
+def m_cam0_k1_50(seq):
+    edit_yaml(os.path.join(seq, "mav0/cam0/sensor.yaml"),
+              r"^distortion_coefficients: \[[^,]*,", "distortion_coefficients: [50.0,")
+
+
+def m_cam0_cu_negative(seq):
+    edit_yaml(os.path.join(seq, "mav0/cam0/sensor.yaml"),
+              r"^intrinsics: \[([^,]*), ([^,]*), [^,]*,", r"intrinsics: [\1, \2, -3000,")
+
+
+def m_settings_cx_typo(seq):
+    edit_yaml(os.path.join(seq, "settings.yaml"), r"^Camera1\.cx:.*", "Camera1.cx: 3672.15")
+
+
+def m_duplicate_intrinsics(seq):
+    p = os.path.join(seq, "mav0/cam1/sensor.yaml")
+    lines = read_lines(p)
+    i = next(k for k, l in enumerate(lines) if l.startswith("intrinsics:"))
+    write_lines(p, lines[:i + 1] + ["intrinsics: [458.654, 457.296, 367.215, 248.375]"] +
+                lines[i + 1:])
+
+
+def m_depth_factor_one(seq):
+    edit_yaml(os.path.join(seq, "settings.yaml"), r"^RGBD\.DepthMapFactor:.*",
+              "RGBD.DepthMapFactor: 1.0")
+
+
+def m_microseconds(seq):
+    def fn(rows):
+        for r in rows:
+            r[0] = str(int(r[0]) // 1000)
+        return rows
+    for csv in (cam_csv(seq, "cam0"), cam_csv(seq, "cam1"), imu_csv(seq),
+                os.path.join(seq, "mav0/state_groundtruth_estimate0/data.csv")):
+        edit_csv(csv, fn)
+
+
+def m_seconds_list(seq):
+    """--timestamps rows of whole seconds ('1600000000 name.png'), read as nanoseconds."""
+    names = [os.path.basename(p) for p in cam_images(seq, "cam0")]
+    with open(os.path.join(seq, "ts_seconds.txt"), "w") as f:
+        for i, n in enumerate(names):
+            f.write(f"{1600000000 + i} {n}\n")
+
+
+def gt_rows(seq):
+    return [l.split(",") for l in read_lines(os.path.join(
+        seq, "mav0/state_groundtruth_estimate0/data.csv")) if l and not l.startswith("#")]
+
+
+def m_identical_poses(seq):
+    """81 estimate poses, all the same, over the last 1.6 s (the truth moves there)."""
+    with open(os.path.join(seq, "same.txt"), "w") as f:
+        for r in gt_rows(seq)[-324::4]:
+            f.write(f"{int(r[0]) * 1e-9:.9f} 1 2 3 0 0 0 1\n")
+
+
+def m_legacy_no_size(seq):
+    """An ORB-SLAM2-style settings file without the image size."""
+    with open(os.path.join(seq, "orbslam2.yaml"), "w") as f:
+        f.write("%YAML:1.0\nCamera.fx: 458.654\nCamera.fy: 457.296\nCamera.cx: 367.215\n"
+                "Camera.cy: 248.375\nCamera.k1: -0.28340811\nCamera.k2: 0.07395907\n"
+                "Camera.p1: 0.00019359\nCamera.p2: 1.76187114e-05\nCamera.fps: 20.0\n")
+
+
+def m_no_version(seq):
+    with open(os.path.join(seq, "no_version.yaml"), "w") as f:
+        f.write("%YAML:1.0\nCamera1.fx: 458.654\nCamera1.fy: 457.296\n")
+
+
+def huge_bench(work):
+    suite = os.path.join(work, "huge_runs.yaml")
+    with open(suite, "w") as f:
+        f.write("runs: 100000000\nselectors: [orbslam3]\nsensors: [stereo]\n"
+                "datasets: [{name: a, path: no_such_dir}]\n")
+    return suite
+
+
+def poses_at_least(n):
+    def check(out):
+        path = os.path.join(out, "trajectory.txt")
+        if not os.path.exists(path):
+            return False, "no trajectory.txt"
+        poses = sum(1 for l in read_lines(path) if l and not l.startswith("#"))
+        return poses >= n, f"{poses} poses in trajectory.txt (at least {n} expected)"
+    return check
+
+
+RUN_IMAGES = ("run --images {seq}/mav0/cam0/data --timestamps {seq}/timestamps.txt "
+              "--settings {seq}/settings.yaml --quiet --out {out}")
+GT = "{seq}/mav0/state_groundtruth_estimate0/data.csv"
+
+ROUND2_CASES = [
+    # Usage errors: exit 1, one line, the nearest valid word.
+    Case("usage_unknown_flag", "euroc", m_none, "run --dataset {seq} --sensr stereo --out {out}",
+         "error", ["--sensr", "did you mean '--sensor'"]),
+    Case("usage_bad_sensor_value", "euroc", m_none, RUN_M.replace("mono", "stero"), "error",
+         ["'stero' is not one of", "did you mean 'stereo'"]),
+    Case("usage_unknown_command", "euroc", m_none, "rnu --dataset {seq}", "error",
+         ["unknown command 'rnu'", "did you mean 'run'"]),
+    Case("images_default_mono", "euroc", m_none, RUN_IMAGES, "correct", ["sensor mono"]),
+    # A run that never tracks is no estimate (exit 5), not a success.
+    Case("mono_never_tracks", "euroc", m_blank_cam0, RUN_IMAGES + " --max-frames 40 --strict",
+         "noestimate", ["no estimate", "0 of 40 frames", "never initialised"]),
+    Case("black_frames_keep_earlier_poses", "euroc", m_black_stretch, RUN_S, "correct", [],
+         check=poses_at_least(75)),
+    # Outputs never change inputs nor delete what pkslam did not make.
+    Case("out_is_the_dataset", "euroc", m_none, RUN_S.replace("--out {out}", "--out {seq}"),
+         "error", ["is the input --dataset"]),
+    Case("dense_out_onto_image", "euroc", m_none,
+         "dense --run {work}/base_run --dataset {seq} --out {first_image}", "error",
+         ["would overwrite a file of the input --dataset"]),
+    Case("simulate_onto_recording", "euroc", m_no_sim_yaml,
+         "simulate --out {seq} --no-images --duration 3 --quiet", "error",
+         ["not a pkslam render"]),
+    Case("bench_keeps_users_plots", "euroc", m_users_plots,
+         "bench {suite} --out {seq} --quiet", "error", ["plots", "not made by pkslam"]),
+    Case("save_map_is_load_map", "euroc", m_none,
+         RUN_S + " --load-map {out}/x.pkmap --save-map {out}/x.pkmap", "error",
+         ["is the input --load-map"]),
+    # Calibration that cannot be a camera.
+    Case("cam0_k1_50", "euroc", m_cam0_k1_50, RUN_S, "error",
+         ["cam0/sensor.yaml", "distortion"]),
+    Case("cam0_cu_negative", "euroc", m_cam0_cu_negative, RUN_S, "error",
+         ["cam0/sensor.yaml", "cx -3000"]),
+    Case("settings_cx_typo", "euroc", m_settings_cx_typo, RUN_S + " --settings {seq}/settings.yaml",
+         "error", ["settings.yaml", "Camera1.cx", "3672.15"]),
+    Case("duplicate_intrinsics", "euroc", m_duplicate_intrinsics, RUN_S, "error",
+         ["cam1/sensor.yaml", "appears twice"]),
+    Case("rgbd_depth_factor_one", "tum", m_depth_factor_one,
+         RUN_RGBD + " --settings {seq}/settings.yaml", "error",
+         ["depth/", "DepthMapFactor", "the depth factor is wrong"]),
+    # Time bases.
+    Case("csv_in_microseconds", "euroc", m_microseconds, RUN_SI, "error",
+         ["cam0/data.csv", "microseconds"]),
+    Case("timestamps_whole_seconds", "euroc", m_seconds_list,
+         RUN_IMAGES.replace("{seq}/timestamps.txt", "{seq}/ts_seconds.txt"), "error",
+         ["ts_seconds.txt", "Camera.fps"]),
+    # Evaluation that would measure nothing, or the wrong frame.
+    Case("eval_identical_poses_sim3", "euroc", m_identical_poses,
+         "eval --gt " + GT + " --est {seq}/same.txt --align sim3", "error",
+         ["same.txt", "one place"]),
+    Case("eval_camera_against_body", "euroc", m_none,
+         "eval --gt " + GT + " --est {work}/base_run/trajectory.txt", "error",
+         ["trajectory.txt", "--body-from-camera"]),
+    # Settings in the wild.
+    Case("settings_orbslam2_without_size", "euroc", m_legacy_no_size,
+         RUN_M + " --settings {seq}/orbslam2.yaml", "error", ["orbslam2.yaml", "Camera.width"]),
+    Case("settings_without_version", "euroc", m_no_version,
+         RUN_M + " --settings {seq}/no_version.yaml", "error",
+         ["no_version.yaml", "File.version", "settings convert"]),
+    # Internal words replaced by the user's.
+    Case("out_unwritable", "euroc", m_none, RUN_S.replace("--out {out}", "--out /proc/pkslam/out"),
+         "error", ["/proc/pkslam/out"]),
+    Case("load_map_is_a_folder", "euroc", m_none, RUN_S + " --load-map {seq}", "error",
+         ["is a folder, not a map file"]),
+    Case("suite_runs_huge", "euroc", m_none, "bench {huge_suite} --out {out} --quiet", "error",
+         ["huge_runs.yaml", "must be <= 1000"]),
+    Case("simulate_duration_within_rest", "euroc", m_none,
+         "simulate --out {out}/sim --duration 2 --quiet", "error", ["--duration 2", "at rest"]),
+    Case("eval_offset_out_of_range", "euroc", m_none,
+         "eval --gt " + GT + " --est {work}/base_run/trajectory_body.txt --t-offset 1e9", "error",
+         ["--t-offset"]),
+]
+
+
 # --------------------------------------------------------------------------------------------
 # Signals: the trajectory so far must be readable by `pkslam eval`.
 
@@ -375,7 +577,7 @@ SIGNAL_CASES = [
         [signal.SIGKILL], (-signal.SIGKILL,), "trajectory.txt.partial")),
 ]
 
-ALL = {c.name: c for c in CASES + SIGNAL_CASES}
+ALL = {c.name: c for c in CASES + ROUND2_CASES + SIGNAL_CASES}
 
 
 # --------------------------------------------------------------------------------------------
@@ -404,6 +606,20 @@ def classify(case, rc, output, out):
         return "crashed"
     found = all(n in output for n in case.needles)
     stats_path = os.path.join(out, "stats.json")
+    if case.expect == "correct":
+        if rc != 0 and not (rc == 5 and case.check is None):
+            return "unnamed" if "pkslam: error:" in output else "silent"
+        ok, detail = case.check(out) if case.check else (True, "")
+        return "correct" if found and ok else "silent"
+    if case.expect == "noestimate":
+        if rc == 0:
+            return "silent"
+        try:
+            with open(stats_path) as f:
+                reason = json.load(f)["estimate"]["no_estimate"]
+        except (OSError, ValueError, KeyError):
+            reason = ""
+        return "clean" if rc == 5 and found and reason else "unnamed"
     if case.expect == "error":
         if rc == 0:
             return "silent"
@@ -433,7 +649,10 @@ def run_case(pkslam, work, case):
     if case.runner:
         result, output = case.runner(pkslam, seq, out, work)
         return (result or "hung"), output
-    args = case.args.format(seq=seq, out=out, work=work, suite=bad_bench(seq, work))
+    first_image = cam_images(seq, "cam0")[0] if os.path.isdir(
+        os.path.join(seq, "mav0/cam0/data")) else ""
+    args = case.args.format(seq=seq, out=out, work=work, suite=bad_bench(seq, work),
+                            huge_suite=huge_bench(work), first_image=first_image)
 
     def limits():
         if case.limit_file_kb:
@@ -478,15 +697,15 @@ def main():
         results[name] = result
         last = [l for l in output.strip().splitlines() if l.strip()][-1:] or [""]
         print(f"{name:32s} {result:8s} {last[0][:150]}")
-        if a.verbose or result not in ("clean", "warned"):
+        if a.verbose or result not in ("clean", "warned", "correct"):
             print("    " + output.strip().replace("\n", "\n    "))
     totals = {k: sum(1 for v in results.values() if v == k)
-              for k in ("clean", "warned", "crashed", "hung", "silent", "unnamed")}
+              for k in ("clean", "warned", "correct", "crashed", "hung", "silent", "unnamed")}
     print("totals: " + ", ".join(f"{k} {v}" for k, v in totals.items()))
     if a.json:
         with open(a.json, "w") as f:
             json.dump({"cases": results, "totals": totals}, f, indent=1)
-    return 0 if all(v in ("clean", "warned") for v in results.values()) else 1
+    return 0 if all(v in ("clean", "warned", "correct") for v in results.values()) else 1
 
 
 if __name__ == "__main__":
