@@ -81,7 +81,8 @@ void RegisterEvalCommand(CLI::App& app) {
   cmd->add_option("--align", args->align, "Alignment: se3|sim3|posyaw|none")->capture_default_str();
   cmd->add_option("--max-diff", args->max_diff_s,
                   "Largest time difference of an associated pose pair (s)")
-      ->check(CLI::Range(1e-9, 1e3))
+      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   cmd->add_option("--t-offset", args->offset_s,
                   "Offset added to the estimate's timestamps before association (s)")

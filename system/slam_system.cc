@@ -251,7 +251,14 @@ SlamSystem::MapFileInfo SlamSystem::LoadMap(const std::filesystem::path& file) {
     } catch (const InputError&) {
       throw;
     } catch (const Error& e) {
-      throw InputError(file, fmt::format("inconsistent map: {}", e.what()));
+      // The restore's consistency checks speak in source locations; the user needs only what
+      // is inconsistent (a checksum that matches means the bytes were written this way).
+      std::string what = e.what();
+      const std::size_t failed = what.find("' failed: ");
+      if (failed != std::string::npos) what = what.substr(failed + 10);
+      throw InputError(file, fmt::format("inconsistent map (damaged, though its checksum "
+                                         "matches): {}",
+                                         what));
     }
     if (options_.tracking.localise_only) {
       // Every loaded map still counts as this session's here: the largest one.

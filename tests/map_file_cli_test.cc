@@ -81,5 +81,40 @@ TEST(MapFileCli, SaveRoundTripLocaliseAndRefuseDamage) {
   EXPECT_THAT(no_map.output, HasSubstr("--localise-only needs --load-map"));
 }
 
+// Localisation beyond a short map: a 3 s map (2 s of it at rest), then the next 5 s of a
+// difficult flight that mostly looks elsewhere. The run keeps a pose for nearly every frame —
+// against the map where it is in view, by visual odometry where not — and says which.
+TEST(MapFileCli, LocalisationGoesOnBeyondAShortMap) {
+  const auto dir = testing::MakeTempDir("map_file_cli_short");
+  const auto seq = dir / "seq";
+  const auto sim = RunPkslam(fmt::format(
+      "--log-level warn simulate --out '{}' --motion difficult --duration 8 --quality fast "
+      "--quiet --no-cloud --seed 2",
+      seq.string()));
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const auto map = dir / "short.pkmap";
+  const auto mapping = RunPkslam(fmt::format(
+      "run --dataset '{}' --sensor stereo --deterministic --max-frames 60 --quiet --save-map "
+      "'{}' --out '{}'",
+      seq.string(), map.string(), (dir / "mapping").string()));
+  ASSERT_EQ(mapping.exit_code, 0) << mapping.output;
+  const auto localise = RunPkslam(fmt::format(
+      "run --dataset '{}' --sensor stereo --deterministic --first-frame 60 --load-map '{}' "
+      "--localise-only --out '{}'",
+      seq.string(), map.string(), (dir / "localise").string()));
+  ASSERT_EQ(localise.exit_code, 0) << localise.output;
+  EXPECT_THAT(localise.output, ::testing::Not(HasSubstr("new (or reset) map")));
+  const auto stats = dir / "localise/stats.json";
+  const long long frames = JsonIntField(stats, "frames");
+  EXPECT_GE(JsonIntField(stats, "frames_in_trajectory"), frames * 9 / 10);
+  EXPECT_GT(JsonIntField(stats, "visual_odometry"), 0);
+  EXPECT_GT(JsonIntField(stats, "localised"), JsonIntField(stats, "visual_odometry"));
+  EXPECT_THAT(testing::ReadFileBytes(stats), HasSubstr("\"suspect\": false"));
+  const auto eval = RunPkslam(fmt::format(
+      "eval --gt '{}' --est '{}'", (seq / "mav0/state_groundtruth_estimate0/data.csv").string(),
+      (dir / "localise/trajectory_body.txt").string()));
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+}
+
 }  // namespace
 }  // namespace pkslam

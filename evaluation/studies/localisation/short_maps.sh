@@ -2,8 +2,9 @@
 # Localisation on short maps (issue 37): for three simulated replays of real EuRoC flights
 # (../shared/data/euroc/groundtruth, 40 s from take-off), a stereo-inertial map of the first
 # 10 s and of the first 20 s, then --localise-only on the rest of the same render. Per map:
-# frames localised after the map ends, seconds to the first relocalisation, gaps, and the
-# SE3-aligned ATE of the localised frames. Results in OUT/short_maps.tsv with the commit.
+# frames with a pose after the map ends, how many of them against the map (the rest by visual
+# odometry), seconds to the first pose, stretches without a pose, and the SE3-aligned ATE of the
+# frames with a pose. Results in OUT/short_maps.tsv with the commit.
 #
 #   evaluation/studies/localisation/short_maps.sh OUT_DIR [PKSLAM]
 set -euo pipefail
@@ -31,7 +32,7 @@ for k in sys.argv[2:]: d = d[k]
 print(d)' "$@"
 }
 commit=$(git -C "$root" rev-parse --short HEAD)
-printf 'replay\tmap_s\tframes\tlocalised\tshare\tfirst_s\tgaps\tunrecovered\tate_mm\tcommit\n' \
+printf 'replay\tmap_s\tframes\tlocalised\tshare\tin_map\todometry\tfirst_s\tgaps\tunrecovered\tate_mm\tcommit\n' \
   > short_maps.tsv
 while read -r name file start; do
   for map_s in 10 20; do
@@ -46,7 +47,8 @@ while read -r name file start; do
       --est "$name-$map_s-loc/trajectory_body.txt" 2>/dev/null | awk '/^ATE \[m\]/ {print $3}')
     /usr/bin/python3 -c "
 f, l = $(json "$s" localisation frames), $(json "$s" localisation localised)
-print('\t'.join(map(str, ['$name', $map_s, f, l, f'{100 * l / f:.1f}%',
+vo = $(json "$s" localisation visual_odometry 2>/dev/null || echo 0)
+print('\t'.join(map(str, ['$name', $map_s, f, l, f'{100 * l / f:.1f}%', f'{100 * (l - vo) / f:.1f}%', vo,
       '$(json "$s" localisation first_localised_after_s)', $(json "$s" localisation gaps),
       $(json "$s" localisation unrecovered_frames),
       f'{1e3 * float(\"${ate:-nan}\"):.2f}', '$commit'])))" >> short_maps.tsv
