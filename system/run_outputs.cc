@@ -283,6 +283,15 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   // The trajectory first: when a later file fails (full disk) or a second signal ends the
   // process, the most valuable output is already complete.
   const int frames_in_trajectory = WriteTrajectoryOutputs(system, options);
+  // A EuRoC recording's ground truth is the body (IMU); settings without IMU.T_b_c1 (ORB-SLAM2
+  // stereo files, visual-only ones) give no way there, so the "body" is the camera.
+  if (options.system.sensor != Sensor::kMonocular && !system.settings().body_from_cam0 &&
+      std::filesystem::exists(options.dataset / "mav0")) {
+    PKSLAM_LOG_WARN("{}: no camera-IMU extrinsic (IMU.T_b_c1), so trajectory_body.txt holds the "
+                    "camera's poses; compare trajectory.txt with `pkslam eval "
+                    "--body-from-camera` and the dataset's cam0 T_BS, or add IMU.T_b_c1",
+                    options.settings ? options.settings->string() : std::string("settings"));
+  }
   WriteRigidTransform(system.rig().body_from_camera, out / "body_from_camera.txt",
                       "body_from_camera (row-major 4x4, metres)");
   WriteTrajectory(system.KeyFrameTrajectory(), out / "keyframes.txt", TrajectoryFormat::kTum);
