@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/util/error.h"
+#include "core/util/output_guard.h"
 #include "core/util/log.h"
 #include "core/util/progress.h"
 #include "io/settings.h"
@@ -215,7 +216,9 @@ void ClearEarlierRender(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::exists(dir, ec) || (fs::is_directory(dir, ec) && fs::is_empty(dir, ec))) return;
-  if (!fs::is_directory(dir, ec) || !fs::exists(dir / "sim.yaml", ec)) {
+  // sim.yaml is written last; the marker first, so an interrupted render is recognised too.
+  if (!fs::is_directory(dir, ec) ||
+      !(fs::exists(dir / "sim.yaml", ec) || fs::exists(dir / kOwnedFolderMarker, ec))) {
     throw OptionError(fmt::format(
         "--out {}: exists and is not a pkslam render (no sim.yaml); simulate writes into an empty "
         "or new folder, or replaces an earlier render",
@@ -331,9 +334,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
     if (ec) throw Error(fmt::format("cannot create {}: {}", o.output_dir.string(), ec.message()));
   } else if (!o.bench) {
     ClearEarlierRender(o.output_dir);
-    std::error_code ec;
-    std::filesystem::create_directories(o.output_dir, ec);
-    if (ec) throw Error(fmt::format("cannot create {}: {}", o.output_dir.string(), ec.message()));
+    CreateOwnedDirectory(o.output_dir);
     if (o.rgbd) {
       tum = std::make_unique<TumRgbdWriter>(o.output_dir);
     } else {

@@ -328,8 +328,10 @@ def m_black_stretch(seq):
 
 
 def m_no_sim_yaml(seq):
-    """A recording, not a render: no sim.yaml."""
-    os.unlink(os.path.join(seq, "sim.yaml"))
+    """A recording, not a render: no sim.yaml, no pkslam marker."""
+    for name in ("sim.yaml", ".pkslam-output"):
+        if os.path.exists(os.path.join(seq, name)):
+            os.unlink(os.path.join(seq, name))
 
 
 def m_users_plots(seq):

@@ -24,6 +24,7 @@ while read -r name trajectory seed; do
     extra=()
     [ $variant = calibration_off ] && extra=(--realism-off calibration)
     echo "render.sh: $dir"
+    rm -rf "$dir.partial"  # an interrupted render (simulate writes only into new folders)
     "$pkslam" simulate --out "$dir.partial" --trajectory "$shared/euroc/groundtruth/$trajectory.txt" \
       --seed "$seed" --realism euroc "${extra[@]}" --no-cloud --quiet
     mv "$dir.partial" "$dir"
