@@ -85,8 +85,9 @@ void RunRoundTrip(const MapArgs& args) {
   const bool same = ReadBytes(out) == ReadBytes(args.file);
   std::cout << fmt::format(
       "{} map(s), {} keyframes, {} points loaded in {:.2f} s; saved again "
-      "to {}: {}\n",
+      "to {}{}: {}\n",
       loaded.maps, loaded.keyframes, loaded.map_points, loaded.seconds, out.string(),
+      args.out.empty() ? " (a new file beside the input; --out chooses another)" : "",
       same ? "byte-identical" : "DIFFERENT");
   if (!same) throw CommandExit{1, "map round trip changed the file"};
 }
