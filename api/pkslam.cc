@@ -51,15 +51,10 @@ auto Guard(F&& f) -> decltype(f()) {
 }
 
 SE3d ToSE3(const Eigen::Matrix4d& m, const char* what) {
-  if (!m.allFinite()) throw std::invalid_argument(fmt::format("{}: not finite", what));
-  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
-  if (!(r.transpose() * r).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || r.determinant() < 0 ||
-      !m.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1))) {
-    throw std::invalid_argument(fmt::format("{}: not a rigid transform (rotation block not "
-                                            "orthonormal, or bottom row not 0 0 0 1)",
-                                            what));
+  if (const auto problem = FindRigidTransformProblem(m)) {
+    throw std::invalid_argument(fmt::format("{}: {}", what, problem->what));
   }
-  return SE3d(SO3d(r), m.topRightCorner<3, 1>());
+  return SE3d(SO3d(Eigen::Matrix3d(m.topLeftCorner<3, 3>())), m.topRightCorner<3, 1>());
 }
 
 // An 8-bit image of the settings' size as the grey image tracking reads (BGR converted).

@@ -4,20 +4,11 @@
 
 #include <iostream>
 
+#include "core/sensor/sensor.h"
 #include "core/util/closest_match.h"
 
 namespace pkslam::apps {
 namespace {
-
-// The subcommand the parser had reached: the last parsed one, nested subcommands followed.
-CLI::App* DeepestSubcommand(CLI::App& app) {
-  CLI::App* current = &app;
-  for (;;) {
-    const auto parsed = current->get_subcommands();
-    if (parsed.empty()) return current;
-    current = parsed.back();
-  }
-}
 
 // Every flag spelling ("--sensor", "-h") of `command` and the commands above it (a global flag
 // such as --log-level is valid anywhere).
@@ -67,6 +58,22 @@ std::string UnexpectedHint(CLI::App* command, int argc, char** argv) {
 }
 
 }  // namespace
+
+CLI::App* DeepestSubcommand(CLI::App& app) {
+  CLI::App* current = &app;
+  while (!current->get_subcommands().empty()) current = current->get_subcommands().back();
+  return current;
+}
+
+std::vector<std::string> SensorNames() {
+  std::vector<std::string> names;
+  for (const Sensor s : {Sensor::kMonocular, Sensor::kStereo, Sensor::kRgbd,
+                         Sensor::kMonocularInertial, Sensor::kStereoInertial,
+                         Sensor::kRgbdInertial}) {
+    names.emplace_back(SensorName(s));
+  }
+  return names;
+}
 
 int ReportParseError(CLI::App& app, const CLI::ParseError& error, int argc, char** argv) {
   if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version

@@ -110,8 +110,7 @@ void RegisterMapCommand(CLI::App& app) {
                         "EuRoC dataset whose sensor.yaml files give the camera (or --settings)");
   roundtrip->add_option("--settings", args->settings, "ORB-SLAM3 settings file");
   roundtrip->add_option("--sensor", args->sensor, "Sensor the map was built with")
-      ->check(OneOf({"mono", "stereo", "rgbd", "mono-inertial", "stereo-inertial",
-                     "rgbd-inertial"}))
+      ->check(OneOf(SensorNames()))
       ->capture_default_str();
   roundtrip->add_option("--vocabulary", args->vocabulary, "ORB vocabulary (default: shipped)");
   roundtrip->add_option("--out", args->out, "Where to write the re-saved map (FILE.roundtrip)");

@@ -107,8 +107,7 @@ void RegisterRunCommand(CLI::App& app) {
   cmd->add_option("--sensor", args->sensor,
                   "Sensor configuration (default: stereo for --dataset, mono for --video, "
                   "--camera and --images)")
-      ->check(OneOf({"mono", "stereo", "rgbd", "mono-inertial", "stereo-inertial",
-                     "rgbd-inertial"}));
+      ->check(OneOf(SensorNames()));
   cmd->add_option("--settings", args->settings,
                   "ORB-SLAM3 v1.0 settings file (EuRoC: default from the sensor.yaml files)");
   cmd->add_option("--vocabulary", args->vocabulary, "ORB vocabulary (DBoW2 .txt or pkslam .bin)");
@@ -196,10 +195,8 @@ void RegisterRunCommand(CLI::App& app) {
                 "see stats.json \"estimate\")");
   cmd->callback([args] {
     RunOptions& o = args->options;
-    const auto sensor =
-        ParseSensor(args->sensor.value_or(o.dataset.empty() ? "mono" : "stereo"));
-    if (!sensor) throw OptionError(fmt::format("unknown --sensor '{}'", *args->sensor));
-    o.system.sensor = *sensor;
+    // --sensor was checked against SensorNames(), which ParseSensor reads back.
+    o.system.sensor = *ParseSensor(args->sensor.value_or(o.dataset.empty() ? "mono" : "stereo"));
     if (!args->settings.empty()) o.settings = args->settings;
     if (!args->vocabulary.empty()) o.vocabulary = args->vocabulary;
     o.out = args->out;

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "core/util/error.h"
+#include "core/util/quantile.h"
 
 namespace pkslam {
 namespace {
@@ -100,9 +101,7 @@ void CheckSameBodyFrame(const std::vector<SE3d>& ref, const std::vector<SE3d>& e
   if (offset_deg <= 5.0) return;
   std::vector<double> residual_deg;
   for (const SO3d& r : offsets) residual_deg.push_back((mean.Inverse() * r).Angle() * kRadToDeg);
-  std::nth_element(residual_deg.begin(), residual_deg.begin() + residual_deg.size() * 9 / 10,
-                   residual_deg.end());
-  const double p90_deg = residual_deg[residual_deg.size() * 9 / 10];
+  const double p90_deg = *Quantile(std::move(residual_deg), 0.9);
   if (p90_deg > offset_deg / 3.0) return;  // not constant: drift or a failed run, measured as is
   throw InputError(
       est_name,

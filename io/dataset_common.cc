@@ -7,6 +7,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/quantile.h"
 
 namespace pkslam {
 
@@ -18,6 +19,16 @@ std::uint64_t Interval(std::int64_t t0, std::int64_t t1) {
   return static_cast<std::uint64_t>(t1) - static_cast<std::uint64_t>(t0);
 }
 
+// The median interval between consecutive stamps (the upper median of an even count); t_ns has at
+// least two stamps.
+double MedianIntervalNs(const std::vector<std::int64_t>& t_ns) {
+  std::vector<double> dt(t_ns.size() - 1);
+  for (std::size_t i = 1; i < t_ns.size(); ++i) {
+    dt[i - 1] = static_cast<double>(Interval(t_ns[i - 1], t_ns[i]));
+  }
+  return *Quantile(std::move(dt), 0.5);
+}
+
 }  // namespace
 
 std::vector<TimeGap> FindTimeGaps(const std::vector<std::int64_t>& t_ns, double nominal_period_ns,
@@ -25,10 +36,7 @@ std::vector<TimeGap> FindTimeGaps(const std::vector<std::int64_t>& t_ns, double 
   std::vector<TimeGap> gaps;
   if (t_ns.size() < 2) return gaps;
   if (nominal_period_ns <= 0) {
-    std::vector<std::uint64_t> dt(t_ns.size() - 1);
-    for (std::size_t i = 1; i < t_ns.size(); ++i) dt[i - 1] = Interval(t_ns[i - 1], t_ns[i]);
-    std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
-    nominal_period_ns = static_cast<double>(dt[dt.size() / 2]);
+    nominal_period_ns = MedianIntervalNs(t_ns);
     if (nominal_period_ns <= 0) return gaps;
   }
   for (std::size_t i = 1; i < t_ns.size(); ++i) {
@@ -42,11 +50,7 @@ void CheckTimeBase(const std::vector<std::int64_t>& t_ns, double nominal_rate_hz
                    std::string_view rate_source, const std::filesystem::path& file,
                    std::string_view what) {
   if (nominal_rate_hz <= 0 || t_ns.size() < 3) return;
-  std::vector<std::int64_t> intervals;
-  intervals.reserve(t_ns.size() - 1);
-  for (std::size_t i = 1; i < t_ns.size(); ++i) intervals.push_back(t_ns[i] - t_ns[i - 1]);
-  std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
-  const double median_ns = static_cast<double>(intervals[intervals.size() / 2]);
+  const double median_ns = MedianIntervalNs(t_ns);
   const double nominal_ns = 1e9 / nominal_rate_hz;
   const double ratio = nominal_ns / std::max(median_ns, 1.0);  // > 1: stamps too close
   if (ratio <= 5.0 && ratio >= 0.2) return;

@@ -41,14 +41,22 @@ SE3d ReadRigidTransform(const std::filesystem::path& file) {
     ++rows;
   });
   if (rows != 4) throw InputError(file, fmt::format("{} matrix rows, expected 4", rows));
+  if (const auto problem = FindRigidTransformProblem(m)) {
+    throw InputError(file, problem->in_last_row ? last_line : 0, problem->what);
+  }
+  return SE3d(SO3d::FitToMatrix(m.topLeftCorner<3, 3>()), m.topRightCorner<3, 1>());
+}
+
+std::optional<RigidTransformProblem> FindRigidTransformProblem(const Eigen::Matrix4d& m) {
+  if (!m.allFinite()) return RigidTransformProblem{"not finite", false};
   if (!m.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1), 1e-9)) {
-    throw InputError(file, last_line, "last row is not 0 0 0 1");
+    return RigidTransformProblem{"last row is not 0 0 0 1", true};
   }
   const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
   if (!(r.transpose() * r).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || r.determinant() < 0) {
-    throw InputError(file, "the upper-left 3x3 block is not a rotation");
+    return RigidTransformProblem{"the upper-left 3x3 block is not a rotation", false};
   }
-  return SE3d(SO3d::FitToMatrix(r), m.topRightCorner<3, 1>());
+  return std::nullopt;
 }
 
 Trajectory ChangeSensorFrame(const Trajectory& world_from_a, const SE3d& a_from_b) {

@@ -8,7 +8,9 @@
 #pragma once
 
 #include <filesystem>
+#include <Eigen/Core>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "core/geometry/se3.h"
@@ -22,6 +24,15 @@ void WriteRigidTransform(const SE3d& transform, const std::filesystem::path& fil
 // Throws InputError (file and line) for a missing file, a row without four numbers, a wrong
 // row count, a last row other than 0 0 0 1 or a rotation block that is not a rotation (1e-6).
 SE3d ReadRigidTransform(const std::filesystem::path& file);
+
+// What keeps a 4x4 matrix from being a rigid transform, or nothing: a value that is not finite,
+// a last row other than 0 0 0 1, or a rotation block that is not a rotation (1e-6). The file
+// reader and the library's pose arguments share it.
+struct RigidTransformProblem {
+  std::string what;
+  bool in_last_row = false;
+};
+std::optional<RigidTransformProblem> FindRigidTransformProblem(const Eigen::Matrix4d& m);
 
 // world_from_b = world_from_a * a_from_b for every pose; per-pose extras are dropped (the
 // velocity of another point of the body differs).

@@ -8,6 +8,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/quantile.h"
 #include "io/opencv_yaml.h"
 #include "io/text_rows.h"
 
@@ -178,7 +179,7 @@ void TumRgbdDataset::RequireValidDepth(std::size_t images) const {
 void TumRgbdDataset::CheckDepthScale(double factor, const std::string& factor_source,
                                      std::size_t images) const {
   const std::size_t n = std::min(images, associations_.size());
-  std::vector<float> raw;
+  std::vector<double> raw;
   for (std::size_t k = 0; k < n; ++k) {
     cv::Mat depth;
     LoadDepthRaw(associations_[k].depth).convertTo(depth, CV_32F);
@@ -190,14 +191,14 @@ void TumRgbdDataset::CheckDepthScale(double factor, const std::string& factor_so
     }
   }
   if (raw.empty() || factor <= 0) return;  // RequireValidDepth's and the settings' business
-  std::nth_element(raw.begin(), raw.begin() + raw.size() / 2, raw.end());
-  const double median_m = raw[raw.size() / 2] / factor;
+  const double raw_median = *Quantile(std::move(raw), 0.5);
+  const double median_m = raw_median / factor;
   if (median_m >= 0.1 && median_m <= 50.0) return;
   throw InputError(depth_.images[associations_.front().depth].path,
                    fmt::format("median depth of the first {} depth images is {:.4g} m with {} "
                                "{:g} (raw median {:g}): the depth factor is wrong (TUM RGB-D: "
                                "5000 per metre; a sensor in millimetres: 1000)",
-                               n, median_m, factor_source, factor, raw[raw.size() / 2]));
+                               n, median_m, factor_source, factor, raw_median));
 }
 
 cv::Mat TumRgbdDataset::LoadDepthMetres(std::size_t i) const {

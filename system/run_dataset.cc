@@ -156,10 +156,9 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
     settings =
         options.settings ? ReadOrbSlam3Settings(*options.settings) : SettingsFromEuroc(*euroc);
     if (IsStereo(sensor) && settings.camera2 && settings.right_from_left) {
-      // Rectified here once to name the file when the rig cannot be a rig (the system
-      // rectifies again; a few milliseconds).
+      // Checked here, where the calibration's file is known, to name it.
       try {
-        StereoRectification(settings.camera1, *settings.camera2, *settings.right_from_left);
+        StereoRectification::Check(settings.camera1, *settings.camera2, *settings.right_from_left);
       } catch (const OptionError& e) {
         throw InputError(options.settings.value_or(euroc->mav0() / "cam1" / "sensor.yaml"),
                          e.what());

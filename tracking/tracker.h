@@ -132,6 +132,9 @@ class Tracker {
   // Localisation only: motion model or reference keyframe while tracked, relocalisation
   // otherwise, then the local map; sets state_ (kOk or kLost). Atlas lock held (shared).
   bool TrackLocalisationOnly();
+  // Inlier matches of `frame`: to map points only (temporary visual-odometry points have no
+  // observations), or all.
+  static int InlierMatches(const Frame& frame, bool map_only);
   void UpdateLastFrame();
   // Localisation only (stereo/RGB-D): temporary points from the last frame's depth for the
   // keypoints without a map point, so the motion model can track where the map has none.

@@ -45,6 +45,16 @@ bool Tracker::TrackReferenceKeyFrame() {
   return DiscardOutliers(&current_) >= 10;
 }
 
+int Tracker::InlierMatches(const Frame& frame, bool map_only) {
+  int n = 0;
+  for (int i = 0; i < frame.size(); ++i) {
+    const auto& mp = frame.map_points[i];
+    const bool outlier = i < static_cast<int>(frame.outliers.size()) && frame.outliers[i];
+    if (mp && !outlier && (!map_only || mp->NumObservations() > 0)) ++n;
+  }
+  return n;
+}
+
 void Tracker::UpdateLastFrame() {
   // The reference keyframe may have moved (local BA) since the last frame was tracked.
   const FrameRecord& record = records_.back();
@@ -97,10 +107,7 @@ bool Tracker::TrackWithMotionModel() {
   if (options_.localise_only && !mono) {
     // Localisation: temporary visual-odometry points count too (TrackLocalisationOnly decides
     // whether the map or odometry placed the frame); ORB-SLAM asks for 20 matches in all.
-    const int all = static_cast<int>(std::count_if(current_.map_points.begin(),
-                                                   current_.map_points.end(),
-                                                   [](const MapPointPtr& p) { return p != nullptr; }));
-    return in_map >= 10 || all >= 20;
+    return in_map >= 10 || InlierMatches(current_, /*map_only=*/false) >= 20;
   }
   return in_map >= 10;
 }

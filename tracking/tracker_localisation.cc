@@ -3,6 +3,10 @@
 // few points in view, stereo and RGB-D frames go on by visual odometry (temporary points from
 // the previous frame's depth) while every frame also tries to relocalise, and a relocalisation
 // wins. Without it a 10 s map lost the camera for good the moment it looked elsewhere.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
 #include "core/util/error.h"
 #include "map_model/map.h"
 #include "map_model/map_point.h"
@@ -11,26 +15,23 @@
 namespace pkslam {
 namespace {
 
-// Inlier matches to points of the map (temporary visual-odometry points have no observations).
-int MapMatches(const Frame& frame) {
-  int n = 0;
-  for (int i = 0; i < frame.size(); ++i) {
-    const auto& mp = frame.map_points[i];
-    const bool outlier = i < static_cast<int>(frame.outliers.size()) && frame.outliers[i];
-    if (mp && !outlier && mp->NumObservations() > 0) ++n;
-  }
-  return n;
-}
+// What tracking changes in a frame: its pose and its matches. Kept aside to restore an odometry
+// pose after a failed map search (a copy of the whole frame would take its keypoints and
+// descriptors too, on every localised frame).
+struct PoseAndMatches {
+  SE3d camera_from_world;
+  std::vector<MapPointPtr> map_points;
+  std::vector<std::uint8_t> outliers;
 
-// All inlier matches (map and temporary points).
-int Matches(const Frame& frame) {
-  int n = 0;
-  for (int i = 0; i < frame.size(); ++i) {
-    const bool outlier = i < static_cast<int>(frame.outliers.size()) && frame.outliers[i];
-    if (frame.map_points[i] && !outlier) ++n;
+  static PoseAndMatches Of(const Frame& frame) {
+    return {frame.camera_from_world(), frame.map_points, frame.outliers};
   }
-  return n;
-}
+  void RestoreTo(Frame* frame) const {
+    frame->SetPose(camera_from_world);
+    frame->map_points = map_points;
+    frame->outliers = outliers;
+  }
+};
 
 // Map matches below which a frame counts as tracked by visual odometry, and the matches a
 // visual-odometry pose needs in all (ORB-SLAM: 10 and 20).
@@ -57,20 +58,21 @@ bool Tracker::TrackLocalisationOnly() {
   }
   if (visual_odometry_) {
     // Visual odometry from the last frame, and a relocalisation attempt; the map wins.
-    const bool motion =
-        velocity_ && TrackWithMotionModel() && Matches(current_) >= kMinOdometryMatches;
-    const Frame odometry = current_;
+    const bool motion = velocity_ && TrackWithMotionModel() &&
+                        InlierMatches(current_, /*map_only=*/false) >= kMinOdometryMatches;
+    std::optional<PoseAndMatches> odometry;
+    if (motion) odometry = PoseAndMatches::Of(current_);
     if (Relocalize() && TrackLocalMap()) {
       visual_odometry_ = false;
       return true;
     }
-    if (motion) {
-      current_ = odometry;
-      if (MapMatches(current_) >= kMinMapMatches && TrackLocalMap()) {
+    if (odometry) {
+      odometry->RestoreTo(&current_);
+      if (InlierMatches(current_, /*map_only=*/true) >= kMinMapMatches && TrackLocalMap()) {
         visual_odometry_ = false;  // back in the map
         return true;
       }
-      current_ = odometry;
+      odometry->RestoreTo(&current_);
       visual_odometry_ = true;
       return true;
     }
@@ -82,12 +84,16 @@ bool Tracker::TrackLocalisationOnly() {
   if (velocity_ && current_.id() >= last_reloc_frame_id_ + 2) ok = TrackWithMotionModel();
   if (!ok) ok = TrackReferenceKeyFrame();
   if (ok) {
-    const Frame before_local_map = current_;
+    // The map may be running out of view: then go on by visual odometry if the frame-to-frame
+    // pose holds (stereo / RGB-D).
+    std::optional<PoseAndMatches> before_local_map;
+    if (odometry_possible && velocity_ &&
+        InlierMatches(current_, /*map_only=*/false) >= kMinOdometryMatches) {
+      before_local_map = PoseAndMatches::Of(current_);
+    }
     if (TrackLocalMap()) return true;
-    // The map is running out of view: go on by visual odometry if the frame-to-frame pose
-    // holds (stereo / RGB-D).
-    if (odometry_possible && velocity_ && Matches(before_local_map) >= kMinOdometryMatches) {
-      current_ = before_local_map;
+    if (before_local_map) {
+      before_local_map->RestoreTo(&current_);
       visual_odometry_ = true;
       return true;
     }

@@ -18,11 +18,15 @@ Eigen::Matrix3d ToEigen3x3(const cv::Mat& m) {
   return e;
 }
 
-}  // namespace
+// The rectifying rotations and projections of a rig, after the checks that it can be rectified
+// for row-wise stereo matching; the pixel maps are the constructor's (most of its cost).
+struct RectifyingTransforms {
+  cv::Mat r1, r2, p1, p2;
+  double baseline = 0;
+};
 
-StereoRectification::StereoRectification(const CameraModel& left, const CameraModel& right,
-                                         const SE3d& right_from_left)
-    : left_(left), right_(right) {
+RectifyingTransforms ComputeRectifyingTransforms(const CameraModel& left, const CameraModel& right,
+                                                 const SE3d& right_from_left) {
   PKSLAM_CHECK_OPTION(left.type() == CameraType::kPinhole && right.type() == CameraType::kPinhole,
                       "stereo cameras",
                       "rectification supports pinhole (radial-tangential) cameras only");
@@ -40,22 +44,23 @@ StereoRectification::StereoRectification(const CameraModel& left, const CameraMo
     translation.at<double>(i, 0) = right_from_left.translation()[i];
   }
   const cv::Size size(left.width(), left.height());
-  cv::Mat r1, r2, p1, p2, q;
+  RectifyingTransforms t;
+  cv::Mat q;
   cv::stereoRectify(left.CvK(), left.CvDistortion(), right.CvK(), right.CvDistortion(), size,
-                    rotation, translation, r1, r2, p1, p2, q, cv::CALIB_ZERO_DISPARITY,
+                    rotation, translation, t.r1, t.r2, t.p1, t.p2, q, cv::CALIB_ZERO_DISPARITY,
                     /*alpha=*/0.0, size);
   // OpenCV rectifies a vertical rig along the columns; the stereo matcher needs rows.
-  PKSLAM_CHECK_OPTION(std::abs(p2.at<double>(1, 3)) == 0.0, "stereo extrinsic",
+  PKSLAM_CHECK_OPTION(std::abs(t.p2.at<double>(1, 3)) == 0.0, "stereo extrinsic",
                       "the cameras are displaced vertically; only horizontal rigs are supported");
-  baseline_ = -p2.at<double>(0, 3) / p2.at<double>(0, 0);
-  PKSLAM_CHECK_OPTION(baseline_ > 0.0, "stereo extrinsic",
+  t.baseline = -t.p2.at<double>(0, 3) / t.p2.at<double>(0, 0);
+  PKSLAM_CHECK_OPTION(t.baseline > 0.0, "stereo extrinsic",
                       "the right camera is on the left of the left camera (baseline {} m); "
                       "swap the cameras",
-                      baseline_);
+                      t.baseline);
   // With alpha 0 the rectified view keeps only pixels both cameras see; implausible intrinsics
   // or extrinsics shrink that to a sliver and the focal length to tens of thousands of pixels
   // (0 frames tracked). A real rig stays near its cameras' focal length.
-  const double focal = p1.at<double>(0, 0);
+  const double focal = t.p1.at<double>(0, 0);
   const double camera_focal = std::min(left.fx(), right.fx());
   if (!(focal >= 0.25 * camera_focal && focal <= 4.0 * camera_focal)) {
     throw OptionError(fmt::format(
@@ -64,16 +69,33 @@ StereoRectification::StereoRectification(const CameraModel& left, const CameraMo
         "be a real rig)",
         focal, left.fx(), right.fx()));
   }
-  rectified_ = CameraModel::Pinhole(left.width(), left.height(), p1.at<double>(0, 0),
-                                    p1.at<double>(1, 1), p1.at<double>(0, 2), p1.at<double>(1, 2));
-  rect_left_from_left_ = SO3d(ToEigen3x3(r1));
-  rect_right_from_right_ = SO3d(ToEigen3x3(r2));
+  return t;
+}
+
+}  // namespace
+
+void StereoRectification::Check(const CameraModel& left, const CameraModel& right,
+                                const SE3d& right_from_left) {
+  ComputeRectifyingTransforms(left, right, right_from_left);
+}
+
+StereoRectification::StereoRectification(const CameraModel& left, const CameraModel& right,
+                                         const SE3d& right_from_left)
+    : left_(left), right_(right) {
+  const RectifyingTransforms t = ComputeRectifyingTransforms(left, right, right_from_left);
+  baseline_ = t.baseline;
+  rectified_ =
+      CameraModel::Pinhole(left.width(), left.height(), t.p1.at<double>(0, 0),
+                           t.p1.at<double>(1, 1), t.p1.at<double>(0, 2), t.p1.at<double>(1, 2));
+  rect_left_from_left_ = SO3d(ToEigen3x3(t.r1));
+  rect_right_from_right_ = SO3d(ToEigen3x3(t.r2));
 
   // Float maps: fixed-point (CV_16SC2) maps would quantise sampling positions to 1/32 px,
   // which costs sub-pixel stereo accuracy for a negligible speed gain at VGA size.
-  cv::initUndistortRectifyMap(left.CvK(), left.CvDistortion(), r1, p1, size, CV_32FC1, left_map_x_,
-                              left_map_y_);
-  cv::initUndistortRectifyMap(right.CvK(), right.CvDistortion(), r2, p2, size, CV_32FC1,
+  const cv::Size size(left.width(), left.height());
+  cv::initUndistortRectifyMap(left.CvK(), left.CvDistortion(), t.r1, t.p1, size, CV_32FC1,
+                              left_map_x_, left_map_y_);
+  cv::initUndistortRectifyMap(right.CvK(), right.CvDistortion(), t.r2, t.p2, size, CV_32FC1,
                               right_map_x_, right_map_y_);
 }
 

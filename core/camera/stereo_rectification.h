@@ -30,6 +30,10 @@ class StereoRectification {
   // Throws OptionError for unsupported inputs (fisheye, size mismatch, zero baseline).
   StereoRectification(const CameraModel& left, const CameraModel& right,
                       const SE3d& right_from_left);
+  // The constructor's checks alone, without the pixel maps: throws the same OptionError (an
+  // unsupported rig, or a rectified focal length outside 1/4-4x the cameras': implausible).
+  static void Check(const CameraModel& left, const CameraModel& right,
+                    const SE3d& right_from_left);
 
   // The shared rectified camera: ideal pinhole, zero distortion, the raw image size.
   const CameraModel& rectified_camera() const { return rectified_; }

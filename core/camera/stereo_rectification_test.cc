@@ -144,6 +144,32 @@ TEST(StereoRectificationTest, RejectsUnsupportedInput) {
   EXPECT_THROW(rect.Rectify(cv::Mat(480, 752, CV_8U), cv::Mat(100, 100, CV_8U)), Error);
 }
 
+// Check: the constructor's verdict without building the pixel maps, the implausible rig included.
+TEST(StereoRectificationTest, CheckAgreesWithTheConstructor) {
+  const CameraModel left = testing::EurocCam0();
+  EXPECT_NO_THROW(
+      StereoRectification::Check(left, testing::EurocCam1(), testing::EurocCam1FromCam0()));
+  EXPECT_THROW(StereoRectification::Check(left, testing::EurocCam1(),
+                                          testing::EurocCam1FromCam0().Inverse()),
+               OptionError);
+  // k1 = 50 on the right camera: the views share a sliver, the rectified focal length explodes.
+  const CameraModel absurd =
+      CameraModel::Pinhole(752, 480, 457.587, 456.134, 379.999, 255.238, {50.0, 0.0, 0.0, 0.0});
+  for (const bool check_only : {true, false}) {
+    try {
+      if (check_only) {
+        StereoRectification::Check(left, absurd, testing::EurocCam1FromCam0());
+      } else {
+        StereoRectification(left, absurd, testing::EurocCam1FromCam0());
+      }
+      ADD_FAILURE() << "accepted";
+    } catch (const OptionError& e) {
+      EXPECT_NE(std::string(e.what()).find("implausible stereo calibration"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 // First image-pair file names present in both cam0 and cam1 of the static EuRoC sequence.
 std::optional<std::pair<std::filesystem::path, std::filesystem::path>> FirstPair(
     const std::filesystem::path& mav0) {
