@@ -157,10 +157,11 @@ void RegisterRunCommand(CLI::App& app) {
                   "came twice as fast as their timestamps)")
       ->capture_default_str();
   cmd->add_option("--live-clock", args->options.system.live_clock,
-                  "--mapping-sync live: measure local mapping's work in its thread's CPU time "
-                  "(cpu: the same emulated machine however loaded this one is) or in wall time "
+                  "--mapping-sync live: measure local mapping's work in units of work priced "
+                  "at a reference machine's speed (work: the same result on every machine), in "
+                  "its thread's CPU time (cpu: this machine, however loaded) or in wall time "
                   "(wall: this machine under its present load)")
-      ->check(OneOf({"cpu", "wall"}))
+      ->check(OneOf({"work", "cpu", "wall"}))
       ->capture_default_str();
   cmd->add_option("--max-frames", args->options.max_frames, "Stop after N frames (0: all)");
   cmd->add_option("--first-frame", args->options.first_frame,

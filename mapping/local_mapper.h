@@ -19,6 +19,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string_view>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -27,6 +28,7 @@
 #include "core/sensor/camera_rig.h"
 #include "core/sensor/rig_calibration.h"
 #include "core/util/annotated_mutex.h"
+#include "core/util/work_meter.h"
 #include "map_model/atlas.h"
 #include "map_model/estimation/bundle_collect.h"
 #include "map_model/mapping_backend.h"
@@ -81,6 +83,9 @@ struct LocalMappingStats {
   // times above also count lock waits and preemption on a busy machine).
   std::vector<double> keyframe_cpu_ms;
   std::vector<double> ba_cpu_ms;
+  // Units of work per keyframe (core/util/work_meter.h), the measure of live emulation's work
+  // clock; with keyframe_cpu_ms, the data its model is fitted to.
+  std::vector<WorkCounts> keyframe_work;
   // Live emulation: total wall ms tracking waited in AcceptsKeyFramesAt.
   double live_wait_ms = 0;
   int ba_aborted = 0;
@@ -95,6 +100,24 @@ struct LocalMappingStats {
   int gravity_refinements_dropped = 0;  // results dropped: the map moved meanwhile
   std::vector<CalibrationRefinementStat> calibration_refinements;
 };
+
+// How live emulation measures local mapping's work on a keyframe.
+enum class LiveClock {
+  // Units of work priced by kReferenceWork (core/util/work_meter.h): the same emulated machine
+  // on every machine, loaded or not, fast or slow.
+  kWork,
+  // The mapping thread's CPU time: this machine, however loaded it is.
+  kCpu,
+  // Wall time: this machine under its present load.
+  kWall,
+};
+// "work", "cpu" or "wall"; nullopt for anything else.
+std::optional<LiveClock> ParseLiveClock(std::string_view name);
+
+// The work clock's prices: CPU seconds per unit of work of local mapping on the machine the
+// defaults were tuned on (2 cores, 2026-11; fitted to per-keyframe CPU times by
+// evaluation/studies/coupling/fit_work_model.py, docs/speed.md "One core or two").
+extern const WorkModel kReferenceWork;
 
 class LocalMapper : public MappingBackend {
  public:
@@ -128,14 +151,13 @@ class LocalMapper : public MappingBackend {
   // Offline runs: emulate a live run's timing (AcceptsKeyFramesAt); set before Start().
   // `pace`: playback speed of the emulated live run (2: frames arrive twice as fast as their
   // timestamps say, so mapping's work spans twice as much data time).
-  // `cpu_clock`: measure each keyframe's processing in the mapping thread's CPU time (true) or
-  // in wall time (false). Wall time grows with the machine's load (a run sharing a core with
-  // another one maps "twice as slowly"), so CPU time emulates the same machine whatever the
-  // load; wall time emulates the loaded machine.
-  void EmulateLive(bool on, double pace = 1.0, bool cpu_clock = true) {
+  // `clock`: how each keyframe's processing time is measured (LiveClock). CPU time halves on a
+  // machine twice as fast and wall time also grows with the machine's load, so only the work
+  // clock gives every machine the same offline result.
+  void EmulateLive(bool on, double pace = 1.0, LiveClock clock = LiveClock::kWork) {
     emulate_live_ = on;
     live_pace_ = pace;
-    live_cpu_clock_ = cpu_clock;
+    live_clock_ = clock;
   }
   // Total wall ms AcceptsKeyFramesAt blocked.
   double live_wait_ms() const { return stats().live_wait_ms; }
@@ -192,12 +214,15 @@ class LocalMapper : public MappingBackend {
   double live_pace_ = 1.0;
   std::int64_t live_free_ns_ PKSLAM_GUARDED_BY(mutex_) = std::numeric_limits<std::int64_t>::min();
   std::int64_t live_job_start_ns_ PKSLAM_GUARDED_BY(mutex_) = 0;
-  bool live_cpu_clock_ = true;
+  LiveClock live_clock_ = LiveClock::kWork;
+  // Local mapping's work so far: added to by the mapping thread (its solvers' callbacks
+  // included), read by tracking through LiveClockSeconds.
+  WorkMeter work_;
   // The mapping thread's CPU clock (set by Run() before it takes a keyframe).
   std::optional<clockid_t> mapping_cpu_clock_ PKSLAM_GUARDED_BY(mutex_);
   // The emulation clock (mapping CPU or wall seconds) when the current keyframe was taken.
   double live_job_clock_start_ PKSLAM_GUARDED_BY(mutex_) = 0;
-  // Seconds on the emulation clock: the mapping thread's CPU time, or steady wall time.
+  // Seconds on the emulation clock: priced work, the mapping thread's CPU time, or wall time.
   double LiveClockSeconds() const PKSLAM_REQUIRES(mutex_);
   bool finish_requested_ PKSLAM_GUARDED_BY(mutex_) = false;
   bool stop_requested_ PKSLAM_GUARDED_BY(mutex_) = false;

@@ -73,7 +73,7 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
   ba.covariance = false;
   ba.min_iterations_before_abort = o.min_iterations;
   ba.prior = o.prior;
-  const CalibrationBundleResult result = SolveCalibrationBundle(problem, ba, &abort_ba_);
+  const CalibrationBundleResult result = SolveCalibrationBundle(problem, ba, &abort_ba_, &work_);
   stat.iterations = result.bundle.visual.iterations;
   stat.initial_cost = result.bundle.visual.initial_cost;
   stat.final_cost = result.bundle.visual.final_cost;

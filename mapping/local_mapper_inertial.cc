@@ -169,7 +169,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
   // (mono-inertial V1_02 replay with live timing: mapping busy 350 ms in a fast turn, inliers
   // 215 -> 31, tracking lost). Tracking may interrupt it like a local BA; the best iterate so
   // far is applied (each accepted iteration lowers the cost), or nothing if none was made.
-  const InertialBundleResult result = SolveInertialBundle(problem, ba, &abort_ba_);
+  const InertialBundleResult result = SolveInertialBundle(problem, ba, &abort_ba_, &work_);
   if (result.visual.aborted && result.visual.iterations == 0) {
     PKSLAM_LOG_DEBUG("gravity refinement at t = {:.2f} s interrupted before its first step",
                      kf->t_s());
@@ -339,7 +339,7 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
   problem.shared_bias = true;
   problem.gyro_prior_information = gyro_prior;
   problem.accel_prior_information = accel_prior;
-  const InertialBundleResult result = SolveInertialBundle(problem, ba);
+  const InertialBundleResult result = SolveInertialBundle(problem, ba, nullptr, &work_);
   auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
   Map* map = atlas_->FindMap(problem.visual.map_id);
   if (kf->map() == nullptr || map == nullptr) return;
@@ -381,7 +381,7 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
     problem = CollectLocalInertialBundle(kf.get(), ba);
   }
   if (problem.empty() || problem.edges.empty()) return false;
-  const InertialBundleResult result = SolveInertialBundle(problem, ba, &abort_ba_);
+  const InertialBundleResult result = SolveInertialBundle(problem, ba, &abort_ba_, &work_);
   auto lock = MapEditor(atlas_).Write(MapEdit::kApplyInertialBundle);
   Map* map = atlas_->FindMap(problem.visual.map_id);
   if (kf->map() == nullptr || map == nullptr) return true;

@@ -45,9 +45,9 @@ void Compute(std::chrono::milliseconds work) {
 
 // A started mapper whose every keyframe takes at least `work` (the consumer runs inside the
 // processing): computing (CPU time) or, with `sleep`, sleeping (wall time only); live
-// emulation at `pace` (0: off) on the CPU clock or, with `wall_clock`, the wall clock.
+// emulation at `pace` (0: off) on `clock`.
 std::unique_ptr<LocalMapper> StartMapper(Fixture* f, std::chrono::milliseconds work, double pace,
-                                         bool sleep = false, bool wall_clock = false) {
+                                         bool sleep = false, LiveClock clock = LiveClock::kCpu) {
   LocalMappingOptions options;
   options.cull_keyframes = false;
   auto mapper = std::make_unique<LocalMapper>(&f->atlas, f->rig, options);
@@ -58,7 +58,7 @@ std::unique_ptr<LocalMapper> StartMapper(Fixture* f, std::chrono::milliseconds w
       Compute(work);
     }
   });
-  if (pace > 0) mapper->EmulateLive(true, pace, /*cpu_clock=*/!wall_clock);
+  if (pace > 0) mapper->EmulateLive(true, pace, clock);
   mapper->Start();
   return mapper;
 }
@@ -115,13 +115,35 @@ TEST(LocalMapperLive, CpuClockIgnoresTimeNotSpentWorking) {
   }
   {
     Fixture f;
-    auto owned = StartMapper(&f, 300ms, 1.0, /*sleep=*/true, /*wall_clock=*/true);
+    auto owned = StartMapper(&f, 300ms, 1.0, /*sleep=*/true, LiveClock::kWall);
     const std::int64_t t0 = f.map.keyframes[0]->t_ns();
     owned->InsertKeyFrame(f.map.keyframes[0]);
     EXPECT_FALSE(owned->AcceptsKeyFramesAt(t0 + 100 * kMs));
     EXPECT_TRUE(owned->AcceptsKeyFramesAt(t0 + 10'000 * kMs));
     owned->Finish();
   }
+}
+
+// The work clock (the default) prices the work local mapping counted (kReferenceWork), not the
+// time it took: a keyframe whose processing also computes for 300 ms of CPU spans only its
+// priced work in data time (times the pace), which is the same on any machine.
+TEST(LocalMapperLive, WorkClockSpansThePricedWorkOnly) {
+  Fixture f;
+  auto owned = StartMapper(&f, 300ms, 2.0, /*sleep=*/false, LiveClock::kWork);
+  LocalMapper& mapper = *owned;
+  const std::int64_t t0 = f.map.keyframes[0]->t_ns();
+  mapper.InsertKeyFrame(f.map.keyframes[0]);
+  mapper.WaitUntilIdle();
+  const LocalMappingStats stats = mapper.stats();
+  ASSERT_EQ(stats.keyframe_work.size(), 1u);
+  EXPECT_EQ(stats.keyframe_work[0][static_cast<std::size_t>(WorkKind::kKeyFrame)], 1);
+  const double priced_s = kReferenceWork.Seconds(stats.keyframe_work[0]);
+  EXPECT_GT(priced_s, 0.0);
+  EXPECT_LT(priced_s, 0.1);  // far below the 300 ms the CPU clock would have counted
+  const auto span_ns = static_cast<std::int64_t>(2.0 * priced_s * 1e9);
+  EXPECT_FALSE(mapper.AcceptsKeyFramesAt(t0 + span_ns / 2));
+  EXPECT_TRUE(mapper.AcceptsKeyFramesAt(t0 + span_ns + kMs));
+  mapper.Finish();
 }
 
 // Without emulation the answer is the wall-clock state, whatever the data time.

@@ -36,6 +36,8 @@ void LocalMapper::ProcessNext() {
   }
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuSeconds();
+  const WorkCounts work_start = work_.Snapshot();
+  work_.Add(WorkKind::kKeyFrame, 1);
   abort_ba_.store(false);
   ProcessNewKeyFrame(kf);
   CullRecentPoints(kf);
@@ -70,6 +72,7 @@ void LocalMapper::ProcessNext() {
     stats_.ba_ms.push_back(ba_ms);
     stats_.keyframe_cpu_ms.push_back(1e3 * (ThreadCpuSeconds() - cpu_start));
     stats_.ba_cpu_ms.push_back(ba_cpu_ms);
+    stats_.keyframe_work.push_back(work_.Snapshot() - work_start);
   }
   if (consumer_) consumer_(kf);
 }
@@ -136,6 +139,9 @@ void LocalMapper::CreateNewMapPoints(const KeyFramePtr& kf) {
       if (n > 0 && HasQueued()) break;
       KeyFrame* other = neighbours[n];
       if (!HasTriangulationBaseline(*kf, *other, mono)) continue;
+      work_.Add(WorkKind::kTriangulationPair,
+                static_cast<std::int64_t>(kf->keypoints_undistorted().size() +
+                                          other->keypoints_undistorted().size()));
       const auto pairs = matcher.SearchForTriangulation(*kf, *other);
       for (const auto& [i1, i2] : pairs) {
         if (claimed.count(i1) > 0) continue;
@@ -203,6 +209,8 @@ void LocalMapper::SearchInNeighbours(const KeyFramePtr& kf) {
     }
   }
   matcher.Fuse(kf.get(), candidates);
+  work_.Add(WorkKind::kFuseProjection,
+            static_cast<std::int64_t>(ours.size() * targets.size() + candidates.size()));
   for (const auto& mp : kf->GoodMapPoints()) {
     mp->ComputeDistinctiveDescriptor();
     mp->UpdateNormalAndDepth();
@@ -218,7 +226,7 @@ void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
     problem = CollectLocalBundle(kf.get(), options_.ba);
   }
   if (problem.empty()) return;
-  const BundleResult result = SolveBundle(problem, options_.ba, &abort_ba_);
+  const BundleResult result = SolveBundle(problem, options_.ba, &abort_ba_, &work_);
   auto lock = MapEditor(atlas_).Write(MapEdit::kApplyBundle);
   // A map merged away while the solver ran takes its keyframes with it: nothing to write.
   if (Map* map = atlas_->FindMap(problem.map_id)) ApplyBundle(map, problem, result);

@@ -462,6 +462,15 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   WriteArray(&json, "build_cpu_ms", build_cpu_ms);
   WriteArray(&json, "local_mapping_cpu_ms", mapping.keyframe_cpu_ms);
   WriteArray(&json, "local_ba_cpu_ms", mapping.ba_cpu_ms);
+  // Per keyframe: [keyframes, triangulation keypoints, fused projections, solver residuals]
+  // (core/util/work_meter.h), what live emulation's work clock prices.
+  json.Key("local_mapping_work").BeginArray();
+  for (const WorkCounts& w : mapping.keyframe_work) {
+    json.BeginArray();
+    for (std::int64_t units : w) json.Value(units);
+    json.EndArray();
+  }
+  json.EndArray();
   json.EndObject();
   WriteFileAtomically(out / "stats.json", json.str() + '\n');
 }

@@ -29,7 +29,7 @@ void SystemOptions::Check() const {
       mapping_sync == "live" || mapping_sync == "lockstep" || mapping_sync == "free",
       "mapping_sync", "'{}' (live|lockstep|free)", mapping_sync);
   PKSLAM_CHECK_OPTION(live_pace > 0 && live_pace <= 100, "live_pace", "{}", live_pace);
-  PKSLAM_CHECK_OPTION(live_clock == "cpu" || live_clock == "wall", "live_clock", "'{}' (cpu|wall)",
+  PKSLAM_CHECK_OPTION(ParseLiveClock(live_clock).has_value(), "live_clock", "'{}' (work|cpu|wall)",
                       live_clock);
   tracking.Check();
   mapping.Check();
@@ -93,7 +93,7 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
     loop_->Start();
   }
   mapper_->EmulateLive(options_.mapping_sync == "live", options_.live_pace,
-                       options_.live_clock == "cpu");
+                       *ParseLiveClock(options_.live_clock));
   mapper_->Start();
   PKSLAM_LOG_INFO("sensor {}, camera {}, baseline {:.4f} m, selector {}{}",
                   SensorName(options_.sensor), setup_.rig->camera.ToString(), setup_.rig->baseline,

@@ -41,9 +41,11 @@ struct SystemOptions {
   // "live": playback speed of the emulated live run (1: frames at their timestamps; 2: twice
   // as fast, so local mapping's work spans twice as much data time).
   double live_pace = 2.0;
-  // "live": the clock local mapping's work is measured in, "cpu" (its thread's CPU time: the
-  // same emulated machine whatever else runs) or "wall" (the loaded machine as it is).
-  std::string live_clock = "cpu";
+  // "live": the clock local mapping's work is measured in (mapping/local_mapper.h LiveClock):
+  // "work" (units of work at a reference machine's prices: the same result on every machine),
+  // "cpu" (its thread's CPU time: this machine however loaded) or "wall" (this machine as
+  // loaded).
+  std::string live_clock = "work";
   // Record per-frame keyframe decisions (keyframe_trace.csv).
   bool trace = false;
   // Record each tracked frame's matched map points (RUN/frame_tracks.txt).

@@ -160,9 +160,10 @@ std::vector<CalibrationParameter> CalibrationParameters(const RigCalibration& pr
                                                         bool inertial);
 
 // Pure computation; `abort` (may be null) is polled between iterations (the best iterate so far
-// is returned).
+// is returned); `work` (may be null) counts the residual evaluations (core/util/work_meter.h).
 CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& problem,
                                                const CalibrationBundleOptions& options,
-                                               const std::atomic<bool>* abort = nullptr);
+                                               const std::atomic<bool>* abort = nullptr,
+                                               WorkMeter* work = nullptr);
 
 }  // namespace pkslam

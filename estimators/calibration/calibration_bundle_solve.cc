@@ -134,7 +134,7 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
 
 CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& problem,
                                                const CalibrationBundleOptions& options,
-                                               const std::atomic<bool>* abort) {
+                                               const std::atomic<bool>* abort, WorkMeter* work) {
   options.Check();
   const BundleProblem& visual = problem.bundle.visual;
   PKSLAM_CHECK(problem.raw.size() == visual.observations.size(),
@@ -408,7 +408,7 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
     ordering->AddElementToGroup(block, 1);
   }
   solver_options.linear_solver_ordering = ordering;
-  AbortCallback abort_callback(abort, options.min_iterations_before_abort);
+  AbortCallback abort_callback(abort, work, &ceres_problem, options.min_iterations_before_abort);
   solver_options.callbacks.push_back(&abort_callback);
 
   bool first = true;

@@ -104,8 +104,10 @@ struct InertialBundleResult {
   std::optional<InertialStatePrior> next_prior;
 };
 
-// Pure computation; `abort` (may be null) is polled between iterations.
+// Pure computation; `abort` (may be null) is polled between iterations; `work` (may be null)
+// counts the residual evaluations as they happen (core/util/work_meter.h).
 InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
                                          const InertialBundleOptions& options,
-                                         const std::atomic<bool>* abort = nullptr);
+                                         const std::atomic<bool>* abort = nullptr,
+                                         WorkMeter* work = nullptr);
 }  // namespace pkslam

@@ -124,7 +124,7 @@ void InertialBundleOptions::Check() const {
 
 InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
                                          const InertialBundleOptions& options,
-                                         const std::atomic<bool>* abort) {
+                                         const std::atomic<bool>* abort, WorkMeter* work) {
   options.Check();
   const BundleProblem& visual = problem.visual;
   const int num_kf = static_cast<int>(visual.keyframes.size());
@@ -300,7 +300,7 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
     }
   }
   solver_options.linear_solver_ordering = ordering;
-  AbortCallback abort_callback(abort);
+  AbortCallback abort_callback(abort, work, &ceres_problem);
   solver_options.callbacks.push_back(&abort_callback);
 
   bool first = true;

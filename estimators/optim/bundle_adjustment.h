@@ -12,6 +12,7 @@
 
 #include "core/geometry/se3.h"
 #include "core/util/ids.h"
+#include "core/util/work_meter.h"
 
 namespace pkslam {
 
@@ -73,7 +74,8 @@ struct BundleResult {
   double final_cost = 0;
 };
 
-// Pure computation; `abort` (may be null) is polled between iterations.
+// Pure computation; `abort` (may be null) is polled between iterations; `work` (may be null)
+// counts the residual evaluations as they happen (core/util/work_meter.h).
 BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOptions& options,
-                         const std::atomic<bool>* abort = nullptr);
+                         const std::atomic<bool>* abort = nullptr, WorkMeter* work = nullptr);
 }  // namespace pkslam

@@ -18,6 +18,8 @@ struct BundleSolverOverrides {
   std::optional<ceres::LinearSolverType> linear_solver;
   // Called after every solver iteration, before the abort flag is polled (may be null).
   ceres::IterationCallback* callback = nullptr;
+  // Counts the residual evaluations (may be null).
+  WorkMeter* work = nullptr;
 };
 
 BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOptions& options,

@@ -58,8 +58,10 @@ void BundleAdjustmentOptions::Check() const {
 }
 
 BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOptions& options,
-                         const std::atomic<bool>* abort) {
-  return internal::SolveBundle(problem, options, abort, {});
+                         const std::atomic<bool>* abort, WorkMeter* work) {
+  internal::BundleSolverOverrides overrides;
+  overrides.work = work;
+  return internal::SolveBundle(problem, options, abort, overrides);
 }
 
 namespace internal {
@@ -147,9 +149,9 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
     if (pose_added[i]) ordering->AddElementToGroup(state.pose(i), 1);
   }
   solver_options.linear_solver_ordering = ordering;
-  AbortCallback abort_callback(abort);
+  AbortCallback abort_callback(abort, overrides.work, &ceres_problem);
   if (overrides.callback != nullptr) solver_options.callbacks.push_back(overrides.callback);
-  if (abort != nullptr) solver_options.callbacks.push_back(&abort_callback);
+  if (abort_callback.active()) solver_options.callbacks.push_back(&abort_callback);
 
   bool first_solve = true;
   auto solve = [&](int iterations) {

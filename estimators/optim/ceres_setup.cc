@@ -1,10 +1,15 @@
 #include "estimators/optim/ceres_setup.h"
 
+#include <ceres/problem.h>
+
 #include <cmath>
 
 namespace pkslam {
 
 ceres::CallbackReturnType AbortCallback::operator()(const ceres::IterationSummary& summary) {
+  if (work_ != nullptr && problem_ != nullptr) {
+    work_->Add(WorkKind::kSolverResidual, problem_->NumResiduals());
+  }
   if (abort_ == nullptr || !abort_->load(std::memory_order_relaxed)) return ceres::SOLVER_CONTINUE;
   if (summary.iteration < min_iterations_) return ceres::SOLVER_CONTINUE;
   fired_ = true;

@@ -11,6 +11,12 @@
 
 #include <atomic>
 
+#include "core/util/work_meter.h"
+
+namespace ceres {
+class Problem;
+}
+
 namespace pkslam {
 
 // Stops the solver once *abort is set (never with a null flag). It returns
@@ -19,18 +25,30 @@ namespace pkslam {
 // does in ORB-SLAM). SOLVER_ABORT leaves the blocks unchanged, and combined with
 // update_state_every_iteration it was measured to leave a state worse than the initial one
 // (Ceres 2.1).
+// With a work meter, every iteration (the initial evaluation included) adds the problem's scalar
+// residual count to WorkKind::kSolverResidual as it happens, so live emulation's work clock
+// advances during a long solve and not only at its end.
 class AbortCallback final : public ceres::IterationCallback {
  public:
   // `min_iterations`: the flag is obeyed only from this iteration on (a solve that would never
   // finish between two interruptions still makes that much progress).
   explicit AbortCallback(const std::atomic<bool>* abort, int min_iterations = 0)
       : abort_(abort), min_iterations_(min_iterations) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override;
+  // Also meters `problem`'s residual evaluations into `work` (both may be null; `problem` must
+  // outlive the solves).
+  AbortCallback(const std::atomic<bool>* abort, WorkMeter* work, const ceres::Problem* problem,
+                int min_iterations = 0)
+      : abort_(abort), min_iterations_(min_iterations), work_(work), problem_(problem) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override;
   bool fired() const { return fired_; }
+  // Whether the solver needs this callback at all.
+  bool active() const { return abort_ != nullptr || (work_ != nullptr && problem_ != nullptr); }
 
  private:
   const std::atomic<bool>* abort_;
   int min_iterations_ = 0;
+  WorkMeter* work_ = nullptr;
+  const ceres::Problem* problem_ = nullptr;
   bool fired_ = false;
 };
 

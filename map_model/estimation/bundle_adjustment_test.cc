@@ -405,6 +405,39 @@ TEST_F(BundleAdjustmentTest, AbortMidwayKeepsTheProgress) {
   EXPECT_LT(after.max_point, 0.5 * before.max_point);
 }
 
+// The work meter (live emulation's work clock) counts every residual evaluation as it happens:
+// iterations 0 (the initial evaluation), 1 and 2 of the aborted first pass, each over all the
+// problem's scalar residuals (stereo 3, monocular 2).
+TEST_F(BundleAdjustmentTest, WorkMeterCountsResidualEvaluations) {
+  Build(true);
+  BundleProblem problem;
+  {
+    auto lock = MapReader(atlas_).Lock();
+    problem = CollectLocalBundle(LastKeyFrame(), {});
+  }
+  Perturb(&problem, 11);
+  std::int64_t residuals = 0;
+  for (const auto& o : problem.observations) residuals += o.u_right >= 0 ? 3 : 2;
+  std::atomic<bool> abort{false};
+  AbortAt trigger(&abort, 2);
+  WorkMeter work;
+  internal::BundleSolverOverrides overrides;
+  overrides.callback = &trigger;
+  overrides.work = &work;
+  const BundleResult r = internal::SolveBundle(problem, {}, &abort, overrides);
+  ASSERT_TRUE(r.aborted);
+  const WorkCounts counts = work.Snapshot();
+  EXPECT_EQ(counts[static_cast<std::size_t>(WorkKind::kSolverResidual)], 3 * residuals);
+  EXPECT_EQ(counts[static_cast<std::size_t>(WorkKind::kKeyFrame)], 0);
+  // A whole solve counts more, and the same problem counts the same again.
+  WorkMeter full1;
+  WorkMeter full2;
+  SolveBundle(problem, {}, nullptr, &full1);
+  SolveBundle(problem, {}, nullptr, &full2);
+  EXPECT_GT(full1.Snapshot()[3], counts[3]);
+  EXPECT_EQ(full1.Snapshot(), full2.Snapshot());
+}
+
 TEST_F(BundleAdjustmentTest, SingleThreadedIsBitIdentical) {
   Build(true, 1.0, 0.03);
   BundleProblem problem;

@@ -1,20 +1,26 @@
 #!/bin/bash
 # Does an offline run's accuracy depend on the machine? (issue 37, item 7.) Three realistic 60 s
-# replays (V1_02, V1_03, V2_02 under the euroc realism preset), mono-inertial and
-# stereo-inertial, the offline default coupling (mono-inertial: live emulation at pace 2;
-# stereo-inertial: free) and lockstep, each on one core (taskset -c 0) and on two (-c 0-1),
-# RUNS runs per cell (default 3) with seeds 1..RUNS. One line per run in OUT/cores.tsv (ATE of
+# replays (V1_02, V1_03, V2_02 under the euroc realism preset), SENSORS (default mono-inertial
+# and stereo-inertial), COUPLINGS (default "default lockstep"), each on CORES (default "0 0-1":
+# one core, taskset -c 0, and two), RUNS runs per cell (default 3) with seeds 1..RUNS.
+# Couplings: default (the offline default: mono-inertial live emulation at pace 2 on the work
+# clock, stereo-inertial free), lockstep, cpu (live emulation on the mapping thread's CPU clock,
+# the default before the work clock), cpu-slow (the CPU clock at pace 4: what the CPU clock does
+# on a machine twice as slow as this one). One line per run in OUT/cores.tsv (ATE of
 # trajectory_body.txt, SE3; frames with a pose; real-time factor; suspect flag; commit).
 # Resumes: a finished run (stats.json) is not run again.
 #
-#   [RUNS=3] evaluation/studies/coupling/cores.sh OUT [PKSLAM]
+#   [RUNS=3] [COUPLINGS=...] [CORES=...] [SENSORS=...] evaluation/studies/coupling/cores.sh OUT [PKSLAM]
 #   /usr/bin/python3 evaluation/studies/coupling/cores_table.py OUT/cores.tsv
 set -euo pipefail
-if [ $# -lt 1 ]; then sed -n '2,12p' "$0"; exit 2; fi
+if [ $# -lt 1 ]; then sed -n '2,16p' "$0"; exit 2; fi
 out=$1
 root=$(cd "$(dirname "$0")/../../.." && pwd)
 pkslam=${2:-$root/build/bin/pkslam}
 runs=${RUNS:-3}
+couplings=${COUPLINGS:-default lockstep}
+core_sets=${CORES:-0 0-1}
+sensors=${SENSORS:-mono-inertial stereo-inertial}
 shared=${PKSLAM_SHARED_DATA:-$root/../shared/data}
 commit=$(git -C "$root" rev-parse --short HEAD)
 mkdir -p "$out/runs"
@@ -34,17 +40,22 @@ done <<< "$replays"
 tsv=$out/cores.tsv
 [ -f "$tsv" ] || printf 'replay\tsensor\tcoupling\tcores\trun\tate_m\tposed\tframes\trealtime\tsuspect\texit\tcommit\n' > "$tsv"
 while read -r name trajectory start seed; do
-  for sensor in mono-inertial stereo-inertial; do
-    for coupling in default lockstep; do
-      for cores in 0 0-1; do
+  for sensor in $sensors; do
+    for coupling in $couplings; do
+      for cores in $core_sets; do
         for run in $(seq 1 "$runs"); do
           dir=$out/runs/$name-$sensor-$coupling-c${cores/-/}-r$run
           [ -f "$dir/stats.json" ] && continue
-          extra=()
-          [ $coupling = lockstep ] && extra=(--mapping-sync lockstep)
+          case $coupling in
+            default) extra=() ;;
+            lockstep) extra=(--mapping-sync lockstep) ;;
+            cpu) extra=(--live-clock cpu) ;;
+            cpu-slow) extra=(--live-clock cpu --live-pace 4) ;;
+            *) echo "cores.sh: unknown coupling '$coupling' (default|lockstep|cpu|cpu-slow)" >&2; exit 2 ;;
+          esac
           set +e
           taskset -c "$cores" "$pkslam" --log-level warn run --dataset "$out/$name" --sensor "$sensor" \
-            --seed "$run" "${extra[@]}" --quiet --out "$dir" > "$dir.log" 2>&1
+            --seed "$run" ${extra[@]+"${extra[@]}"} --quiet --out "$dir" > "$dir.log" 2>&1
           code=$?
           set -e
           ate=$("$pkslam" eval --gt "$out/$name/mav0/state_groundtruth_estimate0/data.csv" \

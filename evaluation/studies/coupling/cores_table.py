@@ -32,18 +32,21 @@ def main():
     for replay, sensor, coupling in keys:
         one = cells.get((replay, sensor, coupling, "0"), [])
         two = cells.get((replay, sensor, coupling, "0-1"), [])
-        if not one or not two:
-            continue
-        m1 = statistics.median(a for a, *_ in one)
-        m2 = statistics.median(a for a, *_ in two)
-        ratio = m1 / m2 if math.isfinite(m1) and math.isfinite(m2) and m2 > 0 else math.nan
-        rt1 = statistics.median(r for *_, r in one)
-        rt2 = statistics.median(r for *_, r in two)
         fmt = lambda v: f"{1e3 * v:.1f} mm" if math.isfinite(v) else "failed"
-        runs1 = ", ".join(fmt(a) for a, *_ in one)
-        runs2 = ", ".join(fmt(a) for a, *_ in two)
-        print(f"| {replay} | {sensor} | {coupling} | {fmt(m1)} ({runs1}) | {fmt(m2)} ({runs2}) | "
-              f"{ratio:.2f} | {rt1:.2f}x / {rt2:.2f}x |")
+
+        def cell(runs):
+            if not runs:
+                return "-", math.nan, "-"
+            m = statistics.median(a for a, *_ in runs)
+            rt = statistics.median(r for *_, r in runs)
+            return f"{fmt(m)} ({', '.join(fmt(a) for a, *_ in runs)})", m, f"{rt:.2f}x"
+
+        text1, m1, rt1 = cell(one)
+        text2, m2, rt2 = cell(two)
+        ratio = m1 / m2 if math.isfinite(m1) and math.isfinite(m2) and m2 > 0 else math.nan
+        ratio_text = f"{ratio:.2f}" if math.isfinite(ratio) else "-"
+        print(f"| {replay} | {sensor} | {coupling} | {text1} | {text2} | {ratio_text} | "
+              f"{rt1} / {rt2} |")
     return 0
 
 
