@@ -36,6 +36,10 @@ class MappingBackend {
   // keyframe whose data-clock span has not yet reached t_ns). Tracking thereby sees mapping
   // as a live run at real-time pace would, without sleeping when mapping is idle.
   virtual bool AcceptsKeyFramesAt(std::int64_t t_ns) = 0;
+  // Tracking is about to process the frame at data time `t_ns`: every earlier frame is done
+  // (called for every frame, before any map access; never blocks). Live emulation on the work
+  // clock holds local mapping's map changes back until tracking has reached their data time.
+  virtual void NoteFrameTime(std::int64_t /*t_ns*/) {}
   // Whether AcceptsKeyFramesAt emulates a live run (else it is AcceptsKeyFrames()).
   virtual bool EmulatesLive() const = 0;
   // Map reset by tracking: drop queued keyframes (called with no Atlas lock held).

@@ -68,6 +68,7 @@ void LocalMapper::Finish() {
     stop_requested_ = false;
   }
   wake_.notify_all();
+  paced_.notify_all();
   if (thread_.joinable()) {
     thread_.join();
   } else {
@@ -106,7 +107,47 @@ void LocalMapper::WaitUntilIdle() {
     return;
   }
   MutexLock lock(mutex_);
+  // Whoever waits for idle sends no more frames meanwhile: paced work must not wait for them.
+  ++idle_waiters_;
+  paced_.notify_all();
   while (!((queue_.empty() && !busy_) || stopped_ || finish_requested_)) idle_.wait(lock);
+  --idle_waiters_;
+}
+
+void LocalMapper::EmulateLive(bool on, double pace, LiveClock clock) {
+  PKSLAM_CHECK(!thread_.joinable(), "live emulation is set before Start()");
+  emulate_live_ = on;
+  live_pace_ = pace;
+  live_clock_ = clock;
+  if (Paced()) {
+    work_.SetPacer([this] { PaceToTracker(); });
+  } else {
+    work_.SetPacer(nullptr);
+  }
+}
+
+void LocalMapper::NoteFrameTime(std::int64_t t_ns) {
+  if (!Paced()) return;
+  {
+    MutexLock lock(mutex_);
+    tracker_ns_ = std::max(tracker_ns_, t_ns);
+  }
+  paced_.notify_all();
+}
+
+std::int64_t LocalMapper::LiveReachedNs() const {
+  return live_job_start_ns_ + DataNs(LiveClockSeconds() - live_job_clock_start_);
+}
+
+void LocalMapper::PaceToTracker() {
+  if (!Paced() || !thread_.joinable() || std::this_thread::get_id() != thread_.get_id()) return;
+  MutexLock lock(mutex_);
+  const std::int64_t reached = LiveReachedNs();
+  idle_.notify_all();  // tracking may be waiting for the work to reach its frame's time
+  while (tracker_ns_ < reached && idle_waiters_ == 0 && !stop_requested_ && !finish_requested_ &&
+         !reset_requested_) {
+    paced_.wait(lock);
+  }
 }
 
 bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
@@ -118,8 +159,7 @@ bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
     if (!busy_ && queue_.empty()) break;
     if (busy_) {
       // Where the current keyframe's processing has got to on the data clock, at least.
-      const std::int64_t reached =
-          live_job_start_ns_ + DataNs(LiveClockSeconds() - live_job_clock_start_);
+      const std::int64_t reached = LiveReachedNs();
       if (reached >= t_ns) break;  // still busy at t_ns, for certain
       // The CPU and wall clocks cannot run faster than real time: wait until the job could
       // have reached t_ns. Work advances with solver iterations, which notify nobody: poll.
@@ -159,6 +199,7 @@ void LocalMapper::ResetQueue() {
   MutexLock lock(mutex_);
   reset_requested_ = true;
   wake_.notify_all();
+  paced_.notify_all();
   while (reset_requested_ && !finish_requested_) idle_.wait(lock);
 }
 
@@ -169,6 +210,7 @@ void LocalMapper::RequestStop() {
   }
   abort_ba_.store(true);
   wake_.notify_all();
+  paced_.notify_all();
 }
 
 bool LocalMapper::IsStopped() const {
@@ -225,7 +267,7 @@ void LocalMapper::Run() {
     lock.unlock();
     ProcessNext();
     lock.lock();
-    live_free_ns_ = live_job_start_ns_ + DataNs(LiveClockSeconds() - live_job_clock_start_);
+    live_free_ns_ = LiveReachedNs();
     busy_ = false;
     if (queue_.empty()) accept_keyframes_.store(true);
     idle_.notify_all();

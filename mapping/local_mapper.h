@@ -148,17 +148,18 @@ class LocalMapper : public MappingBackend {
   void WaitUntilIdle() override;
   bool AcceptsKeyFramesAt(std::int64_t t_ns) override;
   bool EmulatesLive() const override { return emulate_live_; }
+  void NoteFrameTime(std::int64_t t_ns) override;
   // Offline runs: emulate a live run's timing (AcceptsKeyFramesAt); set before Start().
   // `pace`: playback speed of the emulated live run (2: frames arrive twice as fast as their
   // timestamps say, so mapping's work spans twice as much data time).
   // `clock`: how each keyframe's processing time is measured (LiveClock). CPU time halves on a
   // machine twice as fast and wall time also grows with the machine's load, so only the work
   // clock gives every machine the same offline result.
-  void EmulateLive(bool on, double pace = 1.0, LiveClock clock = LiveClock::kWork) {
-    emulate_live_ = on;
-    live_pace_ = pace;
-    live_clock_ = clock;
-  }
+  // On the work clock local mapping is also paced: it changes the map at a data time only once
+  // tracking has processed every earlier frame (NoteFrameTime), and tracking waits for it
+  // (AcceptsKeyFramesAt), so each frame sees the map a live run on the reference machine would
+  // show it, whatever the speed of this one or the number of its cores.
+  void EmulateLive(bool on, double pace = 1.0, LiveClock clock = LiveClock::kWork);
   // Total wall ms AcceptsKeyFramesAt blocked.
   double live_wait_ms() const { return stats().live_wait_ms; }
   void ResetQueue() override;
@@ -175,6 +176,14 @@ class LocalMapper : public MappingBackend {
   // Live emulation: data-clock nanoseconds spanned by `work_s` seconds of work (emulation clock).
   std::int64_t DataNs(double work_s) const;
   bool HasQueued() const;
+  // Live emulation on the work clock: blocks until tracking has reached the data time local
+  // mapping's work has got to (or a stop, reset or finish is requested). Called by the mapping
+  // thread with no map lock held: before each step that changes the map and after each solver
+  // iteration (the work meter's pacer). No-op otherwise.
+  void PaceToTracker();
+  // Live emulation: the data time the current keyframe's processing has reached.
+  std::int64_t LiveReachedNs() const PKSLAM_REQUIRES(mutex_);
+  bool Paced() const { return emulate_live_ && live_clock_ == LiveClock::kWork; }
   void ProcessNext();
   void ProcessNewKeyFrame(const KeyFramePtr& kf);
   void CullRecentPoints(const KeyFramePtr& kf);
@@ -222,6 +231,11 @@ class LocalMapper : public MappingBackend {
   std::optional<clockid_t> mapping_cpu_clock_ PKSLAM_GUARDED_BY(mutex_);
   // The emulation clock (mapping CPU or wall seconds) when the current keyframe was taken.
   double live_job_clock_start_ PKSLAM_GUARDED_BY(mutex_) = 0;
+  // Paced emulation: the data time of the frame tracking processes (every earlier one done),
+  // and the condition local mapping waits on for it to grow.
+  std::int64_t tracker_ns_ PKSLAM_GUARDED_BY(mutex_) = std::numeric_limits<std::int64_t>::min();
+  ConditionVariable paced_;
+  int idle_waiters_ PKSLAM_GUARDED_BY(mutex_) = 0;  // threads in WaitUntilIdle
   // Seconds on the emulation clock: priced work, the mapping thread's CPU time, or wall time.
   double LiveClockSeconds() const PKSLAM_REQUIRES(mutex_);
   bool finish_requested_ PKSLAM_GUARDED_BY(mutex_) = false;

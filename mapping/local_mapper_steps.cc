@@ -39,14 +39,20 @@ void LocalMapper::ProcessNext() {
   const WorkCounts work_start = work_.Snapshot();
   work_.Add(WorkKind::kKeyFrame, 1);
   abort_ba_.store(false);
+  // PaceToTracker (live emulation on the work clock) before every step that changes the map or
+  // asks whether tracking queued a keyframe: both then happen at a data time tracking has
+  // reached, as in a live run.
+  PaceToTracker();
   ProcessNewKeyFrame(kf);
   CullRecentPoints(kf);
   CreateNewMapPoints(kf);
   double ba_ms = 0;
   double ba_cpu_ms = 0;
+  PaceToTracker();
   if (!HasQueued()) {
     SearchInNeighbours(kf);
   }
+  PaceToTracker();
   if (!HasQueued() && !IsStoppedOrStopRequested()) {
     int keyframes = 0;
     {
@@ -62,10 +68,14 @@ void LocalMapper::ProcessNext() {
       ba_ms = MsSince(ba_start);
       ba_cpu_ms = 1e3 * (ThreadCpuSeconds() - ba_cpu_start);
     }
+    PaceToTracker();
     if (options_.cull_keyframes) CullKeyFrames(kf);
   }
+  PaceToTracker();
   if (IsInertial(rig_->sensor) && !IsStoppedOrStopRequested()) InertialStep(kf);
+  PaceToTracker();
   if (options_.calibration.enabled && !IsStoppedOrStopRequested()) RefineCalibration(kf);
+  PaceToTracker();
   {
     MutexLock lock(mutex_);
     stats_.keyframe_ms.push_back(MsSince(start));
@@ -153,6 +163,7 @@ void LocalMapper::CreateNewMapPoints(const KeyFramePtr& kf) {
     }
   }
   if (created.empty()) return;
+  PaceToTracker();
   auto lock = MapEditor(atlas_).Write(MapEdit::kCreatePoints);
   Map* map = kf->map();
   if (kf->IsBad() || map == nullptr) return;
@@ -227,6 +238,7 @@ void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
   }
   if (problem.empty()) return;
   const BundleResult result = SolveBundle(problem, options_.ba, &abort_ba_, &work_);
+  PaceToTracker();
   auto lock = MapEditor(atlas_).Write(MapEdit::kApplyBundle);
   // A map merged away while the solver ran takes its keyframes with it: nothing to write.
   if (Map* map = atlas_->FindMap(problem.map_id)) ApplyBundle(map, problem, result);

@@ -138,6 +138,7 @@ TrackResult Tracker::Track(Frame frame) {
   double frame_wait_ms = 0;
   const double cpu_start = ThreadCpuSeconds();
   current_ = std::move(frame);
+  mapping_->NoteFrameTime(current_.t_ns());
   if (imu_) PreintegrateImu();
   TrackResult result;
   bool new_keyframe = false;

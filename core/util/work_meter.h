@@ -12,6 +12,8 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <utility>
 
 namespace pkslam {
 
@@ -28,8 +30,15 @@ using WorkCounts = std::array<std::int64_t, kNumWorkKinds>;
 // Written by the thread that does the work (and by solver callbacks on it), read by others:
 // every count is an atomic of its own, so a reader sees each count at some moment of the run;
 // counts only grow.
+// The pacer (optional, set before the work starts and never changed while it runs) is what
+// Pace() calls: the working thread calls Pace() where it holds no lock (solver callbacks after
+// each iteration), so live emulation can hold local mapping back to tracking's data time.
 class WorkMeter {
  public:
+  void SetPacer(std::function<void()> pacer) { pacer_ = std::move(pacer); }
+  void Pace() const {
+    if (pacer_) pacer_();
+  }
   void Add(WorkKind kind, std::int64_t units) {
     counts_[static_cast<std::size_t>(kind)].fetch_add(units, std::memory_order_relaxed);
   }
@@ -43,6 +52,7 @@ class WorkMeter {
 
  private:
   std::array<std::atomic<std::int64_t>, kNumWorkKinds> counts_{};
+  std::function<void()> pacer_;
 };
 
 // Seconds a reference machine spends on each unit of work of each kind (a linear model, fitted

@@ -9,6 +9,7 @@ namespace pkslam {
 ceres::CallbackReturnType AbortCallback::operator()(const ceres::IterationSummary& summary) {
   if (work_ != nullptr && problem_ != nullptr) {
     work_->Add(WorkKind::kSolverResidual, problem_->NumResiduals());
+    work_->Pace();
   }
   if (abort_ == nullptr || !abort_->load(std::memory_order_relaxed)) return ceres::SOLVER_CONTINUE;
   if (summary.iteration < min_iterations_) return ceres::SOLVER_CONTINUE;

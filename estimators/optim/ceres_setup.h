@@ -27,7 +27,8 @@ namespace pkslam {
 // (Ceres 2.1).
 // With a work meter, every iteration (the initial evaluation included) adds the problem's scalar
 // residual count to WorkKind::kSolverResidual as it happens, so live emulation's work clock
-// advances during a long solve and not only at its end.
+// advances during a long solve and not only at its end, then calls the meter's pacer (which may
+// block until tracking has caught up; solvers run with no map lock held).
 class AbortCallback final : public ceres::IterationCallback {
  public:
   // `min_iterations`: the flag is obeyed only from this iteration on (a solve that would never

@@ -1,10 +1,10 @@
 #!/bin/bash
 # Does a loaded machine change what an offline mono-inertial run computes? Runs CONCURRENT
-# mono-inertial runs at once (more runs than cores = load), once with --live-clock wall and
-# once with --live-clock cpu (docs/speed.md "The live emulation's clock"), and prints per run
-# the losses for good and the ATE after Sim(3).
+# mono-inertial runs at once (more runs than cores = load), once per clock in CLOCKS (default
+# "wall cpu"; "work" is the offline default; docs/speed.md "The live emulation's clock"), and
+# prints per run the losses for good and the ATE after Sim(3).
 #
-#   evaluation/studies/speed/live_clock_load.sh PKSLAM DATASET OUT CONCURRENT SEED...
+#   [CLOCKS="wall cpu work"] evaluation/studies/speed/live_clock_load.sh PKSLAM DATASET OUT CONCURRENT SEED...
 #
 # DATASET: e.g. a full V1_02 replay,
 #   pkslam simulate --trajectory ../shared/data/euroc/groundtruth/V1_02_medium.txt \
@@ -16,7 +16,7 @@ shift 4
 seeds=("$@")
 gt=$dataset/mav0/state_groundtruth_estimate0/data.csv
 mkdir -p "$out"
-for clock in wall cpu; do
+for clock in ${CLOCKS:-wall cpu}; do
   for ((i = 0; i < ${#seeds[@]}; i += concurrent)); do
     batch=("${seeds[@]:i:concurrent}")
     for s in "${batch[@]}"; do
