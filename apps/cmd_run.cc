@@ -148,7 +148,7 @@ void RegisterRunCommand(CLI::App& app) {
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_option("--mapping-sync", args->options.mapping_sync,
                   "How tracking meets local mapping: live (offline default: local mapping as a "
-                  "live run at real-time pace would see it, without sleeping), lockstep (each "
+                  "live run at --live-pace would see it, without sleeping), lockstep (each "
                   "keyframe mapped before the next frame; --deterministic), free (no coupling; "
                   "--realtime default)")
       ->check(OneOf({"live", "lockstep", "free"}));

@@ -152,6 +152,7 @@ void LocalMapper::PaceToTracker() {
 
 bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
   if (!emulate_live_ || !thread_.joinable()) return AcceptsKeyFrames();
+  NoteFrameTime(t_ns);  // the caller is at this frame (paced emulation must not wait for it)
   const auto wait_start = std::chrono::steady_clock::now();
   MutexLock lock(mutex_);
   while (true) {

@@ -146,6 +146,24 @@ TEST(LocalMapperLive, WorkClockSpansThePricedWorkOnly) {
   mapper.Finish();
 }
 
+// On the work clock local mapping is paced: it does not change the map at a data time tracking
+// has not reached yet, however fast this machine is.
+TEST(LocalMapperLive, WorkClockHoldsMappingBackToTrackingsTime) {
+  Fixture f;
+  auto owned = StartMapper(&f, 0ms, 1.0, /*sleep=*/false, LiveClock::kWork);
+  LocalMapper& mapper = *owned;
+  const std::int64_t t0 = f.map.keyframes[0]->t_ns();
+  mapper.NoteFrameTime(t0 - 1'000 * kMs);  // tracking is a second behind the keyframe
+  mapper.InsertKeyFrame(f.map.keyframes[0]);
+  std::this_thread::sleep_for(300ms);
+  EXPECT_FALSE(mapper.AcceptsKeyFrames());          // still holding the keyframe
+  EXPECT_TRUE(mapper.stats().keyframe_work.empty());  // not processed
+  mapper.NoteFrameTime(t0 + 10'000 * kMs);
+  EXPECT_TRUE(mapper.AcceptsKeyFramesAt(t0 + 10'000 * kMs));
+  EXPECT_EQ(mapper.stats().keyframe_work.size(), 1u);
+  mapper.Finish();
+}
+
 // Without emulation the answer is the wall-clock state, whatever the data time.
 TEST(LocalMapperLive, OffMeansAcceptsKeyFrames) {
   Fixture f;

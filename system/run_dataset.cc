@@ -230,12 +230,14 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   // live run fed at twice real time would, waiting only when that is not yet known. On the
   // 40 s V1_02 replay (docs/speed.md) that keeps lock-step's accuracy (median ATE mono 8.71 vs
   // 8.34 mm over 8 seeds, mono-inertial 17.15 vs 17.31 mm) at 2.76x and 3.16x real time.
-  // Stereo and RGB-D insert keyframes while mapping is busy and stay "free", as do --realtime
-  // runs.
+  // Stereo and RGB-D ran "free" (ORB-SLAM3's coupling) until issue 37, which showed that an
+  // uncoupled offline result depends on the machine (how much of a core local mapping gets
+  // while tracking races ahead): every offline run now emulates the live run on the work clock
+  // (docs/speed.md "One core or two"). --realtime runs stay "free".
   if (!options.mapping_sync.empty()) {
     system_options.mapping_sync = options.mapping_sync;
   } else {
-    system_options.mapping_sync = !options.realtime && IsMonocular(sensor) ? "live" : "free";
+    system_options.mapping_sync = !options.realtime ? "live" : "free";
   }
   SlamSystem system(settings, vocabulary, system_options);
   if (options.load_map) summary.map_loaded = system.LoadMap(*options.load_map);

@@ -51,7 +51,7 @@ struct RunOptions {
   // (system.tracking.localise_only) needs load_map.
   std::optional<std::filesystem::path> load_map;
   std::optional<std::filesystem::path> save_map;
-  // SystemOptions::mapping_sync; empty: "live" for offline monocular runs, "free" otherwise.
+  // SystemOptions::mapping_sync; empty: "live" for offline runs, "free" with `realtime`.
   std::string mapping_sync;
   // No progress line.
   bool quiet = false;

@@ -3,8 +3,8 @@
 # replays (V1_02, V1_03, V2_02 under the euroc realism preset), SENSORS (default mono-inertial
 # and stereo-inertial), COUPLINGS (default "default lockstep"), each on CORES (default "0 0-1":
 # one core, taskset -c 0, and two), RUNS runs per cell (default 3) with seeds 1..RUNS.
-# Couplings: default (the offline default: mono-inertial live emulation at pace 2 on the work
-# clock, stereo-inertial free), lockstep, cpu (live emulation on the mapping thread's CPU clock,
+# Couplings: default (the offline default of the build), lockstep, live and free (--mapping-sync),
+# cpu (live emulation on the mapping thread's CPU clock,
 # the default before the work clock), cpu-slow (the CPU clock at pace 4: what the CPU clock does
 # on a machine twice as slow as this one). One line per run in OUT/cores.tsv (ATE of
 # trajectory_body.txt, SE3; frames with a pose; real-time factor; suspect flag; commit).
@@ -49,9 +49,11 @@ while read -r name trajectory start seed; do
           case $coupling in
             default) extra=() ;;
             lockstep) extra=(--mapping-sync lockstep) ;;
+            live) extra=(--mapping-sync live) ;;
+            free) extra=(--mapping-sync free) ;;
             cpu) extra=(--live-clock cpu) ;;
             cpu-slow) extra=(--live-clock cpu --live-pace 4) ;;
-            *) echo "cores.sh: unknown coupling '$coupling' (default|lockstep|cpu|cpu-slow)" >&2; exit 2 ;;
+            *) echo "cores.sh: unknown coupling '$coupling' (default|lockstep|live|free|cpu|cpu-slow)" >&2; exit 2 ;;
           esac
           set +e
           taskset -c "$cores" "$pkslam" --log-level warn run --dataset "$out/$name" --sensor "$sensor" \
