@@ -325,8 +325,10 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
     builder.AddObject(o, room, group_id++, &parts);
     groups.push_back(std::move(parts));
   }
-  // Scatter: random placements that avoid the path and each other from the start.
-  Rng& rng = builder.rng();
+  // Scatter: random placements that avoid the path and each other from the start. Their own
+  // random stream (not the builder's, which every shape draws texture offsets from), so adding
+  // an object to a scene does not move every scattered one.
+  Rng rng(DeriveSeed(options.seed, 0x5343415454));
   for (const ScatterDesc& s : d.scatter) {
     for (int i = 0; i < s.count; ++i) {
       for (int attempt = 0; attempt < 60; ++attempt) {
