@@ -15,8 +15,12 @@ from collections import defaultdict
 
 # ORB-SLAM3 paper (arXiv v1), real EuRoC, ATE RMSE (m).
 PUBLISHED = {
-    'stereo-inertial': {'MH_01': .037, 'MH_02': .031, 'V1_01': .037, 'V1_02': .014, 'V2_01': .037},
-    'mono-inertial': {'MH_01': .032, 'MH_02': .053, 'V1_01': .043, 'V1_02': .016, 'V2_01': .041},
+    'stereo-inertial': {'MH_01': .037, 'MH_02': .031, 'MH_03': .026, 'MH_04': .059, 'MH_05': .086,
+                        'V1_01': .037, 'V1_02': .014, 'V1_03': .023, 'V2_01': .037, 'V2_02': .014,
+                        'V2_03': .029},
+    'mono-inertial': {'MH_01': .032, 'MH_02': .053, 'MH_03': .033, 'MH_04': .099, 'MH_05': .071,
+                      'V1_01': .043, 'V1_02': .016, 'V1_03': .025, 'V2_01': .041, 'V2_02': .015,
+                      'V2_03': .037},
 }
 PEER = 'orbslam3-peer'
 
