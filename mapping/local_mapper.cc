@@ -152,9 +152,13 @@ void LocalMapper::PaceToTracker() {
 
 bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
   if (!emulate_live_ || !thread_.joinable()) return AcceptsKeyFrames();
-  NoteFrameTime(t_ns);  // the caller is at this frame (paced emulation must not wait for it)
   const auto wait_start = std::chrono::steady_clock::now();
   MutexLock lock(mutex_);
+  if (Paced() && t_ns > tracker_ns_) {
+    // The caller is at this frame (NoteFrameTime's contract): paced work must not wait for it.
+    tracker_ns_ = t_ns;
+    paced_.notify_all();
+  }
   while (true) {
     if (stopped_ || stop_requested_ || finish_requested_ || reset_requested_) break;
     if (!busy_ && queue_.empty()) break;
@@ -163,7 +167,8 @@ bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
       const std::int64_t reached = LiveReachedNs();
       if (reached >= t_ns) break;  // still busy at t_ns, for certain
       // The CPU and wall clocks cannot run faster than real time: wait until the job could
-      // have reached t_ns. Work advances with solver iterations, which notify nobody: poll.
+      // have reached t_ns. Work is counted, and PaceToTracker notifies after each step and
+      // solver iteration; the short timeout only bounds a missed case.
       const double wait_s = live_clock_ == LiveClock::kWork
                                 ? 0.002
                                 : static_cast<double>(t_ns - reached) * 1e-9 / live_pace_;

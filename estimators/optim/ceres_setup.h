@@ -31,12 +31,9 @@ namespace pkslam {
 // block until tracking has caught up; solvers run with no map lock held).
 class AbortCallback final : public ceres::IterationCallback {
  public:
-  // `min_iterations`: the flag is obeyed only from this iteration on (a solve that would never
-  // finish between two interruptions still makes that much progress).
-  explicit AbortCallback(const std::atomic<bool>* abort, int min_iterations = 0)
-      : abort_(abort), min_iterations_(min_iterations) {}
-  // Also meters `problem`'s residual evaluations into `work` (both may be null; `problem` must
-  // outlive the solves).
+  // Meters `problem`'s residual evaluations into `work` (both may be null; `problem` must
+  // outlive the solves). `min_iterations`: the flag is obeyed only from this iteration on (a
+  // solve that would never finish between two interruptions still makes that much progress).
   AbortCallback(const std::atomic<bool>* abort, WorkMeter* work, const ceres::Problem* problem,
                 int min_iterations = 0)
       : abort_(abort), min_iterations_(min_iterations), work_(work), problem_(problem) {}
