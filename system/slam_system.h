@@ -1,5 +1,5 @@
 // The SLAM system: owns the Atlas, the tracker (caller's thread), the LocalMapping thread and
-// (later) loop closing, and turns the map into outputs. One instance per run.
+// the LoopClosing thread, and turns the map into outputs. One instance per run.
 #pragma once
 
 #include <atomic>
