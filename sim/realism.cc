@@ -119,6 +119,12 @@ void AppearanceOptions::Check() const {
                       "{}", "must be named");
   PKSLAM_CHECK_OPTION(max_exposure_ms >= 0 && max_exposure_ms < 50, "appearance.max_exposure_ms",
                       "{}", max_exposure_ms);
+  PKSLAM_CHECK_OPTION(gain_flicker_percent >= 0 && gain_flicker_percent < 50 &&
+                          cam1_gain_flicker_percent >= 0 && cam1_gain_flicker_percent < 50,
+                      "appearance.gain_flicker_percent", "{} {}", gain_flicker_percent,
+                      cam1_gain_flicker_percent);
+  PKSLAM_CHECK_OPTION(veiling_glare_percent >= 0 && veiling_glare_percent < 50,
+                      "appearance.veiling_glare_percent", "{}", veiling_glare_percent);
 }
 
 void RealismOptions::Check() const {
@@ -182,6 +188,8 @@ RealismOptions MakeRealism(RealismPreset preset) {
   a.exposure_adapt = 0.3;
   a.max_exposure_ms = 10.0;
   a.exposure_at_unit_gain_ms = 2.0;
+  a.gain_flicker_percent = 0.20;
+  a.cam1_gain_flicker_percent = 0.43;
   return r;
 }
 
@@ -225,6 +233,17 @@ const std::vector<ParameterRow>& ParameterTable() {
       {S::kAppearance, "appearance.max_exposure_ms",
        [](RealismOptions& r) -> double& { return r.appearance.max_exposure_ms; }, "ms", "3-16",
        "VI-Sensor driver shutter limit 100-500 rows (libvisensor, visensor_node)"},
+      {S::kAppearance, "appearance.gain_flicker_percent",
+       [](RealismOptions& r) -> double& { return r.appearance.gain_flicker_percent; }, "%",
+       "measured",
+       "cam0's frame-to-frame gain change (std) on the real static frames (sensor_noise.py)"},
+      {S::kAppearance, "appearance.cam1_gain_flicker_percent",
+       [](RealismOptions& r) -> double& { return r.appearance.cam1_gain_flicker_percent; }, "%",
+       "measured", "cam1's, same measurement"},
+      {S::kAppearance, "appearance.veiling_glare_percent",
+       [](RealismOptions& r) -> double& { return r.appearance.veiling_glare_percent; }, "%",
+       "not measured",
+       "ISO 9358 veiling glare; issue 38 tried it, off in the preset (docs/realism.md)"},
       {S::kAppearance, "appearance.exposure_at_unit_gain_ms",
        [](RealismOptions& r) -> double& { return r.appearance.exposure_at_unit_gain_ms; }, "ms",
        "model", "exposure the renderer's radiance 1 needs for full scale (sets typical exposure)"},

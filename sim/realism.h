@@ -106,6 +106,9 @@ struct AppearanceOptions {
   double exposure_adapt = 0.3;      // auto-exposure correction per frame (its lag)
   double max_exposure_ms = 0.0;     // > 0: motion blur over the auto-exposure time, capped here
   double exposure_at_unit_gain_ms = 1.0;  // exposure time the radiance scale 1 needs
+  double gain_flicker_percent = 0.0;      // cam0's frame-to-frame gain change (std, %)
+  double cam1_gain_flicker_percent = 0.0;  // cam1's
+  double veiling_glare_percent = 0.0;      // share of the light scattered as veiling glare
 
   void Check() const;
 };

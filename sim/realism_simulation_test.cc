@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/core/persistence.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "io/settings.h"
 #include "io/trajectory.h"
@@ -120,6 +121,39 @@ TEST(RealismSimulation, SameSeedSameBytes) {
     ++files;
   }
   EXPECT_GE(files, 38);  // 2 x 11 images, lists, IMU, ground truths, truth/ files, settings
+}
+
+TEST(RealismSimulation, GainFlickerChangesEachFrameOfItsCameraOnly) {
+  PKSLAM_REQUIRE_SHARED_DATA(shared);
+  const fs::path root = testing::MakeTempDir("realism_flicker");
+  SimulationOptions steady = EurocReplay(shared, root / "steady");
+  SetRealismParameter(&steady.realism, "appearance.cam1_gain_flicker_percent", 0.0);
+  ApplyAppearance(steady.realism.appearance, &steady);
+  RunSimulation(steady);
+  SimulationOptions o = EurocReplay(shared, root / "flicker");
+  SetRealismParameter(&o.realism, "appearance.cam1_gain_flicker_percent", 5.0);
+  ApplyAppearance(o.realism.appearance, &o);
+  RunSimulation(o);
+  std::vector<double> ratios;
+  for (const auto& entry : fs::directory_iterator(root / "steady/mav0/cam1/data")) {
+    const fs::path name = entry.path().filename();
+    // cam0 (and with it the auto exposure, which meters cam0) does not see cam1's flicker.
+    EXPECT_EQ(testing::ReadFileBytes(root / "steady/mav0/cam0/data" / name),
+              testing::ReadFileBytes(root / "flicker/mav0/cam0/data" / name));
+    const cv::Mat a = cv::imread(entry.path().string(), cv::IMREAD_GRAYSCALE);
+    const cv::Mat b = cv::imread((root / "flicker/mav0/cam1/data" / name).string(),
+                                 cv::IMREAD_GRAYSCALE);
+    ratios.push_back(cv::mean(b)[0] / cv::mean(a)[0]);
+  }
+  ASSERT_GE(ratios.size(), 10u);
+  double mean = 0.0;
+  for (double r : ratios) mean += r / static_cast<double>(ratios.size());
+  double var = 0.0;
+  for (double r : ratios) var += (r - mean) * (r - mean) / static_cast<double>(ratios.size() - 1);
+  // 5% per frame (saturated pixels and rounding take a little of it).
+  EXPECT_GT(std::sqrt(var), 0.02);
+  EXPECT_LT(std::sqrt(var), 0.08);
+  EXPECT_NEAR(mean, 1.0, 0.05);
 }
 
 TEST(RealismSimulation, IdealWritesTheEurocCalibrationAndNoTruthFolder) {

@@ -338,7 +338,21 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
         const double half_xy = 0.5 * std::hypot(size.x(), size.y());
         Eigen::Vector3d pos(0, 0, room.min.z());
         double yaw = rng.Uniform(0.0, 360.0);
-        if (s.near_walls) {
+        if (s.region == ScatterRegion::kPath && !path.empty()) {
+          // Drawn only for this region, so scenes without it keep every earlier draw.
+          const Eigen::Vector3d& anchor = path[rng.UniformInt(static_cast<int>(path.size()))];
+          const double angle = rng.Uniform(0.0, 2.0 * std::numbers::pi);
+          const double distance = rng.Uniform(s.path_distance_m.x(), s.path_distance_m.y()) +
+                                  0.5 * std::min(size.x(), size.y());
+          pos.x() = anchor.x() + distance * std::cos(angle);
+          pos.y() = anchor.y() + distance * std::sin(angle);
+          const Eigen::Vector2d lo = room.min.head<2>().array() + half_xy + 0.1;
+          const Eigen::Vector2d hi = room.max.head<2>().array() - half_xy - 0.1;
+          if ((pos.head<2>().array() < lo.array()).any() ||
+              (pos.head<2>().array() > hi.array()).any()) {
+            continue;
+          }
+        } else if (s.region == ScatterRegion::kWalls) {
           const int wall = rng.UniformInt(4);
           const int axis = wall / 2;
           const int along = 1 - axis;

@@ -265,7 +265,18 @@ void ParseContents(const Parser& p, const YAML::Node& root, SceneDescription* dp
     s.size_min = p.Vec(n, "size_min", 3, s.size_min);
     s.size_max = p.Vec(n, "size_max", 3, s.size_max);
     s.materials = p.Names(n, "materials");
-    s.near_walls = p.Get<std::string>(n, "region", "anywhere") == "walls";
+    const auto region = p.Get<std::string>(n, "region", "anywhere");
+    if (region == "walls") {
+      s.region = ScatterRegion::kWalls;
+    } else if (region == "path") {
+      s.region = ScatterRegion::kPath;
+      s.path_distance_m = p.Vec(n, "distance", 2, s.path_distance_m);
+      if (!(s.path_distance_m.x() >= 0.0 && s.path_distance_m.y() > s.path_distance_m.x())) {
+        p.Fail(n, "scatter distance: [min, max] metres with 0 <= min < max");
+      }
+    } else if (region != "anywhere") {
+      p.Fail(n, "scatter region must be anywhere, walls or path, got '" + region + "'");
+    }
     s.levels = p.Get<int>(n, "levels", s.levels);
     if (s.count < 0 || s.count > 2000 || s.materials.empty() || (s.size_min.array() <= 0).any() ||
         (s.size_max - s.size_min).minCoeff() < 0) {

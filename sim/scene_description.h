@@ -45,13 +45,21 @@ struct ObjectDesc {
   int line = 0;                                       // line in the YAML (messages)
 };
 
+enum class ScatterRegion { kAnywhere, kWalls, kPath };
+
 struct ScatterDesc {
   ObjectType type = ObjectType::kBox;
   int count = 0;
   Eigen::Vector3d size_min = Eigen::Vector3d::Constant(0.3);
   Eigen::Vector3d size_max = Eigen::Vector3d::Constant(1.0);
   std::vector<std::string> materials;  // one chosen at random per object
-  bool near_walls = false;             // within 2 m of the walls instead of anywhere
+  // Where the objects go: anywhere in the room, against the walls (within about 2 m), or along
+  // the camera path (a horizontal distance in path_distance_m from a random path point; objects
+  // within the builder's clearance of the path are still refused; without a path, anywhere),
+  // which is how a scene puts structure at the distances a flight sees it from however large
+  // the room grows. YAML: `region: anywhere|walls|path`, `distance: [min, max]` (path).
+  ScatterRegion region = ScatterRegion::kAnywhere;
+  Eigen::Vector2d path_distance_m = Eigen::Vector2d(2.0, 6.0);
   int levels = 4;                      // shelves
 };
 

@@ -88,6 +88,49 @@ TEST(SceneBuilder, RoomGrowsAroundThePathAndNearbyObjectsGo) {
   for (const auto& p : far) EXPECT_GT(c.RoomClearance(p.cast<float>()), 0.29f);
 }
 
+TEST(SceneBuilder, PathScatterStaysAlongTheFlightHoweverLargeTheRoom) {
+  const std::string yaml = std::string(kSmallRoom) +
+                           "scatter:\n"
+                           "  - {type: box, count: 20, size_min: [0.4, 0.4, 0.5], size_max: [0.6, "
+                           "0.6, 1.0], materials: [w], region: path, distance: [1.5, 3.0]}\n";
+  const SceneDescription d = ParseSceneYaml(yaml, "path.yaml");
+  ASSERT_EQ(d.scatter.size(), 1u);
+  EXPECT_EQ(d.scatter[0].region, ScatterRegion::kPath);
+  // A 40 m flight along x and one excursion to y = 20: the room grows to about 42 x 24 m, and the
+  // scattered boxes stay along the path instead of spreading over the whole room.
+  std::vector<Eigen::Vector3d> path;
+  for (double x = -20.0; x <= 20.0; x += 0.25) path.emplace_back(x, 0.0, 1.0);
+  path.emplace_back(0.0, 20.0, 1.0);
+  SceneBuildReport report;
+  const Scene scene = BuildScene(d, Tiny(), path, &report);
+  EXPECT_GT(report.room_max.y(), 20.0);
+  int scattered = 0;
+  for (const Shape& s : scene.shapes) {
+    if (s.name.rfind("scatter", 0) != 0) continue;
+    ++scattered;
+    // The drawn distance from some path point plus half the box's smaller side: at most
+    // 3.0 + 0.3 m from the nearest one (the clearance keeps them off the path itself).
+    double nearest = 1e9;
+    for (const auto& p : path) {
+      nearest = std::min(nearest, (p.head<2>() - s.center.head<2>().cast<double>()).norm());
+    }
+    EXPECT_LE(nearest, 3.3 + 1e-4) << s.name;
+  }
+  EXPECT_GE(scattered, 15);
+  for (const auto& p : path) EXPECT_GT(scene.ObjectClearance(p.cast<float>()), 0.6f);
+
+  EXPECT_THROW(ParseSceneYaml(std::string(kSmallRoom) +
+                                  "scatter:\n  - {type: box, count: 1, materials: [w], region: "
+                                  "pth}\n",
+                              "typo.yaml"),
+               InputError);
+  EXPECT_THROW(ParseSceneYaml(std::string(kSmallRoom) +
+                                  "scatter:\n  - {type: box, count: 1, materials: [w], region: "
+                                  "path, distance: [3, 2]}\n",
+                              "range.yaml"),
+               InputError);
+}
+
 TEST(Scene, IntersectionsAndDistancesAgree) {
   const Scene scene = BuildScene(ParseSceneYaml(kSmallRoom, "small"), Tiny(), {});
   // From the room centre towards +x: the crate's -x face at x = 0.75, 0.25 m up.

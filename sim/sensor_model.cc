@@ -32,6 +32,8 @@ void SensorOptions::Check() const {
                       gain_drift);
   PKSLAM_CHECK_OPTION(max_exposure_s >= 0.0 && max_exposure_s < 0.05, "sensor.max_exposure_s", "{}",
                       max_exposure_s);
+  PKSLAM_CHECK_OPTION(veiling_glare >= 0.0 && veiling_glare < 0.5, "sensor.veiling_glare", "{}",
+                      veiling_glare);
   PKSLAM_CHECK_OPTION(exposure_at_unit_gain_s > 0.0 && exposure_at_unit_gain_s < 0.05,
                       "sensor.exposure_at_unit_gain_s", "{}", exposure_at_unit_gain_s);
 }
@@ -93,6 +95,22 @@ double SensorModel::exposure_s() const {
   return std::min(gain_ * options_.exposure_at_unit_gain_s, options_.max_exposure_s);
 }
 
+cv::Mat SensorModel::AddVeilingGlare(const cv::Mat& radiance) const {
+  // The halo is smooth, so it is computed at an eighth of the resolution (a 0.25-width Gaussian
+  // at full size would cost more than the render).
+  cv::Mat small;
+  cv::resize(radiance, small, cv::Size(std::max(radiance.cols / 8, 1), std::max(radiance.rows / 8, 1)),
+             0, 0, cv::INTER_AREA);
+  const double sigma = 0.25 * small.cols;
+  cv::GaussianBlur(small, small, cv::Size(0, 0), sigma, sigma, cv::BORDER_REFLECT);
+  cv::Mat halo;
+  cv::resize(small, halo, radiance.size(), 0, 0, cv::INTER_LINEAR);
+  const double k = options_.veiling_glare;
+  cv::Mat out;
+  cv::addWeighted(radiance, 1.0 - k, halo, k, 0.0, out);
+  return out;
+}
+
 cv::Mat SensorModel::Develop(const cv::Mat& radiance, double gain, std::uint64_t noise_key) const {
   PKSLAM_CHECK(radiance.type() == CV_32FC1 || radiance.type() == CV_32FC3,
                "radiance must be float grey or RGB");
@@ -103,6 +121,7 @@ cv::Mat SensorModel::Develop(const cv::Mat& radiance, double gain, std::uint64_t
     cv::GaussianBlur(radiance, blurred, cv::Size(0, 0), options_.blur_sigma_px,
                      options_.blur_sigma_px, cv::BORDER_REFLECT);
   }
+  if (options_.veiling_glare > 0.0) blurred = AddVeilingGlare(blurred);
   const int channels = radiance.channels();
   cv::Mat out(radiance.rows, radiance.cols, channels == 1 ? CV_8UC1 : CV_8UC3);
   const std::uint64_t key = DeriveSeed(seed_, noise_key);

@@ -31,6 +31,10 @@ struct SensorOptions {
   // this cap, beyond which analog gain takes over; the simulator blurs over it.
   double max_exposure_s = 0.0;
   double exposure_at_unit_gain_s = 0.002;  // exposure time of gain 1 (radiance 1 -> 255)
+  // Veiling glare (lens flare's diffuse part, ISO 9358): this fraction of the light reaching
+  // the sensor is scattered over it, in a wide halo (a quarter of the image width) around
+  // where it came from, so a bright window lifts and flattens the dark parts of its frame.
+  double veiling_glare = 0.0;
 
   void Check() const;
 };
@@ -56,6 +60,8 @@ class SensorModel {
   cv::Mat Develop(const cv::Mat& radiance, double gain, std::uint64_t noise_key) const;
 
  private:
+  cv::Mat AddVeilingGlare(const cv::Mat& radiance) const;
+
   SensorOptions options_;
   cv::Mat vignette_;  // CV_32F
   std::uint64_t seed_;

@@ -56,5 +56,26 @@ TEST(SensorModel, ExposureTimeFollowsTheGainUpToItsCap) {
   EXPECT_EQ(dark.exposure_s(), 0.010);  // capped: the rest is analog gain
 }
 
+TEST(SensorModel, VeilingGlareLiftsTheRoomUnderAWindow) {
+  const CameraRays rays(CameraModel::Pinhole(200, 100, 100, 100, 99.5, 49.5));
+  SensorOptions o = Flat();
+  o.read_noise_dn = 0.0;
+  o.shot_noise_gain = 0.0;
+  o.blur_sigma_px = 0.0;
+  const SensorModel clean(o, rays, 1);
+  o.veiling_glare = 0.1;
+  const SensorModel glaring(o, rays, 1);
+  const double gain = 0.03;  // nothing saturates: the window at 230 DN, the room at 2.3 DN
+  const cv::Mat a = clean.Develop(WindowFrame(rays), gain, 1);
+  const cv::Mat b = glaring.Develop(WindowFrame(rays), gain, 1);
+  const cv::Rect lower_room(0, 50, 200, 50);
+  // A tenth of the light goes into the halo, which the window dominates: the room far below it
+  // brightens by several times its own tenth (0.23 DN), the window dims.
+  EXPECT_GT(cv::mean(b(lower_room))[0], cv::mean(a(lower_room))[0] + 1.0);
+  EXPECT_LT(cv::mean(b.rowRange(0, 5))[0], cv::mean(a.rowRange(0, 5))[0] - 5.0);
+  // Light is moved, not made: the frame's mean stays.
+  EXPECT_NEAR(cv::mean(b)[0], cv::mean(a)[0], 1.0);
+}
+
 }  // namespace
 }  // namespace pkslam::sim

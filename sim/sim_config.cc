@@ -72,6 +72,9 @@ void SimulationOptions::Check() const {
                       "{} (EuRoC output only)", landmark_tracks);
   PKSLAM_CHECK_OPTION(cam1_relative_gain > 0.1 && cam1_relative_gain < 10.0, "cam1_relative_gain",
                       "{}", cam1_relative_gain);
+  PKSLAM_CHECK_OPTION(gain_flicker[0] >= 0.0 && gain_flicker[0] < 0.5 && gain_flicker[1] >= 0.0 &&
+                          gain_flicker[1] < 0.5,
+                      "gain_flicker", "{} {}", gain_flicker[0], gain_flicker[1]);
   if (trajectory.empty()) motion.Check();
   replay.Check();
   scene_build.Check();
@@ -93,6 +96,8 @@ void ApplyAppearance(const AppearanceOptions& a, SimulationOptions* o) {
   s.max_exposure_s = 1e-3 * a.max_exposure_ms;
   s.exposure_at_unit_gain_s = 1e-3 * a.exposure_at_unit_gain_ms;
   o->cam1_relative_gain = a.cam1_relative_gain;
+  o->gain_flicker = {1e-2 * a.gain_flicker_percent, 1e-2 * a.cam1_gain_flicker_percent};
+  s.veiling_glare = 1e-2 * a.veiling_glare_percent;
 }
 
 std::string DefaultScene(const RealismOptions& realism, const std::filesystem::path& trajectory) {
@@ -185,6 +190,9 @@ void WriteSimYaml(const std::filesystem::path& file, const SimulationOptions& o,
   e << YAML::Key << "gain_drift" << YAML::Value << o.sensor.gain_drift;
   e << YAML::Key << "clip_metering" << YAML::Value << o.sensor.clip_metering;
   e << YAML::Key << "cam1_relative_gain" << YAML::Value << o.cam1_relative_gain;
+  e << YAML::Key << "gain_flicker" << YAML::Value << YAML::Flow << YAML::BeginSeq
+    << o.gain_flicker[0] << o.gain_flicker[1] << YAML::EndSeq;
+  e << YAML::Key << "veiling_glare" << YAML::Value << o.sensor.veiling_glare;
   e << YAML::Key << "max_exposure_s" << YAML::Value << o.sensor.max_exposure_s;
   e << YAML::Key << "exposure_at_unit_gain_s" << YAML::Value << o.sensor.exposure_at_unit_gain_s;
   e << YAML::Key << "motion_blur_exposure_s" << YAML::Value << o.motion_blur_exposure_s;

@@ -449,7 +449,12 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
       }
       const double gain = meter.NextGain(buffers[0].radiance, 1.0 / rate);
       for (std::size_t c = 0; c < cameras.size(); ++c) {
-        const double camera_gain = c == 1 ? gain * o.cam1_relative_gain : gain;
+        double camera_gain = c == 1 ? gain * o.cam1_relative_gain : gain;
+        if (c < o.gain_flicker.size() && o.gain_flicker[c] > 0.0) {
+          // Its own stream per frame and camera: the draw does not depend on anything else.
+          Rng flicker(DeriveSeed(o.seed, 0x464C4B00 + static_cast<std::uint64_t>(k) * 8 + c));
+          camera_gain *= std::max(1.0 + o.gain_flicker[c] * flicker.Normal(), 0.0);
+        }
         images[c] = sensors[c].Develop(buffers[c].radiance, camera_gain,
                                        static_cast<std::uint64_t>(k) * 8 + c);
       }

@@ -14,6 +14,7 @@
 // TBB task while frame k+1 renders (list files are written in order by the calling thread).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -53,6 +54,9 @@ struct SimulationOptions {
   std::string camera = "euroc";
   SensorOptions sensor;
   double cam1_relative_gain = 1.0;      // cam1's response relative to cam0's (gain of its images)
+  // Relative std of each camera's independent frame-to-frame gain change (cam0, cam1): the
+  // exposure flicker a real sensor shows on a static scene (0: none).
+  std::array<double, 2> gain_flicker{0.0, 0.0};
   double motion_blur_exposure_s = 0.0;  // > 0: average sub-renders over this exposure
   int motion_blur_samples = 0;          // sub-renders (0: by quality: 3 / 5 / 9)
   bool rgbd = false;                    // TUM RGB-D output instead of EuRoC

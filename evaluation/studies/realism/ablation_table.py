@@ -1,8 +1,10 @@
 #!/usr/bin/python3
 """Reads the results.csv of evaluation/suites/realism-ablation.yaml and prints the ablation table:
-per trajectory, sensor and system the ATE (SE(3), m; median over runs) with every error source on,
-with none, and with each source switched off in turn, plus how much of the gap between ideal and
-all each source explains (all - source_off).
+per trajectory, sensor and system the ATE (SE(3), m; median over runs, range in brackets when
+there are several; a failed run counts as the worst) with every error source on, with none, and
+with each source switched off in turn. Then, per source, whether switching it off is resolved
+from the run-to-run spread: the runs with the source off all lie below (or all above) the runs
+with every source on, so the ranges do not overlap.
 
   /usr/bin/python3 evaluation/studies/realism/ablation_table.py bench-ablation/results.csv [--md OUT.md]
 """
@@ -15,38 +17,65 @@ VARIANTS = ['all', 'ideal', 'appearance_off', 'calibration_off', 'timing_off', '
             'motion_off', 'ground_truth_off']
 
 
+def build_table(rows):
+    """rows: dicts with dataset, sensor, config, status, ate_se3_rmse_m (results.csv's columns)."""
+    ate = defaultdict(list)
+    failed = defaultdict(int)
+    for row in rows:
+        parts = row['dataset'].split('_')  # V1_02_calibration_off
+        trajectory, variant = '_'.join(parts[:2]), '_'.join(parts[2:])
+        key = (trajectory, row['sensor'], row['config'], variant)
+        if row['status'] == 'ok' and row['ate_se3_rmse_m']:
+            ate[key].append(float(row['ate_se3_rmse_m']))
+        else:
+            failed[key] += 1
+    groups = sorted({k[:3] for k in list(ate) + list(failed)})
+
+    def runs(key):
+        return sorted(ate.get(key, [])) + [float('inf')] * failed.get(key, 0)
+
+    def cell(values):
+        if not values:
+            return ''
+        med = statistics.median(values)
+        text = 'failed' if med == float('inf') else f'{med:.4f}'
+        if len(values) > 1:
+            text += f' [{values[0]:.4f}-{values[-1]:.4f}]'.replace('inf', 'fail')
+        return text
+
+    lines = ['| trajectory | sensor | system | ' + ' | '.join(VARIANTS) + ' |',
+             '|' + '---|' * (3 + len(VARIANTS))]
+    verdicts = []
+    for g in groups:
+        lines.append(f'| {g[0]} | {g[1]} | {g[2]} | ' +
+                     ' | '.join(cell(runs(g + (v,))) for v in VARIANTS) + ' |')
+        base = runs(g + ('all',))
+        for v in VARIANTS[1:]:
+            off = runs(g + (v,))
+            if len(base) < 2 or len(off) < 2:
+                continue
+            if off[-1] < base[0]:
+                verdict = f'lower ({statistics.median(off) / statistics.median(base):.2f}x), resolved'
+            elif off[0] > base[-1]:
+                verdict = f'higher ({statistics.median(off) / statistics.median(base):.2f}x), resolved'
+            else:
+                verdict = 'within the run-to-run spread'
+            verdicts.append(f'{g[0]} {g[1]} {g[2]}: {v} -> {verdict}')
+    text = '\n'.join(lines)
+    if verdicts:
+        text += '\n\nSwitching one source off, against every source on (non-overlapping ranges = resolved):\n'
+        text += '\n'.join('- ' + v for v in verdicts)
+    return text
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('results')
     ap.add_argument('--md', help='also write the table as markdown here')
     args = ap.parse_args()
-    ate = defaultdict(list)
-    failed = defaultdict(int)
     with open(args.results) as f:
-        for row in csv.DictReader(f):
-            parts = row['dataset'].split('_')  # V1_02_calibration_off
-            trajectory, variant = '_'.join(parts[:2]), '_'.join(parts[2:])
-            key = (trajectory, row['sensor'], row['config'], variant)
-            if row['status'] == 'ok' and row['ate_se3_rmse_m']:
-                ate[key].append(float(row['ate_se3_rmse_m']))
-            else:
-                failed[key] += 1
-    groups = sorted({k[:3] for k in list(ate) + list(failed)})
-    lines = ['| trajectory | sensor | system | ' + ' | '.join(VARIANTS) + ' |',
-             '|' + '---|' * (3 + len(VARIANTS))]
-    for g in groups:
-        cells = []
-        for v in VARIANTS:
-            values = ate.get(g + (v,), [])
-            if values:
-                cells.append(f'{statistics.median(values):.4f}')
-            elif failed.get(g + (v,)):
-                cells.append('failed')
-            else:
-                cells.append('')
-        lines.append(f'| {g[0]} | {g[1]} | {g[2]} | ' + ' | '.join(cells) + ' |')
-    text = '\n'.join(lines)
+        text = build_table(csv.DictReader(f))
     print(text)
     if args.md:
         with open(args.md, 'w') as f:
