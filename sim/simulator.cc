@@ -235,6 +235,18 @@ void ClearEarlierRender(const std::filesystem::path& dir) {
   }
 }
 
+// The gain camera c develops frame k with: the rig's exposure gain, cam1's relative response,
+// and each camera's frame-to-frame flicker (its own random stream per frame and camera, so the
+// draw depends on nothing else).
+double CameraGain(const SimulationOptions& o, double rig_gain, int k, std::size_t c) {
+  double gain = c == 1 ? rig_gain * o.cam1_relative_gain : rig_gain;
+  if (c < o.gain_flicker.size() && o.gain_flicker[c] > 0.0) {
+    Rng flicker(DeriveSeed(o.seed, 0x464C4B00 + static_cast<std::uint64_t>(k) * 8 + c));
+    gain *= std::max(1.0 + o.gain_flicker[c] * flicker.Normal(), 0.0);
+  }
+  return gain;
+}
+
 }  // namespace
 
 
@@ -449,13 +461,7 @@ SimulationSummary RunSimulation(const SimulationOptions& options) {
       }
       const double gain = meter.NextGain(buffers[0].radiance, 1.0 / rate);
       for (std::size_t c = 0; c < cameras.size(); ++c) {
-        double camera_gain = c == 1 ? gain * o.cam1_relative_gain : gain;
-        if (c < o.gain_flicker.size() && o.gain_flicker[c] > 0.0) {
-          // Its own stream per frame and camera: the draw does not depend on anything else.
-          Rng flicker(DeriveSeed(o.seed, 0x464C4B00 + static_cast<std::uint64_t>(k) * 8 + c));
-          camera_gain *= std::max(1.0 + o.gain_flicker[c] * flicker.Normal(), 0.0);
-        }
-        images[c] = sensors[c].Develop(buffers[c].radiance, camera_gain,
+        images[c] = sensors[c].Develop(buffers[c].radiance, CameraGain(o, gain, k, c),
                                        static_cast<std::uint64_t>(k) * 8 + c);
       }
       exposure_sum += exposure;

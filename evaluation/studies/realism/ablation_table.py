@@ -17,6 +17,11 @@ VARIANTS = ['all', 'ideal', 'appearance_off', 'calibration_off', 'timing_off', '
             'motion_off', 'ground_truth_off']
 
 
+def ate_text(ate, failed):
+    """An ATE for the table; a failed run (counted as infinite, the worst) as `failed`."""
+    return failed if ate == float('inf') else f'{ate:.4f}'
+
+
 def build_table(rows):
     """rows: dicts with dataset, sensor, config, status, ate_se3_rmse_m (results.csv's columns)."""
     ate = defaultdict(list)
@@ -37,10 +42,9 @@ def build_table(rows):
     def cell(values):
         if not values:
             return ''
-        med = statistics.median(values)
-        text = 'failed' if med == float('inf') else f'{med:.4f}'
+        text = ate_text(statistics.median(values), 'failed')
         if len(values) > 1:
-            text += f' [{values[0]:.4f}-{values[-1]:.4f}]'.replace('inf', 'fail')
+            text += f' [{ate_text(values[0], "fail")}-{ate_text(values[-1], "fail")}]'
         return text
 
     lines = ['| trajectory | sensor | system | ' + ' | '.join(VARIANTS) + ' |',
