@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -201,6 +202,50 @@ class Builder {
   Rng rng_;
 };
 
+// Where one scattered object of `size` goes (floor position, yaw) in its region; nullopt when the
+// draw falls outside the room (the caller draws again). The draw order is part of every scene's
+// identity: the path region's draws come only for that region, so other scenes keep theirs.
+struct ScatterPlacement {
+  Eigen::Vector3d position;
+  double yaw_deg = 0.0;
+};
+
+std::optional<ScatterPlacement> DrawPlacement(const ScatterDesc& s, const RoomFrame& room,
+                                              const std::vector<Eigen::Vector3d>& path,
+                                              const Eigen::Vector3d& size, Rng* rng) {
+  const Eigen::Vector3d extent = room.max - room.min;
+  const double half_xy = 0.5 * std::hypot(size.x(), size.y());
+  ScatterPlacement p;
+  p.position = Eigen::Vector3d(0, 0, room.min.z());
+  Eigen::Vector3d& pos = p.position;
+  p.yaw_deg = rng->Uniform(0.0, 360.0);
+  if (s.region == ScatterRegion::kPath && !path.empty()) {
+    const Eigen::Vector3d& anchor = path[rng->UniformInt(static_cast<int>(path.size()))];
+    const double angle = rng->Uniform(0.0, 2.0 * std::numbers::pi);
+    const double distance = rng->Uniform(s.path_distance_m.x(), s.path_distance_m.y()) +
+                            0.5 * std::min(size.x(), size.y());
+    pos.x() = anchor.x() + distance * std::cos(angle);
+    pos.y() = anchor.y() + distance * std::sin(angle);
+    const Eigen::Vector2d lo = room.min.head<2>().array() + half_xy + 0.1;
+    const Eigen::Vector2d hi = room.max.head<2>().array() - half_xy - 0.1;
+    if ((pos.head<2>().array() < lo.array()).any() || (pos.head<2>().array() > hi.array()).any()) {
+      return std::nullopt;
+    }
+  } else if (s.region == ScatterRegion::kWalls) {
+    const int wall = rng->UniformInt(4);
+    const int axis = wall / 2;
+    const int along = 1 - axis;
+    const double depth = rng->Uniform(0.05, 1.5) + 0.5 * size.y();
+    pos[axis] = wall % 2 == 0 ? room.min[axis] + depth : room.max[axis] - depth;
+    pos[along] = rng->Uniform(room.min[along] + half_xy, room.max[along] - half_xy);
+    p.yaw_deg = (axis == 0 ? 90.0 : 0.0) + rng->Uniform(-8.0, 8.0);
+  } else {
+    pos.x() = room.min.x() + rng->Uniform(half_xy + 0.1, extent.x() - half_xy - 0.1);
+    pos.y() = room.min.y() + rng->Uniform(half_xy + 0.1, extent.y() - half_xy - 0.1);
+  }
+  return p;
+}
+
 bool TooClose(const std::vector<Shape>& shapes, const std::vector<Eigen::Vector3d>& path,
               double clearance) {
   for (const Shape& s : shapes) {
@@ -334,40 +379,12 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
       for (int attempt = 0; attempt < 60; ++attempt) {
         Eigen::Vector3d size;
         for (int k = 0; k < 3; ++k) size[k] = rng.Uniform(s.size_min[k], s.size_max[k]);
-        const Eigen::Vector3d extent = room.max - room.min;
-        const double half_xy = 0.5 * std::hypot(size.x(), size.y());
-        Eigen::Vector3d pos(0, 0, room.min.z());
-        double yaw = rng.Uniform(0.0, 360.0);
-        if (s.region == ScatterRegion::kPath && !path.empty()) {
-          // Drawn only for this region, so scenes without it keep every earlier draw.
-          const Eigen::Vector3d& anchor = path[rng.UniformInt(static_cast<int>(path.size()))];
-          const double angle = rng.Uniform(0.0, 2.0 * std::numbers::pi);
-          const double distance = rng.Uniform(s.path_distance_m.x(), s.path_distance_m.y()) +
-                                  0.5 * std::min(size.x(), size.y());
-          pos.x() = anchor.x() + distance * std::cos(angle);
-          pos.y() = anchor.y() + distance * std::sin(angle);
-          const Eigen::Vector2d lo = room.min.head<2>().array() + half_xy + 0.1;
-          const Eigen::Vector2d hi = room.max.head<2>().array() - half_xy - 0.1;
-          if ((pos.head<2>().array() < lo.array()).any() ||
-              (pos.head<2>().array() > hi.array()).any()) {
-            continue;
-          }
-        } else if (s.region == ScatterRegion::kWalls) {
-          const int wall = rng.UniformInt(4);
-          const int axis = wall / 2;
-          const int along = 1 - axis;
-          const double depth = rng.Uniform(0.05, 1.5) + 0.5 * size.y();
-          pos[axis] = wall % 2 == 0 ? room.min[axis] + depth : room.max[axis] - depth;
-          pos[along] = rng.Uniform(room.min[along] + half_xy, room.max[along] - half_xy);
-          yaw = (axis == 0 ? 90.0 : 0.0) + rng.Uniform(-8.0, 8.0);
-        } else {
-          pos.x() = room.min.x() + rng.Uniform(half_xy + 0.1, extent.x() - half_xy - 0.1);
-          pos.y() = room.min.y() + rng.Uniform(half_xy + 0.1, extent.y() - half_xy - 0.1);
-        }
+        const std::optional<ScatterPlacement> placed = DrawPlacement(s, room, path, size, &rng);
+        if (!placed) continue;
         ObjectDesc o;
         o.type = s.type;
         o.size = size;
-        o.yaw_deg = yaw;
+        o.yaw_deg = placed->yaw_deg;
         o.levels = s.levels;
         o.name = fmt::format("scatter{}", group_id);
         if (s.type == ObjectType::kShelf) {
@@ -377,6 +394,7 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
         }
         if (s.type == ObjectType::kCylinder) o.size.y() = o.size.x();
         // Scatter positions are absolute: convert back to room-relative for AddObject.
+        const Eigen::Vector3d& pos = placed->position;
         const Eigen::Vector3d c = room.centre();
         // Quads lie on the floor, a few millimetres above it and each at its own height, so
         // neither the floor nor a crossing quad z-fights with them.
