@@ -1,15 +1,24 @@
-// pkslam eval: ATE/RPE of an estimated trajectory against ground truth (evo-compatible).
+// pkslam eval: ATE/RPE of estimated trajectories against ground truth (evo-compatible), the
+// segment errors of rpg_trajectory_evaluation, saved errors and figures.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "apps/commands.h"
 #include "core/util/error.h"
+#include "core/util/json_writer.h"
 #include "core/util/output_file.h"
+#include "core/util/project_file.h"
+#include "evaluation/bench/process.h"
 #include "evaluation/evaluate.h"
+#include "evaluation/evaluation_output.h"
 #include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
 
@@ -18,7 +27,8 @@ namespace {
 
 struct EvalArgs {
   std::string gt_file;
-  std::string est_file;
+  std::vector<std::string> est_files;
+  std::vector<std::string> labels;
   std::string gt_format = "auto";
   std::string est_format = "auto";
   std::string align = "se3";
@@ -28,12 +38,44 @@ struct EvalArgs {
   double rpe_delta = 1.0;
   std::string rpe_unit = "frames";
   bool rpe_consecutive = false;
+  bool rpe_all_pairs = false;
+  std::string segments = "auto";
   std::string json_file;
   std::string body_from_camera_file;
   bool allow_frame_offset = false;
+  std::string plot_dir;
+  std::string save_aligned_dir;
+  std::string save_errors_dir;
 };
 
-void RunEval(const EvalArgs& args) {
+// "auto" (rpg's 10-50% of the path), "none", or a comma-separated list of lengths in metres.
+void ParseSegments(const std::string& text, EvaluationOptions& options) {
+  if (text == "none") {
+    options.compute_segments = false;
+    return;
+  }
+  options.compute_segments = true;
+  if (text == "auto") return;
+  std::stringstream list(text);
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    std::size_t used = 0;
+    double length = 0.0;
+    try {
+      length = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size()) {
+      throw OptionError(fmt::format("--segments {}: '{}' is not a length in metres (give auto, "
+                                    "none, or lengths like 10,20,40)",
+                                    text, item));
+    }
+    options.segments.lengths_m.push_back(length);
+  }
+}
+
+EvaluationOptions OptionsFrom(const EvalArgs& args) {
   EvaluationOptions options;
   options.alignment = ParseAlignmentMethod(args.align);
   options.association.max_diff_s = args.max_diff_s;
@@ -41,28 +83,135 @@ void RunEval(const EvalArgs& args) {
   options.association.one_to_one = !args.evo_association;
   options.rpe.delta = args.rpe_delta;
   options.rpe.unit = ParseRpeUnit(args.rpe_unit);
-  options.rpe.all_pairs = !args.rpe_consecutive;
+  if (args.rpe_all_pairs && args.rpe_consecutive) {
+    throw OptionError("--rpe-all-pairs and --rpe-consecutive exclude each other");
+  }
+  options.rpe.all_pairs = args.rpe_all_pairs;
+  ParseSegments(args.segments, options);
   options.allow_frame_offset = args.allow_frame_offset;
   options.Check();
+  return options;
+}
+
+// Runs evaluation/eval_plots.py over the files written into DIR/data; returns the figures.
+std::vector<std::string> DrawPlots(const std::filesystem::path& dir) {
+  const std::filesystem::path script = FindProjectFile("evaluation/eval_plots.py");
+  if (!std::filesystem::exists(script)) throw Error("plot script not found: " + script.string());
+  const std::filesystem::path log = dir / "plots.log";
+  const bench::ProcessResult p = bench::RunProcess(
+      {"/usr/bin/python3", script.string(), "--data", (dir / "data").string(), "--out",
+       dir.string()},
+      log, 600.0);
+  if (!p.ok()) {
+    throw Error(fmt::format("evaluation/eval_plots.py failed ({}); see {}", p.Describe(),
+                            log.string()));
+  }
+  std::filesystem::remove(log);
+  std::vector<std::string> figures;
+  std::ifstream index(dir / "figures.tsv");
+  for (std::string line; std::getline(index, line);) {
+    if (!line.empty()) figures.push_back(line.substr(0, line.find('\t')));
+  }
+  return figures;
+}
+
+void WriteJson(const std::string& file, const std::vector<std::string>& labels,
+               const std::vector<std::string>& est_files,
+               const std::vector<EvaluationResult>& results) {
+  if (results.size() == 1) {
+    WriteFileAtomically(file, EvaluationJson(results.front()));
+    return;
+  }
+  JsonWriter json(2);
+  json.BeginObject().Key("estimates").BeginArray();
+  for (std::size_t k = 0; k < results.size(); ++k) {
+    json.BeginObject().Member("label", labels[k]).Member("file", est_files[k]).Key("result");
+    WriteEvaluationJson(results[k], json);
+    json.EndObject();
+  }
+  json.EndArray().EndObject();
+  WriteFileAtomically(file, json.str());
+}
+
+void RunEval(const EvalArgs& args) {
+  const EvaluationOptions options = OptionsFrom(args);
   const TrajectoryFormat gt_format = ParseTrajectoryFormat(args.gt_format);
   const TrajectoryFormat est_format = ParseTrajectoryFormat(args.est_format);
+  if (!args.labels.empty() && args.labels.size() != args.est_files.size()) {
+    throw OptionError(fmt::format("--label given {} times for {} --est files: give one per "
+                                  "estimate, or none",
+                                  args.labels.size(), args.est_files.size()));
+  }
 
   // Repeated stamps stay (with a warning), as evo keeps them.
   Trajectory gt = ReadTrajectory(args.gt_file, gt_format, DuplicateTimestamps::kKeepAll);
   if (!args.body_from_camera_file.empty()) {
     gt = ChangeSensorFrame(gt, ReadRigidTransform(args.body_from_camera_file));
   }
-  const Trajectory est = ReadTrajectory(args.est_file, est_format, DuplicateTimestamps::kKeepAll);
-  const EvaluationResult result = EvaluateTrajectories(gt, est, options);
+  std::vector<std::filesystem::path> est_paths(args.est_files.begin(), args.est_files.end());
+  const std::vector<std::string> labels =
+      args.labels.empty() ? UniqueLabels(est_paths) : args.labels;
+  std::vector<Trajectory> estimates;
+  std::vector<EvaluationResult> results;
+  for (const std::string& file : args.est_files) {
+    estimates.push_back(ReadTrajectory(file, est_format, DuplicateTimestamps::kKeepAll));
+    results.push_back(EvaluateTrajectories(gt, estimates.back(), options));
+  }
 
   std::cout << fmt::format("ground truth  {} ({} poses, {:.1f} s, {:.2f} m)\n", args.gt_file,
-                           gt.size(), DurationSeconds(gt), PathLengthMeters(gt))
-            << fmt::format("estimate      {} ({} poses, {:.1f} s, {:.2f} m)\n", args.est_file,
-                           est.size(), DurationSeconds(est), PathLengthMeters(est))
-            << FormatEvaluationTable(result);
+                           gt.size(), DurationSeconds(gt), PathLengthMeters(gt));
+  for (std::size_t k = 0; k < estimates.size(); ++k) {
+    std::cout << fmt::format("estimate      {}{} ({} poses, {:.1f} s, {:.2f} m)\n",
+                             args.est_files[k],
+                             estimates.size() > 1 ? fmt::format(" [{}]", labels[k]) : "",
+                             estimates[k].size(), DurationSeconds(estimates[k]),
+                             PathLengthMeters(estimates[k]));
+  }
+  if (results.size() == 1) {
+    std::cout << FormatEvaluationTable(results.front());
+  } else {
+    std::cout << fmt::format("alignment     {}; RPE delta {} {}, {} pairs\n\n",
+                             AlignmentMethodName(options.alignment), options.rpe.delta,
+                             RpeUnitName(options.rpe.unit),
+                             options.rpe.all_pairs ? "all" : "consecutive")
+              << FormatComparisonTable(labels, results);
+    for (std::size_t k = 0; k < results.size(); ++k) {
+      if (!results[k].segments) continue;
+      std::cout << "\n[" << labels[k] << "]" << FormatSegmentTable(*results[k].segments);
+    }
+  }
   if (!args.json_file.empty()) {
-    WriteFileAtomically(args.json_file, EvaluationJson(result));
+    WriteJson(args.json_file, labels, args.est_files, results);
     std::cout << "json          " << args.json_file << '\n';
+  }
+  auto save_all = [&](const std::filesystem::path& dir, bool aligned, bool errors) {
+    for (std::size_t k = 0; k < results.size(); ++k) {
+      if (aligned) WriteAlignedEstimate(dir, labels[k], estimates[k], results[k]);
+      if (errors) WriteErrorFiles(dir, labels[k], estimates[k], results[k]);
+    }
+  };
+  if (!args.save_aligned_dir.empty()) {
+    save_all(args.save_aligned_dir, true, false);
+    std::cout << "aligned       " << args.save_aligned_dir << " (LABEL_aligned.tum)\n";
+  }
+  if (!args.save_errors_dir.empty()) {
+    save_all(args.save_errors_dir, false, true);
+    std::cout << "errors        " << args.save_errors_dir
+              << " (LABEL_poses.csv, LABEL_rpe.csv, LABEL_segments.csv)\n";
+  }
+  if (!args.plot_dir.empty()) {
+    const std::filesystem::path dir = args.plot_dir;
+    save_all(dir / "data", true, true);
+    OutputFile index(dir / "data" / "estimates.tsv");
+    index.stream() << "label\tfile\talignment\tgt\n";
+    for (std::size_t k = 0; k < results.size(); ++k) {
+      index.stream() << labels[k] << '\t' << args.est_files[k] << '\t'
+                     << AlignmentMethodName(options.alignment) << '\t' << args.gt_file << '\n';
+    }
+    index.Commit();
+    const std::vector<std::string> figures = DrawPlots(dir);
+    std::cout << fmt::format("plots         {} ({} figures: {})\n", args.plot_dir,
+                             figures.size(), fmt::join(figures, ", "));
   }
 }
 
@@ -72,12 +221,19 @@ void RegisterEvalCommand(CLI::App& app) {
   auto args = std::make_shared<EvalArgs>();
   auto* cmd = app.add_subcommand(
       "eval",
-      "Compare an estimated trajectory with ground truth: associate by time, align, then "
-      "ATE and RPE statistics (evo_ape / evo_rpe compatible)");
+      "Compare estimated trajectories with ground truth: associate by time, align, then ATE, "
+      "RPE (evo_ape / evo_rpe definitions and defaults) and the relative error over segment "
+      "lengths (rpg_trajectory_evaluation); several --est are compared in one table, --plot "
+      "draws the figures");
   cmd->add_option("--gt", args->gt_file, "Ground-truth trajectory file (tum, euroc, orbslam3)")
       ->required();
-  cmd->add_option("--est", args->est_file, "Estimated trajectory file (tum, euroc, orbslam3)")
+  cmd->add_option("--est", args->est_files,
+                  "Estimated trajectory file(s) (tum, euroc, orbslam3); repeat or list several "
+                  "to compare them")
       ->required();
+  cmd->add_option("--label", args->labels,
+                  "A name per --est for tables, files and legends (default: the file's stem, or "
+                  "its folder's name for trajectory.txt and the like)");
   cmd->add_option("--align", args->align, "Alignment: se3|sim3|posyaw|none")->capture_default_str();
   cmd->add_option("--max-diff", args->max_diff_s,
                   "Largest time difference of an associated pose pair (s)")
@@ -90,12 +246,29 @@ void RegisterEvalCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--evo-association", args->evo_association,
                 "Keep evo's repeated matches instead of strictly one-to-one pairs");
-  cmd->add_option("--rpe-delta", args->rpe_delta, "RPE pose-pair distance (frames or metres)")
+  cmd->add_option("--rpe-delta", args->rpe_delta,
+                  "RPE pose-pair distance (frames or metres; evo's --delta)")
       ->capture_default_str();
-  cmd->add_option("--rpe-unit", args->rpe_unit, "RPE delta unit: frames|m")->capture_default_str();
+  cmd->add_option("--rpe-unit", args->rpe_unit, "RPE delta unit: frames|m (evo's --delta_unit f|m)")
+      ->capture_default_str();
+  cmd->add_flag("--rpe-all-pairs", args->rpe_all_pairs,
+                "RPE from every pose (evo --all_pairs) instead of non-overlapping consecutive "
+                "pairs (evo's default)");
   cmd->add_flag("--rpe-consecutive", args->rpe_consecutive,
-                "RPE on non-overlapping consecutive pairs (evo's default) instead of all pairs");
+                "Non-overlapping consecutive RPE pairs: the default (kept for old scripts)");
+  cmd->add_option("--segments", args->segments,
+                  "Relative error over segment lengths: auto (rpg's 10,20,30,40,50% of the "
+                  "path), none, or lengths in metres like 10,20,40")
+      ->capture_default_str();
   cmd->add_option("--json", args->json_file, "Also write the results as JSON to this file");
+  cmd->add_option("--plot", args->plot_dir,
+                  "Draw figures into this folder (matplotlib): trajectories (top view, xyz, "
+                  "roll/pitch/yaw) against truth, ATE over time and along the path, RPE over "
+                  "time, segment errors and ATE as box plots; the data beside them in DIR/data");
+  cmd->add_option("--save-aligned", args->save_aligned_dir,
+                  "Write each aligned estimate to DIR/LABEL_aligned.tum");
+  cmd->add_option("--save-errors", args->save_errors_dir,
+                  "Write per-pose ATE, per-pair RPE and per-segment errors to DIR/LABEL_*.csv");
   cmd->add_flag("--allow-frame-offset", args->allow_frame_offset,
                 "Measure although the aligned orientations differ by a near-constant rotation "
                 "over 5 deg (by default an error: estimate and truth describe different frames, "

@@ -115,9 +115,28 @@ void CheckSameBodyFrame(const std::vector<SE3d>& ref, const std::vector<SE3d>& e
 
 }  // namespace
 
+std::string FormatSegmentTable(const std::vector<SegmentErrors>& segments) {
+  std::string out = fmt::format("\nrelative error over segment lengths (rpg_trajectory_evaluation):\n"
+                                "{:>10} {:>6} {:>12} {:>12} {:>12} {:>12}\n",
+                                "length [m]", "pairs", "trans median", "trans rmse", "trans [%]",
+                                "rot [deg]");
+  for (const SegmentErrors& s : segments) {
+    if (s.empty()) {
+      out += fmt::format("{:>10.2f} {:>6} (longer than the trajectory allows)\n", s.length_m, 0);
+      continue;
+    }
+    out += fmt::format("{:>10.2f} {:>6} {:>12.6f} {:>12.6f} {:>12.4f} {:>12.4f}\n", s.length_m,
+                       s.pairs.size(), s.translation_m_stats.median, s.translation_m_stats.rmse,
+                       s.translation_percent_stats.median, s.rotation_deg_stats.median);
+  }
+  out += "(translation and rotation medians over the segments; [%] of the segment length)\n";
+  return out;
+}
+
 void EvaluationOptions::Check() const {
   association.Check();
   if (compute_rpe) rpe.Check();
+  if (compute_segments) segments.Check();
 }
 
 EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& est,
@@ -187,6 +206,13 @@ EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& e
   result.ate_translation_m = ComputeErrorStatistics(result.ate_translation_errors_m);
   result.ate_rotation_deg = ComputeErrorStatistics(result.ate_rotation_errors_deg);
   if (options.compute_rpe) result.rpe = ComputeRpe(ref_poses, est_poses, options.rpe);
+  if (options.compute_segments) {
+    SegmentErrorOptions segments = options.segments;
+    if (segments.reference_path_m == 0.0) segments.reference_path_m = PathLengthMeters(ref);
+    result.segments = ComputeSegmentErrors(ref_poses, est_poses, segments);
+  }
+  result.matched_ref = std::move(ref_poses);
+  result.aligned_est = std::move(est_poses);
   return result;
 }
 
@@ -218,6 +244,31 @@ void WriteEvaluationJson(const EvaluationResult& result, JsonWriter& json) {
   } else {
     json.Null();
   }
+  json.Key("segments");
+  if (result.segments) {
+    json.BeginArray();
+    for (const SegmentErrors& segment : *result.segments) {
+      json.BeginObject()
+          .Member("length_m", segment.length_m)
+          .Member("pairs", segment.pairs.size());
+      const std::pair<const char*, const ErrorStatistics*> stats[] = {
+          {"trans_m", &segment.translation_m_stats},
+          {"trans_percent", &segment.translation_percent_stats},
+          {"rot_deg", &segment.rotation_deg_stats}};
+      for (const auto& [key, s] : stats) {
+        json.Key(key);
+        if (segment.empty()) {
+          json.Null();
+        } else {
+          WriteStatistics(*s, json);
+        }
+      }
+      json.EndObject();
+    }
+    json.EndArray();
+  } else {
+    json.Null();
+  }
   json.EndObject();
 }
 
@@ -245,6 +296,7 @@ std::string FormatEvaluationTable(const EvaluationResult& result) {
                        RpeUnitName(rpe.unit), rpe.all_pairs ? "all" : "consecutive",
                        result.rpe->pairs.size());
   }
+  if (result.segments) out += FormatSegmentTable(*result.segments);
   return out;
 }
 

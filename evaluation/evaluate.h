@@ -15,6 +15,7 @@
 #include "evaluation/alignment.h"
 #include "evaluation/association.h"
 #include "evaluation/rpe.h"
+#include "evaluation/segment_error.h"
 #include "evaluation/statistics.h"
 #include "io/trajectory.h"
 
@@ -28,6 +29,9 @@ struct EvaluationOptions {
   // Whether to compute the RPE, and how.
   bool compute_rpe = true;
   RpeOptions rpe;
+  // Relative error over sub-trajectory lengths, as rpg_trajectory_evaluation (segment_error.h).
+  bool compute_segments = false;
+  SegmentErrorOptions segments;
   // Measure even when the aligned estimate's orientation differs from the reference's by a
   // near-constant rotation (CheckSameBodyFrame): by default that is an error, since it means
   // the two trajectories describe different frames (a camera against body ground truth).
@@ -47,6 +51,12 @@ struct EvaluationResult {
   ErrorStatistics ate_translation_m;
   ErrorStatistics ate_rotation_deg;
   std::optional<RpeResult> rpe;  // when options.compute_rpe
+  // When options.compute_segments: one entry per segment length (some may have no pairs).
+  std::optional<std::vector<SegmentErrors>> segments;
+  // The associated poses, pair k of each: the reference's, and the estimate's after alignment
+  // (what the errors above compare; for saving and plotting).
+  std::vector<SE3d> matched_ref;
+  std::vector<SE3d> aligned_est;
   EvaluationOptions options;     // as used
 
   double scale() const { return ref_from_est.scale(); }
@@ -63,12 +73,16 @@ EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& e
 
 // The result as one JSON object: {"pairs", "gt_poses", "est_poses", "max_diff_s",
 // "alignment", "scale", "ate": stats, "ate_rot_deg": stats, "rpe": {"delta", "unit",
-// "all_pairs", "pairs", "trans_m": stats, "rot_deg": stats} or null}; stats = {"rmse", "mean",
-// "median", "std", "min", "max", "sse"}.
+// "all_pairs", "pairs", "trans_m": stats, "rot_deg": stats} or null, "segments": [{"length_m",
+// "pairs", "trans_m", "trans_percent", "rot_deg": stats or null}] or null}; stats = {"rmse",
+// "mean", "median", "std", "min", "max", "sse"}.
 void WriteEvaluationJson(const EvaluationResult& result, JsonWriter& json);
 std::string EvaluationJson(const EvaluationResult& result);
 
 // A readable multi-line table of the same numbers.
 std::string FormatEvaluationTable(const EvaluationResult& result);
+
+// The segment errors' medians, one line per length (part of FormatEvaluationTable).
+std::string FormatSegmentTable(const std::vector<SegmentErrors>& segments);
 
 }  // namespace pkslam

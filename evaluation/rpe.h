@@ -37,8 +37,9 @@ struct RpeOptions {
   // Distance between the poses of a pair: a whole number of frames, or metres of path.
   double delta = 1.0;
   RpeUnit unit = RpeUnit::kFrames;
-  // Every pose starts a pair (evo --all_pairs) instead of non-overlapping consecutive pairs.
-  bool all_pairs = true;
+  // Every pose starts a pair (evo --all_pairs) instead of non-overlapping consecutive pairs
+  // (evo's default). With the default delta of one frame both select the same pairs.
+  bool all_pairs = false;
   // Metres with all pairs: accepted |path - delta| relative to delta (evo's rel_delta_tol).
   double relative_tolerance = 0.1;
 

@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "tests/support/test_data.h"
 
@@ -173,6 +175,98 @@ TEST_F(EvalCliTest, BadInputsGiveOneLineErrors) {
   EXPECT_NE(out.find("--max-diff"), std::string::npos) << out;  // the flag, not a field name
   out = ExpectOneLineError(fmt::format("--gt {} --est {} --rpe-delta 50", good, good));
   EXPECT_NE(out.find("RPE delta 50 frames selects no pose pair"), std::string::npos) << out;
+}
+
+// A circle of 200 poses (5 Hz) and estimates that drift from it differently.
+std::string CircleTrajectory(double radius_gain, double height_drift_per_s) {
+  std::string text;
+  for (int k = 0; k < 200; ++k) {
+    const double t = 0.2 * k;
+    const double a = 2.0 * M_PI * t / 40.0;
+    const double r = 3.0 * (1.0 + radius_gain * t / 40.0);
+    // Heading along the circle: yaw a + 90 deg.
+    const double half = 0.5 * (a + M_PI / 2);
+    text += fmt::format("{:.3f} {:.9f} {:.9f} {:.9f} 0 0 {:.12f} {:.12f}\n", 100.0 + t,
+                        r * std::cos(a), r * std::sin(a), height_drift_per_s * t, std::sin(half),
+                        std::cos(half));
+  }
+  return text;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::stringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty()) lines.push_back(line);
+  }
+  return lines;
+}
+
+// --plot with three estimates: one table, one JSON entry each, the eight figures listed and
+// drawn, and the saved per-pose errors agree with the JSON's statistics.
+TEST_F(EvalCliTest, PlotsAndSavesSeveralEstimatesAgainstOneTruth) {
+  if (!fs::exists("/usr/bin/python3")) GTEST_SKIP() << "no /usr/bin/python3 for matplotlib";
+  const std::string gt = Write("gt.txt", CircleTrajectory(0.0, 0.0));
+  const std::string a = Write("grow.txt", CircleTrajectory(0.02, 0.0));
+  const std::string b = Write("climb.txt", CircleTrajectory(0.0, 0.002));
+  const std::string c = Write("both.txt", CircleTrajectory(0.02, 0.002));
+  const fs::path plots = dir_ / "plots";
+  const testing::CommandResult r = Eval(fmt::format(
+      "--gt {} --est {} {} {} --label grow climb both --plot {} --save-aligned {} --save-errors {} "
+      "--json {}",
+      gt, a, b, c, plots.string(), (dir_ / "aligned").string(), (dir_ / "errors").string(),
+      (dir_ / "all.json").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* label : {"grow ", "climb ", "both "}) {
+    EXPECT_NE(r.output.find(label), std::string::npos) << r.output;
+  }
+  EXPECT_NE(r.output.find("relative error over segment lengths"), std::string::npos) << r.output;
+
+  const std::vector<std::string> figures = Lines(ReadFile(plots / "figures.tsv"));
+  const std::vector<std::string> expected = {
+      "trajectories_top.png", "trajectories_xyz.png", "trajectories_rpy.png", "ate_over_time.png",
+      "ate_along_path.png",   "rpe_over_time.png",    "segment_errors.png",   "ate_box.png"};
+  ASSERT_EQ(figures.size(), expected.size()) << ReadFile(plots / "figures.tsv");
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(figures[k].substr(0, figures[k].find('\t')), expected[k]);
+    EXPECT_GT(fs::file_size(plots / expected[k]), 10000u) << expected[k];  // a drawn PNG
+  }
+
+  // One JSON entry per estimate, in order; the per-pose file reproduces its ATE rmse.
+  const std::string json = ReadFile(dir_ / "all.json");
+  const std::size_t grow = json.find("\"label\": \"grow\"");
+  const std::size_t climb = json.find("\"label\": \"climb\"");
+  const std::size_t both = json.find("\"label\": \"both\"");
+  ASSERT_NE(both, std::string::npos) << json;
+  EXPECT_LT(grow, climb);
+  EXPECT_LT(climb, both);
+  const std::vector<std::string> rows = Lines(ReadFile(dir_ / "errors" / "climb_poses.csv"));
+  ASSERT_EQ(rows.size(), 201u);  // header + one per matched pose
+  double sum_sq = 0.0;
+  for (std::size_t k = 1; k < rows.size(); ++k) {
+    std::vector<std::string> cells;
+    std::stringstream line(rows[k]);
+    for (std::string cell; std::getline(line, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 16u) << rows[k];
+    sum_sq += std::stod(cells[13]) * std::stod(cells[13]);
+  }
+  EXPECT_NEAR(std::sqrt(sum_sq / 200.0), JsonNumber(json.substr(climb), "\"ate\"", "rmse"), 1e-7);
+  EXPECT_GT(JsonNumber(json.substr(climb), "\"ate\"", "rmse"), 0.01);  // the climb is measured
+  EXPECT_EQ(Lines(ReadFile(dir_ / "aligned" / "both_aligned.tum")).size(), 201u);  // + header
+  EXPECT_TRUE(fs::exists(dir_ / "errors" / "grow_segments.csv"));
+  EXPECT_TRUE(fs::exists(dir_ / "errors" / "grow_rpe.csv"));
+}
+
+TEST_F(EvalCliTest, SeveralEstimatesBadOptionsGiveOneLineErrors) {
+  const std::string good = Write("good.txt", kGood);
+  std::string out =
+      ExpectOneLineError(fmt::format("--gt {} --est {} {} --label only_one", good, good, good));
+  EXPECT_NE(out.find("--label given 1 times for 2 --est files"), std::string::npos) << out;
+  out = ExpectOneLineError(fmt::format("--gt {} --est {} --segments 10,abc", good, good));
+  EXPECT_NE(out.find("'abc' is not a length"), std::string::npos) << out;
+  out = ExpectOneLineError(
+      fmt::format("--gt {} --est {} --rpe-all-pairs --rpe-consecutive", good, good));
+  EXPECT_NE(out.find("exclude each other"), std::string::npos) << out;
 }
 
 TEST_F(EvalCliTest, MissingRequiredOptionFails) {
