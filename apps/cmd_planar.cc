@@ -1,4 +1,4 @@
-// pkslam planar: seed 001's planar modelling with plane-sampled ICP (rgbd/planar_run.h).
+// pkslam planar: planar RGB-D modelling with plane-sampled ICP (rgbd/planar_run.h).
 #include <fmt/format.h>
 
 #include "apps/commands.h"

@@ -1,4 +1,4 @@
-// pkslam rgbd-odometry: seed 000's frame-to-frame RGB-D modelling (rgbd/odometry_run.h).
+// pkslam rgbd-odometry: frame-to-frame RGB-D (Kinect) modelling (rgbd/odometry_run.h).
 #include <fmt/format.h>
 
 #include "apps/commands.h"
@@ -21,7 +21,7 @@ void RegisterRgbdOdometryCommand(CLI::App& app) {
                   "ORB-SLAM3 settings file for the camera (default: DIR/settings.yaml, or TUM's "
                   "calibration for freiburg1/2/3 folders)");
   cmd->add_option("--out", o.out, "Output directory")->capture_default_str();
-  cmd->add_option("--voxel", o.voxel_m, "Map voxel size [m] (thesis: 0.01, 0.05, 0.10)")
+  cmd->add_option("--voxel", o.voxel_m, "Map voxel size [m] (the Kinect study compared 0.01, 0.05 and 0.10)")
       ->capture_default_str();
   cmd->add_option("--map-stride", o.map_stride, "Pixel stride of the clouds added to the map")
       ->capture_default_str();
@@ -38,7 +38,7 @@ void RegisterRgbdOdometryCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--matches", o.odometry.max_matches, "Best matches kept")->capture_default_str();
   cmd->add_flag("--no-cross-check", *no_cross_check,
-                "Plain nearest neighbours (the thesis) instead of mutual ones");
+                "Plain nearest neighbours (as the Kinect study matched) instead of mutual ones");
   cmd->add_option("--ransac-threshold", o.odometry.ransac.inlier_threshold_m, "Inlier distance [m]")
       ->capture_default_str();
   cmd->add_option("--ransac-confidence", o.odometry.ransac.confidence,

@@ -1,5 +1,5 @@
-// pkslam tracks: seed 002's reconstruction from 2-D tracks (tracks/): `simulate` (the thesis's
-// synthetic tracks), `reconstruct` (trajectory, map, errors, report) and `export` (tracks of a
+// pkslam tracks: PTAM-style reconstruction from 2-D tracks (tracks/): `simulate` (the source
+// study's synthetic tracks, docs/tracks.md), `reconstruct` (trajectory, map, errors, report) and `export` (tracks of a
 // simulated sequence or of a pkslam run).
 #include <fmt/format.h>
 
@@ -57,7 +57,7 @@ void RegisterSimulate(CLI::App* cmd) {
   auto args = std::make_shared<SimulateArgs>();
   auto* sim = cmd->add_subcommand(
       "simulate",
-      "The thesis's synthetic tracks: random points in a box, a camera path (line, circle or a "
+      "Synthetic tracks as in the PTAM study behind this module (docs/tracks.md): random points in a box, a camera path (line, circle or a "
       "replayed ground truth), projections with Gaussian noise; writes OUT/tracks.txt, "
       "truth_trajectory.txt, truth_points.txt");
   sim->add_option("--out", args->out, "Output directory")->required();
@@ -67,7 +67,7 @@ void RegisterSimulate(CLI::App* cmd) {
   sim->add_option("--frames", options->num_frames, "Frames")->capture_default_str();
   sim->add_option("--fps", options->fps, "Frame rate")->capture_default_str();
   sim->add_option("--shape", options->shape, "Camera path: line | circle")->capture_default_str();
-  sim->add_option("--step", options->step, "Camera motion per frame (thesis units)")
+  sim->add_option("--step", options->step, "Camera motion per frame (scene units: the points lie about 1000 units away)")
       ->capture_default_str();
   sim->add_option("--trajectory", args->trajectory,
                   "Replay this ground truth (TUM or EuRoC csv, world_from_body) at --fps instead "
@@ -138,8 +138,8 @@ void RegisterReconstruct(CLI::App* cmd) {
   rec->add_option("--keyframes", args->keyframes, "Keyframe rule: ptam|match-count|interval|ratio")
       ->capture_default_str();
   rec->add_option("--init", args->init,
-                  "Initial pair: auto (first pair with enough baseline) | first-two (the "
-                  "thesis) | fixed (with --init-frame)")
+                  "Initial pair: auto (first pair with enough baseline) | first-two (frames 1 "
+                  "and 2, the PTAM study's rule) | fixed (with --init-frame)")
       ->capture_default_str();
   rec->add_option("--init-frame", o->init_second_frame, "Second frame of a fixed initial pair");
   rec->add_option("--init-parallax", o->init_min_parallax_deg,
@@ -179,8 +179,8 @@ void RegisterReconstruct(CLI::App* cmd) {
                   "Folder with truth_trajectory.txt (+ truth_points.txt); default: the tracks' "
                   "folder when it has them");
   rec->add_option("--histogram-frames", args->histogram_frames,
-                  "Frames whose reprojection-error histograms the report shows (the thesis's "
-                  "frames 2 and 50 counted from 1)")
+                  "Frames whose reprojection-error histograms the report shows (0-based; the "
+                  "default 1 and 49 are the PTAM study's frames 2 and 50)")
       ->capture_default_str();
   rec->add_flag("--no-report", args->no_report, "Skip report.html and its plots");
   rec->add_flag("--quiet", args->quiet, "No progress");
@@ -288,7 +288,8 @@ void RegisterExport(CLI::App* cmd) {
 }  // namespace
 
 void RegisterTracksCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("tracks", "Reconstruction from 2-D tracks (seed 002)");
+  auto* cmd = app.add_subcommand("tracks", "Trajectory and map from 2-D point tracks (PTAM-style: two-view start, PnP, "
+                                 "triangulation, keyframes; docs/tracks.md)");
   cmd->require_subcommand(1);
   RegisterSimulate(cmd);
   RegisterReconstruct(cmd);
