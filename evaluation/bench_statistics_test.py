@@ -44,7 +44,7 @@ class BenchStatisticsTest(unittest.TestCase):
     def test_exact_permutation_of_complete_separation(self):
         a = np.array([1.0, 2, 3, 4, 5])
         b = np.array([6.0, 7, 8, 9, 10])
-        effect, p, exact = bs.stratified_permutation([(a, b)], np.random.default_rng(1))
+        effect, p, exact = bs.stratified_permutation([(a, b)])
         self.assertTrue(exact)
         self.assertAlmostEqual(effect, 0.5)
         self.assertAlmostEqual(p, 2 / 252)  # the two fully separated arrangements of C(10, 5)
@@ -58,9 +58,9 @@ class BenchStatisticsTest(unittest.TestCase):
         result = bs.analyse(rows)
         pooled = result["pooled"][0]
         self.assertLess(pooled["p"], 0.001)
-        self.assertGreater(pooled["improvement_pct"], 15)
-        self.assertLess(pooled["ci_low"], 18.1)
-        self.assertGreater(pooled["ci_high"], 18.1)
+        self.assertLess(pooled["ate_change_pct"], -15)  # lower error: negative
+        self.assertLess(pooled["ci_low"], -18.1)
+        self.assertGreater(pooled["ci_high"], -18.1)
         self.assertIn("significantly more accurate", pooled["sentence"])
         self.assertIn("inside", pooled["sentence"])
 
@@ -95,11 +95,59 @@ class BenchStatisticsTest(unittest.TestCase):
                          * math.exp(noise[1, d, r])})
         pooled = bs.analyse(rows)["pooled"][0]
         self.assertGreater(pooled["p_holm"], 0.05)
-        self.assertLess(pooled["ci_high"], 0)
+        self.assertGreater(pooled["ci_low"], 0)
+        self.assertGreater(pooled["ate_change_pct"], 0)
         self.assertAlmostEqual(pooled["sequence_change_min_pct"], -10, delta=2)
         self.assertAlmostEqual(pooled["sequence_change_max_pct"], 30, delta=2)
         self.assertIn("excludes 0 but the rank test does not", pooled["sentence"])
         self.assertIn("-10", pooled["sentence"].split("per-sequence changes")[1][:6])
+
+    def test_one_sequence_gives_one_p_and_the_same_sign_everywhere(self):
+        # A suite of one sequence: the per-sequence row and the pooled line are the same
+        # comparison, so they must carry the same test, p and ATE change.
+        rng = np.random.default_rng(8)
+        noise = rng.normal(0, 0.1, size=(2, 1, 10))
+        rows = rows_for({"orbslam3": lambda d, r: 0.05 * math.exp(noise[0, d, r]),
+                         "pks": lambda d, r: 0.045 * math.exp(noise[1, d, r])}, datasets=("A",))
+        result = bs.analyse(rows)
+        pooled = result["pooled"][0]
+        seq = result["per_sequence"][0]
+        self.assertEqual(seq["p"], pooled["p"])
+        self.assertEqual(seq["ate_change_pct"], pooled["ate_change_pct"])
+        self.assertLess(pooled["ate_change_pct"], 0)
+        self.assertIn(f"ATE change {bs.fmt_pct(pooled['ate_change_pct'])}", pooled["sentence"])
+        md = bs.markdown(result)
+        self.assertIn("permutation test on ranks", md)
+        self.assertNotIn("Mann-Whitney", md)
+
+    def test_identical_runs_are_named_not_tested(self):
+        rows = rows_for({"orbslam3": lambda d, r: 0.05, "pks": lambda d, r: 0.04},
+                        datasets=("A", "B"))
+        pooled = bs.analyse(rows)["pooled"][0]
+        self.assertTrue(pooled["identical"])
+        self.assertAlmostEqual(pooled["ate_change_pct"], -20.0)
+        self.assertIn("same ATE (deterministic runs)", pooled["sentence"])
+        self.assertNotIn("significantly", pooled["sentence"])
+        md = bs.markdown(bs.analyse(rows))
+        self.assertIn("0.0500 (10 identical runs)", md)
+        self.assertNotIn("± 0.0000", md)
+
+    def test_a_significant_rank_test_with_a_mean_change_around_zero_says_both(self):
+        # Four sequences 20% better, one 80% worse, tight runs: ranks favour the configuration,
+        # the mean relative change is about 0.
+        rng = np.random.default_rng(9)
+        noise = rng.normal(0, 0.02, size=(2, 5, 10))
+        rows = rows_for({"orbslam3": lambda d, r: 0.05 * math.exp(noise[0, d, r]),
+                         "pks": lambda d, r: (1.8 if d == 0 else 0.8) * 0.05
+                         * math.exp(noise[1, d, r])})
+        pooled = bs.analyse(rows)["pooled"][0]
+        self.assertLess(pooled["p_holm"], 0.05)
+        self.assertGreater(pooled["effect"], 0)
+        self.assertIn("significantly more accurate", pooled["sentence"])
+        self.assertLess(pooled["ci_low"], 0)
+        self.assertGreater(pooled["ci_high"], 0)
+        self.assertIn("interval on the mean change includes 0", pooled["sentence"])
+        self.assertIn("per-sequence changes -2", pooled["sentence"])
 
     def test_failures_count_against_a_configuration(self):
         # Equal ATE where both succeed, but pks fails half its runs on every sequence.

@@ -125,8 +125,14 @@ void WriteErrorFiles(const fs::path& dir, const std::string& label, const Trajec
     }
     rpe.Commit();
   }
+  WriteSegmentErrorsCsv(dir / (label + "_segments.csv"), est, result);
+}
+
+void WriteSegmentErrorsCsv(const fs::path& file, const Trajectory& est,
+                           const EvaluationResult& result) {
+  auto time_of = [&](std::size_t k) { return Seconds(est.poses[result.pairs[k].est].t_ns); };
   if (result.segments) {
-    OutputFile segments(dir / (label + "_segments.csv"));
+    OutputFile segments(file);
     segments.stream() << "length_m,t_start_s,t_end_s,trans_m,trans_percent,rot_deg,"
                          "rot_deg_per_m,yaw_deg,gravity_deg\n";
     for (const SegmentErrors& s : *result.segments) {

@@ -37,6 +37,10 @@ void WriteAlignedEstimate(const std::filesystem::path& dir, const std::string& l
 void WriteErrorFiles(const std::filesystem::path& dir, const std::string& label,
                      const Trajectory& est, const EvaluationResult& result);
 
+// Only LABEL_segments.csv's content, into `file` (nothing when the result has no segments).
+void WriteSegmentErrorsCsv(const std::filesystem::path& file, const Trajectory& est,
+                           const EvaluationResult& result);
+
 // Several estimates against one truth, one line each: pairs, scale, ATE rmse / mean / median /
 // max, ATE rotation rmse, RPE translation and rotation rmse.
 std::string FormatComparisonTable(const std::vector<std::string>& labels,

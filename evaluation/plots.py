@@ -224,6 +224,64 @@ def trajectories(index, rows, roots):
                    "keyframe positions")
 
 
+def read_segments(run_dir):
+    """A run's segment_errors.csv as {segment number (1 = shortest): translation errors in % of
+    the length}, or None. The lengths are rpg's 10-50% of the sequence's path, so segment k
+    covers the same share of every sequence and can be pooled over sequences."""
+    path = os.path.join(run_dir, "segment_errors.csv")
+    if not os.path.exists(path):
+        return None
+    with open(path, newline="") as f:
+        table = list(csv.DictReader(f))
+    lengths = sorted({float(r["length_m"]) for r in table})
+    out = {}
+    for r in table:
+        out.setdefault(lengths.index(float(r["length_m"])) + 1, []).append(
+            float(r["trans_percent"]))
+    return out
+
+
+def segment_boxes(index, rows, roots):
+    """Per sensor: rpg's relative error over segment lengths, one box per configuration and
+    segment (every pair of every successful run of every sequence)."""
+    for sensor in unique(r["sensor"] for r in rows):
+        sub = [r for r in rows if r["sensor"] == sensor and r["ok"] and not r["sweep_param"]]
+        configs = unique(r["config"] for r in sub)
+        pooled = {c: {} for c in configs}
+        for r in sub:
+            d = find_run(roots, r["run_id"])
+            segments = read_segments(d) if d else None
+            for k, values in (segments or {}).items():
+                pooled[r["config"]].setdefault(k, []).extend(values)
+        ks = sorted({k for c in configs for k in pooled[c]})
+        if not ks:
+            continue
+        fig, ax = plt.subplots(figsize=(max(7, 1.4 * len(ks) * max(1, len(configs)) / 2 + 3),
+                                        4.5))
+        colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+        width = 0.8 / len(configs)
+        for i, config in enumerate(configs):
+            data = [pooled[config].get(k) or [math.nan] for k in ks]
+            pos = [k + (i - (len(configs) - 1) / 2) * width for k in ks]
+            box = ax.boxplot(data, positions=pos, widths=width * 0.9, patch_artist=True,
+                             showfliers=False, manage_ticks=False)
+            for patch in box["boxes"]:
+                patch.set_facecolor(colors[i % len(colors)])
+                patch.set_alpha(0.6)
+            ax.plot([], [], color=colors[i % len(colors)], lw=6, alpha=0.6, label=config)
+        ax.set_xticks(ks)
+        ax.set_xticklabels([f"{10 * k}%" for k in ks])
+        ax.set_xlabel("segment length (share of the sequence's path, rpg_trajectory_evaluation)")
+        ax.set_ylabel("translation error [% of the length]")
+        ax.grid(True, axis="y", alpha=0.3)
+        ax.legend(fontsize=8)
+        ax.set_title(f"{sensor}: relative error over segment lengths, all sequences")
+        index.save(fig, f"segments_{safe(sensor)}.png", "accuracy",
+                   f"{sensor}: relative translation error over segments of 10-50% of each "
+                   "sequence's path (rpg_trajectory_evaluation), pooled over sequences and runs; "
+                   "one box per configuration (whiskers 1.5 IQR, outliers not drawn)")
+
+
 def online_calibration(index, rows, roots):
     """Per dataset and sensor, every online-calibration run's estimates over the flight
     (stats.json calibration.history, applied adjustments): time offset, camera-IMU rotation change,
@@ -283,6 +341,7 @@ def sweeps(index, rows):
             fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(16, 4))
         else:
             fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
+        flat = []  # lines on which no value changed keyframes or ATE (said in the caption)
         for dataset in unique(r["dataset"] for r in sub):
             for sensor in unique(r["sensor"] for r in sub if r["dataset"] == dataset):
                 for base in unique(r["config"].split("@")[0] for r in sub):
@@ -294,6 +353,8 @@ def sweeps(index, rows):
                     kfs = [mean_std([r["keyframes"] for r in pts if r["sweep_value"] == v
                                      and r["ok"]]) for v in values]
                     label = f"{dataset}/{sensor}/{base}"
+                    if len(values) > 1 and len({(a, k) for a, k in zip(ate, kfs)}) == 1:
+                        flat.append(label)
                     a1.errorbar(values, [m for m, _ in ate], yerr=[s for _, s in ate],
                                 marker="o", capsize=3, label=label)
                     a2.errorbar(values, [m for m, _ in kfs], yerr=[s for _, s in kfs],
@@ -318,7 +379,10 @@ def sweeps(index, rows):
             a.legend(fontsize=8)
         index.save(fig, f"sweep_{safe(param)}.png", "sweeps",
                    f"Sweep of {param}: accuracy and keyframe count per value"
-                   + (", and the Eq. 13 score from the dense clouds" if dense else ""))
+                   + (", and the Eq. 13 score from the dense clouds" if dense else "")
+                   + (f". No value of {param} changed the runs of {', '.join(flat)} (the same "
+                      f"keyframes and ATE at every value): the parameter did not act there"
+                      if flat else ""))
 
 
 def equal_budget(index, rows):
@@ -524,6 +588,7 @@ def main():
                         "ATE per sequence: mean over runs, error bars one standard deviation")
         ate_cdf(index, main_rows)
         per_sequence_cdf(index, main_rows)
+        segment_boxes(index, rows, a.runs)
         trajectories(index, rows, a.runs)
         keyframe_views(index, rows, a.runs)
         reason_shares(index, rows)

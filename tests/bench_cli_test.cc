@@ -60,6 +60,49 @@ std::vector<std::string> SummaryWithoutTimes(const fs::path& file) {
   return out;
 }
 
+// The report states one comparison once: the headline table's "mean of per-sequence changes" of
+// `config` and the Statistics sentence on it carry the same signed number, and the report names
+// one test (the permutation test on ranks), never a second one for the same comparison.
+void ExpectOneSignAndOneTest(const std::string& report, const std::string& config) {
+  std::vector<std::string> lines;
+  std::stringstream in(report);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  auto cells = [](const std::string& row) {
+    std::vector<std::string> out;
+    std::stringstream cells_in(row);
+    for (std::string cell; std::getline(cells_in, cell, '|');) {
+      const auto b = cell.find_first_not_of(' ');
+      const auto e = cell.find_last_not_of(' ');
+      out.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+    }
+    return out;
+  };
+  std::string headline;
+  std::size_t column = 0;
+  for (const std::string& line : lines) {
+    if (line.rfind("| dataset |", 0) == 0 && column == 0) {
+      const auto header = cells(line);
+      column = static_cast<std::size_t>(std::find(header.begin(), header.end(), config) -
+                                        header.begin());
+    }
+    if (line.rfind("| mean of per-sequence changes |", 0) == 0 && headline.empty()) {
+      const auto row = cells(line);
+      if (column < row.size()) headline = row[column];
+    }
+  }
+  ASSERT_FALSE(headline.empty()) << report;
+  const std::string lead = "- " + config + " vs ";
+  std::string sentence;
+  for (const std::string& line : lines) {
+    if (line.rfind(lead, 0) == 0) sentence = line;
+  }
+  ASSERT_FALSE(sentence.empty()) << report;
+  EXPECT_THAT(sentence, HasSubstr("ATE change " + headline + " ")) << headline << "\n" << sentence;
+  EXPECT_THAT(report, HasSubstr("permutation test on ranks"));
+  EXPECT_THAT(report, Not(HasSubstr("Mann-Whitney")));
+  EXPECT_THAT(report, Not(HasSubstr("improvement")));
+}
+
 const fs::path kSmoke = fs::path(PKSLAM_SOURCE_DIR) / "evaluation/suites/smoke.yaml";
 
 TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
@@ -93,6 +136,14 @@ TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
                   (fs::path(PKSLAM_SOURCE_DIR) / "tests/viewer/check_view.py").string(),
                   (out / "report.html").string()));
   EXPECT_EQ(opened.exit_code, 0) << opened.output;
+  ExpectOneSignAndOneTest(testing::ReadFileBytes(out / "report.md"), "pks");
+  // Runs write their keyframe trace by default (the views colour keyframes by rule), and their
+  // segment errors, which the report draws as box plots.
+  EXPECT_TRUE(fs::exists(out / "runs/sim_medium_5s/stereo/pks/seed1/keyframe_trace.csv"));
+  EXPECT_TRUE(fs::exists(out / "runs/sim_medium_5s/stereo/pks/seed1/segment_errors.csv"));
+  if (fs::exists("/usr/bin/python3")) {
+    EXPECT_TRUE(fs::exists(out / "plots/segments_stereo.png")) << r.output;
+  }
 
   // Resume: everything is finished, nothing runs again; --reevaluate measures the finished
   // runs again (same numbers: the same files and ground truth).

@@ -189,6 +189,7 @@ std::vector<std::string> RunArguments(const Suite& suite, const RunSpec& run,
   }
   if (d.max_frames > 0) a.insert(a.end(), {"--max-frames", std::to_string(d.max_frames)});
   if (suite.deterministic) a.push_back("--deterministic");
+  if (suite.trace) a.push_back("--trace");
   a.insert(a.end(), run.run_args.begin(), run.run_args.end());
   return a;
 }

@@ -268,7 +268,8 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
   doc.Paragraph(fmt::format(
       "{} runs ({} succeeded, {} failed) in {} configurations; generated {}. ATE is the RMSE of "
       "positions after the alignment each table names (results.csv has both SE(3) and Sim(3)); "
-      "improvement = 100 · (ATE_{} − ATE) / ATE_{} on the means over runs. [cov N%] flags a "
+      "ATE change = 100 · (ATE − ATE_{}) / ATE_{} on the means over runs, negative = lower error: "
+      "the one sign used by every table, plot and sentence below. [cov N%] flags a "
       "configuration whose evaluated trajectory (the largest map) holds fewer than 90% of the "
       "frames: its ATE covers only that part and is not comparable. Data: results.csv (one row "
       "per run), summary.csv (one row per configuration).",

@@ -11,6 +11,7 @@
 #include "core/util/log.h"
 #include "evaluation/bench/bias_evaluation.h"
 #include "evaluation/evaluate.h"
+#include "evaluation/evaluation_output.h"
 #include "io/json_file.h"
 #include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
@@ -223,10 +224,16 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   options.compute_rpe = true;
   options.rpe.delta = files.rpe_delta_m;
   options.rpe.unit = RpeUnit::kMeters;
+  // Every pose starts a pair (evo --all_pairs), as the bench has always measured: over a
+  // metre, consecutive pairs would leave a few dozen per run.
+  options.rpe.all_pairs = true;
+  // rpg's relative error over 10-50% of the path, per pair, for the report's box plots.
+  options.compute_segments = true;
   try {
     const EvaluationResult with_rpe = EvaluateTrajectories(gt, est, options);
     result->rpe_trans_m = with_rpe.rpe->translation_m.rmse;
     result->rpe_rot_deg = with_rpe.rpe->rotation_deg.rmse;
+    WriteSegmentErrorsCsv(files.run_dir / "segment_errors.csv", est, with_rpe);
   } catch (const OptionError&) {
   }
   result->coverage = stats.frames > 0 ? static_cast<double>(se3.pairs.size()) / stats.frames : 0.0;

@@ -303,7 +303,8 @@ Suite ParseSuite(const std::string& text, const fs::path& file) {
   }
   if (!root || root.IsNull()) throw InputError(file, "empty suite");
   CheckKeys(c, root, "the suite",
-            {"name", "runs", "seed", "deterministic", "dense", "baseline", "alignment", "timeout_s",
+            {"name", "runs", "seed", "deterministic", "trace", "dense", "baseline", "alignment",
+             "timeout_s",
              "rpe_delta_m", "sensors", "selectors", "peers", "params", "sweeps", "datasets"});
   Suite s;
   s.file = file;
@@ -317,6 +318,7 @@ Suite ParseSuite(const std::string& text, const fs::path& file) {
   }
   if (root["seed"]) s.seed = static_cast<std::uint64_t>(Integer(c, root["seed"], "seed", 0));
   if (root["deterministic"]) s.deterministic = Bool(c, root["deterministic"], "deterministic");
+  if (root["trace"]) s.trace = Bool(c, root["trace"], "trace");
   if (root["dense"]) s.dense = Bool(c, root["dense"], "dense");
   if (root["baseline"]) s.baseline = String(c, root["baseline"], "baseline");
   if (root["alignment"]) {

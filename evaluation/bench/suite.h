@@ -6,6 +6,8 @@
 //   runs: 10                    # runs per configuration (distinct seeds seed, seed+1, ...)
 //   seed: 1
 //   deterministic: false        # pass --deterministic to every `pkslam run`
+//   trace: true                 # pass --trace (keyframe_trace.csv: the viewer colours each
+//                               # keyframe by the rule that made it); false to skip the file
 //   baseline: orbslam3          # selector label relative improvements are measured against
 //   alignment: auto             # headline ATE: se3 | sim3 | auto (sim3 for mono sensors)
 //   sensors: [stereo, mono]     # passed through to `pkslam run --sensor`
@@ -107,6 +109,7 @@ struct Suite {
   int runs = 10;
   std::uint64_t seed = 1;
   bool deterministic = false;
+  bool trace = true;
   bool dense = false;  // a dense cloud for every run (`pkslam dense` after `pkslam run`)
   std::string baseline = "orbslam3";
   double timeout_s = 3600.0;  // per run; a run that takes longer is killed and marked failed

@@ -70,6 +70,19 @@ TEST(Suite, RunArgumentsCarryTheRunSeed) {
   }
 }
 
+// Every run writes its keyframe trace unless the suite says trace: false (the viewer colours
+// keyframes by rule from it).
+TEST(Suite, RunsWriteTheirTraceByDefault) {
+  const Suite s = ParseSuite(kSuite, "dir/suite.yaml");
+  const auto runs = ExpandSuite(s);
+  auto has_trace = [](const std::vector<std::string>& a) {
+    return std::find(a.begin(), a.end(), "--trace") != a.end();
+  };
+  EXPECT_TRUE(has_trace(RunArguments(s, runs[0], "data", "out")));
+  const Suite quiet = ParseSuite(std::string(kSuite) + "trace: false\n", "dir/suite.yaml");
+  EXPECT_FALSE(has_trace(RunArguments(quiet, ExpandSuite(quiet)[0], "data", "out")));
+}
+
 TEST(Suite, DenseCloudsForTheSweepOrTheWholeSuite) {
   std::string text = kSuite;
   text.replace(text.find("values: [10, 20]}"), 17, "values: [10, 20], dense: true}");

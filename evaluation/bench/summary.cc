@@ -1,5 +1,8 @@
 #include "evaluation/bench/summary.h"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -184,7 +187,7 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results) {
     for (const auto& b : groups) {
       if (b.dataset == g.dataset && b.sensor == g.sensor && b.config == g.baseline &&
           std::isfinite(b.ate_m.mean) && b.ate_m.mean > 0 && std::isfinite(g.ate_m.mean)) {
-        g.improvement_pct = 100.0 * (b.ate_m.mean - g.ate_m.mean) / b.ate_m.mean;
+        g.ate_change_pct = 100.0 * (g.ate_m.mean - b.ate_m.mean) / b.ate_m.mean;
       }
     }
   }
@@ -197,7 +200,7 @@ void WriteSummaryCsv(const fs::path& file, const std::vector<GroupSummary>& grou
   std::ostream& out = output.stream();
   out << "dataset,sensor,config,selector,sweep_param,sweep_value,runs,ok,alignment,"
          "ate_mean_m,ate_std_m,ate_median_m,ate_se3_mean_m,ate_sim3_mean_m,scale_mean,"
-         "rpe_trans_mean_m,improvement_pct,keyframes_mean,keyframes_std,map_points_mean,"
+         "rpe_trans_mean_m,ate_change_pct,keyframes_mean,keyframes_std,map_points_mean,"
          "lost_frames_mean,coverage_mean,wall_mean_s,median_tracking_mean_ms,dense_points_mean,"
          "sweep_score,gyro_bias_err_mean_pct,accel_bias_err_mean_pct\n";
   for (const auto& g : groups) {
@@ -206,7 +209,7 @@ void WriteSummaryCsv(const fs::path& file, const std::vector<GroupSummary>& grou
         CsvField(g.dataset), CsvField(g.sensor), CsvField(g.config), CsvField(g.selector),
         CsvField(g.sweep_param), Num(g.sweep_value), g.runs, g.ok, g.alignment, Num(g.ate_m.mean),
         Num(g.ate_m.std), Num(g.ate_median_m), Num(g.ate_se3_m.mean), Num(g.ate_sim3_m.mean),
-        Num(g.scale.mean), Num(g.rpe_trans_m.mean), Num(g.improvement_pct), Num(g.keyframes.mean),
+        Num(g.scale.mean), Num(g.rpe_trans_m.mean), Num(g.ate_change_pct), Num(g.keyframes.mean),
         Num(g.keyframes.std), Num(g.map_points.mean), Num(g.lost_frames.mean), Num(g.coverage.mean),
         Num(g.wall_s.mean), Num(g.median_tracking_ms.mean), Num(g.dense_points.mean),
         Num(g.sweep_score), Num(g.gyro_bias_err_pct.mean), Num(g.accel_bias_err_pct.mean));
@@ -216,6 +219,8 @@ void WriteSummaryCsv(const fs::path& file, const std::vector<GroupSummary>& grou
 
 std::string FormatMeanStd(const MeanStd& m, int decimals) {
   if (m.n == 0) return "—";
+  if (m.n == 1) return fmt::format("{:.{}f} (1 run)", m.mean, decimals);
+  if (m.std == 0.0) return fmt::format("{:.{}f} ({} identical runs)", m.mean, decimals, m.n);
   return fmt::format("{:.{}f} ± {:.{}f}", m.mean, decimals, m.std, decimals);
 }
 
@@ -233,7 +238,7 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
   for (const auto& sensor : sensors) {
     Table t;
     std::string alignment;
-    std::map<std::string, std::vector<double>> improvements;
+    std::map<std::string, std::vector<double>> changes;
     for (const auto& dataset : datasets) {
       std::vector<std::string> row = {dataset};
       bool any = false;
@@ -244,9 +249,9 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
           any = true;
           alignment = g.alignment;
           cell = FormatMeanStd(g.ate_m, 4);
-          if (config != g.baseline && std::isfinite(g.improvement_pct)) {
-            cell += " (" + Percent(g.improvement_pct) + ")";
-            improvements[config].push_back(g.improvement_pct);
+          if (config != g.baseline && std::isfinite(g.ate_change_pct)) {
+            cell += " (" + Percent(g.ate_change_pct) + ")";
+            changes[config].push_back(g.ate_change_pct);
           }
           if (g.ok < g.runs) cell += fmt::format(" [{}/{} ok]", g.ok, g.runs);
           if (g.coverage.n > 0 && g.coverage.mean < kLowCoverage) {
@@ -259,17 +264,17 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
     }
     if (t.rows.empty()) continue;
     t.title = fmt::format(
-        "ATE RMSE [m] ({} alignment), {}: mean ± std over runs (improvement "
-        "over the baseline)",
+        "ATE RMSE [m] ({} alignment), {}: mean ± std over runs (ATE change against the "
+        "baseline; negative = lower error)",
         alignment == "sim3" ? "Sim(3)" : "SE(3)", sensor);
     t.header = {"dataset"};
     t.header.insert(t.header.end(), configs.begin(), configs.end());
-    if (!improvements.empty()) {
-      // The paper's summary lines: mean ATE over the sequences (and its improvement), the mean
-      // of the per-sequence improvements, and on how many sequences a configuration wins.
+    if (!changes.empty()) {
+      // The paper's summary lines: mean ATE over the sequences (and its change), the mean of
+      // the per-sequence changes, and on how many sequences a configuration's ATE is lower.
       std::vector<std::string> mean_row = {"mean over sequences"};
-      std::vector<std::string> avg_row = {"mean of per-sequence improvements"};
-      std::vector<std::string> wins_row = {"better than baseline on"};
+      std::vector<std::string> avg_row = {"mean of per-sequence changes"};
+      std::vector<std::string> wins_row = {"lower ATE than the baseline on"};
       std::map<std::string, double> mean_ate;
       for (const auto& config : configs) {
         std::vector<double> means;
@@ -283,16 +288,16 @@ std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups) {
         std::string cell = fmt::format("{:.4f}", mean_ate[config]);
         const auto b = mean_ate.find(baseline);
         if (config != baseline && b != mean_ate.end() && b->second > 0) {
-          cell += " (" + Percent(100.0 * (b->second - mean_ate[config]) / b->second) + ")";
+          cell += " (" + Percent(100.0 * (mean_ate[config] - b->second) / b->second) + ")";
         }
         mean_row.push_back(cell);
-        const auto it = improvements.find(config);
-        avg_row.push_back(it == improvements.end() ? "" : Percent(ComputeMeanStd(it->second).mean));
-        if (it == improvements.end()) {
+        const auto it = changes.find(config);
+        avg_row.push_back(it == changes.end() ? "" : Percent(ComputeMeanStd(it->second).mean));
+        if (it == changes.end()) {
           wins_row.push_back("");
         } else {
           const auto wins =
-              std::count_if(it->second.begin(), it->second.end(), [](double p) { return p > 0; });
+              std::count_if(it->second.begin(), it->second.end(), [](double p) { return p < 0; });
           wins_row.push_back(fmt::format("{}/{}", wins, it->second.size()));
         }
       }
@@ -333,6 +338,32 @@ Table DetailTable(const std::vector<GroupSummary>& groups) {
   return t;
 }
 
+namespace {
+
+// The (dataset / sensor / selector) lines of a sweep on which no value changed the runs: the same
+// keyframe count and ATE at every value (a parameter the selector does not read, or one whose
+// range never reaches a decision). Said in the table so one flat line is not read as a result.
+std::vector<std::string> SweepLinesWithoutEffect(const std::vector<GroupSummary>& groups,
+                                                 const std::string& param) {
+  std::map<std::string, std::vector<const GroupSummary*>> lines;
+  for (const auto& g : groups) {
+    if (g.sweep_param == param) lines[g.dataset + "/" + g.sensor + "/" + g.selector].push_back(&g);
+  }
+  std::vector<std::string> flat;
+  for (const auto& [name, points] : lines) {
+    if (points.size() < 2) continue;
+    const GroupSummary& first = *points.front();
+    const bool same = std::all_of(points.begin(), points.end(), [&](const GroupSummary* g) {
+      return g->ok == g->runs && g->keyframes.mean == first.keyframes.mean &&
+             g->ate_m.mean == first.ate_m.mean;
+    });
+    if (same) flat.push_back(name);
+  }
+  return flat;
+}
+
+}  // namespace
+
 std::vector<Table> SweepTables(const std::vector<GroupSummary>& groups) {
   std::vector<std::string> params;
   for (const auto& g : groups) {
@@ -345,6 +376,13 @@ std::vector<Table> SweepTables(const std::vector<GroupSummary>& groups) {
   for (const auto& p : params) {
     Table t;
     t.title = "Sweep of " + p;
+    const std::vector<std::string> flat = SweepLinesWithoutEffect(groups, p);
+    if (!flat.empty()) {
+      t.title += fmt::format(
+          " (no value of {} changed the runs of {}: the same keyframes and ATE at every value, so "
+          "the parameter did not act there)",
+          p, fmt::join(flat, ", "));
+    }
     t.header = {"dataset", "sensor", "config", p, "ATE [m]", "keyframes", "ok/runs"};
     const bool dense = std::any_of(groups.begin(), groups.end(), [&](const GroupSummary& g) {
       return g.sweep_param == p && g.dense_points.n > 0;

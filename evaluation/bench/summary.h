@@ -1,6 +1,7 @@
 // Aggregates run results per (dataset, sensor, configuration): mean +- std over the runs that
-// succeeded, and the relative improvement over the baseline configuration as the PKS paper
-// reports it: 100 * (ATE_baseline - ATE) / ATE_baseline (positive = more accurate).
+// succeeded, and the ATE change against the baseline configuration, in one sign convention
+// shared by every table, plot and sentence of the report (bench_statistics.py too):
+// 100 * (ATE - ATE_baseline) / ATE_baseline, negative = lower error (more accurate).
 #pragma once
 
 #include <filesystem>
@@ -58,7 +59,8 @@ struct GroupSummary {
   MeanStd accel_bias_err_pct;
   double ate_median_m = kNaN;
   SpeedMedians speed;
-  double improvement_pct = kNaN;  // vs the baseline group of the same dataset and sensor
+  // ATE change (%) against the baseline group of the same dataset and sensor; negative = lower.
+  double ate_change_pct = kNaN;
   // Sweep points with dense clouds: the PKS paper's Eq. 13 criterion, mean density and mean
   // ATE each min-max normalised over the sweep's values, density_n - ATE_n (the paper picks
   // the value with the largest score).
@@ -71,7 +73,8 @@ std::vector<GroupSummary> Summarize(const std::vector<RunResult>& results);
 // summary.csv: one row per group (the numbers --collect must reproduce).
 void WriteSummaryCsv(const std::filesystem::path& file, const std::vector<GroupSummary>& groups);
 
-// "0.0123 ± 0.0012" (or "—" without values).
+// "0.0123 ± 0.0012" (or "—" without values); "0.0123 (1 run)", and "0.0123 (3 identical runs)"
+// when the runs gave the same value (deterministic runs: a spread of zero is not a measured one).
 std::string FormatMeanStd(const MeanStd& m, int decimals);
 
 // A table: header row and body rows of cells (rendered to Markdown or HTML by report.cc).
@@ -82,9 +85,10 @@ struct Table {
 };
 
 // Headline: one table per sensor, rows = datasets, columns = the non-sweep configurations,
-// cells = ATE mean ± std [m] and the improvement over the baseline, flagged "[cov N%]" when the
-// evaluated trajectory covers less than kLowCoverage of the frames (an ATE over a short piece
-// is not comparable); summary rows as the paper's (mean ATE, mean improvement, wins).
+// cells = ATE mean ± std [m] and the ATE change against the baseline, flagged "[cov N%]" when
+// the evaluated trajectory covers less than kLowCoverage of the frames (an ATE over a short piece
+// is not comparable); summary rows as the paper's (mean ATE and its change, the mean of the
+// per-sequence changes, on how many sequences the ATE is lower).
 inline constexpr double kLowCoverage = 0.9;
 std::vector<Table> HeadlineTables(const std::vector<GroupSummary>& groups);
 // Keyframes, map points, lost frames and timings per group.

@@ -34,7 +34,14 @@ TEST(Summary, MeanAndSampleStd) {
   EXPECT_DOUBLE_EQ(ComputeMeanStd({5.0}).std, 0.0);
 }
 
-TEST(Summary, GroupsInMatrixOrderWithImprovementOverBaseline) {
+TEST(Summary, ASpreadOfZeroSaysTheRunsWereIdentical) {
+  EXPECT_EQ(FormatMeanStd(ComputeMeanStd({0.0123, 0.0123, 0.0123}), 4), "0.0123 (3 identical runs)");
+  EXPECT_EQ(FormatMeanStd(ComputeMeanStd({0.0123}), 4), "0.0123 (1 run)");
+  EXPECT_EQ(FormatMeanStd(ComputeMeanStd({0.01, 0.02}), 3), "0.015 ± 0.007");
+  EXPECT_EQ(FormatMeanStd(ComputeMeanStd({}), 3), "—");
+}
+
+TEST(Summary, GroupsInMatrixOrderWithTheAteChangeAgainstTheBaseline) {
   // Deliberately shuffled input; failed runs count in runs but not in the statistics.
   const std::vector<RunResult> results = {
       Result(3, "A", "pks", 0.08, 30),      Result(0, "A", "orbslam3", 0.10, 50),
@@ -49,18 +56,18 @@ TEST(Summary, GroupsInMatrixOrderWithImprovementOverBaseline) {
   EXPECT_EQ(groups[1].ok, 2);
   EXPECT_NEAR(groups[1].ate_m.mean, 0.075, 1e-12);
   EXPECT_NEAR(groups[1].keyframes.mean, 29.0, 1e-12);
-  EXPECT_NEAR(groups[1].improvement_pct, 25.0, 1e-9);   // (0.10 - 0.075) / 0.10
-  EXPECT_NEAR(groups[3].improvement_pct, -50.0, 1e-9);  // worse than the baseline
-  EXPECT_NEAR(groups[0].improvement_pct, 0.0, 1e-12);
+  EXPECT_NEAR(groups[1].ate_change_pct, -25.0, 1e-9);  // (0.075 - 0.10) / 0.10: lower
+  EXPECT_NEAR(groups[3].ate_change_pct, 50.0, 1e-9);   // higher than the baseline's
+  EXPECT_NEAR(groups[0].ate_change_pct, 0.0, 1e-12);
 
   const auto tables = HeadlineTables(groups);
   ASSERT_EQ(tables.size(), 1u);
   ASSERT_EQ(tables[0].header, (std::vector<std::string>{"dataset", "orbslam3", "pks"}));
-  ASSERT_EQ(tables[0].rows.size(), 5u);  // A, B, mean ATE, mean improvement, wins
-  EXPECT_EQ(tables[0].rows[0][2], "0.0750 ± 0.0071 (+25.0%) [2/3 ok]");
+  ASSERT_EQ(tables[0].rows.size(), 5u);  // A, B, mean ATE, mean change, wins
+  EXPECT_EQ(tables[0].rows[0][2], "0.0750 ± 0.0071 (-25.0%) [2/3 ok]");
   EXPECT_EQ(tables[0].rows[2][1], "0.1500");
-  EXPECT_EQ(tables[0].rows[2][2], "0.1875 (-25.0%)");  // (0.15 - 0.1875) / 0.15
-  EXPECT_EQ(tables[0].rows[3][2], "-12.5%");
+  EXPECT_EQ(tables[0].rows[2][2], "0.1875 (+25.0%)");  // (0.1875 - 0.15) / 0.15
+  EXPECT_EQ(tables[0].rows[3][2], "+12.5%");
   EXPECT_EQ(tables[0].rows[4][2], "1/2");
   EXPECT_EQ(FailureTable(results).rows.size(), 1u);
   // Every table's rows are as wide as its header (a missing header cell shifts the columns).
@@ -74,7 +81,7 @@ TEST(Summary, GroupsInMatrixOrderWithImprovementOverBaseline) {
   for (auto& r : partial) {
     if (r.dataset == "B" && r.config == "pks") r.coverage = 0.25;
   }
-  EXPECT_EQ(HeadlineTables(Summarize(partial))[0].rows[1][2], "0.3000 ± 0.0000 (-50.0%) [cov 25%]");
+  EXPECT_EQ(HeadlineTables(Summarize(partial))[0].rows[1][2], "0.3000 (1 run) (+50.0%) [cov 25%]");
   const std::string md = MarkdownTable(tables[0]);
   EXPECT_NE(md.find("| dataset | orbslam3 | pks |"), std::string::npos) << md;
 }
@@ -155,6 +162,30 @@ TEST(Summary, SweepScoreFollowsEquation13) {
   const auto plain = Summarize(results);
   EXPECT_TRUE(std::isnan(plain[2].sweep_score));
   EXPECT_EQ(SweepTables(plain)[0].header.back(), "ok/runs");
+}
+
+// A swept parameter that changed nothing (same keyframes and ATE at every value) is named in the
+// sweep's table instead of plotting as a flat line without a word.
+TEST(Summary, ASweepWhoseParameterDidNotActIsSaidSo) {
+  std::vector<RunResult> results;
+  for (int i = 0; i < 3; ++i) {
+    for (const char* selector : {"pks", "orbslam3"}) {
+      const bool acts = std::string(selector) == "pks";
+      RunResult r = Result(static_cast<int>(results.size()), "V1",
+                           std::string(selector) + "@tau=" + std::to_string(i),
+                           acts ? 0.01 * (i + 1) : 0.02, acts ? 20 + i : 30);
+      r.selector = selector;
+      r.sweep_param = "tau";
+      r.sweep_value = i;
+      results.push_back(r);
+    }
+  }
+  const auto tables = SweepTables(Summarize(results));
+  ASSERT_EQ(tables.size(), 1u);
+  EXPECT_NE(tables[0].title.find("no value of tau changed the runs of V1/"), std::string::npos)
+      << tables[0].title;
+  EXPECT_NE(tables[0].title.find("/orbslam3"), std::string::npos) << tables[0].title;
+  EXPECT_EQ(tables[0].title.find("/pks"), std::string::npos) << tables[0].title;
 }
 
 TEST(Summary, ReasonTableCountsEveryRuleAKeyframeNames) {

@@ -64,8 +64,8 @@ def per_sequence_table(result, datasets, sensors, configs, baseline):
                     text += f", {o['failures']}/{o['runs']} failed"
                 s = change.get((dataset, sensor, config))
                 if s is not None:
-                    text += (f" ({pct(-s['improvement_pct'])} [{pct(-s['ci_high'])}, "
-                             f"{pct(-s['ci_low'])}], p = {s['p']:.2g})")
+                    text += (f" ({pct(s['ate_change_pct'])} [{pct(s['ci_low'])}, "
+                             f"{pct(s['ci_high'])}], p = {s['p']:.2g})")
                 cells.append(text)
             lines.append(f"| {short(dataset)} | {sensor} | " + " | ".join(cells) + " |")
     return lines
