@@ -4,25 +4,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <unordered_map>
 
 #include "core/util/error.h"
-#include "core/util/json_writer.h"
-#include "evaluation/evaluate.h"
 #include "io/json_file.h"
 #include "io/point_cloud.h"
 #include "io/rigid_transform_file.h"
 #include "io/text_rows.h"
 #include "io/trajectory.h"
+#include "viewer/view_tracks.h"
 
 namespace pkslam {
 
 namespace fs = std::filesystem;
 
+TrajectorySensorFrame ParseTrajectorySensorFrame(std::string_view name) {
+  if (name == "body") return TrajectorySensorFrame::kBody;
+  if (name == "camera") return TrajectorySensorFrame::kCamera;
+  throw OptionError(fmt::format("option --trajectory-frame: '{}' (body or camera)", name));
+}
+
 void ViewOptions::Check() const {
   PKSLAM_CHECK_OPTION(!run.empty(), "--run", "{}", "a run folder is required");
   PKSLAM_CHECK_OPTION(max_map_points > 0 && max_cloud_points > 0, "point budgets", "{} / {}",
                       max_map_points, max_cloud_points);
+  if ((!more_runs.empty() || !trajectories.empty()) && ground_truth.empty() && dataset.empty()) {
+    throw OptionError(
+        "option --gt or --dataset: needed with several runs or a --trajectory (each is aligned "
+        "to the ground truth, so they share one frame)");
+  }
+  PKSLAM_CHECK_OPTION(trajectory_alignment == AlignmentMethod::kSE3 ||
+                          trajectory_alignment == AlignmentMethod::kSim3,
+                      "--trajectory-align", "{} (se3 or sim3)",
+                      AlignmentMethodName(trajectory_alignment));
 }
 
 namespace {
@@ -100,7 +115,7 @@ ViewData LoadViewData(const ViewOptions& options) {
   const fs::path& run = options.run;
   if (!fs::is_directory(run)) throw InputError(run, "not a run folder");
   ViewData data;
-  data.title = fs::absolute(run).filename().string();
+  data.title = RunFolderName(run);
   fs::path gt = options.ground_truth;
   if (gt.empty() && !options.dataset.empty()) {
     const auto found = FindDatasetGroundTruth(options.dataset);
@@ -113,31 +128,20 @@ ViewData LoadViewData(const ViewOptions& options) {
   }
 
   Sim3d world_from_map;  // the displayed world from the run's map world
+  Trajectory shown_ground_truth;
+  bool shown_in_camera = true;
   if (!gt.empty()) {
     // Camera poses throughout (the ground truth moved into the camera when the run has the
     // extrinsic): the keyframe frustums are cameras, and drawn along a body path they sat a
     // lever arm (6.7 cm on EuRoC) off it.
-    const RunAndGroundTruth pair = ReadRunAndGroundTruth(run, gt, /*monocular=*/true);
+    RunAndGroundTruth pair = ReadRunAndGroundTruth(run, gt, /*monocular=*/true);
     const bool monocular = !fs::exists(run / "trajectory_body.txt");
-    EvaluationOptions eval;
-    eval.alignment = monocular ? AlignmentMethod::kSim3 : AlignmentMethod::kSE3;
-    eval.compute_rpe = false;
-    eval.allow_frame_offset = true;  // the run's own frame pairing (as the bench); for drawing
-    const EvaluationResult e = EvaluateTrajectories(pair.ground_truth, pair.estimate, eval);
-    world_from_map = e.ref_from_est;
-    data.alignment = monocular ? "sim3" : "se3";
-    data.ate_rmse_m = e.ate_translation_m.rmse;
-    std::vector<double> ate(pair.estimate.poses.size(), -1.0);
-    for (std::size_t i = 0; i < e.pairs.size(); ++i) {
-      ate[e.pairs[i].est] = e.ate_translation_errors_m[i];
-    }
-    for (std::size_t i = 0; i < pair.estimate.poses.size(); ++i) {
-      const StampedPose& p = pair.estimate.poses[i];
-      data.estimate.push_back(
-          {static_cast<double>(p.t_ns) * 1e-9,
-           SE3d(world_from_map.so3() * p.pose.so3(), world_from_map * p.pose.translation()),
-           ate[i]});
-    }
+    const AlignmentMethod method = monocular ? AlignmentMethod::kSim3 : AlignmentMethod::kSE3;
+    AlignedEstimate aligned = AlignToGroundTruth(pair.ground_truth, pair.estimate, method);
+    world_from_map = aligned.world_from_map;
+    data.alignment = std::string(AlignmentMethodName(method));
+    data.ate_rmse_m = aligned.ate_rmse_m;
+    data.estimate = std::move(aligned.poses);
     // The ground truth over the estimate's time span, at most ~5000 vertices.
     const auto& g = pair.ground_truth.poses;
     const std::int64_t t0 = pair.estimate.poses.empty() ? 0 : pair.estimate.poses.front().t_ns;
@@ -149,6 +153,8 @@ ViewData LoadViewData(const ViewOptions& options) {
       }
     }
     data.ground_truth = Subsample(path, 5000);
+    shown_in_camera = pair.estimate_file.filename() == "trajectory.txt";
+    shown_ground_truth = std::move(pair.ground_truth);
   } else {
     data.alignment = "none";
     const Trajectory t = ReadTrajectory(run / "trajectory.txt");
@@ -156,9 +162,6 @@ ViewData LoadViewData(const ViewOptions& options) {
       data.estimate.push_back({static_cast<double>(p.t_ns) * 1e-9, p.pose, -1.0});
     }
   }
-  auto to_world = [&](const SE3d& pose) {
-    return SE3d(world_from_map.so3() * pose.so3(), world_from_map * pose.translation());
-  };
 
   // Keyframes and the rule that created each.
   std::unordered_map<std::int64_t, std::string> reasons;  // by time (us)
@@ -182,7 +185,9 @@ ViewData LoadViewData(const ViewOptions& options) {
           insert = f == "1";
         } else if (header[i] == "reason") {
           reason = std::string(f);
-        } else if (header[i] != "selector" && !f.empty()) {
+        } else if (header[i] == "selector") {
+          if (data.selector.empty()) data.selector = std::string(f);
+        } else if (!f.empty()) {
           if (const auto v = ParseDouble(f)) values[header[i]] = *v;
         }
       }
@@ -191,12 +196,9 @@ ViewData LoadViewData(const ViewOptions& options) {
       trace_rows.emplace_back(reason, std::move(values));
     });
   }
-  if (fs::exists(run / "keyframes.txt")) {
-    for (const StampedPose& p : ReadTrajectory(run / "keyframes.txt").poses) {
-      const double t = static_cast<double>(p.t_ns) * 1e-9;
-      const auto it = reasons.find(Micros(t));
-      data.keyframes.push_back({t, to_world(p.pose), it != reasons.end() ? it->second : ""});
-    }
+  data.keyframes = ReadRunKeyframes(run, world_from_map);
+  for (ViewKeyframe& k : data.keyframes) {
+    if (const auto it = reasons.find(Micros(k.t_s)); it != reasons.end()) k.reason = it->second;
   }
 
   // Map points and the dense cloud, in the displayed world.
@@ -243,98 +245,23 @@ ViewData LoadViewData(const ViewOptions& options) {
   }
   data.warnings = RunWarnings(run / "stats.json");
   ReadCalibration(run / "stats.json", &data);
+
+  // Further runs and bare trajectories, aligned to the same ground truth (Check: there is one).
+  for (const fs::path& r : options.more_runs) data.tracks.push_back(LoadRunTrack(r, gt));
+  for (const ViewTrajectoryFile& f : options.trajectories) {
+    data.tracks.push_back(LoadTrajectoryTrack(f, shown_ground_truth, shown_in_camera, run,
+                                              options.trajectory_alignment));
+  }
+  // Labels name the legend's rows: two runs in folders of the same name get "name (2)".
+  std::vector<std::string> labels{data.title};
+  for (ViewTrack& t : data.tracks) {
+    const std::string base = t.label;
+    for (int n = 2; std::find(labels.begin(), labels.end(), t.label) != labels.end(); ++n) {
+      t.label = fmt::format("{} ({})", base, n);
+    }
+    labels.push_back(t.label);
+  }
   return data;
-}
-
-namespace {
-
-void Vec3(JsonWriter& json, const Eigen::Vector3d& v) {
-  json.BeginArray();
-  for (int i = 0; i < 3; ++i) json.Value(std::round(v[i] * 1e4) / 1e4);
-  json.EndArray();
-}
-
-}  // namespace
-
-std::string ViewDataJson(const ViewData& data) {
-  JsonWriter json(0);
-  json.BeginObject();
-  json.Member("title", data.title);
-  json.Member("alignment", data.alignment);
-  json.Member("ate_rmse_m", data.ate_rmse_m);
-  json.Key("warnings").BeginArray();
-  for (const std::string& w : data.warnings) json.Value(w);
-  json.EndArray();
-  // Flat arrays keep a 60 s run small: t, x, y, z, qx, qy, qz, qw, ate per pose.
-  json.Key("estimate").BeginArray();
-  for (const ViewPose& p : data.estimate) {
-    const Eigen::Vector3d& t = p.world_from_camera.translation();
-    const Eigen::Quaterniond& q = p.world_from_camera.quaternion();
-    for (double v : {p.t_s, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w(), p.ate_m}) {
-      json.Value(std::round(v * 1e5) / 1e5);
-    }
-  }
-  json.EndArray();
-  json.Key("ground_truth").BeginArray();
-  for (const Eigen::Vector3d& p : data.ground_truth) {
-    for (int i = 0; i < 3; ++i) json.Value(std::round(p[i] * 1e4) / 1e4);
-  }
-  json.EndArray();
-  json.Key("keyframes").BeginArray();
-  for (const ViewKeyframe& k : data.keyframes) {
-    json.BeginObject();
-    json.Member("t", k.t_s);
-    json.Key("p");
-    Vec3(json, k.world_from_camera.translation());
-    const Eigen::Quaterniond& q = k.world_from_camera.quaternion();
-    json.Key("q").BeginArray().Value(q.x()).Value(q.y()).Value(q.z()).Value(q.w()).EndArray();
-    json.Member("reason", k.reason);
-    json.EndObject();
-  }
-  json.EndArray();
-  auto points = [&](std::string_view key, const std::vector<Eigen::Vector3f>& pts) {
-    json.Key(key).BeginArray();
-    for (const Eigen::Vector3f& p : pts) {
-      for (int i = 0; i < 3; ++i) json.Value(std::round(static_cast<double>(p[i]) * 1e3) / 1e3);
-    }
-    json.EndArray();
-  };
-  points("map_points", data.map_points);
-  points("cloud", data.cloud);
-  json.Key("cloud_colours").BeginArray();
-  for (const auto& c : data.cloud_colours) {
-    for (int i = 0; i < 3; ++i) json.Value(static_cast<int>(c[static_cast<std::size_t>(i)]));
-  }
-  json.EndArray();
-  json.Key("calibration").BeginArray();
-  for (const ViewCalibrationStep& s : data.calibration) {
-    json.BeginObject();
-    json.Member("t", s.t_s);
-    json.Key("e").BeginObject();
-    for (const auto& [k, v] : s.estimate) json.Member(k, v);
-    json.EndObject();
-    json.EndObject();
-  }
-  json.EndArray();
-  json.Key("calibration_file").BeginObject();
-  for (const auto& [k, v] : data.calibration_file) json.Member(k, v);
-  json.EndObject();
-  json.Key("timeline").BeginArray();
-  for (const ViewTimelineRow& r : data.timeline) {
-    json.BeginObject();
-    json.Member("t", r.t_s).Member("frame", r.frame).Member("state", r.state);
-    json.Member("tracked", r.tracked_points).Member("kf", r.keyframe);
-    if (!r.decision_reason.empty()) json.Member("reason", r.decision_reason);
-    if (!r.quantities.empty()) {
-      json.Key("q").BeginObject();
-      for (const auto& [k, v] : r.quantities) json.Member(k, v);
-      json.EndObject();
-    }
-    json.EndObject();
-  }
-  json.EndArray();
-  json.EndObject();
-  return json.str();
 }
 
 }  // namespace pkslam

@@ -3,20 +3,39 @@
 // the keyframes with the rule that created each (keyframe_trace.csv, from --trace), the map
 // points, an optional dense cloud or mesh vertices (subsampled), and the per-frame timeline
 // (frames.csv: tracking state and tracked points; keyframe_trace.csv: decision, reason and
-// every selector quantity such as PKS's M, D, Th and ECOG).
+// every selector quantity such as PKS's M, D, Th and ECOG). Beside the run, further runs and
+// bare trajectory files (issue 41), each aligned to the same ground truth (view_tracks.h).
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/geometry/se3.h"
+#include "evaluation/alignment.h"
 
 namespace pkslam {
+
+// The sensor a bare trajectory file describes (ORB-SLAM3 writes the IMU body for inertial
+// runs, the camera otherwise).
+enum class TrajectorySensorFrame { kBody, kCamera };
+
+// "body" or "camera"; throws OptionError otherwise.
+TrajectorySensorFrame ParseTrajectorySensorFrame(std::string_view name);
+
+// A bare trajectory shown beside the run: another system's estimate, such as ORB-SLAM3's
+// f_*.txt (TUM, EuRoC or ORB-SLAM3 format, detected by io/trajectory.h).
+struct ViewTrajectoryFile {
+  std::filesystem::path file;
+  std::string label;  // empty: the file's name
+  TrajectorySensorFrame frame = TrajectorySensorFrame::kBody;
+};
 
 struct ViewOptions {
   std::filesystem::path run;
@@ -25,6 +44,11 @@ struct ViewOptions {
   std::filesystem::path cloud;         // empty: RUN/dense.ply when present
   std::size_t max_map_points = 200000;
   std::size_t max_cloud_points = 300000;
+  // Shown beside `run`, aligned to the same ground truth (which they require): further runs
+  // (trajectory and keyframes) and bare trajectory files.
+  std::vector<std::filesystem::path> more_runs;
+  std::vector<ViewTrajectoryFile> trajectories;
+  AlignmentMethod trajectory_alignment = AlignmentMethod::kSE3;  // of the bare files: se3|sim3
 
   void Check() const;
 };
@@ -58,8 +82,19 @@ struct ViewCalibrationStep {
   std::map<std::string, double> estimate;
 };
 
+// A further run or bare trajectory, aligned to the run's ground truth as the run is.
+struct ViewTrack {
+  std::string label;
+  std::string source;     // "run" or "trajectory"
+  std::string alignment;  // "se3" or "sim3"
+  double ate_rmse_m = -1;
+  std::vector<ViewPose> estimate;
+  std::vector<ViewKeyframe> keyframes;  // a run's (reason not read); none for a bare file
+};
+
 struct ViewData {
   std::string title;
+  std::string selector;   // the keyframe selector of keyframe_trace.csv ("" without --trace)
   std::string alignment;  // "se3", "sim3" or "none"
   double ate_rmse_m = -1;
   std::vector<ViewPose> estimate;
@@ -76,9 +111,12 @@ struct ViewData {
   // off or older runs).
   std::vector<ViewCalibrationStep> calibration;
   std::map<std::string, double> calibration_file;
+  // Further runs and bare trajectories (ViewOptions::more_runs, trajectories), in that order.
+  std::vector<ViewTrack> tracks;
 };
 
-// Reads the run (InputError naming the missing or malformed file).
+// Reads the run and the tracks beside it (InputError naming the missing or malformed file,
+// OptionError for tracks without ground truth).
 ViewData LoadViewData(const ViewOptions& options);
 
 // The data as one JSON object (the page's PKSLAM_DATA).

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/util/error.h"
 #include "core/util/output_file.h"
@@ -45,18 +46,42 @@ std::string ScriptSafe(const std::string& text) {
   return out;
 }
 
+// The timeline is 150 px high; its strip and scrubber start GUTTER (64) px in
+// (viewer_strip.js), so the strip's time axis lines up with the scrubber.
 constexpr const char* kStyle = R"(
 html, body { margin: 0; height: 100%; overflow: hidden; font: 13px sans-serif; background: #fff; }
-#view { position: absolute; inset: 0 0 110px 0; }
+#view { position: absolute; inset: 0 0 150px 0; }
 #panel { position: absolute; top: 8px; left: 8px; background: rgba(255,255,255,0.92);
-  border: 1px solid #ccc; padding: 6px 10px; max-width: 320px; }
+  border: 1px solid #ccc; padding: 6px 10px; max-width: 340px; max-height: calc(100% - 180px);
+  overflow-y: auto; font-size: 12px; }
 #panel h1 { font-size: 14px; margin: 0 0 4px 0; }
 #panel .warning { color: #b00000; font-weight: bold; margin: 2px 0 4px 0; }
-#legend span { display: inline-block; width: 10px; height: 10px; margin-right: 4px; }
-#timeline { position: absolute; left: 0; right: 0; bottom: 0; height: 110px; background: #f4f4f4;
-  border-top: 1px solid #ccc; padding: 4px 10px; box-sizing: border-box; }
-#scrub { width: 100%; }
-#strip { width: 100%; height: 46px; display: block; }
+#panel .sec { font-weight: bold; margin: 6px 0 2px 0; border-bottom: 1px solid #ddd; }
+#panel .sub { margin-left: 18px; }
+#panel .gloss { color: #555; }
+#panel #legend { margin-left: 18px; }
+#panel .rule { display: inline-block; margin: 1px 10px 1px 0; white-space: nowrap; }
+#panel details { margin-left: 18px; }
+#panel summary { cursor: pointer; color: #333; }
+#panel .hint { color: #777; margin-top: 6px; }
+.sw { display: inline-block; width: 10px; height: 10px; margin-right: 4px; vertical-align: middle; }
+.sw.line { height: 3px; width: 14px; }
+.sw.dot { border-radius: 50%; width: 7px; height: 7px; }
+.sw.tick { width: 2px; height: 10px; }
+.sw.ramp { width: 14px; height: 4px; }
+.ramp-bar { display: inline-block; width: 150px; height: 8px; vertical-align: middle; }
+.ramp-ticks { display: inline-flex; justify-content: space-between; width: 190px; }
+#scalebar { position: absolute; right: 12px; bottom: 160px; background: rgba(255,255,255,0.85);
+  padding: 2px 6px; font-size: 12px; text-align: center; }
+#scalebar-bar { height: 5px; border: 2px solid #000; border-top: none; margin: 0 auto 1px auto; }
+#timeline { position: absolute; left: 0; right: 0; bottom: 0; height: 150px; background: #f4f4f4;
+  border-top: 1px solid #ccc; padding: 3px 10px; box-sizing: border-box; }
+#striplegend { font-size: 11px; white-space: nowrap; overflow: hidden; text-overflow: ellipsis;
+  height: 15px; }
+#striplegend .entry { margin-right: 12px; }
+#striplegend .note { color: #777; }
+#strip { width: 100%; height: 78px; display: block; }
+#scrub { margin: 0 0 0 64px; width: calc(100% - 64px); box-sizing: border-box; }
 #frameinfo { white-space: nowrap; overflow: hidden; text-overflow: ellipsis; }
 )";
 
@@ -64,38 +89,54 @@ html, body { margin: 0; height: 100%; overflow: hidden; font: 13px sans-serif; b
 
 namespace {
 
-struct Scripts {
-  fs::path three, orbit, viewer;
-};
+// The page's scripts in load order: three.js, its OrbitControls, then pkslam's (viewer.js last:
+// it draws with the helpers the others define).
+constexpr const char* kViewerScripts[] = {"viewer/viewer_scene.js", "viewer/viewer_legend.js",
+                                          "viewer/viewer_strip.js", "viewer/viewer.js"};
 
-Scripts FindScripts(const ViewPageOptions& options) {
+std::vector<fs::path> FindScripts(const ViewPageOptions& options) {
   const std::string hint = "install Debian's libjs-three, or pass --three-js DIR";
-  Scripts s{options.three_dir / "three.min.js",
-            options.three_dir / "examples/js/controls/OrbitControls.js",
-            FindProjectFile("viewer/viewer.js")};
-  for (const fs::path& f : {s.three, s.orbit}) {
+  std::vector<fs::path> s{options.three_dir / "three.min.js",
+                          options.three_dir / "examples/js/controls/OrbitControls.js"};
+  for (const fs::path& f : s) {
     if (!fs::exists(f)) throw Error(fmt::format("{} not found ({})", f.string(), hint));
   }
-  if (!fs::exists(s.viewer)) throw Error(s.viewer.string() + " not found (the source tree's)");
+  for (const char* name : kViewerScripts) {
+    s.push_back(FindProjectFile(name));
+    if (!fs::exists(s.back())) throw Error(s.back().string() + " not found (the source tree's)");
+  }
   return s;
+}
+
+// Copies each script into dir unless an identical copy is there (a folder shared by many
+// pages stays as it is; one made by an older version gets the scripts this page needs).
+void CopyScripts(const std::vector<fs::path>& scripts, const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw OutputError(dir, "cannot create: " + ec.message());
+  for (const fs::path& f : scripts) {
+    const std::string text = ReadAll(f, "viewer script");
+    const fs::path target = dir / f.filename();
+    if (fs::exists(target) && ReadAll(target, "shared viewer script") == text) continue;
+    WriteFileAtomically(target, text);
+  }
 }
 
 }  // namespace
 
 void CopyViewScripts(const fs::path& dir, const ViewPageOptions& options) {
-  const Scripts s = FindScripts(options);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw OutputError(dir, "cannot create: " + ec.message());
-  for (const fs::path& f : {s.three, s.orbit, s.viewer}) {
-    WriteFileAtomically(dir / f.filename(), ReadAll(f, "viewer script"));
-  }
+  CopyScripts(FindScripts(options), dir);
 }
 
 void WriteViewPage(const ViewData& data, const fs::path& file, const ViewPageOptions& options) {
   options.Check();
-  const Scripts scripts = FindScripts(options);
+  const std::vector<fs::path> scripts = FindScripts(options);
   const bool inline_scripts = options.shared_scripts.empty();
+  if (!inline_scripts) {
+    fs::path page_dir = file.parent_path();
+    if (page_dir.empty()) page_dir = ".";
+    CopyScripts(scripts, page_dir / options.shared_scripts);
+  }
   auto script = [&](const fs::path& f) {
     if (!inline_scripts) {
       return fmt::format("<script src=\"{}\"></script>\n",
@@ -111,13 +152,16 @@ void WriteViewPage(const ViewData& data, const fs::path& file, const ViewPageOpt
   page +=
       "</style>\n</head><body>\n"
       "<div id=\"view\"></div>\n<div id=\"panel\"></div>\n"
-      "<div id=\"timeline\"><canvas id=\"strip\"></canvas><input id=\"scrub\" "
-      "type=\"range\" min=\"0\" max=\"0\" value=\"0\"><div id=\"frameinfo\"></div></div>\n"
+      "<div id=\"scalebar\"><div id=\"scalebar-bar\"></div><div id=\"scalebar-text\"></div>"
+      "</div>\n"
+      "<div id=\"timeline\"><div id=\"striplegend\"></div><canvas id=\"strip\"></canvas>"
+      "<input id=\"scrub\" type=\"range\" min=\"0\" max=\"0\" value=\"0\">"
+      "<div id=\"frameinfo\"></div></div>\n"
       "<div id=\"status\" data-state=\"loading\" hidden></div>\n";
-  page += script(scripts.three);
-  page += script(scripts.orbit);
+  // three.js and OrbitControls, the data, then pkslam's scripts.
+  for (std::size_t i = 0; i < 2; ++i) page += script(scripts[i]);
   page += "<script>\nconst PKSLAM_DATA = " + ScriptSafe(ViewDataJson(data)) + ";\n</script>\n";
-  page += script(scripts.viewer);
+  for (std::size_t i = 2; i < scripts.size(); ++i) page += script(scripts[i]);
   page += "</body></html>\n";
   WriteFileAtomically(file, page);
 }

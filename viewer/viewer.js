@@ -1,9 +1,12 @@
-// pkslam view: draws PKSLAM_DATA (viewer/view_data.h) with three.js. Layers: the estimated
-// trajectory coloured by its ATE (blue = small, red = the 95th percentile or more), the ground
-// truth (grey), keyframe frustums coloured by the rule that created them, map points, dense
-// cloud; a timeline scrubber moves a marker along the trajectory and shows the frame's
-// tracking state, keyframe decision and selector quantities. #status reports "drawn" (with
-// the time to the first frame) or "error" for tests.
+// pkslam view: draws PKSLAM_DATA (viewer/view_data.h) with three.js and the helpers of
+// viewer_scene.js, viewer_legend.js and viewer_strip.js (loaded before it). Layers: the
+// estimated trajectory coloured by its ATE (blue = small, red = the 95th percentile or more),
+// further runs and trajectory files in their own colours, the ground truth (grey), keyframe
+// frustums coloured by the rule that created them, map points, dense cloud, world axes, a
+// ground grid and a scale bar; a timeline scrubber moves a marker along the trajectory and
+// shows the frame's tracking state, keyframe decision and selector quantities. #status reports
+// "drawn" (with the time to the first frame) or "error"; window.pkslamView describes what was
+// drawn, for tests.
 (function () {
   'use strict';
   const status = document.getElementById('status');
@@ -18,8 +21,13 @@
   console.error = function (...args) { fail(args.join(' ')); consoleError(...args); };
 
   const D = PKSLAM_DATA;
+  const S = PkslamScene;
   const RULE_COLOURS = ['#d62728', '#2ca02c', '#ff7f0e', '#9467bd', '#8c564b', '#e377c2',
                         '#17becf', '#bcbd22'];
+  // Further runs and trajectory files: a categorical palette apart from the rule colours and
+  // the ATE ramp (none has a top channel of 222 to 236 with another near 0).
+  const TRACK_COLOURS = ['#1b9e77', '#d95f02', '#7570b3', '#e7298a', '#66a61e', '#a6761d',
+                         '#1f1f1f', '#b8860b'];
   const COLOURS = { groundTruth: 0x888888, mapPoints: 0x2828c8, marker: 0xff00ff,
                     noReason: 0x555555, cloud: 0x9a9a9a };
 
@@ -35,15 +43,10 @@
   const zUp = D.alignment !== 'none';
   camera.up.set(0, zUp ? 0 : -1, zUp ? 1 : 0);
 
-  // Estimate: flat array t, x, y, z, qx, qy, qz, qw, ate per pose.
-  const E = D.estimate;
-  const poses = [];
-  for (let i = 0; i + 8 < E.length; i += 9) {
-    poses.push({ t: E[i], p: new THREE.Vector3(E[i + 1], E[i + 2], E[i + 3]), ate: E[i + 8] });
-  }
+  const poses = S.readPoses(D.estimate);
   const ates = poses.map((p) => p.ate).filter((a) => a >= 0).sort((a, b) => a - b);
   const ateTop = ates.length ? Math.max(1e-9, ates[Math.floor(0.95 * (ates.length - 1))]) : 0;
-  function ateColour(a) {  // blue -> cyan -> green -> yellow -> red
+  function ateColour(a) {  // blue -> cyan -> green -> yellow -> red (viewer_legend.js ateRampCss)
     if (a < 0 || !ateTop) return new THREE.Color(0x1f77b4);
     const x = Math.min(1, a / ateTop);
     const c = new THREE.Color();
@@ -51,6 +54,7 @@
     return c;
   }
 
+  // Layers: name -> three.js object (or {visible, element} for an overlay), one checkbox each.
   const layers = {};
   function addLayer(name, object, visible = true) {
     object.visible = visible;
@@ -58,19 +62,21 @@
     layers[name] = object;
   }
 
+  // Trajectories: the run's coloured by ATE, then further runs and files in their colours.
+  const tracks = [];
   if (poses.length > 1) {
-    const g = new THREE.BufferGeometry();
-    const pos = new Float32Array(poses.length * 3);
-    const col = new Float32Array(poses.length * 3);
-    poses.forEach((p, i) => {
-      pos.set([p.p.x, p.p.y, p.p.z], 3 * i);
-      const c = ateColour(p.ate);
-      col.set([c.r, c.g, c.b], 3 * i);
-    });
-    g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-    g.setAttribute('color', new THREE.BufferAttribute(col, 3));
-    addLayer('estimate', new THREE.Line(g, new THREE.LineBasicMaterial({ vertexColors: true })));
+    addLayer('estimate', S.trajectoryLine(poses, null, (p) => ateColour(p.ate)));
+    tracks.push({ label: D.title, layer: 'estimate', ate: D.ate_rmse_m, alignment: D.alignment,
+                  source: 'run', colour: null, poses });
   }
+  (D.tracks || []).forEach((t, i) => {
+    const colour = TRACK_COLOURS[i % TRACK_COLOURS.length];
+    const p = S.readPoses(t.estimate);
+    const layer = `trajectory: ${t.label}`;
+    addLayer(layer, S.trajectoryLine(p, new THREE.Color(colour), null));
+    tracks.push({ label: t.label, layer, ate: t.ate_rmse_m, alignment: t.alignment,
+                  source: t.source, colour, poses: p, keyframes: t.keyframes });
+  });
   if (D.ground_truth.length >= 6) {
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(D.ground_truth), 3));
@@ -78,9 +84,9 @@
              new THREE.Line(g, new THREE.LineBasicMaterial({ color: COLOURS.groundTruth })));
   }
 
-  // Scene size (for frustums and the initial view).
+  // Scene size (for frustums, grid, axes and the initial view).
   const box = new THREE.Box3();
-  poses.forEach((p) => box.expandByPoint(p.p));
+  tracks.forEach((t) => t.poses.forEach((p) => box.expandByPoint(p.p)));
   for (let i = 0; i + 2 < D.ground_truth.length; i += 3) {
     box.expandByPoint(new THREE.Vector3(D.ground_truth[i], D.ground_truth[i + 1],
                                         D.ground_truth[i + 2]));
@@ -89,37 +95,24 @@
   if (box.isEmpty()) box.expandByPoint(new THREE.Vector3(0, 0, 0));
   const size = Math.max(box.getSize(new THREE.Vector3()).length(), 0.1);
 
-  // Keyframe frustums, coloured by rule.
+  // Keyframe frustums: the run's coloured by rule, further runs' in their colour (hidden at
+  // first).
   const reasons = [...new Set(D.keyframes.map((k) => k.reason))].sort();
   const reasonColour = {};
   reasons.forEach((r, i) => {
     reasonColour[r] = r === '' ? COLOURS.noReason
                                : new THREE.Color(RULE_COLOURS[i % RULE_COLOURS.length]).getHex();
   });
+  const counts = {};
+  D.keyframes.forEach((k) => { counts[k.reason] = (counts[k.reason] || 0) + 1; });
   if (D.keyframes.length) {
-    const s = 0.025 * size;
-    const corners = [[-1, -0.75, 1.2], [1, -0.75, 1.2], [1, 0.75, 1.2], [-1, 0.75, 1.2]]
-      .map((c) => new THREE.Vector3(c[0] * s, c[1] * s, c[2] * s));
-    const pos = [];
-    const col = [];
-    D.keyframes.forEach((k) => {
-      const q = new THREE.Quaternion(k.q[0], k.q[1], k.q[2], k.q[3]);
-      const o = new THREE.Vector3(...k.p);
-      const w = corners.map((c) => c.clone().applyQuaternion(q).add(o));
-      const segs = [[o, w[0]], [o, w[1]], [o, w[2]], [o, w[3]],
-                    [w[0], w[1]], [w[1], w[2]], [w[2], w[3]], [w[3], w[0]]];
-      const c = new THREE.Color(reasonColour[k.reason]);
-      segs.forEach(([a, b]) => {
-        pos.push(a.x, a.y, a.z, b.x, b.y, b.z);
-        col.push(c.r, c.g, c.b, c.r, c.g, c.b);
-      });
-    });
-    const g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(pos), 3));
-    g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(col), 3));
-    addLayer('keyframes',
-             new THREE.LineSegments(g, new THREE.LineBasicMaterial({ vertexColors: true })));
+    addLayer('keyframes', S.frustums(D.keyframes, 0.025 * size, (k) => reasonColour[k.reason]));
   }
+  tracks.forEach((t) => {
+    if (!t.keyframes || !t.keyframes.length) return;
+    t.kfLayer = `keyframes: ${t.label}`;
+    addLayer(t.kfLayer, S.frustums(t.keyframes, 0.025 * size, () => t.colour), false);
+  });
 
   function pointsLayer(name, flat, colours, colour, pixels, visible) {
     if (flat.length < 3) return;
@@ -138,6 +131,21 @@
   pointsLayer('map points', D.map_points, null, COLOURS.mapPoints, 2, true);
   pointsLayer('dense cloud', D.cloud, D.cloud_colours, COLOURS.cloud, 1, D.cloud.length > 0);
 
+  // Reference: world axes at the origin, a ground grid under the paths (horizontal: the x-y
+  // plane with ground truth, z up; the first camera's x-z plane without, y down), a scale bar.
+  const upAxis = zUp ? 2 : 1;
+  const extent = box.getSize(new THREE.Vector3()).toArray().filter((_, i) => i !== upAxis);
+  const gridCell = S.roundStep(Math.max(0.1, ...extent) / 8);
+  addLayer('grid', S.makeGrid(box, upAxis, zUp ? 1 : -1, gridCell));
+  const gridPlane = zUp ? 'horizontal (x-y plane) at the lowest point of the paths'
+                        : 'in the first camera\'s x-z plane below the paths (no ground truth: ' +
+                          'map frame, y down)';
+  const axesLength = S.roundStep(size / 6);
+  addLayer('axes', S.makeAxes(axesLength));
+  const scaleBarElement = document.getElementById('scalebar');
+  layers['scale bar'] = { visible: true, element: scaleBarElement };
+  let scaleBarMetres = 0;
+
   const marker = new THREE.Mesh(new THREE.SphereGeometry(0.012 * size, 12, 8),
                                 new THREE.MeshBasicMaterial({ color: COLOURS.marker }));
   scene.add(marker);
@@ -155,36 +163,21 @@
   camera.updateProjectionMatrix();
   controls.update();
 
-  // Panel: summary, legend, layer toggles.
+  // Panel: summary, legends for every colour, a checkbox per layer (viewer_legend.js).
   const panel = document.getElementById('panel');
-  const esc = (s) => String(s).replace(/[&<>]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;' })[c]);
-  let html = `<h1>${esc(D.title)}</h1>`;
-  // The run's own warnings (degraded input, suspect estimate) come before any number.
-  (D.warnings || []).forEach((w) => { html += `<div class="warning">⚠ ${esc(w)}</div>`; });
-  html += `${poses.length} poses, ${D.keyframes.length} keyframes, ` +
-          `${D.map_points.length / 3} map points`;
-  if (D.cloud.length) html += `, ${D.cloud.length / 3} cloud points`;
-  html += '<br>';
-  if (D.ate_rmse_m >= 0) {
-    html += `ATE ${D.ate_rmse_m.toFixed(4)} m rmse (${D.alignment}); colour: ` +
-            `blue 0 → red ≥ ${ateTop.toFixed(3)} m<br>`;
-  } else {
-    html += 'no ground truth (map frame)<br>';
-  }
-  const counts = {};
-  D.keyframes.forEach((k) => { counts[k.reason] = (counts[k.reason] || 0) + 1; });
-  html += '<div id="legend">' + reasons.map((r) =>
-    `<div><span style="background:#${new THREE.Color(reasonColour[r]).getHexString()}"></span>` +
-    `${esc(r === '' ? 'no decision traced (initial map, or a run without --trace)' : r)}: ` +
-    `${counts[r]}</div>`).join('') +
-    '</div>';
-  html += Object.keys(layers).map((n) =>
-    `<label><input type="checkbox" data-layer="${esc(n)}" ${layers[n].visible ? 'checked' : ''}>` +
-    ` ${esc(n)}</label>`).join('<br>');
-  panel.innerHTML = html;
-  panel.querySelectorAll('input[data-layer]').forEach((box) => {
-    box.addEventListener('change', () => { layers[box.dataset.layer].visible = box.checked; draw(); });
+  panel.innerHTML = PkslamLegend.panelHtml({
+    D, layers, tracks, ateTop, reasons, reasonColour, counts, axesLength, gridCell, gridPlane,
+    colours: COLOURS, poses: poses.length,
   });
+  panel.querySelectorAll('input[data-layer]').forEach((box) => {
+    box.addEventListener('change', () => {
+      const layer = layers[box.dataset.layer];
+      layer.visible = box.checked;
+      if (layer.element) layer.element.style.display = box.checked ? '' : 'none';
+      draw();
+    });
+  });
+  const esc = PkslamLegend.esc;
 
   // Timeline.
   const rows = D.timeline.length ? D.timeline
@@ -247,58 +240,17 @@
     }
     info.innerHTML = text;
   }
-  // The timeline strip: tracked points (grey), keyframes (red ticks), and when the trace has
-  // them PKS's D_c (blue) against its adaptive threshold Th_adaptive (orange), each scaled to
-  // its own maximum; with online calibration its time-offset estimate (purple steps, scaled to
-  // its largest value, labelled) and a purple tick at each adjustment; a black line marks the
-  // current frame.
+  // The strip above the scrubber (viewer_strip.js): the whole run against time, with a legend.
   const strip = document.getElementById('strip');
-  function drawStrip(current) {
-    const w = strip.clientWidth, h = strip.clientHeight;
-    strip.width = w;
-    strip.height = h;
-    const g = strip.getContext('2d');
-    g.clearRect(0, 0, w, h);
-    if (rows.length < 2) return;
-    const x = (i) => (i / (rows.length - 1)) * (w - 1);
-    function series(value, colour) {
-      const v = rows.map(value);
-      const top = Math.max(...v.filter((a) => a !== undefined && isFinite(a)), 0);
-      if (!(top > 0)) return;
-      g.strokeStyle = colour;
-      g.beginPath();
-      let pen = false;
-      v.forEach((a, i) => {
-        if (a === undefined || !isFinite(a)) { pen = false; return; }
-        const y = h - 2 - (a / top) * (h - 4);
-        if (pen) g.lineTo(x(i), y); else g.moveTo(x(i), y);
-        pen = true;
-      });
-      g.stroke();
-    }
-    series((r) => r.tracked, '#999999');
-    series((r) => (r.q ? r.q.D_c : undefined), '#1f77b4');
-    series((r) => (r.q ? r.q.Th_adaptive : undefined), '#ff7f0e');
-    if (steps.length) {
-      series((r) => { const c = calibrationAt(r.t); return c ? c.e.time_offset : undefined; },
-             '#9467bd');
-      g.fillStyle = '#9467bd';
-      let last = -1;
-      rows.forEach((r, i) => {
-        const c = calibrationAt(r.t);
-        if (c && c !== last) { g.fillRect(x(i), h - 6, 1, 6); last = c; }
-      });
-      const top = Math.max(...steps.map((s) => s.e.time_offset || 0));
-      if (top > 0) {
-        g.font = '10px sans-serif';
-        g.fillText(`time offset estimate (top ${top.toFixed(2)} ms)`, 4, 11);
-      }
-    }
-    g.fillStyle = '#d62728';
-    rows.forEach((r, i) => { if (r.kf) g.fillRect(x(i), 0, 1, 6); });
-    g.fillStyle = '#000000';
-    g.fillRect(x(current), 0, 1, h);
-  }
+  const series = PkslamStrip.seriesOf(rows, (r) => {
+    const c = calibrationAt(r.t);
+    return c ? c.e.time_offset : undefined;
+  });
+  const stripLegend = document.getElementById('striplegend');
+  stripLegend.innerHTML = PkslamStrip.legendHtml(series);
+  stripLegend.title = stripLegend.textContent;
+  let stripDrawn = { ticks: [], yLabels: [] };
+  function drawStrip(current) { stripDrawn = PkslamStrip.draw(strip, rows, series, current); }
   scrub.addEventListener('input', () => {
     showRow(Number(scrub.value));
     drawStrip(Number(scrub.value));
@@ -308,7 +260,11 @@
   drawStrip(0);
   showRow(0);
 
-  function draw() { renderer.render(scene, camera); }
+  function draw() {
+    scaleBarMetres = S.updateScaleBar(scaleBarElement, camera, controls.target,
+                                      container.clientHeight);
+    renderer.render(scene, camera);
+  }
   controls.addEventListener('change', draw);
   window.addEventListener('resize', () => {
     camera.aspect = container.clientWidth / container.clientHeight;
@@ -317,6 +273,24 @@
     draw();
   });
   draw();
+
+  // For tests and the console: what the page drew.
+  window.pkslamView = {
+    tracks: tracks.map((t) => ({ label: t.label, source: t.source, ate_rmse_m: t.ate,
+                                 colour: t.colour, object: layers[t.layer],
+                                 keyframes: t.kfLayer ? layers[t.kfLayer] : null })),
+    layers,
+    axes: layers.axes,
+    axesLength,
+    grid: layers.grid,
+    gridCell,
+    scaleBar: { element: scaleBarElement, metres: () => scaleBarMetres },
+    strip: () => ({ ticks: stripDrawn.ticks, yLabels: stripDrawn.yLabels,
+                    legend: series.map((s) => s.name) }),
+    camera,
+    controls,
+    draw,
+  };
   requestAnimationFrame(() => {
     if (status.dataset.state !== 'error') status.dataset.state = 'drawn';
     status.dataset.firstFrameMs = performance.now().toFixed(0);

@@ -5,8 +5,18 @@ would see.
   check_view.py view PKSLAM WORK      simulate 12 s of V1_02 (or a random flight), run
                                       stereo-inertial with PKS and --trace, `pkslam view`, open it:
                                       the page reports "drawn" without console errors, and the
-                                      screenshot has pixels of the trajectory (ATE colours), the
-                                      keyframe frustums (rule colours) and the map points.
+                                      screenshot (legend panel hidden) has pixels of the trajectory
+                                      (ATE colours), the keyframe frustums (rule colours) and the
+                                      map points. Then a second run (ORB-SLAM3's selector) and its
+                                      body trajectory in ORB-SLAM3's f_*.txt format on one page
+                                      with the first: the file's ATE equals the second run's (the
+                                      body poses are moved into the camera), and from the page
+                                      (window.pkslamView and the DOM): 3 trajectory rows with
+                                      checkboxes, unchecking one hides that trajectory only, the
+                                      axes, grid and scale bar exist, the scale bar reads a length
+                                      in metres that grows when the camera backs off, every
+                                      keyframe rule is explained, and the strip has time tick
+                                      labels, y labels and a legend of its series.
   check_view.py page VIEW.html [PNG]  open an existing viewer page: the same checks, its size and
                                       time to the first frame, the screenshot kept as PNG.
   check_view.py report REPORT.html    every <img> of a bench report loads (naturalWidth > 0).
@@ -14,6 +24,8 @@ would see.
 Exits 1 with one line per failed check. CTest: viewer.page, viewer.bench_report.
 """
 
+import html
+import json
 import os
 import re
 import subprocess
@@ -57,7 +69,143 @@ def check_view(pkslam, work):
          "--trace", "--out", out, "--quiet"])
     page = os.path.join(work, "view.html")
     print(run([pkslam, "view", "--run", out, "--dataset", seq, "--out", page]).strip())
-    return check_page(page, os.path.join(work, "view.png"))
+    failures = check_page(page, os.path.join(work, "view.png"))
+    return failures + check_several(pkslam, work, seq, out)
+
+
+def orbslam3_format(tum_file, out_file):
+    """A TUM trajectory rewritten as ORB-SLAM3's f_*.txt (nanosecond stamps, TUM columns)."""
+    with open(tum_file) as f, open(out_file, "w") as g:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            stamp, rest = line.split(None, 1)
+            seconds, _, fraction = stamp.partition(".")
+            g.write(f"{int(seconds) * 10**9 + int(fraction.ljust(9, '0')[:9])}.000000 {rest}")
+
+
+# Runs inside the page after viewer.js; leaves its findings as JSON in <body data-probe>.
+PROBE = """<script>(function () {
+  const out = {};
+  try {
+    const v = window.pkslamView;
+    const rows = [...document.querySelectorAll('#panel .track-row')];
+    out.rows = rows.length;
+    out.rowsWithCheckbox = rows.filter((r) => r.querySelector('input[type=checkbox]')).length;
+    out.labels = v.tracks.map((t) => t.label);
+    out.before = v.tracks.map((t) => t.object.visible);
+    const box = rows[1].querySelector('input[data-layer]');
+    box.checked = false;
+    box.dispatchEvent(new Event('change'));
+    out.after = v.tracks.map((t) => t.object.visible);
+    box.checked = true;
+    box.dispatchEvent(new Event('change'));
+    out.again = v.tracks[1].object.visible;
+    out.axes = v.axes ? v.axes.children.length : 0;
+    out.axesVisible = !!(v.axes && v.axes.visible);
+    out.grid = !!(v.grid && v.grid.visible && v.grid.geometry.attributes.position.count > 4);
+    out.gridCell = v.gridCell;
+    out.gridText = document.querySelector('#panel input[data-layer="grid"]').parentElement
+      .parentElement.textContent;
+    const gridBox = document.querySelector('#panel input[data-layer="grid"]');
+    gridBox.checked = false;
+    gridBox.dispatchEvent(new Event('change'));
+    out.gridHidden = !v.grid.visible;
+    out.scaleText = document.getElementById('scalebar-text').textContent;
+    out.scaleWidth = document.getElementById('scalebar-bar').getBoundingClientRect().width;
+    out.scaleBefore = v.scaleBar.metres();
+    const t = v.controls.target;
+    v.camera.position.sub(t).multiplyScalar(4).add(t);
+    v.controls.update();
+    v.draw();
+    out.scaleAfter = v.scaleBar.metres();
+    out.rules = [...document.querySelectorAll('#legend .rule b')].map((b) => b.textContent);
+    out.glossed = [...document.querySelectorAll('#panel details .gloss b')]
+      .map((b) => b.textContent);
+    out.rampTicks = document.querySelector('#panel .ramp-ticks').textContent;
+    const strip = v.strip();
+    out.ticks = strip.ticks;
+    out.yLabels = strip.yLabels;
+    out.legend = strip.legend;
+    out.stripLegend = document.getElementById('striplegend').textContent;
+  } catch (e) {
+    out.error = String(e.stack || e);
+  }
+  document.body.setAttribute('data-probe', JSON.stringify(out));
+})();</script>"""
+
+
+def probe(page):
+    """Runs PROBE in a copy of the page; returns (its findings, the status attributes, console
+    errors)."""
+    probe_page = page + ".probe.html"
+    with open(page) as f, open(probe_page, "w") as g:
+        before, tag, after = f.read().rpartition("</body>")  # the page's own, not a script's
+        g.write(before + PROBE + tag + after)
+    dom, log = chromium(["--dump-dom"], "file://" + os.path.abspath(probe_page))
+    os.remove(probe_page)
+    m = re.search(r'data-probe="([^"]*)"', dom)
+    found = json.loads(html.unescape(m.group(1))) if m else {"error": "the probe did not run"}
+    m = re.search(r'<div id="status"([^>]*)>', dom)
+    status = dict(re.findall(r'data-([\w-]+)="([^"]*)"', m.group(1))) if m else {}
+    console = [line for line in log.splitlines() if "CONSOLE" in line and "ERROR" in line]
+    return found, status, console
+
+
+def check_several(pkslam, work, seq, first):
+    """Two runs and a bare trajectory on one page."""
+    second = os.path.join(work, "run_orbslam3")
+    run([pkslam, "run", "--dataset", seq, "--sensor", "stereo-inertial", "--selector",
+         "orbslam3", "--trace", "--out", second, "--quiet"])
+    bare = os.path.join(work, "f_run_orbslam3.txt")
+    orbslam3_format(os.path.join(second, "trajectory_body.txt"), bare)
+    page = os.path.join(work, "view_several.html")
+    text = run([pkslam, "view", "--run", first, "--run", second, "--trajectory", bare,
+                "--label", "ORB-SLAM3 format", "--dataset", seq, "--out", page]).strip()
+    print(text)
+    failures = []
+    ates = dict(re.findall(r"^  \+ (.+?) \((?:run|trajectory)\): .*ATE ([0-9.]+) m", text, re.M))
+    if ates.get("ORB-SLAM3 format") is None or ates.get("ORB-SLAM3 format") != ates.get(
+            "run_orbslam3"):
+        failures.append(f"the body file's ATE is not the second run's camera ATE: {ates}")
+    found, status, console = probe(page)
+    print("page:", json.dumps(found)[:1500])
+    if status.get("state") != "drawn":
+        failures.append(f"several: page state {status.get('state')!r}: {status.get('errors', '')}")
+    if console:
+        failures.append("several: console errors: " + " | ".join(console[:3]))
+    if "error" in found:
+        return failures + ["several: probe failed: " + found["error"]]
+    expect = [
+        ("3 trajectory rows with checkboxes", found["rows"] == 3 and found["rowsWithCheckbox"] == 3),
+        ("labels", found["labels"] == ["run", "run_orbslam3", "ORB-SLAM3 format"]),
+        ("unchecking row 2 hides trajectory 2 only",
+         found["before"] == [True, True, True] and found["after"] == [True, False, True]
+         and found["again"]),
+        ("axes: 3 labels and the lines", found["axes"] == 4 and found["axesVisible"]),
+        ("grid drawn, its cell stated, toggled off",
+         found["grid"] and found["gridCell"] > 0 and " m cells" in found["gridText"]
+         and found["gridHidden"]),
+        ("scale bar reads a length in metres",
+         re.fullmatch(r"[0-9.]+ m", found["scaleText"]) is not None
+         and 60 <= found["scaleWidth"] <= 151),
+        ("scale bar grows as the camera backs off", found["scaleAfter"] > found["scaleBefore"]),
+        ("every rule name explained",
+         len(found["rules"]) > 0 and all(part in found["glossed"] for rule in found["rules"]
+                                         for part in re.split(r"[+;]", rule))),
+        ("ATE ramp numbers in metres", re.search(r"0.*≥ [0-9.]+ m", found["rampTicks"]) is not None),
+        ("strip time ticks in seconds",
+         len(found["ticks"]) >= 3 and all(re.fullmatch(r"[0-9.]+ s", t) for t in found["ticks"])),
+        ("strip y labels", any(y.startswith("tracked:") for y in found["yLabels"])
+         and any(y.startswith("D_c:") for y in found["yLabels"])),
+        ("strip legend names the series",
+         all(name in found["stripLegend"] for name in
+             ["tracked points", "keyframes", "D_c", "Th_adaptive", "current frame"])),
+    ]
+    for name, ok in expect:
+        if not ok:
+            failures.append("several: " + name)
+    return failures
 
 
 def check_page(page, shot):
@@ -73,12 +221,18 @@ def check_page(page, shot):
     console = [line for line in log.splitlines() if "CONSOLE" in line and "ERROR" in line]
     if console:
         failures.append("console errors: " + " | ".join(console[:3]))
+    # The screenshot is of the 3-D view: the legend panel (whose swatches have the colours
+    # counted below) is hidden in a copy of the page.
     shot = os.path.abspath(shot)
-    chromium([f"--screenshot={shot}", "--virtual-time-budget=5000"], "file://" + page)
+    bare = page + ".nopanel.html"
+    with open(page) as f, open(bare, "w") as g:
+        g.write(f.read().replace("</head>", "<style>#panel { visibility: hidden; }</style></head>", 1))
+    chromium([f"--screenshot={shot}", "--virtual-time-budget=5000"], "file://" + bare)
+    os.remove(bare)
     img = cv2.imread(shot)
     if img is None:
         sys.exit(f"no screenshot at {shot}")
-    img = img[:690]  # above the timeline bar
+    img = img[:650]  # above the timeline bar (150 px of the 800)
     points = count(img, (40, 40, 200))
     rules = sum(count(img, c) for c in [(214, 39, 40), (44, 160, 44), (255, 127, 14),
                                         (148, 103, 189), (140, 86, 75), (227, 119, 194),
