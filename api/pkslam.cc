@@ -108,6 +108,10 @@ const char* SlamStateName(SlamState state) {
 
 struct Slam::Impl {
   std::unique_ptr<SlamSystem> system;
+  // What the system was made from, so Reset() can make it again.
+  Settings settings;
+  std::shared_ptr<const Vocabulary> vocabulary;
+  SystemOptions options;
   Sensor sensor = Sensor::kStereo;
   TrackResult last;
   bool shut_down = false;
@@ -140,8 +144,12 @@ Slam::Slam(const SlamOptions& options) : impl_(std::make_unique<Impl>()) {
     system.deterministic = options.deterministic;
     system.no_loop = !options.loop_closing;
     system.tracking.localise_only = options.localise_only;
+    system.selector_parameters = options.selector_parameters;
     if (!options.deterministic) system.mapping_sync = "free";  // a live caller
-    impl_->system = std::make_unique<SlamSystem>(settings, LoadRunVocabulary(run), system);
+    impl_->settings = settings;
+    impl_->vocabulary = LoadRunVocabulary(run);
+    impl_->options = system;
+    impl_->system = std::make_unique<SlamSystem>(settings, impl_->vocabulary, system);
     impl_->sensor = *sensor;
     return 0;
   });
@@ -212,6 +220,56 @@ std::optional<Eigen::Matrix4d> Slam::CurrentPose() const {
 
 int Slam::NumKeyFrames() const { return impl_->system->NumKeyFrames(); }
 int Slam::NumMapPoints() const { return impl_->system->NumMapPoints(); }
+
+std::vector<MapPoint> Slam::MapPoints() const {
+  std::vector<MapPoint> out;
+  for (const auto& p : impl_->system->MapPoints()) {
+    out.push_back({p.id, p.world_position, p.observations});
+  }
+  return out;
+}
+
+std::vector<KeyFrame> Slam::KeyFrames() const {
+  std::vector<KeyFrame> out;
+  for (const auto& k : impl_->system->KeyFrames()) {
+    out.push_back({k.id, k.t_ns, k.world_from_camera.Matrix()});
+  }
+  return out;
+}
+
+std::vector<TrackedKeypoint> Slam::TrackedKeypoints() const {
+  std::vector<TrackedKeypoint> out;
+  for (const auto& o : impl_->system->TrackedObservations()) out.push_back({o.u, o.v, o.point});
+  return out;
+}
+
+void Slam::SetLocalisationMode(bool on) {
+  if (impl_->shut_down) throw std::invalid_argument("Slam: SetLocalisationMode after Shutdown()");
+  impl_->system->SetLocalisationMode(on);
+}
+
+bool Slam::LocalisationMode() const { return impl_->system->localisation_mode(); }
+
+void Slam::Reset() {
+  Guard([&] {
+    // The old system's threads stop before the new one starts (one set of threads at a time).
+    impl_->system->Shutdown();
+    impl_->system.reset();
+    impl_->system =
+        std::make_unique<SlamSystem>(impl_->settings, impl_->vocabulary, impl_->options);
+    return 0;
+  });
+  impl_->last = TrackResult{};
+  impl_->shut_down = false;
+  impl_->last_frame_t_ns.reset();
+  impl_->last_imu_t_ns.reset();
+}
+
+std::string Slam::Selector() const { return impl_->system->selector_name(); }
+
+std::map<std::string, double> Slam::SelectorParameters() const {
+  return impl_->system->selector_parameters();
+}
 
 void Slam::SaveMap(const std::string& file) const {
   Guard([&] { return impl_->system->SaveMap(file); });

@@ -8,9 +8,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <map>
 #include <opencv2/core/mat.hpp>
-#include <stdexcept>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -112,7 +113,8 @@ PYBIND11_MODULE(_pkslam, m) {
   py::class_<api::Slam>(m, "Slam")
       .def(py::init([](const std::string& settings, const std::string& vocabulary,
                        const std::string& sensor, const std::string& selector, bool deterministic,
-                       bool localise_only, bool loop_closing) {
+                       bool localise_only, bool loop_closing,
+                       const std::map<std::string, double>& selector_parameters) {
              api::SlamOptions o;
              o.settings = settings;
              o.vocabulary = vocabulary;
@@ -121,11 +123,13 @@ PYBIND11_MODULE(_pkslam, m) {
              o.deterministic = deterministic;
              o.localise_only = localise_only;
              o.loop_closing = loop_closing;
+             o.selector_parameters = selector_parameters;
              return std::make_unique<api::Slam>(o);
            }),
            py::arg("settings"), py::arg("vocabulary"), py::arg("sensor") = "stereo",
            py::arg("selector") = "orbslam3", py::arg("deterministic") = false,
-           py::arg("localise_only") = false, py::arg("loop_closing") = true)
+           py::arg("localise_only") = false, py::arg("loop_closing") = true,
+           py::arg("selector_parameters") = std::map<std::string, double>{})
       .def(
           "track_mono",
           [](api::Slam& s, const py::array& image, std::int64_t t_ns) {
@@ -172,6 +176,70 @@ PYBIND11_MODULE(_pkslam, m) {
                              [](const api::Slam& s) { return api::SlamStateName(s.state()); })
       .def("pose", &api::Slam::CurrentPose,
            "world_from_camera (4x4) of the last frame, or None when it was not tracked")
+      .def(
+          "map_points",
+          [](const api::Slam& s) {
+            const auto points = s.MapPoints();
+            const auto n = static_cast<py::ssize_t>(points.size());
+            py::array_t<double> xyz({n, py::ssize_t{3}});
+            py::array_t<std::int64_t> ids(n);
+            py::array_t<std::int32_t> observations(n);
+            auto x = xyz.mutable_unchecked<2>();
+            auto id = ids.mutable_unchecked<1>();
+            auto obs = observations.mutable_unchecked<1>();
+            for (py::ssize_t i = 0; i < n; ++i) {
+              const auto& p = points[static_cast<std::size_t>(i)];
+              for (int c = 0; c < 3; ++c) x(i, c) = p.world_position(c);
+              id(i) = p.id;
+              obs(i) = p.observations;
+            }
+            return py::make_tuple(xyz, ids, observations);
+          },
+          "(world positions[N, 3], ids[N], observing keyframes[N]) of the largest map's points")
+      .def(
+          "keyframes",
+          [](const api::Slam& s) {
+            const auto keyframes = s.KeyFrames();
+            std::vector<api::StampedPose> poses;
+            py::array_t<std::int64_t> ids(static_cast<py::ssize_t>(keyframes.size()));
+            auto id = ids.mutable_unchecked<1>();
+            for (std::size_t i = 0; i < keyframes.size(); ++i) {
+              poses.push_back({keyframes[i].t_ns, keyframes[i].world_from_camera});
+              id(static_cast<py::ssize_t>(i)) = keyframes[i].id;
+            }
+            const py::tuple trajectory = TrajectoryArrays(poses);
+            return py::make_tuple(trajectory[0], trajectory[1], ids);
+          },
+          "(t_ns[N], world_from_camera[N, 4, 4], ids[N]) of the largest map's keyframes")
+      .def(
+          "tracked_keypoints",
+          [](const api::Slam& s) {
+            const auto keypoints = s.TrackedKeypoints();
+            const auto n = static_cast<py::ssize_t>(keypoints.size());
+            py::array_t<float> uv({n, py::ssize_t{2}});
+            py::array_t<std::int64_t> ids(n);
+            auto x = uv.mutable_unchecked<2>();
+            auto id = ids.mutable_unchecked<1>();
+            for (py::ssize_t i = 0; i < n; ++i) {
+              const auto& k = keypoints[static_cast<std::size_t>(i)];
+              x(i, 0) = k.u;
+              x(i, 1) = k.v;
+              id(i) = k.map_point_id;
+            }
+            return py::make_tuple(uv, ids);
+          },
+          "(undistorted pixels[N, 2], map point ids[N]) of the last frame's pose inliers "
+          "(empty when it was not tracked)")
+      .def_property(
+          "localisation_mode", &api::Slam::LocalisationMode, &api::Slam::SetLocalisationMode,
+          "Localisation mode: True tracks against the current map without new keyframes (ORB-"
+          "SLAM3's ActivateLocalizationMode); False resumes mapping")
+      .def("reset", &api::Slam::Reset, py::call_guard<py::gil_scoped_release>(),
+           "Forget every map and start again with the same options (ORB-SLAM3's Reset)")
+      .def_property_readonly("selector", &api::Slam::Selector)
+      .def_property_readonly("selector_parameters", &api::Slam::SelectorParameters,
+                             "The parameters given to the selector (settings' Keyframe.* and "
+                             "selector_parameters); others are at its defaults")
       .def_property_readonly("num_keyframes", &api::Slam::NumKeyFrames)
       .def_property_readonly("num_map_points", &api::Slam::NumMapPoints)
       .def("save_map", &api::Slam::SaveMap, py::arg("file"))

@@ -56,9 +56,9 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   options_.tracking.seed = options_.seed;
   options_.loop.seed = options_.seed;
   options_.Check();
-  std::map<std::string, double> selector_parameters = settings.keyframe;
-  for (const auto& [k, v] : options_.selector_parameters) selector_parameters[k] = v;
-  auto selector = MakeKeyframeSelector(options_.selector, selector_parameters);
+  selector_parameters_ = settings.keyframe;
+  for (const auto& [k, v] : options_.selector_parameters) selector_parameters_[k] = v;
+  auto selector = MakeKeyframeSelector(options_.selector, selector_parameters_);
 
   atlas_.SetDatabase(std::make_unique<KeyFrameDatabase>(*vocabulary_));
   {
@@ -401,6 +401,31 @@ Trajectory SlamSystem::KeyFrameTrajectory() const {
   }
   std::sort(out.poses.begin(), out.poses.end(),
             [](const StampedPose& a, const StampedPose& b) { return a.t_ns < b.t_ns; });
+  return out;
+}
+
+std::vector<SlamSystem::MapPointView> SlamSystem::MapPoints() const {
+  std::vector<MapPointView> out;
+  auto lock = MapReader(atlas_).Lock();
+  if (const Map* map = LargestMap()) {
+    out.reserve(map->map_points().size());
+    for (const auto& [id, mp] : map->map_points()) {
+      out.push_back({id, mp->position(), static_cast<int>(mp->observations().size())});
+    }
+  }
+  return out;
+}
+
+std::vector<SlamSystem::KeyFrameView> SlamSystem::KeyFrames() const {
+  std::vector<KeyFrameView> out;
+  auto lock = MapReader(atlas_).Lock();
+  if (const Map* map = LargestMap()) {
+    for (const auto& [id, kf] : map->keyframes()) {
+      out.push_back({id, kf->t_ns(), kf->world_from_camera()});
+    }
+  }
+  std::sort(out.begin(), out.end(),
+            [](const KeyFrameView& a, const KeyFrameView& b) { return a.t_ns < b.t_ns; });
   return out;
 }
 

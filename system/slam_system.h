@@ -121,6 +121,32 @@ class SlamSystem {
   LocalMappingStats mapping_stats() const { return mapper_->stats(); }
   // Empty stats with --no-loop.
   LoopClosingStats loop_stats() const { return loop_ ? loop_->stats() : LoopClosingStats{}; }
+  // The largest map's points and keyframes, copied under the Atlas lock (for the library).
+  struct MapPointView {
+    MapPointId id = 0;
+    Eigen::Vector3d world_position = Eigen::Vector3d::Zero();
+    int observations = 0;  // keyframes observing it
+  };
+  struct KeyFrameView {
+    KeyFrameId id = 0;
+    std::int64_t t_ns = 0;
+    SE3d world_from_camera;
+  };
+  std::vector<MapPointView> MapPoints() const;
+  std::vector<KeyFrameView> KeyFrames() const;
+  // Localisation mode at run time (Tracker::SetLocaliseOnly): caller's thread, between frames.
+  void SetLocalisationMode(bool on) { tracker_->SetLocaliseOnly(on); }
+  bool localisation_mode() const { return tracker_->localise_only(); }
+  // The last frame's pose inliers (Tracker::LastFrameInliers).
+  std::vector<FrameRecord::Observation> TrackedObservations() const {
+    return tracker_->LastFrameInliers();
+  }
+  // The keyframe selector's name and the parameters given to it (the settings' Keyframe.* with
+  // the options' selector_parameters over them); others are at the selector's defaults.
+  const std::string& selector_name() const { return options_.selector; }
+  const std::map<std::string, double>& selector_parameters() const {
+    return selector_parameters_;
+  }
   // Keyframes and map points in the largest map; number of maps.
   int NumKeyFrames() const;
   int NumMapPoints() const;
@@ -134,6 +160,7 @@ class SlamSystem {
 
  private:
   SystemOptions options_;
+  std::map<std::string, double> selector_parameters_;  // as given to the selector
   Settings settings_;
   RigSetup setup_;
   RigCalibration file_calibration_;

@@ -272,6 +272,18 @@ TrackResult Tracker::Track(Frame frame) {
   return result;
 }
 
+std::vector<FrameRecord::Observation> Tracker::LastFrameInliers() const {
+  std::vector<FrameRecord::Observation> out;
+  if (state_ != TrackingState::kOk) return out;
+  const auto& keypoints = last_.keypoints_undistorted();
+  for (std::size_t i = 0; i < last_.map_points.size() && i < keypoints.size(); ++i) {
+    const MapPointPtr& mp = last_.map_points[i];
+    if (!mp || (i < last_.outliers.size() && last_.outliers[i] != 0)) continue;
+    out.push_back({mp->id(), keypoints[i].pt.x, keypoints[i].pt.y});
+  }
+  return out;
+}
+
 void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
   FrameRecord r;
   r.t_ns = current_.t_ns();

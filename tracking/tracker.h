@@ -107,6 +107,18 @@ class Tracker {
   // next frame is relocalised against the current map (tracking/tracker_localisation.cc).
   void StartLocalisation();
   int relocalisations() const { return relocalisations_; }
+  // Localisation mode switched at run time (the library's SetLocalisationMode, as ORB-SLAM3's
+  // ActivateLocalizationMode): from the next frame on, tracking only against the current map,
+  // no keyframes, visual tracking (ImuReady() is false while on). Tracking thread, between
+  // frames.
+  void SetLocaliseOnly(bool on) {
+    options_.localise_only = on;
+    visual_odometry_ = false;
+  }
+  bool localise_only() const { return options_.localise_only; }
+  // The last frame's pose inliers (map point id, undistorted left-image pixel); empty when it
+  // was not tracked. Tracking thread.
+  std::vector<FrameRecord::Observation> LastFrameInliers() const;
 
   // Drops the current map (a reset) and starts again from NOT_INITIALIZED.
   void Reset();

@@ -21,14 +21,27 @@ gt_file = os.path.join(root, "..", "shared", "data", "euroc", "groundtruth", "V1
 seq = pkslam.simulate(os.path.join(out, "v101"), trajectory=gt_file if os.path.exists(gt_file) else None,
                       start=5, duration=10, seed=1)
 
-# %% 2. Stereo SLAM, one frame at a time, images as NumPy arrays.
-slam = pkslam.Slam(os.path.join(seq, "settings.yaml"), pkslam.VOCABULARY, sensor="stereo")
-for left_file in sorted(glob.glob(os.path.join(seq, "mav0/cam0/data/*.png"))):
+# %% 2. Stereo SLAM, one frame at a time, images as NumPy arrays. Each frame: the tracked
+# keypoints (undistorted pixels, map point ids) and, now and then, the map's points. Half way
+# through, localisation mode: tracking only, the map stops growing.
+slam = pkslam.Slam(os.path.join(seq, "settings.yaml"), pkslam.VOCABULARY, sensor="stereo",
+                   selector="pks")
+print("selector", slam.selector, slam.selector_parameters)
+left_files = sorted(glob.glob(os.path.join(seq, "mav0/cam0/data/*.png")))
+for k, left_file in enumerate(left_files):
+    if k == len(left_files) // 2:
+        slam.localisation_mode = True
+        print(f"frame {k}: localisation mode on with {slam.num_keyframes} keyframes")
     right_file = left_file.replace("/cam0/", "/cam1/")
     t_ns = int(os.path.basename(left_file)[:-4])
     state = slam.track_stereo(cv2.imread(left_file, cv2.IMREAD_GRAYSCALE),
                               cv2.imread(right_file, cv2.IMREAD_GRAYSCALE), t_ns)
+    uv, point_ids = slam.tracked_keypoints()
+    if k % 50 == 0:
+        xyz, map_ids, observations = slam.map_points()
+        print(f"frame {k}: {state}, {len(point_ids)} tracked keypoints, {len(map_ids)} map points")
 print("last state", state, "pose\n", np.round(slam.pose(), 3))
+print("keyframes at the end", slam.num_keyframes)
 
 # %% 3. The trajectory and its error against the ground truth. EuRoC's ground truth describes
 # the body (IMU): compare body poses with it, or camera poses with the extrinsic.

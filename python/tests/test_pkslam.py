@@ -74,6 +74,59 @@ def test_stereo_slam_through_python_meets_the_ate_bar(sequence, tmp_path):
     assert map_file.stat().st_size > 1000
 
 
+def test_map_keypoints_localisation_mode_and_reset(sequence):
+    """The script the API is for: run SLAM, read the map points and tracked keypoints each
+    frame, switch to localisation mode half way (the map stops growing), evaluate the body
+    trajectory; then reset and run again from an empty map."""
+    slam = pkslam.Slam(os.path.join(sequence, "settings.yaml"), pkslam.VOCABULARY,
+                       sensor="stereo", selector="pks", deterministic=True,
+                       selector_parameters={"delta": 30})
+    assert slam.selector == "pks" and slam.selector_parameters["delta"] == 30
+    all_frames = list(frames(sequence))
+    half = len(all_frames) // 2
+    keyframes_at_switch = None
+    ids_seen = set()
+    for k, (t_ns, left, right) in enumerate(all_frames):
+        if k == half:
+            slam.localisation_mode = True
+            assert slam.localisation_mode
+            keyframes_at_switch = slam.keyframes()[0].size
+        state = slam.track_stereo(left, right, t_ns)
+        uv, point_ids = slam.tracked_keypoints()
+        if state == "OK":
+            assert uv.shape == (len(point_ids), 2) and len(point_ids) > 30
+            assert np.all((uv[:, 0] >= 0) & (uv[:, 0] < left.shape[1]))
+            ids_seen.update(point_ids.tolist())
+        else:
+            assert len(point_ids) == 0
+        if k % 10 == 0:
+            xyz, map_ids, observations = slam.map_points()
+            assert xyz.shape == (len(map_ids), 3) and np.all(np.isfinite(xyz))
+            assert len(map_ids) == 0 or observations.min() >= 1
+    # In localisation mode no keyframe was added; tracking went on against the map.
+    kf_t, kf_poses, kf_ids = slam.keyframes()
+    assert len(kf_t) == keyframes_at_switch > 2
+    assert kf_poses.shape == (len(kf_t), 4, 4) and np.all(np.diff(kf_t) > 0)
+    _, map_ids, _ = slam.map_points()
+    assert ids_seen & set(map_ids.tolist())  # tracked keypoints name points of the map
+    slam.shutdown()
+    gt = os.path.join(sequence, "mav0/state_groundtruth_estimate0/data.csv")
+    body = pkslam.evaluate(gt, slam.body_trajectory(), align="se3")
+    assert body["pairs"] >= 0.9 * len(all_frames)
+    assert body["ate_rmse_m"] < 0.05
+    # Reset: an empty system with the same options; frame times may start over.
+    slam.reset()
+    assert slam.num_keyframes == 0 and len(slam.map_points()[1]) == 0
+    assert not slam.localisation_mode
+    for t_ns, left, right in all_frames[:20]:
+        slam.track_stereo(left, right, t_ns)
+    assert slam.num_keyframes >= 1
+    slam.shutdown()
+    with pytest.raises(RuntimeError, match="has no parameter 'no_such_parameter'"):
+        pkslam.Slam(os.path.join(sequence, "settings.yaml"), pkslam.VOCABULARY,
+                    selector="pks", selector_parameters={"no_such_parameter": 1})
+
+
 def test_bad_inputs_raise(sequence):
     with pytest.raises(RuntimeError, match="no_such_settings"):
         pkslam.Slam("/no_such_settings.yaml", pkslam.VOCABULARY)

@@ -12,6 +12,7 @@
 //   for (...) slam.TrackStereo(left, right, t_ns);
 //   slam.Shutdown();
 //   for (const pkslam::api::StampedBodyPose& p : slam.BodyTrajectory()) ...
+// While it runs: MapPoints(), KeyFrames(), TrackedKeypoints(), SetLocalisationMode(), Reset().
 //
 // Frames: camera trajectories hold world_from_camera (the left camera), body trajectories
 // world_from_body (the IMU: what EuRoC ground truth describes). Every name says which.
@@ -24,6 +25,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <opencv2/core/mat.hpp>
 #include <optional>
@@ -32,7 +34,7 @@
 
 namespace pkslam::api {
 
-inline constexpr const char* kApiVersion = "0.2.0";
+inline constexpr const char* kApiVersion = "0.3.0";
 
 enum class SlamState { kNotInitialized, kOk, kRecentlyLost, kLost };
 const char* SlamStateName(SlamState state);
@@ -53,12 +55,36 @@ struct ImuSample {
   Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // m/s^2
 };
 
+// A map point of the largest map: its world position and how many keyframes observe it.
+struct MapPoint {
+  std::int64_t id = 0;
+  Eigen::Vector3d world_position = Eigen::Vector3d::Zero();
+  int observations = 0;
+};
+
+// A keyframe of the largest map.
+struct KeyFrame {
+  std::int64_t id = 0;
+  std::int64_t t_ns = 0;
+  Eigen::Matrix4d world_from_camera = Eigen::Matrix4d::Identity();
+};
+
+// A keypoint of the last frame that tracking matched to a map point and kept as an inlier of
+// the pose: its undistorted pixel in the left (or only) image, and the point's id.
+struct TrackedKeypoint {
+  float u = 0, v = 0;
+  std::int64_t map_point_id = 0;
+};
+
 struct SlamOptions {
   std::string settings;    // ORB-SLAM3 v1.0 settings file (camera, ORB, IMU)
   std::string vocabulary;  // DBoW2 text or pkslam binary vocabulary
   // mono | stereo | rgbd | mono-inertial | stereo-inertial | rgbd-inertial
   std::string sensor = "stereo";
   std::string selector = "orbslam3";  // keyframe selector (orbslam3, pks, pks-released, ...)
+  // Selector parameters over the settings' Keyframe.* values (docs/keyframe_selectors.md), e.g.
+  // {"delta", 30} for PKS; a name the selector does not know is an error.
+  std::map<std::string, double> selector_parameters;
   bool deterministic = false;         // fixed seeds, local mapping in lock-step
   bool localise_only = false;         // with LoadMap before the first frame
   bool loop_closing = true;
@@ -85,6 +111,24 @@ class Slam {
   std::optional<Eigen::Matrix4d> CurrentPose() const;
   int NumKeyFrames() const;
   int NumMapPoints() const;
+  // The largest map (the one the outputs describe), copied: safe while tracking goes on.
+  std::vector<MapPoint> MapPoints() const;
+  std::vector<KeyFrame> KeyFrames() const;
+  // The last frame's tracked keypoints (empty when it was not tracked).
+  std::vector<TrackedKeypoint> TrackedKeypoints() const;
+
+  // Localisation mode (ORB-SLAM3's ActivateLocalizationMode / DeactivateLocalizationMode): from
+  // the next frame on, track against the current map without making keyframes, so the map no
+  // longer grows; off again, mapping resumes. Inertial sensors track visually while it is on.
+  void SetLocalisationMode(bool on);
+  bool LocalisationMode() const;
+  // Forget everything (maps, trajectory, IMU queue) and start again with the same options, as
+  // ORB-SLAM3's Reset(): the next frame initialises a new map; frame times may start over.
+  void Reset();
+  // The keyframe selector and the parameters it was given (settings' Keyframe.* with
+  // SlamOptions::selector_parameters over them; unlisted parameters are at its defaults).
+  std::string Selector() const;
+  std::map<std::string, double> SelectorParameters() const;
 
   // Map files (docs/maps.md): SaveMap after Shutdown for the final map; LoadMap before the
   // first frame.
