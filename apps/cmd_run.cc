@@ -3,11 +3,13 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdio>
 #include <memory>
 #include <optional>
 
 #include "apps/cli_errors.h"
 #include "apps/commands.h"
+#include "apps/live_view.h"
 #include "core/util/error.h"
 #include "system/run_dataset.h"
 #include "system/run_source.h"
@@ -56,6 +58,8 @@ struct RunArgs {
   std::optional<int> camera;
   std::string images;
   std::string timestamps;
+  std::optional<int> live_view_port;  // --live-view [PORT]
+  std::string live_view_host = "127.0.0.1";
 };
 
 std::map<std::string, double> ParseParams(const std::vector<std::string>& params) {
@@ -179,6 +183,15 @@ void RegisterRunCommand(CLI::App& app) {
   cmd->add_flag("--frame-tracks", args->options.system.frame_tracks,
                 "Write OUT/frame_tracks.txt: every tracked frame's matched map points as 2-D "
                 "tracks (for `pkslam tracks reconstruct`)");
+  cmd->add_option("--live-view", args->live_view_port,
+                  "Serve a live 3-D view of the run at http://127.0.0.1:PORT/ (default port "
+                  "8765): the path so far, keyframes, map points, the current image with its "
+                  "tracked keypoints")
+      ->expected(0, 1)
+      ->default_str("8765");
+  cmd->add_option("--live-view-host", args->live_view_host,
+                  "Address the live view listens on (0.0.0.0: reachable from other machines)")
+      ->capture_default_str();
   cmd->add_flag("--quiet", args->options.quiet, "No progress line");
   cmd->add_flag("--allow-imu-gaps", args->options.allow_imu_gaps,
                 "Inertial sensors: run although some frames have no IMU samples (tracked "
@@ -219,6 +232,20 @@ void RegisterRunCommand(CLI::App& app) {
     if (args->fps && args->video.empty()) throw OptionError("--fps goes with --video");
     if (args->images.empty() != args->timestamps.empty()) {
       throw OptionError("--images and --timestamps go together");
+    }
+    std::unique_ptr<LiveView> live;
+    if (args->live_view_port) {
+      LiveViewOptions live_options;
+      live_options.port = *args->live_view_port;
+      live_options.host = args->live_view_host;
+      live = std::make_unique<LiveView>(live_options);
+      fmt::print("live view: {}\n", live->url());
+      std::fflush(stdout);
+      control.frame_tracked = [&live](const SlamSystem& system, const TrackResult& r,
+                                      const cv::Mat& image, std::int64_t t_ns) {
+        live->OnFrame(system, r, image, t_ns);
+      };
+      control.tracking_finished = [&live] { live->Finish(nullptr); };
     }
     std::unique_ptr<FrameSource> source;
     if (!args->video.empty()) source = OpenVideoFile(args->video, args->fps);

@@ -12,6 +12,9 @@ find_package(TBB REQUIRED)
 find_package(ZLIB REQUIRED)    # map file checksums (map_model/storage)
 find_package(cereal REQUIRED)  # map file payloads (map_model/storage)
 find_package(Open3D REQUIRED)  # TSDF fusion and meshes (dense/mesh.h)
+find_package(PkgConfig REQUIRED)
+# pkslam run --live-view's HTTP server (apps/live_view.h): Debian's libcpp-httplib-dev.
+pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
 
 # nanoflann ships no CMake config in Debian 12; it is a single header.
 find_path(NANOFLANN_INCLUDE_DIR nanoflann.hpp REQUIRED)

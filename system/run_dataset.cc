@@ -359,10 +359,12 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
                         partial.path().string(), partial.error());
       }
     }
+    if (control.frame_tracked) control.frame_tracked(system, r, loaded.a, s.t_ns);
     progress.SetSuffix(fmt::format("{} KFs {}", TrackingStateName(r.state), system.NumKeyFrames()));
     progress.Add();
   }
   progress.Finish();
+  if (control.tracking_finished) control.tracking_finished();
   if (report.frames_without_depth > 0) {
     report.Warn(fmt::format("{}: {} of {} depth images hold no valid depth (all zero)",
                             options.dataset.string(), report.frames_without_depth, summary.frames));

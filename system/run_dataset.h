@@ -122,6 +122,13 @@ struct RunControl {
   // mapping and loop closing and the other outputs (apps/cmd_run.cc lets a second Ctrl-C end
   // the process from then on).
   std::function<void()> trajectory_written;
+  // Called on the tracking thread after every frame with the system, the frame's result and its
+  // (left / only) image: a live view copies what it shows. Unset: no cost.
+  std::function<void(const SlamSystem&, const TrackResult&, const cv::Mat& image,
+                     std::int64_t t_ns)>
+      frame_tracked;
+  // Called once the run has stopped tracking (before the outputs are written).
+  std::function<void()> tracking_finished;
 };
 
 // Throws InputError / OptionError on bad input, OutputError when an output cannot be written.

@@ -103,10 +103,12 @@ RunSummary RunFrameSource(const RunOptions& options_in, FrameSource& source,
     if (r.camera_from_world) {
       partial.Append(FormatTumLine({frame->t_ns, r.camera_from_world->Inverse()}));
     }
+    if (control.frame_tracked) control.frame_tracked(system, r, frame->image, frame->t_ns);
     progress.SetSuffix(fmt::format("{} KFs {}", TrackingStateName(r.state), system.NumKeyFrames()));
     progress.Add();
   }
   progress.Finish();
+  if (control.tracking_finished) control.tracking_finished();
   if (summary.frames == 0) throw InputError(source.Name(), "no frames to process");
   WriteTrajectoryOutputs(system, options);
   if (control.trajectory_written) control.trajectory_written();

@@ -128,6 +128,43 @@ void CopyViewScripts(const fs::path& dir, const ViewPageOptions& options) {
   CopyScripts(FindScripts(options), dir);
 }
 
+std::string LiveViewPage(const ViewPageOptions& options) {
+  options.Check();
+  const std::vector<fs::path> scripts = FindScripts(options);
+  const fs::path live = FindProjectFile("viewer/viewer_live.js");
+  if (!fs::exists(live)) throw Error(live.string() + " not found (the source tree's)");
+  std::string page =
+      "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">\n<title>pkslam run (live)</title>\n"
+      "<style>";
+  page += kStyle;
+  page +=
+      "#frame { position: absolute; left: 0; bottom: 0; height: 150px; background: #222; }\n"
+      "#live-info { margin: 2px 0 4px 0; }\n"
+      "</style>\n</head><body>\n<div id=\"view\"></div>\n"
+      "<div id=\"panel\"><h1>pkslam run (live)</h1><div id=\"live-info\">waiting for the run"
+      "</div><div class=\"sec\">Legend</div>"
+      "<div><span class=\"sw line\" style=\"background:#1f77b4\"></span>camera path so far "
+      "(map frame)</div>"
+      "<div><span class=\"sw line\" style=\"background:#d62728\"></span>keyframes</div>"
+      "<div><span class=\"sw dot\" style=\"background:#2828c8\"></span>map points</div>"
+      "<div><span class=\"sw dot\" style=\"background:#00c000\"></span>tracked keypoints "
+      "(bottom: the current left image)</div>"
+      "<div>axes: <span style=\"color:#f00\">x</span> <span style=\"color:#0b0\">y</span> "
+      "<span style=\"color:#00f\">z</span> at the map origin; grey grid; scale bar lower right"
+      "</div><div class=\"hint\">drag: orbit · right-drag: pan · wheel: zoom</div></div>\n"
+      "<div id=\"scalebar\"><div id=\"scalebar-bar\"></div><div id=\"scalebar-text\"></div>"
+      "</div>\n<canvas id=\"frame\"></canvas>\n"
+      "<div id=\"status\" data-state=\"loading\" hidden></div>\n";
+  for (std::size_t i = 0; i < 2; ++i) {
+    page += "<script>\n" + ScriptSafe(ReadAll(scripts[i], "three.js")) + "\n</script>\n";
+  }
+  for (const fs::path& f : {FindProjectFile("viewer/viewer_scene.js"), live}) {
+    page += "<script>\n" + ScriptSafe(ReadAll(f, "viewer script")) + "\n</script>\n";
+  }
+  page += "</body></html>\n";
+  return page;
+}
+
 void WriteViewPage(const ViewData& data, const fs::path& file, const ViewPageOptions& options) {
   options.Check();
   const std::vector<fs::path> scripts = FindScripts(options);

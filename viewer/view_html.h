@@ -31,4 +31,9 @@ void CopyViewScripts(const std::filesystem::path& dir, const ViewPageOptions& op
 void WriteViewPage(const ViewData& data, const std::filesystem::path& file,
                    const ViewPageOptions& options = {});
 
+// The live page of `pkslam run --live-view`: three.js, OrbitControls, viewer_scene.js and
+// viewer_live.js inlined; it polls data.json and frame.jpg from the server that sent it.
+// Throws Error when a script cannot be found.
+std::string LiveViewPage(const ViewPageOptions& options = {});
+
 }  // namespace pkslam
