@@ -19,6 +19,7 @@
 #include "evaluation/bench/process.h"
 #include "evaluation/evaluate.h"
 #include "evaluation/evaluation_output.h"
+#include "io/kitti_dataset.h"
 #include "io/rigid_transform_file.h"
 #include "io/trajectory.h"
 
@@ -46,7 +47,41 @@ struct EvalArgs {
   std::string plot_dir;
   std::string save_aligned_dir;
   std::string save_errors_dir;
+  bool kitti = false;
+  std::vector<double> kitti_lengths;
+  std::string times_file;
 };
+
+// KITTI poses files (12 numbers per line, no time): their first data line has 12 fields.
+bool IsKittiPoses(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    std::stringstream fields(line);
+    std::string first;
+    if (!(fields >> first) || first[0] == '#') continue;
+    int n = 1;
+    for (std::string f; fields >> f;) ++n;
+    return n == 12;
+  }
+  return false;
+}
+
+// A trajectory file of any format pkslam reads; KITTI poses get their stamps from --times, or
+// from ../sequences/NN/times.txt beside poses/NN.txt.
+Trajectory ReadForEval(const std::string& file, TrajectoryFormat format,
+                       const std::string& times_file) {
+  if (format == TrajectoryFormat::kAuto && std::filesystem::exists(file) && IsKittiPoses(file)) {
+    std::filesystem::path times = times_file;
+    if (times.empty()) times = KittiTimesFor(file);
+    if (times.empty()) {
+      throw InputError(file,
+                       "KITTI poses (12 numbers per line) carry no times: give --times "
+                       "sequences/NN/times.txt");
+    }
+    return ReadKittiPoses(file, ReadKittiTimes(times));
+  }
+  return ReadTrajectory(file, format, DuplicateTimestamps::kKeepAll);
+}
 
 // "auto" (rpg's 10-50% of the path), "none", or a comma-separated list of lengths in metres.
 void ParseSegments(const std::string& text, EvaluationOptions& options) {
@@ -67,9 +102,10 @@ void ParseSegments(const std::string& text, EvaluationOptions& options) {
       used = 0;
     }
     if (used == 0 || used != item.size()) {
-      throw OptionError(fmt::format("--segments {}: '{}' is not a length in metres (give auto, "
-                                    "none, or lengths like 10,20,40)",
-                                    text, item));
+      throw OptionError(
+          fmt::format("--segments {}: '{}' is not a length in metres (give auto, "
+                      "none, or lengths like 10,20,40)",
+                      text, item));
     }
     options.segments.lengths_m.push_back(length);
   }
@@ -88,6 +124,8 @@ EvaluationOptions OptionsFrom(const EvalArgs& args) {
   }
   options.rpe.all_pairs = args.rpe_all_pairs;
   ParseSegments(args.segments, options);
+  options.compute_kitti = args.kitti || !args.kitti_lengths.empty();
+  if (!args.kitti_lengths.empty()) options.kitti.lengths_m = args.kitti_lengths;
   options.allow_frame_offset = args.allow_frame_offset;
   options.Check();
   return options;
@@ -98,13 +136,12 @@ std::vector<std::string> DrawPlots(const std::filesystem::path& dir) {
   const std::filesystem::path script = FindProjectFile("evaluation/eval_plots.py");
   if (!std::filesystem::exists(script)) throw Error("plot script not found: " + script.string());
   const std::filesystem::path log = dir / "plots.log";
-  const bench::ProcessResult p = bench::RunProcess(
-      {"/usr/bin/python3", script.string(), "--data", (dir / "data").string(), "--out",
-       dir.string()},
-      log, 600.0);
+  const bench::ProcessResult p = bench::RunProcess({"/usr/bin/python3", script.string(), "--data",
+                                                    (dir / "data").string(), "--out", dir.string()},
+                                                   log, 600.0);
   if (!p.ok()) {
-    throw Error(fmt::format("evaluation/eval_plots.py failed ({}); see {}", p.Describe(),
-                            log.string()));
+    throw Error(
+        fmt::format("evaluation/eval_plots.py failed ({}); see {}", p.Describe(), log.string()));
   }
   std::filesystem::remove(log);
   std::vector<std::string> figures;
@@ -138,13 +175,14 @@ void RunEval(const EvalArgs& args) {
   const TrajectoryFormat gt_format = ParseTrajectoryFormat(args.gt_format);
   const TrajectoryFormat est_format = ParseTrajectoryFormat(args.est_format);
   if (!args.labels.empty() && args.labels.size() != args.est_files.size()) {
-    throw OptionError(fmt::format("--label given {} times for {} --est files: give one per "
-                                  "estimate, or none",
-                                  args.labels.size(), args.est_files.size()));
+    throw OptionError(
+        fmt::format("--label given {} times for {} --est files: give one per "
+                    "estimate, or none",
+                    args.labels.size(), args.est_files.size()));
   }
 
   // Repeated stamps stay (with a warning), as evo keeps them.
-  Trajectory gt = ReadTrajectory(args.gt_file, gt_format, DuplicateTimestamps::kKeepAll);
+  Trajectory gt = ReadForEval(args.gt_file, gt_format, args.times_file);
   if (!args.body_from_camera_file.empty()) {
     gt = ChangeSensorFrame(gt, ReadRigidTransform(args.body_from_camera_file));
   }
@@ -154,18 +192,17 @@ void RunEval(const EvalArgs& args) {
   std::vector<Trajectory> estimates;
   std::vector<EvaluationResult> results;
   for (const std::string& file : args.est_files) {
-    estimates.push_back(ReadTrajectory(file, est_format, DuplicateTimestamps::kKeepAll));
+    estimates.push_back(ReadForEval(file, est_format, args.times_file));
     results.push_back(EvaluateTrajectories(gt, estimates.back(), options));
   }
 
   std::cout << fmt::format("ground truth  {} ({} poses, {:.1f} s, {:.2f} m)\n", args.gt_file,
                            gt.size(), DurationSeconds(gt), PathLengthMeters(gt));
   for (std::size_t k = 0; k < estimates.size(); ++k) {
-    std::cout << fmt::format("estimate      {}{} ({} poses, {:.1f} s, {:.2f} m)\n",
-                             args.est_files[k],
-                             estimates.size() > 1 ? fmt::format(" [{}]", labels[k]) : "",
-                             estimates[k].size(), DurationSeconds(estimates[k]),
-                             PathLengthMeters(estimates[k]));
+    std::cout << fmt::format(
+        "estimate      {}{} ({} poses, {:.1f} s, {:.2f} m)\n", args.est_files[k],
+        estimates.size() > 1 ? fmt::format(" [{}]", labels[k]) : "", estimates[k].size(),
+        DurationSeconds(estimates[k]), PathLengthMeters(estimates[k]));
   }
   if (results.size() == 1) {
     std::cout << FormatEvaluationTable(results.front());
@@ -210,8 +247,8 @@ void RunEval(const EvalArgs& args) {
     }
     index.Commit();
     const std::vector<std::string> figures = DrawPlots(dir);
-    std::cout << fmt::format("plots         {} ({} figures: {})\n", args.plot_dir,
-                             figures.size(), fmt::join(figures, ", "));
+    std::cout << fmt::format("plots         {} ({} figures: {})\n", args.plot_dir, figures.size(),
+                             fmt::join(figures, ", "));
   }
 }
 
@@ -222,10 +259,11 @@ void RegisterEvalCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "eval",
       "Compare estimated trajectories with ground truth: associate by time, align, then ATE, "
-      "RPE (evo_ape / evo_rpe definitions and defaults) and the relative error over segment "
-      "lengths (rpg_trajectory_evaluation); several --est are compared in one table, --plot "
-      "draws the figures");
-  cmd->add_option("--gt", args->gt_file, "Ground-truth trajectory file (tum, euroc, orbslam3)")
+      "RPE (evo_ape / evo_rpe definitions and defaults), the relative error over segment "
+      "lengths (rpg_trajectory_evaluation) and with --kitti KITTI's odometry metric; several "
+      "--est are compared in one table, --plot draws the figures");
+  cmd->add_option("--gt", args->gt_file,
+                  "Ground-truth trajectory file (tum, euroc, orbslam3, KITTI poses/NN.txt)")
       ->required();
   cmd->add_option("--est", args->est_files,
                   "Estimated trajectory file(s) (tum, euroc, orbslam3); repeat or list several "
@@ -260,6 +298,16 @@ void RegisterEvalCommand(CLI::App& app) {
                   "Relative error over segment lengths: auto (rpg's 10,20,30,40,50% of the "
                   "path), none, or lengths in metres like 10,20,40")
       ->capture_default_str();
+  cmd->add_flag("--kitti", args->kitti,
+                "Also KITTI odometry's metric (the devkit's): translation error in % and rotation "
+                "error in deg/100 m over segments of 100-800 m starting every 10 frames");
+  cmd->add_option("--kitti-lengths", args->kitti_lengths,
+                  "Segment lengths of the KITTI metric in metres instead of the devkit's 100..800 "
+                  "(e.g. 5,10,20 for a short simulated flight; implies --kitti)")
+      ->delimiter(',');
+  cmd->add_option("--times", args->times_file,
+                  "times.txt of a KITTI sequence: the stamps of files in KITTI's pose format (12 "
+                  "numbers per line; default: sequences/NN/times.txt beside poses/NN.txt)");
   cmd->add_option("--json", args->json_file, "Also write the results as JSON to this file");
   cmd->add_option("--plot", args->plot_dir,
                   "Draw figures into this folder (matplotlib): trajectories (top view, xyz, "

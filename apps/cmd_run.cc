@@ -11,6 +11,7 @@
 #include "apps/commands.h"
 #include "apps/live_view.h"
 #include "core/util/error.h"
+#include "system/run_bag.h"
 #include "system/run_dataset.h"
 #include "system/run_source.h"
 
@@ -58,6 +59,8 @@ struct RunArgs {
   std::optional<int> camera;
   std::string images;
   std::string timestamps;
+  std::string bag;                    // --bag FILE (system/run_bag.h)
+  std::string topics;                 // --topics for --bag
   std::optional<int> live_view_port;  // --live-view [PORT]
   std::string live_view_host = "127.0.0.1";
 };
@@ -91,9 +94,11 @@ std::map<std::string, double> ParseParams(const std::vector<std::string>& params
 
 void RegisterRunCommand(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
-  auto* cmd = app.add_subcommand(
-      "run", "Run SLAM over a EuRoC or TUM RGB-D dataset, a video, a camera or an image folder");
-  cmd->add_option("--dataset", args->options.dataset, "Dataset directory (EuRoC ASL or TUM RGB-D)");
+  auto* cmd = app.add_subcommand("run",
+                                 "Run SLAM over a EuRoC, TUM RGB-D or KITTI odometry dataset, a "
+                                 "video, a camera or an image folder");
+  cmd->add_option("--dataset", args->options.dataset,
+                  "Dataset directory (EuRoC ASL, TUM RGB-D, or a KITTI sequences/NN folder)");
   cmd->add_option("--video", args->video,
                   "Monocular: a video file (OpenCV VideoCapture), with --settings CAM.yaml; "
                   "timestamps from the container or --fps");
@@ -108,9 +113,15 @@ void RegisterRunCommand(CLI::App& app) {
   cmd->add_option("--timestamps", args->timestamps,
                   "--images: one frame per line, 't_ns' (DIR/t_ns.png) or 't name' (t in s "
                   "with a decimal point, else ns)");
+  cmd->add_option("--bag", args->bag,
+                  "A ROS 1 bag (EuRoC, TUM-VI), with --settings: the run of the EuRoC folder "
+                  "`pkslam convert --bag` makes (docs/bags.md)");
+  cmd->add_option("--topics", args->topics,
+                  "--bag: topics of the streams, e.g. cam0=/cam0/image_raw,cam1=/cam1/image_raw,"
+                  "imu=/imu0 (the defaults)");
   cmd->add_option("--sensor", args->sensor,
-                  "Sensor configuration (default: stereo for --dataset, mono for --video, "
-                  "--camera and --images)")
+                  "Sensor configuration (default: stereo for --dataset and --bag, mono for "
+                  "--video, --camera and --images)")
       ->check(OneOf(SensorNames()));
   cmd->add_option("--settings", args->settings,
                   "ORB-SLAM3 v1.0 settings file (EuRoC: default from the sensor.yaml files)");
@@ -150,6 +161,9 @@ void RegisterRunCommand(CLI::App& app) {
                 "--calibrate online, monocular-inertial: estimate the camera's intrinsics too "
                 "(held at the file's values by default; docs/calibration.md)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
+  cmd->add_flag(
+      "--kitti-colour", args->options.kitti_colour,
+      "KITTI sequences: track the colour pair (image_2, image_3) instead of the grey one");
   cmd->add_option("--mapping-sync", args->options.mapping_sync,
                   "How tracking meets local mapping: live (offline default: local mapping as a "
                   "live run at --live-pace would see it, without sleeping), lockstep (each "
@@ -210,7 +224,8 @@ void RegisterRunCommand(CLI::App& app) {
   cmd->callback([args] {
     RunOptions& o = args->options;
     // --sensor was checked against SensorNames(), which ParseSensor reads back.
-    o.system.sensor = *ParseSensor(args->sensor.value_or(o.dataset.empty() ? "mono" : "stereo"));
+    o.system.sensor = *ParseSensor(
+        args->sensor.value_or(o.dataset.empty() && args->bag.empty() ? "mono" : "stereo"));
     if (!args->settings.empty()) o.settings = args->settings;
     if (!args->vocabulary.empty()) o.vocabulary = args->vocabulary;
     o.out = args->out;
@@ -225,10 +240,12 @@ void RegisterRunCommand(CLI::App& app) {
     };
     control.trajectory_written = OnTrajectoryWritten;
     const int inputs = (o.dataset.empty() ? 0 : 1) + (args->video.empty() ? 0 : 1) +
-                       (args->camera ? 1 : 0) + (args->images.empty() ? 0 : 1);
+                       (args->camera ? 1 : 0) + (args->images.empty() ? 0 : 1) +
+                       (args->bag.empty() ? 0 : 1);
     if (inputs != 1) {
-      throw OptionError("give exactly one input: --dataset, --video, --camera or --images");
+      throw OptionError("give exactly one input: --dataset, --bag, --video, --camera or --images");
     }
+    if (!args->topics.empty() && args->bag.empty()) throw OptionError("--topics goes with --bag");
     if (args->fps && args->video.empty()) throw OptionError("--fps goes with --video");
     if (args->images.empty() != args->timestamps.empty()) {
       throw OptionError("--images and --timestamps go together");
@@ -242,16 +259,18 @@ void RegisterRunCommand(CLI::App& app) {
       fmt::print("live view: {}\n", live->url());
       std::fflush(stdout);
       control.frame_tracked = [&live](const SlamSystem& system, const TrackResult& r,
-                                      const cv::Mat& image, std::int64_t t_ns) {
-        live->OnFrame(system, r, image, t_ns);
-      };
+                                      const cv::Mat& image,
+                                      std::int64_t t_ns) { live->OnFrame(system, r, image, t_ns); };
       control.tracking_finished = [&live] { live->Finish(nullptr); };
     }
     std::unique_ptr<FrameSource> source;
     if (!args->video.empty()) source = OpenVideoFile(args->video, args->fps);
     if (args->camera) source = OpenCamera(*args->camera);
     if (!args->images.empty()) source = OpenImageFolder(args->images, args->timestamps);
-    const RunSummary s = source ? RunFrameSource(o, *source, control) : RunDataset(o, control);
+    const RunSummary s = source ? RunFrameSource(o, *source, control)
+                         : !args->bag.empty()
+                             ? RunBag(o, args->bag, ParseBagTopics(args->topics), control)
+                             : RunDataset(o, control);
     fmt::print("frames {} tracked {} lost {} keyframes {} map points {} maps {}\n", s.frames,
                s.tracked, s.lost, s.keyframes, s.map_points, s.maps);
     fmt::print(
@@ -259,9 +278,10 @@ void RegisterRunCommand(CLI::App& app) {
         s.wall_s, s.sequence_s, s.wall_s > 0 ? s.sequence_s / s.wall_s : 0.0, s.median_tracking_ms);
     // trajectory_body.txt (body = IMU frame, what EuRoC ground truth describes) is written for
     // every metric run (system/run_outputs.cc); a visual monocular map has no metric lever arm.
-    fmt::print("outputs: {}/{{trajectory.txt, {}keyframes.txt, map_points.ply, stats.json, "
-               "run.log}} (docs/run.md lists all)\n",
-               o.out.string(), o.system.sensor == Sensor::kMonocular ? "" : "trajectory_body.txt, ");
+    fmt::print(
+        "outputs: {}/{{trajectory.txt, {}keyframes.txt, map_points.ply, stats.json, "
+        "run.log}} (docs/run.md lists all)\n",
+        o.out.string(), o.system.sensor == Sensor::kMonocular ? "" : "trajectory_body.txt, ");
     if (s.input.degraded()) {
       fmt::print("degraded input: {} warning(s), see {}/stats.json \"input\"\n",
                  s.input.warnings.size(), o.out.string());

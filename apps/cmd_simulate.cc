@@ -9,6 +9,8 @@
 #include "apps/cli_errors.h"
 #include "apps/commands.h"
 #include "core/util/error.h"
+#include "io/kalibr_files.h"
+#include "io/kitti_writer.h"
 #include "sim/scene_description.h"
 #include "sim/simulator.h"
 
@@ -100,9 +102,10 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
   o.trajectory = a.trajectory;
   o.motion.level = sim::ParseMotionLevel(a.motion);
   if (a.trajectory.empty() && o.duration_s > 0 && o.duration_s <= o.motion.rest_s) {
-    throw OptionError(fmt::format("--duration {}: random motion starts with {} s at rest (as "
-                                  "EuRoC's flights before take-off); give more than that",
-                                  o.duration_s, o.motion.rest_s));
+    throw OptionError(
+        fmt::format("--duration {}: random motion starts with {} s at rest (as "
+                    "EuRoC's flights before take-off); give more than that",
+                    o.duration_s, o.motion.rest_s));
   }
   o.quality = sim::ParseQuality(a.quality);
   if (!a.blackout.empty()) {
@@ -115,6 +118,16 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
   o.write_cloud = !a.no_cloud && !a.no_images;
   o.write_images = !a.no_images;
   if (o.camera == "kitti") o.camera_rate_hz = 10.0;  // KITTI odometry's frame rate
+  if (o.camera == "tumvi") {
+    // TUM-VI's Bosch BMI160 as its calibration states it (the values of ORB-SLAM3's TUM-VI
+    // settings), cameras at 20 Hz.
+    o.camera_rate_hz = 20.0;
+    o.imu.gyro_noise_density = 0.00016;
+    o.imu.accel_noise_density = 0.0028;
+    o.imu.gyro_random_walk = 0.000022;
+    o.imu.accel_random_walk = 0.00086;
+    o.imu.rate_hz = 200.0;
+  }
   if (o.realism.On(sim::RealismSource::kAppearance)) ApplyAppearanceUnderFlags(cmd, &o);
   o.sensor.auto_exposure = !a.no_auto_exposure;
   const sim::SimulationSummary s = sim::RunSimulation(o);
@@ -151,6 +164,21 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
     std::cout << fmt::format(
         "  {:.1f} frames/s end to end (rendering, image formation and PNG files)\n",
         s.frames / s.total_seconds);
+  }
+  if (o.camera == "tumvi" && !o.rgbd && o.write_images) {
+    WriteTumViFiles(o.output_dir);
+    std::cout << fmt::format(
+        "  TUM-VI files: {}/dso/camchain.yaml, imu_config.yaml, "
+        "mav0/mocap0/data.csv\n",
+        o.output_dir.string());
+  }
+  // KITTI's rig: the same sequence in KITTI odometry's layout beside the EuRoC one (images
+  // hard-linked), so `run --dataset OUT/kitti/sequences/00` and `eval --kitti` have exact poses.
+  if (o.camera == "kitti" && !o.rgbd && o.write_images) {
+    const std::filesystem::path kitti = o.output_dir / "kitti";
+    WriteKittiLayoutFromEuroc(o.output_dir, kitti, "00");
+    std::cout << fmt::format("  KITTI layout: {}/sequences/00 (poses: {}/poses/00.txt)\n",
+                             kitti.string(), kitti.string());
   }
 }
 
@@ -201,12 +229,16 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("--seed", o.seed, "Random seed (same seed -> identical bytes)")
       ->capture_default_str();
   cmd->add_flag("--rgbd", o.rgbd, "TUM RGB-D output (colour + depth) instead of EuRoC stereo");
-  cmd->add_option("--camera", o.camera,
-                  "Stereo rig of EuRoC-format output: euroc (752x480, 20 Hz), kitti (KITTI "
-                  "odometry's 1241x376 pair, 0.537 m baseline, 10 Hz, settings.yaml with 2000 "
-                  "ORB features), vga (640x480, 20 Hz, 1000 features); run with --settings "
-                  "DATASET/settings.yaml to use its feature count")
-      ->check(OneOf({"euroc", "kitti", "vga"}))
+  cmd->add_option(
+         "--camera", o.camera,
+         "Stereo rig of EuRoC-format output: euroc (752x480, 20 Hz), kitti (KITTI "
+         "odometry's 1241x376 pair, 0.537 m baseline, 10 Hz, settings.yaml with 2000 "
+         "ORB features; also written in KITTI's layout under OUT/kitti), vga (640x480, 20 Hz, "
+         "1000 features), tumvi (TUM-VI's 512x512 fisheye pair, 20 Hz, TUM-VI's IMU "
+         "noise; also its dso/camchain.yaml and mocap0); run with --settings DATASET/settings.yaml "
+         "to use its feature "
+         "count")
+      ->check(OneOf({"euroc", "kitti", "vga", "tumvi"}))
       ->capture_default_str();
   cmd->add_option("--blackout", args->blackout, "Black images between T0 and T1 (s from start)")
       ->expected(2);

@@ -38,5 +38,6 @@ void RegisterPlanarCommand(CLI::App& app);
 void RegisterSimulateCommand(CLI::App& app);
 void RegisterBenchCommand(CLI::App& app);
 void RegisterSettingsCommand(CLI::App& app);
+void RegisterConvertCommand(CLI::App& app);
 
 }  // namespace pkslam::apps

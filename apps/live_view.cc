@@ -14,8 +14,7 @@ namespace pkslam::apps {
 namespace {
 
 double WallSeconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 void AppendNumbers(std::string& out, const std::vector<float>& values, std::size_t from) {
@@ -70,9 +69,10 @@ LiveView::LiveView(LiveViewOptions options)
     res.set_content(reinterpret_cast<const char*>(jpeg.data()), jpeg.size(), "image/jpeg");
   });
   if (!server_->bind_to_port(options_.host, options_.port)) {
-    throw Error(fmt::format("--live-view: cannot listen on {}:{} (in use, or not an address of "
-                            "this machine); give another port",
-                            options_.host, options_.port));
+    throw Error(
+        fmt::format("--live-view: cannot listen on {}:{} (in use, or not an address of "
+                    "this machine); give another port",
+                    options_.host, options_.port));
   }
   thread_ = std::thread([this] { server_->listen_after_bind(); });
   PKSLAM_LOG_INFO("live view: {}", url());
@@ -107,9 +107,9 @@ void LiveView::OnFrame(const SlamSystem& system, const TrackResult& result, cons
     MutexLock lock(mutex_);
     if (result.camera_from_world) {
       const Eigen::Vector3d c = result.camera_from_world->Inverse().translation();
-      state_.positions.insert(state_.positions.end(), {static_cast<float>(c.x()),
-                                                       static_cast<float>(c.y()),
-                                                       static_cast<float>(c.z())});
+      state_.positions.insert(
+          state_.positions.end(),
+          {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())});
     }
     state_.frame += 1;
     state_.t_s = static_cast<double>(t_ns - first_t_ns_) * 1e-9;
@@ -135,7 +135,8 @@ void LiveView::CopyMap(const SlamSystem& system) {
   std::vector<float> flat_points;
   flat_points.reserve(3 * (points.size() / stride + 1));
   for (std::size_t i = 0; i < points.size(); i += stride) {
-    for (int c = 0; c < 3; ++c) flat_points.push_back(static_cast<float>(points[i].world_position(c)));
+    for (int c = 0; c < 3; ++c)
+      flat_points.push_back(static_cast<float>(points[i].world_position(c)));
   }
   std::vector<float> flat_keyframes;
   for (const auto& k : keyframes) {
@@ -162,8 +163,7 @@ std::string LiveView::DataJson(std::size_t since) const {
   std::string out = fmt::format(
       "{{\"frame\":{},\"t_s\":{:.3f},\"state\":\"{}\",\"finished\":{},\"gravity_aligned\":{},"
       "\"image_seq\":{},\"pose_count\":{},\"poses\":",
-      s.frame, s.t_s, s.state, s.finished, s.gravity_aligned, s.image_seq,
-      s.positions.size() / 3);
+      s.frame, s.t_s, s.state, s.finished, s.gravity_aligned, s.image_seq, s.positions.size() / 3);
   AppendNumbers(out, s.positions, std::min(3 * since, s.positions.size()));
   out += ",\"keyframes\":";
   AppendNumbers(out, s.keyframes, 0);

@@ -26,8 +26,8 @@ namespace pkslam::apps {
 struct LiveViewOptions {
   std::string host = "127.0.0.1";  // 0.0.0.0 to be seen from other machines
   int port = 8765;
-  double image_period_s = 0.2;  // the current image is copied at most this often
-  double map_period_s = 1.0;    // the map's points and keyframes at most this often
+  double image_period_s = 0.2;     // the current image is copied at most this often
+  double map_period_s = 1.0;       // the map's points and keyframes at most this often
   std::size_t max_points = 60000;  // map points sent (every k-th beyond)
 
   void Check() const;  // throws OptionError

@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   pkslam::apps::RegisterSimulateCommand(app);
   pkslam::apps::RegisterBenchCommand(app);
   pkslam::apps::RegisterSettingsCommand(app);
+  pkslam::apps::RegisterConvertCommand(app);
 
   try {
     app.parse(argc, argv);

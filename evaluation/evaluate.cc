@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <cmath>
 
@@ -62,10 +61,10 @@ void CheckPosesUsable(const std::vector<SE3d>& poses, const std::vector<IndexPai
   for (const SE3d& pose : poses) spread_sq += (pose.translation() - mean).squaredNorm();
   const double spread_m = std::sqrt(spread_sq / static_cast<double>(poses.size()));
   if (spread_m < 1e-6) {
-    throw InputError(name, fmt::format("the {} matched {} poses all sit at one place (RMS spread "
-                                       "{:.2g} m): a Sim(3) alignment has no scale to find",
-                                       poses.size(), estimate ? "estimate" : "reference",
-                                       spread_m));
+    throw InputError(name,
+                     fmt::format("the {} matched {} poses all sit at one place (RMS spread "
+                                 "{:.2g} m): a Sim(3) alignment has no scale to find",
+                                 poses.size(), estimate ? "estimate" : "reference", spread_m));
   }
 }
 
@@ -116,10 +115,10 @@ void CheckSameBodyFrame(const std::vector<SE3d>& ref, const std::vector<SE3d>& e
 }  // namespace
 
 std::string FormatSegmentTable(const std::vector<SegmentErrors>& segments) {
-  std::string out = fmt::format("\nrelative error over segment lengths (rpg_trajectory_evaluation):\n"
-                                "{:>10} {:>6} {:>12} {:>12} {:>12} {:>12}\n",
-                                "length [m]", "pairs", "trans median", "trans rmse", "trans [%]",
-                                "rot [deg]");
+  std::string out = fmt::format(
+      "\nrelative error over segment lengths (rpg_trajectory_evaluation):\n"
+      "{:>10} {:>6} {:>12} {:>12} {:>12} {:>12}\n",
+      "length [m]", "pairs", "trans median", "trans rmse", "trans [%]", "rot [deg]");
   for (const SegmentErrors& s : segments) {
     if (s.empty()) {
       out += fmt::format("{:>10.2f} {:>6} (longer than the trajectory allows)\n", s.length_m, 0);
@@ -133,10 +132,27 @@ std::string FormatSegmentTable(const std::vector<SegmentErrors>& segments) {
   return out;
 }
 
+std::string FormatKittiTable(const KittiErrors& kitti) {
+  if (kitti.empty()) {
+    return "\nKITTI odometry metric: no segment (the path is shorter than the shortest length)\n";
+  }
+  std::string out = fmt::format(
+      "\nKITTI odometry metric (devkit): translation {:.4f} %, rotation {:.4f} deg/100 m over {} "
+      "segments\n{:>10} {:>9} {:>12} {:>16}\n",
+      kitti.translation_percent, kitti.rotation_deg_per_100m, kitti.segments.size(), "length [m]",
+      "segments", "trans [%]", "rot [deg/100 m]");
+  for (const auto& p : kitti.per_length) {
+    out += fmt::format("{:>10.0f} {:>9} {:>12.4f} {:>16.4f}\n", p.length_m, p.segments,
+                       p.translation_percent, p.rotation_deg_per_100m);
+  }
+  return out;
+}
+
 void EvaluationOptions::Check() const {
   association.Check();
   if (compute_rpe) rpe.Check();
   if (compute_segments) segments.Check();
+  if (compute_kitti) kitti.Check();
 }
 
 EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& est,
@@ -211,6 +227,7 @@ EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& e
     if (segments.reference_path_m == 0.0) segments.reference_path_m = PathLengthMeters(ref);
     result.segments = ComputeSegmentErrors(ref_poses, est_poses, segments);
   }
+  if (options.compute_kitti) result.kitti = ComputeKittiErrors(ref_poses, est_poses, options.kitti);
   result.matched_ref = std::move(ref_poses);
   result.aligned_est = std::move(est_poses);
   return result;
@@ -248,9 +265,7 @@ void WriteEvaluationJson(const EvaluationResult& result, JsonWriter& json) {
   if (result.segments) {
     json.BeginArray();
     for (const SegmentErrors& segment : *result.segments) {
-      json.BeginObject()
-          .Member("length_m", segment.length_m)
-          .Member("pairs", segment.pairs.size());
+      json.BeginObject().Member("length_m", segment.length_m).Member("pairs", segment.pairs.size());
       const std::pair<const char*, const ErrorStatistics*> stats[] = {
           {"trans_m", &segment.translation_m_stats},
           {"trans_percent", &segment.translation_percent_stats},
@@ -266,6 +281,25 @@ void WriteEvaluationJson(const EvaluationResult& result, JsonWriter& json) {
       json.EndObject();
     }
     json.EndArray();
+  } else {
+    json.Null();
+  }
+  json.Key("kitti");
+  if (result.kitti) {
+    json.BeginObject()
+        .Member("segments", result.kitti->segments.size())
+        .Member("trans_percent", result.kitti->translation_percent)
+        .Member("rot_deg_per_100m", result.kitti->rotation_deg_per_100m);
+    json.Key("per_length").BeginArray();
+    for (const auto& p : result.kitti->per_length) {
+      json.BeginObject()
+          .Member("length_m", p.length_m)
+          .Member("segments", p.segments)
+          .Member("trans_percent", p.translation_percent)
+          .Member("rot_deg_per_100m", p.rotation_deg_per_100m)
+          .EndObject();
+    }
+    json.EndArray().EndObject();
   } else {
     json.Null();
   }
@@ -297,6 +331,7 @@ std::string FormatEvaluationTable(const EvaluationResult& result) {
                        result.rpe->pairs.size());
   }
   if (result.segments) out += FormatSegmentTable(*result.segments);
+  if (result.kitti) out += FormatKittiTable(*result.kitti);
   return out;
 }
 

@@ -14,6 +14,7 @@
 #include "core/util/json_writer.h"
 #include "evaluation/alignment.h"
 #include "evaluation/association.h"
+#include "evaluation/kitti_error.h"
 #include "evaluation/rpe.h"
 #include "evaluation/segment_error.h"
 #include "evaluation/statistics.h"
@@ -32,6 +33,9 @@ struct EvaluationOptions {
   // Relative error over sub-trajectory lengths, as rpg_trajectory_evaluation (segment_error.h).
   bool compute_segments = false;
   SegmentErrorOptions segments;
+  // KITTI odometry's metric (kitti_error.h: translation % and deg per 100 m over 100-800 m).
+  bool compute_kitti = false;
+  KittiErrorOptions kitti;
   // Measure even when the aligned estimate's orientation differs from the reference's by a
   // near-constant rotation (CheckSameBodyFrame): by default that is an error, since it means
   // the two trajectories describe different frames (a camera against body ground truth).
@@ -53,11 +57,12 @@ struct EvaluationResult {
   std::optional<RpeResult> rpe;  // when options.compute_rpe
   // When options.compute_segments: one entry per segment length (some may have no pairs).
   std::optional<std::vector<SegmentErrors>> segments;
+  std::optional<KittiErrors> kitti;  // when options.compute_kitti
   // The associated poses, pair k of each: the reference's, and the estimate's after alignment
   // (what the errors above compare; for saving and plotting).
   std::vector<SE3d> matched_ref;
   std::vector<SE3d> aligned_est;
-  EvaluationOptions options;     // as used
+  EvaluationOptions options;  // as used
 
   double scale() const { return ref_from_est.scale(); }
 };
@@ -74,7 +79,8 @@ EvaluationResult EvaluateTrajectories(const Trajectory& ref, const Trajectory& e
 // The result as one JSON object: {"pairs", "gt_poses", "est_poses", "max_diff_s",
 // "alignment", "scale", "ate": stats, "ate_rot_deg": stats, "rpe": {"delta", "unit",
 // "all_pairs", "pairs", "trans_m": stats, "rot_deg": stats} or null, "segments": [{"length_m",
-// "pairs", "trans_m", "trans_percent", "rot_deg": stats or null}] or null}; stats = {"rmse",
+// "pairs", "trans_m", "trans_percent", "rot_deg": stats or null}] or null, "kitti":
+// {"segments", "trans_percent", "rot_deg_per_100m", "per_length": [...]} or null}; stats = {"rmse",
 // "mean", "median", "std", "min", "max", "sse"}.
 void WriteEvaluationJson(const EvaluationResult& result, JsonWriter& json);
 std::string EvaluationJson(const EvaluationResult& result);
@@ -84,5 +90,7 @@ std::string FormatEvaluationTable(const EvaluationResult& result);
 
 // The segment errors' medians, one line per length (part of FormatEvaluationTable).
 std::string FormatSegmentTable(const std::vector<SegmentErrors>& segments);
+// KITTI's numbers and one line per length (part of FormatEvaluationTable).
+std::string FormatKittiTable(const KittiErrors& kitti);
 
 }  // namespace pkslam

@@ -27,9 +27,14 @@ Eigen::Vector3d RollPitchYawDeg(const SO3d& rotation) {
 double Seconds(std::int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
 
 bool IsGenericStem(const std::string& stem) {
-  static constexpr const char* kGeneric[] = {"trajectory", "trajectory_body", "trajectory_camera",
-                                             "CameraTrajectory", "FrameTrajectory", "data",
-                                             "stamped_traj_estimate", "estimate"};
+  static constexpr const char* kGeneric[] = {"trajectory",
+                                             "trajectory_body",
+                                             "trajectory_camera",
+                                             "CameraTrajectory",
+                                             "FrameTrajectory",
+                                             "data",
+                                             "stamped_traj_estimate",
+                                             "estimate"};
   for (const char* generic : kGeneric) {
     if (stem == generic) return true;
   }
@@ -39,8 +44,8 @@ bool IsGenericStem(const std::string& stem) {
 std::string Sanitize(const std::string& text) {
   std::string out;
   for (const char c : text) {
-    const bool keep = std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ||
-                      c == '.';
+    const bool keep =
+        std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
     out += keep ? c : '_';
   }
   return out.empty() ? std::string("estimate") : out;
@@ -53,8 +58,12 @@ std::string EstimateLabel(const fs::path& estimate_file) {
   if (!IsGenericStem(stem)) return Sanitize(stem);
   const fs::path folder = fs::absolute(estimate_file).parent_path();
   std::string label = folder.filename().string();
-  // A run folder named only by its index (seed1, run2) reads better with its configuration.
-  const bool index_only = label.rfind("seed", 0) == 0 || label.rfind("run", 0) == 0;
+  // A bench run folder is named by its seed (CONFIG/seed1): it reads better with its
+  // configuration.
+  const bool index_only = label.size() > 4 && label.rfind("seed", 0) == 0 &&
+                          std::all_of(label.begin() + 4, label.end(), [](char c) {
+                            return std::isdigit(static_cast<unsigned char>(c)) != 0;
+                          });
   if (index_only && folder.has_parent_path() && !folder.parent_path().filename().empty()) {
     label = folder.parent_path().filename().string() + "_" + label;
   }
@@ -152,21 +161,22 @@ std::string FormatComparisonTable(const std::vector<std::string>& labels,
                                   const std::vector<EvaluationResult>& results) {
   std::size_t width = 8;
   for (const std::string& label : labels) width = std::max(width, label.size());
-  std::string out = fmt::format("{:<{}} {:>6} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} "
-                                "{:>10}\n",
-                                "estimate", width, "pairs", "scale", "ATE rmse", "mean", "median",
-                                "max", "rot rmse", "RPE rmse", "RPE rot");
+  std::string out = fmt::format(
+      "{:<{}} {:>6} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} "
+      "{:>10}\n",
+      "estimate", width, "pairs", "scale", "ATE rmse", "mean", "median", "max", "rot rmse",
+      "RPE rmse", "RPE rot");
   for (std::size_t k = 0; k < results.size(); ++k) {
     const EvaluationResult& r = results[k];
-    const std::string rpe =
-        r.rpe ? fmt::format("{:>10.6f} {:>10.4f}", r.rpe->translation_m.rmse,
-                            r.rpe->rotation_deg.rmse)
-              : fmt::format("{:>10} {:>10}", "-", "-");
-    out += fmt::format("{:<{}} {:>6} {:>8.4f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.4f} "
-                       "{}\n",
-                       labels[k], width, r.pairs.size(), r.scale(), r.ate_translation_m.rmse,
-                       r.ate_translation_m.mean, r.ate_translation_m.median,
-                       r.ate_translation_m.max, r.ate_rotation_deg.rmse, rpe);
+    const std::string rpe = r.rpe ? fmt::format("{:>10.6f} {:>10.4f}", r.rpe->translation_m.rmse,
+                                                r.rpe->rotation_deg.rmse)
+                                  : fmt::format("{:>10} {:>10}", "-", "-");
+    out += fmt::format(
+        "{:<{}} {:>6} {:>8.4f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.4f} "
+        "{}\n",
+        labels[k], width, r.pairs.size(), r.scale(), r.ate_translation_m.rmse,
+        r.ate_translation_m.mean, r.ate_translation_m.median, r.ate_translation_m.max,
+        r.ate_rotation_deg.rmse, rpe);
   }
   out += "(ATE and RPE translation in m, rotations in deg)\n";
   return out;

@@ -49,8 +49,8 @@ void SegmentErrorOptions::Check() const {
     throw OptionError(fmt::format("segment reference path {} m: must be >= 0", reference_path_m));
   }
   if (!(max_length_difference > 0.0 && max_length_difference < 1.0)) {
-    throw OptionError(fmt::format("segment max length difference {}: must be in (0, 1)",
-                                  max_length_difference));
+    throw OptionError(
+        fmt::format("segment max length difference {}: must be in (0, 1)", max_length_difference));
   }
 }
 
@@ -80,10 +80,9 @@ std::vector<PosePairIndices> SelectSegmentPairs(const std::vector<double>& accum
   for (std::size_t i = 0; i < accumulated_m.size(); ++i) {
     const double target = accumulated_m[i] + length_m;
     // The nearest lengths to the target are the first at or above it and the last below it.
-    const std::size_t above =
-        static_cast<std::size_t>(std::lower_bound(begin + static_cast<std::ptrdiff_t>(i),
-                                                  accumulated_m.end(), target) -
-                                 begin);
+    const std::size_t above = static_cast<std::size_t>(
+        std::lower_bound(begin + static_cast<std::ptrdiff_t>(i), accumulated_m.end(), target) -
+        begin);
     std::size_t best = accumulated_m.size();
     double best_error = tolerance;
     if (above > i) {

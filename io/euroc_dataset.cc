@@ -7,6 +7,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "io/kalibr_files.h"
 #include "io/text_rows.h"
 
 namespace pkslam {
@@ -140,6 +141,71 @@ bool EurocDataset::LooksLikeEuroc(const fs::path& root) {
          fs::is_regular_file(root / "cam0" / "data.csv", ec);
 }
 
+namespace {
+
+// A camera's sensor description: its sensor.yaml, or (TUM-VI's folders have none) entry
+// `index` of Kalibr's camchain.yaml beside the dataset, with the rate from its data.csv.
+EurocCameraSensor CameraSensorOf(const fs::path& mav0, const fs::path& dir, std::size_t index) {
+  const auto camchain = FindKalibrCamchain(mav0);
+  if (fs::exists(dir / "sensor.yaml") || !camchain) {
+    return ReadEurocCameraSensor(dir / "sensor.yaml");
+  }
+  const std::vector<EurocCameraSensor> cameras = ReadKalibrCamchain(*camchain);
+  if (index >= cameras.size()) {
+    throw InputError(*camchain, fmt::format("no cam{} entry for {}", index, dir.string()));
+  }
+  EurocCameraSensor sensor = cameras[index];
+  const std::vector<ImageEntry> list = ReadEurocImageList(dir / "data.csv", dir / "data");
+  std::vector<std::int64_t> dt;
+  for (std::size_t i = 1; i < list.size(); ++i) dt.push_back(list[i].t_ns - list[i - 1].t_ns);
+  if (dt.empty()) throw InputError(dir / "data.csv", "fewer than two images: no frame rate");
+  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+  sensor.rate_hz = 1e9 / static_cast<double>(dt[dt.size() / 2]);
+  return sensor;
+}
+
+// Both lists are strictly increasing: a merge finds exact timestamp matches.
+std::vector<StereoPair> MatchStereoPairs(const ImageStream& cam0, const ImageStream& cam1,
+                                         const fs::path& name) {
+  std::vector<StereoPair> pairs;
+  const auto& left = cam0.images;
+  const auto& right = cam1.images;
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < left.size() && j < right.size()) {
+    if (left[i].t_ns < right[j].t_ns) {
+      ++i;
+    } else if (right[j].t_ns < left[i].t_ns) {
+      ++j;
+    } else {
+      pairs.push_back({left[i].t_ns, i, j});
+      ++i;
+      ++j;
+    }
+  }
+  const std::size_t unpaired = left.size() + right.size() - 2 * pairs.size();
+  if (unpaired > 0) {
+    PKSLAM_LOG_DEBUG("{}: {} usable images have no partner with the same timestamp", name.string(),
+                     unpaired);
+  }
+  return pairs;
+}
+
+}  // namespace
+
+EurocDataset EurocDataset::FromImageStreams(const fs::path& root, ImageStream cam0,
+                                            std::optional<ImageStream> cam1) {
+  EurocDataset d;
+  d.mav0_ = root;
+  d.cam0_ = std::move(cam0);
+  if (cam1 && !cam1->images.empty()) {
+    d.cam1_ = std::move(*cam1);
+    d.cam1_sensor_ = EurocCameraSensor{};
+    d.stereo_pairs_ = MatchStereoPairs(d.cam0_, *d.cam1_, root);
+  }
+  return d;
+}
+
 EurocDataset EurocDataset::Open(const fs::path& root, const EurocOptions& options) {
   options.Check();
   EurocDataset d;
@@ -149,39 +215,22 @@ EurocDataset EurocDataset::Open(const fs::path& root, const EurocOptions& option
   if (!fs::is_regular_file(cam0_dir / "data.csv")) {
     throw InputError(cam0_dir / "data.csv", "file not found (cam0 is required)");
   }
-  d.cam0_sensor_ = ReadEurocCameraSensor(cam0_dir / "sensor.yaml");
+  d.cam0_sensor_ = CameraSensorOf(d.mav0_, cam0_dir, 0);
   d.cam0_ = ReadCameraStream(cam0_dir, "cam0", d.cam0_sensor_, options.frame_gap_periods);
 
   const fs::path cam1_dir = d.mav0_ / "cam1";
   if (fs::is_directory(cam1_dir)) {
-    d.cam1_sensor_ = ReadEurocCameraSensor(cam1_dir / "sensor.yaml");
+    d.cam1_sensor_ = CameraSensorOf(d.mav0_, cam1_dir, 1);
     d.cam1_ = ReadCameraStream(cam1_dir, "cam1", *d.cam1_sensor_, options.frame_gap_periods);
-    // Both lists are strictly increasing: a merge finds exact timestamp matches.
-    const auto& left = d.cam0_.images;
-    const auto& right = d.cam1_->images;
-    std::size_t i = 0;
-    std::size_t j = 0;
-    while (i < left.size() && j < right.size()) {
-      if (left[i].t_ns < right[j].t_ns) {
-        ++i;
-      } else if (right[j].t_ns < left[i].t_ns) {
-        ++j;
-      } else {
-        d.stereo_pairs_.push_back({left[i].t_ns, i, j});
-        ++i;
-        ++j;
-      }
-    }
-    const std::size_t unpaired = left.size() + right.size() - 2 * d.stereo_pairs_.size();
-    if (unpaired > 0) {
-      PKSLAM_LOG_DEBUG("{}: {} usable images have no partner with the same timestamp",
-                       d.mav0_.string(), unpaired);
-    }
+    d.stereo_pairs_ = MatchStereoPairs(d.cam0_, *d.cam1_, d.mav0_);
   }
 
   const fs::path imu_dir = d.mav0_ / "imu0";
   if (options.read_imu && fs::is_directory(imu_dir)) {
-    d.imu_sensor_ = ReadEurocImuSensor(imu_dir / "sensor.yaml");
+    const auto kalibr_imu = FindKalibrImu(d.mav0_);
+    d.imu_sensor_ = !fs::exists(imu_dir / "sensor.yaml") && kalibr_imu
+                        ? ReadKalibrImu(*kalibr_imu)
+                        : ReadEurocImuSensor(imu_dir / "sensor.yaml");
     d.imu_ = ReadEurocImu(imu_dir / "data.csv", options.imu_limits);
     std::vector<std::int64_t> t_ns;
     t_ns.reserve(d.imu_.size());

@@ -65,6 +65,10 @@ class EurocDataset {
   // (file, line) for missing/empty/malformed files, wrong column counts, non-increasing or
   // duplicate timestamps; OptionError for bad options.
   static EurocDataset Open(const std::filesystem::path& root, const EurocOptions& options = {});
+  // Image streams that did not come from an EuRoC folder (a KITTI sequence, io/kitti_dataset.h):
+  // no sensor files, no IMU, no ground truth; `root` names the dataset in messages.
+  static EurocDataset FromImageStreams(const std::filesystem::path& root, ImageStream cam0,
+                                       std::optional<ImageStream> cam1);
   // True if `root` has the EuRoC layout (mav0/cam0/data.csv or cam0/data.csv).
   static bool LooksLikeEuroc(const std::filesystem::path& root);
 

@@ -456,8 +456,9 @@ std::optional<std::int64_t> ParseDecimalAsInt64(std::string_view text, int decim
 }
 
 std::optional<std::filesystem::path> FindDatasetGroundTruth(const std::filesystem::path& dataset) {
-  for (const std::filesystem::path& f :
-       {dataset / "mav0/state_groundtruth_estimate0/data.csv", dataset / "groundtruth.txt"}) {
+  for (const std::filesystem::path& f : {dataset / "mav0/state_groundtruth_estimate0/data.csv",
+                                         dataset / "mav0/mocap0/data.csv",  // TUM-VI
+                                         dataset / "groundtruth.txt"}) {
     if (std::filesystem::exists(f)) return f;
   }
   return std::nullopt;

@@ -92,8 +92,8 @@ Trajectory ReadTrajectory(const std::filesystem::path& file,
                           TrajectoryFormat format = TrajectoryFormat::kAuto,
                           DuplicateTimestamps duplicates = DuplicateTimestamps::kKeepFirst);
 
-// A dataset folder's ground truth: EuRoC's mav0/state_groundtruth_estimate0/data.csv or TUM
-// RGB-D's groundtruth.txt (nullopt when it has neither).
+// A dataset folder's ground truth: EuRoC's mav0/state_groundtruth_estimate0/data.csv, TUM-VI's
+// mav0/mocap0/data.csv or TUM RGB-D's groundtruth.txt (nullopt when it has none).
 std::optional<std::filesystem::path> FindDatasetGroundTruth(const std::filesystem::path& dataset);
 
 // Writers (kAuto is not allowed). tum: seconds with exactly 9 decimals, so nanosecond

@@ -37,8 +37,42 @@ CameraRig EurocCam1() {
   return c;
 }
 
+// TUM-VI's 512x512 fisheye pair as its published calibration gives it (the numbers ORB-SLAM3's
+// TUM-VI settings carry): Kannala-Brandt intrinsics, IMU.T_b_c1 and Stereo.T_c1_c2.
+std::vector<CameraRig> TumViRig() {
+  CameraRig left;
+  left.name = "cam0";
+  left.camera = CameraModel::KannalaBrandt8(512, 512, 190.97847715128717, 190.9733070521226,
+                                            254.93170605935475, 256.8974428996504,
+                                            {0.0034823894022493434, 0.0007150348452162257,
+                                             -0.0020532361418706202, 0.00020293673591811182});
+  Eigen::Matrix4d body_from_cam0;
+  body_from_cam0 << -0.9995250378696743, 0.0075019185074052044, -0.02989013031643309,
+      0.045574835649698026,                                                                    //
+      0.029615343885863205, -0.03439736061393144, -0.998969345370175, -0.071161801837997044,   //
+      -0.008522328211654736, -0.9993800792498829, 0.03415885127385616, -0.044681254117144367,  //
+      0.0, 0.0, 0.0, 1.0;
+  left.body_from_camera = SE3d(SO3d::FitToMatrix(body_from_cam0.topLeftCorner<3, 3>()),
+                               body_from_cam0.topRightCorner<3, 1>());
+  CameraRig right;
+  right.name = "cam1";
+  right.camera = CameraModel::KannalaBrandt8(
+      512, 512, 190.44236969414825, 190.4344384721956, 252.59949716835982, 254.91723064636983,
+      {0.0034003170790442797, 0.001766278153469831, -0.00266312569781606, 0.0003299517423931039});
+  Eigen::Matrix4d cam0_from_cam1;
+  cam0_from_cam1 << 0.999999445773493, 0.000791687752817, 0.000694034010224, 0.101063427414194,
+      -0.000823363992158, 0.998899461915674, 0.046895490788700, 0.001946204678584,   //
+      -0.000656143613644, -0.046896036240590, 0.998899560146304, 0.001015350132563,  //
+      0.0, 0.0, 0.0, 1.0;
+  right.body_from_camera =
+      left.body_from_camera * SE3d(SO3d::FitToMatrix(cam0_from_cam1.topLeftCorner<3, 3>()),
+                                   cam0_from_cam1.topRightCorner<3, 1>());
+  return {left, right};
+}
+
 std::vector<CameraRig> StereoRig(const std::string& camera) {
   if (camera == "euroc") return {EurocCam0(), EurocCam1()};
+  if (camera == "tumvi") return TumViRig();
   CameraRig left = EurocCam0();
   CameraRig right = EurocCam1();
   double baseline_m = 0;
@@ -49,7 +83,7 @@ std::vector<CameraRig> StereoRig(const std::string& camera) {
     left.camera = CameraModel::Pinhole(640, 480, 525.0, 525.0, 319.5, 239.5);
     baseline_m = 0.11;
   } else {
-    throw OptionError(fmt::format("unknown --camera '{}' (euroc|kitti|vga)", camera));
+    throw OptionError(fmt::format("unknown --camera '{}' (euroc|kitti|vga|tumvi)", camera));
   }
   right.camera = left.camera;
   // A rectified pair: the right camera sits `baseline_m` along the left camera's x axis.
@@ -61,6 +95,7 @@ std::vector<CameraRig> StereoRig(const std::string& camera) {
 int OrbFeaturesFor(const std::string& camera) {
   if (camera == "kitti") return 2000;
   if (camera == "vga") return 1000;
+  if (camera == "tumvi") return 1000;  // ORB-SLAM3's TUM-VI settings
   return 1200;
 }
 
@@ -105,7 +140,8 @@ std::string CameraYaml(const CameraRig& c) {
   sensor.height = cam.height();
   sensor.camera_model = "pinhole";
   sensor.intrinsics = {cam.fx(), cam.fy(), cam.cx(), cam.cy()};
-  sensor.distortion_model = "radial-tangential";
+  sensor.distortion_model =
+      cam.type() == CameraType::kKannalaBrandt8 ? "equidistant" : "radial-tangential";
   sensor.distortion_coefficients = cam.distortion();
   return EurocCameraSensorYaml(
       sensor, fmt::format("pkslam simulated {} (EuRoC VI-Sensor geometry)", c.name));

@@ -34,9 +34,11 @@ CameraRig EurocCam1();
 // The stereo rig of EuRoC-format output by --camera: "euroc" (EuRoC's cam0/cam1, 752x480),
 // "kitti" (KITTI odometry's grey pair: 1241x376, f 718.856 px, 0.537 m baseline, no
 // distortion), "vga" (640x480 with TUM's default Kinect intrinsics, 0.11 m baseline, no
-// distortion). Every rig is mounted like EuRoC's cam0; OptionError for other names.
+// distortion), "tumvi" (TUM-VI's 512x512 Kannala-Brandt fisheye pair with its own extrinsics).
+// kitti and vga are mounted like EuRoC's cam0; OptionError for other names.
 std::vector<CameraRig> StereoRig(const std::string& camera);
-// ORB features per image the camera's ORB-SLAM3 settings use (EuRoC 1200, KITTI 2000, TUM 1000).
+// ORB features per image the camera's ORB-SLAM3 settings use (EuRoC 1200, KITTI 2000, TUM and
+// TUM-VI 1000).
 int OrbFeaturesFor(const std::string& camera);
 
 // One row of state_groundtruth_estimate0/data.csv.

@@ -33,8 +33,9 @@ void SimulationOptions::Check() const {
   PKSLAM_CHECK_OPTION(duration_s >= 0.0, "--duration", "{}", duration_s);
   PKSLAM_CHECK_OPTION(trajectory.empty() || duration_s == 0.0 || duration_s >= 0.1, "--duration",
                       "replay windows must be >= 0.1 s, got {}", duration_s);
-  PKSLAM_CHECK_OPTION(camera == "euroc" || camera == "kitti" || camera == "vga", "camera",
-                      "'{}' (euroc|kitti|vga)", camera);
+  PKSLAM_CHECK_OPTION(
+      camera == "euroc" || camera == "kitti" || camera == "vga" || camera == "tumvi", "camera",
+      "'{}' (euroc|kitti|vga|tumvi)", camera);
   PKSLAM_CHECK_OPTION(!(rgbd && camera != "euroc"), "camera",
                       "'{}' with --rgbd (its camera is "
                       "TUM's 640x480 Kinect)",

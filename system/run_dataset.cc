@@ -18,6 +18,7 @@
 #include "core/util/progress.h"
 #include "io/dataset_fingerprint.h"
 #include "io/euroc_dataset.h"
+#include "io/kitti_dataset.h"
 #include "io/rigid_transform_file.h"
 #include "io/settings_euroc.h"
 #include "io/trajectory.h"
@@ -120,12 +121,24 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
   std::optional<TumRgbdDataset> tum;
   std::vector<DatasetFrame> sources;
   Settings settings;
-  if (EurocDataset::LooksLikeEuroc(options.dataset)) {
+  // A KITTI sequence runs as an EuRoC dataset of its two image streams (no IMU, no sensor
+  // files), with the settings calib.txt gives unless --settings names a file.
+  std::optional<KittiSequence> kitti;
+  if (LooksLikeKitti(options.dataset)) {
+    KittiOptions ko;
+    ko.colour = options.kitti_colour;
+    kitti = OpenKittiSequence(options.dataset, ko);
+  }
+  if (kitti || EurocDataset::LooksLikeEuroc(options.dataset)) {
     EurocOptions eo;
     // The IMU sensor carries the body frame (EuRoC ground truth) even for visual-only runs.
     eo.read_imu = true;
     eo.imu_limits = options.imu_limits;
-    euroc = EurocDataset::Open(options.dataset, eo);
+    euroc = kitti ? EurocDataset::FromImageStreams(options.dataset, kitti->left, kitti->right)
+                  : EurocDataset::Open(options.dataset, eo);
+    if (kitti && IsInertial(sensor)) {
+      throw OptionError("a KITTI odometry sequence has no IMU: use stereo or mono");
+    }
     if (IsRgbd(sensor)) throw OptionError("an EuRoC dataset has no depth: use stereo or mono");
     if (IsInertial(sensor) && !euroc->has_imu()) {
       throw InputError(euroc->mav0() / "imu0", fmt::format("sensor {} needs IMU data (imu0/ "
@@ -153,8 +166,9 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
       const auto& images = euroc->cam0().images;
       for (std::size_t i = 0; i < images.size(); ++i) sources.push_back({images[i].t_ns, i, 0});
     }
-    settings =
-        options.settings ? ReadOrbSlam3Settings(*options.settings) : SettingsFromEuroc(*euroc);
+    settings = options.settings ? ReadOrbSlam3Settings(*options.settings)
+               : kitti          ? SettingsFromKitti(*kitti)
+                                : SettingsFromEuroc(*euroc);
     if (IsStereo(sensor) && settings.camera2 && settings.right_from_left) {
       // Checked here, where the calibration's file is known, to name it.
       try {
@@ -191,8 +205,9 @@ RunSummary RunDataset(const RunOptions& options, const RunControl& control) {
     settings = ReadOrbSlam3Settings(options.settings.value_or(fallback));
     if (!settings.depth_map_factor) settings.depth_map_factor = tum->depth_factor();
     if (IsRgbd(sensor)) {
-      tum->CheckDepthScale(*settings.depth_map_factor,
-                           "RGBD.DepthMapFactor of " + options.settings.value_or(fallback).string());
+      tum->CheckDepthScale(
+          *settings.depth_map_factor,
+          "RGBD.DepthMapFactor of " + options.settings.value_or(fallback).string());
     }
   } else {
     throw InputError(options.dataset,

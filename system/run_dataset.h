@@ -58,6 +58,8 @@ struct RunOptions {
   // Inertial sensors: frames the IMU does not cover are an error unless this is set (then a
   // warning, and the run is flagged degraded).
   bool allow_imu_gaps = false;
+  // KITTI sequences: the colour pair (image_2, image_3) instead of the grey one.
+  bool kitti_colour = false;
   // Plausibility limits of IMU samples (EuRoC reader).
   ImuLimits imu_limits;
   SystemOptions system;

@@ -25,7 +25,8 @@ AlignedEstimate AlignToGroundTruth(const Trajectory& ground_truth, const Traject
   out.world_from_map = e.ref_from_est;
   out.ate_rmse_m = e.ate_translation_m.rmse;
   std::vector<double> ate(estimate.poses.size(), -1.0);
-  for (std::size_t i = 0; i < e.pairs.size(); ++i) ate[e.pairs[i].est] = e.ate_translation_errors_m[i];
+  for (std::size_t i = 0; i < e.pairs.size(); ++i)
+    ate[e.pairs[i].est] = e.ate_translation_errors_m[i];
   const Sim3d& w = out.world_from_map;
   for (std::size_t i = 0; i < estimate.poses.size(); ++i) {
     const StampedPose& p = estimate.poses[i];
@@ -39,14 +40,14 @@ std::string RunFolderName(const fs::path& run) {
   fs::path p = fs::absolute(run).lexically_normal();
   if (p.filename().empty()) p = p.parent_path();
   std::string name = p.filename().string();
-  // Bench run folders are named by their index (CONFIG/seed1): the configuration tells them
+  // Bench run folders are named by their seed (CONFIG/seed1): the configuration tells them
   // apart in a legend, the index alone does not.
   auto numbered = [&](std::string_view prefix) {
     return name.size() > prefix.size() && name.rfind(prefix, 0) == 0 &&
            std::all_of(name.begin() + static_cast<std::ptrdiff_t>(prefix.size()), name.end(),
                        [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; });
   };
-  const bool index_only = numbered("seed") || numbered("run");
+  const bool index_only = numbered("seed");
   if (index_only && !p.parent_path().filename().empty()) {
     name = p.parent_path().filename().string() + "/" + name;
   }

@@ -27,9 +27,8 @@ struct RectifyingTransforms {
 
 RectifyingTransforms ComputeRectifyingTransforms(const CameraModel& left, const CameraModel& right,
                                                  const SE3d& right_from_left) {
-  PKSLAM_CHECK_OPTION(left.type() == CameraType::kPinhole && right.type() == CameraType::kPinhole,
-                      "stereo cameras",
-                      "rectification supports pinhole (radial-tangential) cameras only");
+  PKSLAM_CHECK_OPTION(left.type() == right.type(), "stereo cameras",
+                      "both cameras need the same model (pinhole or Kannala-Brandt)");
   PKSLAM_CHECK_OPTION(left.width() == right.width() && left.height() == right.height(),
                       "stereo cameras", "image sizes differ ({}x{} vs {}x{})", left.width(),
                       left.height(), right.width(), right.height());
@@ -46,9 +45,18 @@ RectifyingTransforms ComputeRectifyingTransforms(const CameraModel& left, const 
   const cv::Size size(left.width(), left.height());
   RectifyingTransforms t;
   cv::Mat q;
-  cv::stereoRectify(left.CvK(), left.CvDistortion(), right.CvK(), right.CvDistortion(), size,
-                    rotation, translation, t.r1, t.r2, t.p1, t.p2, q, cv::CALIB_ZERO_DISPARITY,
-                    /*alpha=*/0.0, size);
+  if (left.type() == CameraType::kKannalaBrandt8) {
+    // Kannala-Brandt with 4 coefficients is OpenCV's fisheye model (Kalibr's "equidistant");
+    // balance 0 keeps the central view both cameras see, as alpha 0 does for pinhole rigs.
+    cv::fisheye::stereoRectify(left.CvK(), left.CvDistortion(), right.CvK(), right.CvDistortion(),
+                               size, rotation, translation, t.r1, t.r2, t.p1, t.p2, q,
+                               cv::CALIB_ZERO_DISPARITY, size, /*balance=*/0.0,
+                               /*fov_scale=*/1.0);
+  } else {
+    cv::stereoRectify(left.CvK(), left.CvDistortion(), right.CvK(), right.CvDistortion(), size,
+                      rotation, translation, t.r1, t.r2, t.p1, t.p2, q, cv::CALIB_ZERO_DISPARITY,
+                      /*alpha=*/0.0, size);
+  }
   // OpenCV rectifies a vertical rig along the columns; the stereo matcher needs rows.
   PKSLAM_CHECK_OPTION(std::abs(t.p2.at<double>(1, 3)) == 0.0, "stereo extrinsic",
                       "the cameras are displaced vertically; only horizontal rigs are supported");
@@ -93,10 +101,17 @@ StereoRectification::StereoRectification(const CameraModel& left, const CameraMo
   // Float maps: fixed-point (CV_16SC2) maps would quantise sampling positions to 1/32 px,
   // which costs sub-pixel stereo accuracy for a negligible speed gain at VGA size.
   const cv::Size size(left.width(), left.height());
-  cv::initUndistortRectifyMap(left.CvK(), left.CvDistortion(), t.r1, t.p1, size, CV_32FC1,
-                              left_map_x_, left_map_y_);
-  cv::initUndistortRectifyMap(right.CvK(), right.CvDistortion(), t.r2, t.p2, size, CV_32FC1,
-                              right_map_x_, right_map_y_);
+  if (left.type() == CameraType::kKannalaBrandt8) {
+    cv::fisheye::initUndistortRectifyMap(left.CvK(), left.CvDistortion(), t.r1, t.p1, size,
+                                         CV_32FC1, left_map_x_, left_map_y_);
+    cv::fisheye::initUndistortRectifyMap(right.CvK(), right.CvDistortion(), t.r2, t.p2, size,
+                                         CV_32FC1, right_map_x_, right_map_y_);
+  } else {
+    cv::initUndistortRectifyMap(left.CvK(), left.CvDistortion(), t.r1, t.p1, size, CV_32FC1,
+                                left_map_x_, left_map_y_);
+    cv::initUndistortRectifyMap(right.CvK(), right.CvDistortion(), t.r2, t.p2, size, CV_32FC1,
+                                right_map_x_, right_map_y_);
+  }
 }
 
 SE3d StereoRectification::rect_right_from_rect_left() const {

@@ -1,6 +1,6 @@
-// Stereo rectification of a calibrated pinhole pair (EuRoC-style): after it, both cameras
-// share one ideal pinhole model, their optical axes are parallel, and the right camera sits at
-// x = +baseline in the rectified left frame, so a point appears on the same row in both images
+// Stereo rectification of a calibrated pinhole or fisheye pair (EuRoC, TUM-VI): after it, both
+// cameras share one ideal pinhole model, their optical axes are parallel, and the right camera sits
+// at x = +baseline in the rectified left frame, so a point appears on the same row in both images
 // with disparity u_left - u_right = bf / depth.
 //
 // Frames: "left"/"right" are the raw (physical) camera frames, "rect_left"/"rect_right" the
@@ -24,16 +24,17 @@ namespace pkslam {
 
 class StereoRectification {
  public:
-  // Both cameras must be pinhole (radial-tangential) models of the same size; right_from_left
-  // maps left-camera points to right-camera points. Uses cv::stereoRectify with alpha 0 (only
-  // valid pixels in the rectified images) and CALIB_ZERO_DISPARITY (shared principal point).
-  // Throws OptionError for unsupported inputs (fisheye, size mismatch, zero baseline).
+  // Both cameras must be of one model (pinhole radial-tangential, or Kannala-Brandt fisheye:
+  // OpenCV's cv::fisheye model) and one size; right_from_left maps left-camera points to
+  // right-camera points. Uses cv::stereoRectify with alpha 0 (only valid pixels in the rectified
+  // images), or cv::fisheye::stereoRectify with balance 0, and CALIB_ZERO_DISPARITY (shared
+  // principal point). Throws OptionError for unsupported inputs (mixed models, size mismatch,
+  // zero baseline).
   StereoRectification(const CameraModel& left, const CameraModel& right,
                       const SE3d& right_from_left);
   // The constructor's checks alone, without the pixel maps: throws the same OptionError (an
   // unsupported rig, or a rectified focal length outside 1/4-4x the cameras': implausible).
-  static void Check(const CameraModel& left, const CameraModel& right,
-                    const SE3d& right_from_left);
+  static void Check(const CameraModel& left, const CameraModel& right, const SE3d& right_from_left);
 
   // The shared rectified camera: ideal pinhole, zero distortion, the raw image size.
   const CameraModel& rectified_camera() const { return rectified_; }
