@@ -102,7 +102,8 @@ TEST(RosMessages, UnsupportedEncodingsAndBadSizesAreErrorsAtTheMessage) {
   // mono16 (TUM-VI) is read as its high byte, in either byte order.
   {
     const std::string little("\x34\x12\xff\x80\x00\x01\x10\x00", 8);  // 0x1234 0x80ff ...
-    ByteReader in(ImageBytes("mono16", 2, 2, 4, little), kWhere, 0);
+    const std::string bytes = ImageBytes("mono16", 2, 2, 4, little);  // outlives the reader
+    ByteReader in(bytes, kWhere, 0);
     const ByteReader start = in;
     const cv::Mat grey = RosImageToGrey(ParseRosImage(in), start);
     ASSERT_EQ(grey.type(), CV_8UC1);
