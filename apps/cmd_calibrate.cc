@@ -37,6 +37,7 @@ struct CalibrateArgs {
   bool no_verify = false;
   bool lever_arm = false;
   bool mono_intrinsics = false;
+  bool gyro_scale = true;
   bool quiet = false;
   std::string python = "/usr/bin/python3";
 };
@@ -143,6 +144,7 @@ void RunCalibrate(const CalibrateArgs& args) {
   c.enabled = true;
   c.imu_translation = args.lever_arm;
   c.monocular_intrinsics = args.mono_intrinsics;
+  c.gyro_scale = args.gyro_scale;
   c.final_max_observations_per_keyframe = 0;
   c.final_iterations_first = 30;
   c.final_iterations_second = 15;
@@ -223,6 +225,9 @@ void RegisterCalibrateCommand(CLI::App& app) {
                 "Estimate the camera-IMU translation too (held at the file's value by default)");
   cmd->add_flag("--calibrate-mono-intrinsics", args->mono_intrinsics,
                 "mono-inertial: estimate the camera's intrinsics too (held by default)");
+  cmd->add_flag("--calibrate-hold-gyro-scale{false}", args->gyro_scale,
+                "inertial: hold the gyroscope's scale factors at the file's values (estimated by "
+                "default)");
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
   cmd->add_option("--python", args->python, "Python with matplotlib, for the plot")
       ->capture_default_str();

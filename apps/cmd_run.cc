@@ -149,7 +149,7 @@ void RegisterRunCommand(CLI::App& app) {
            args->options.system.mapping.calibration.enabled = mode == "online";
          },
          "online: estimate the rig's calibration while mapping (intrinsics, stereo and "
-         "camera-IMU extrinsics, time offset; docs/calibration.md) | off: take the settings' "
+         "camera-IMU extrinsics, time offset, gyro scale factors; docs/calibration.md) | off: take the settings' "
          "calibration as exact")
       ->check(OneOf({"online", "off"}))
       ->default_str("off");
@@ -160,6 +160,10 @@ void RegisterRunCommand(CLI::App& app) {
                 args->options.system.mapping.calibration.monocular_intrinsics,
                 "--calibrate online, monocular-inertial: estimate the camera's intrinsics too "
                 "(held at the file's values by default; docs/calibration.md)");
+  cmd->add_flag("--calibrate-hold-gyro-scale{false}",
+                args->options.system.mapping.calibration.gyro_scale,
+                "--calibrate online, inertial: hold the gyroscope's scale factors at the file's "
+                "values (estimated by default; docs/calibration.md)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_flag(
       "--kitti-colour", args->options.kitti_colour,

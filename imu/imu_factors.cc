@@ -76,32 +76,11 @@ Eigen::Matrix<double, N, N> SqrtOfInformation(const Eigen::Matrix<double, N, N>&
   return sqrt_eig.asDiagonal() * es.eigenvectors().transpose();
 }
 
-}  // namespace
-
-Eigen::Matrix<double, 9, 1> InertialResidual(const PreintegratedImu& pim, const Vec3& gravity_world,
-                                             const NavState& state_i, const ImuBias& bias_i,
-                                             const NavState& state_j) {
-  const SO3d& r_i = state_i.world_from_body.so3();
-  const double dt = pim.dt;
-  const Vec3 u_v = state_j.velocity_world - state_i.velocity_world - gravity_world * dt;
-  const Vec3 u_p = state_j.world_from_body.translation() - state_i.world_from_body.translation() -
-                   state_i.velocity_world * dt - 0.5 * gravity_world * dt * dt;
-  Vec9 r;
-  r.segment<3>(0) = EvaluateRotation(pim, bias_i.gyro, r_i, state_j.world_from_body.so3(), false).r;
-  r.segment<3>(3) = r_i.Inverse() * u_v - DeltaVelocity(pim, bias_i);
-  r.segment<3>(6) = r_i.Inverse() * u_p - DeltaPosition(pim, bias_i);
-  return r;
-}
-
-InertialError::InertialError(const PreintegratedImu& pim, const Vec3& gravity_world)
-    : pim_(WithoutSteps(pim)),
-      gravity_world_(gravity_world),
-      sqrt_info_(PreintegrationSqrtInformation(pim)) {
-  PKSLAM_CHECK(pim.dt > 0, "inertial edge over an empty preintegration");
-}
-
-bool InertialError::Evaluate(double const* const* parameters, double* residuals,
-                             double** jacobians) const {
+// The inertial edge's residual and Jacobians for a preintegration `pim` (InertialError and, with
+// deltas shifted by the gyro scale, GyroScaledInertialError).
+bool EvaluateInertialEdge(const PreintegratedImu& pim_, const Vec3& gravity_world_,
+                          const Mat9& sqrt_info_, double const* const* parameters,
+                          double* residuals, double** jacobians) {
   const SE3d pose_i = BodyPoseFromBlock(parameters[0]);
   const Eigen::Map<const Vec3> v_i(parameters[1]);
   const Eigen::Map<const Vec3> bg(parameters[2]);
@@ -163,6 +142,85 @@ bool InertialError::Evaluate(double const* const* parameters, double* residuals,
     j.block<3, 3>(3, 0) = rt_i;
     Write<RowMajorJacobian<3>>(jacobians[5], sqrt_info_ * j);
   }
+  return true;
+}
+
+}  // namespace
+
+Eigen::Matrix<double, 9, 1> InertialResidual(const PreintegratedImu& pim, const Vec3& gravity_world,
+                                             const NavState& state_i, const ImuBias& bias_i,
+                                             const NavState& state_j) {
+  const SO3d& r_i = state_i.world_from_body.so3();
+  const double dt = pim.dt;
+  const Vec3 u_v = state_j.velocity_world - state_i.velocity_world - gravity_world * dt;
+  const Vec3 u_p = state_j.world_from_body.translation() - state_i.world_from_body.translation() -
+                   state_i.velocity_world * dt - 0.5 * gravity_world * dt * dt;
+  Vec9 r;
+  r.segment<3>(0) = EvaluateRotation(pim, bias_i.gyro, r_i, state_j.world_from_body.so3(), false).r;
+  r.segment<3>(3) = r_i.Inverse() * u_v - DeltaVelocity(pim, bias_i);
+  r.segment<3>(6) = r_i.Inverse() * u_p - DeltaPosition(pim, bias_i);
+  return r;
+}
+
+InertialError::InertialError(const PreintegratedImu& pim, const Vec3& gravity_world)
+    : pim_(WithoutSteps(pim)),
+      gravity_world_(gravity_world),
+      sqrt_info_(PreintegrationSqrtInformation(pim)) {
+  PKSLAM_CHECK(pim.dt > 0, "inertial edge over an empty preintegration");
+}
+
+bool InertialError::Evaluate(double const* const* parameters, double* residuals,
+                             double** jacobians) const {
+  return EvaluateInertialEdge(pim_, gravity_world_, sqrt_info_, parameters, residuals, jacobians);
+}
+
+GyroScaledInertialError::GyroScaledInertialError(const PreintegratedImu& pim,
+                                                 const Vec3& gravity_world,
+                                                 const GyroScaleJacobians& scale,
+                                                 const Vec3& integrated_scale)
+    : pim_(WithoutSteps(pim)),
+      gravity_world_(gravity_world),
+      sqrt_info_(PreintegrationSqrtInformation(pim)),
+      scale_(scale),
+      inv_integrated_(Vec3::Ones().cwiseQuotient(Vec3::Ones() + integrated_scale)),
+      integrated_scale_(integrated_scale) {
+  PKSLAM_CHECK(pim.dt > 0, "inertial edge over an empty preintegration");
+  PKSLAM_CHECK(integrated_scale.allFinite() && integrated_scale.cwiseAbs().maxCoeff() < 0.5,
+               "gyro scale error ({}, {}, {}) out of range", integrated_scale.x(),
+               integrated_scale.y(), integrated_scale.z());
+}
+
+bool GyroScaledInertialError::Evaluate(double const* const* parameters, double* residuals,
+                                       double** jacobians) const {
+  // The steps were corrected with integrated_scale_: the change to 1 / (1 + k) is, to first
+  // order, a scale change dk = (k - k_integrated) / (1 + k_integrated) of the corrected rates.
+  const Eigen::Map<const Vec3> k(parameters[6]);
+  const Vec3 dk = (k - integrated_scale_).cwiseProduct(inv_integrated_);
+  const Vec3 psi = scale_.rotation * dk;
+  PreintegratedImu shifted = pim_;
+  shifted.delta_R = pim_.delta_R * SO3d::Exp(psi);
+  shifted.delta_v = pim_.delta_v + scale_.velocity * dk;
+  shifted.delta_p = pim_.delta_p + scale_.position * dk;
+  if (!EvaluateInertialEdge(shifted, gravity_world_, sqrt_info_, parameters, residuals,
+                            jacobians)) {
+    return false;
+  }
+  if (jacobians == nullptr || jacobians[6] == nullptr) return true;
+  const Eigen::Map<const Vec3> bg(parameters[2]);
+  const SO3d r_i = BodyPoseFromBlock(parameters[0]).so3();
+  const SO3d r_j = BodyPoseFromBlock(parameters[4]).so3();
+  const RotationResidual rot = EvaluateRotation(shifted, bg, r_i, r_j, true);
+  // r_R = Log(B^T Exp(-psi) dR^T R_i^T R_j) with B the bias correction: a change of psi enters
+  // as Exp(-B^T Jr(psi) d psi) on the left of the error rotation.
+  const Mat3 b = SO3d::Exp(shifted.J_R_bg * (bg - shifted.bias.gyro)).Matrix();
+  const Mat3 d_psi = -rot.jr_inv * SO3d::Exp(rot.r).Matrix().transpose() * b.transpose() *
+                     SO3d::RightJacobian(psi);
+  RowMajorJacobian<3> j;
+  j.block<3, 3>(0, 0) = d_psi * scale_.rotation;
+  j.block<3, 3>(3, 0) = -scale_.velocity;
+  j.block<3, 3>(6, 0) = -scale_.position;
+  j = j * inv_integrated_.asDiagonal();
+  Write<RowMajorJacobian<3>>(jacobians[6], sqrt_info_ * j);
   return true;
 }
 

@@ -19,6 +19,7 @@
 
 #include "core/geometry/se3.h"
 #include "core/imu/imu_types.h"
+#include "imu/preintegration.h"
 
 namespace pkslam {
 
@@ -41,6 +42,29 @@ class InertialError final : public ceres::SizedCostFunction<9, 7, 3, 3, 3, 7, 3>
   PreintegratedImu pim_;  // without its steps
   Eigen::Vector3d gravity_world_;
   Eigen::Matrix<double, 9, 9> sqrt_info_;
+};
+
+// The inertial edge with the gyroscope's per-axis scale-factor error k as a parameter (online
+// calibration, docs/calibration.md: the gyro reads (1 + k) times the true rate). pim's steps were
+// corrected with `integrated_scale` (divided by 1 + k_integrated); the deltas follow k to first
+// order through GyroScaleJacobiansOf (imu/preintegration.h), then the residual is InertialError's.
+// Parameters {pose_i[7], v_i[3], bias_gyro_i[3], bias_accel_i[3], pose_j[7], v_j[3], k[3]};
+// residual 9.
+class GyroScaledInertialError final : public ceres::SizedCostFunction<9, 7, 3, 3, 3, 7, 3, 3> {
+ public:
+  // `scale` = GyroScaleJacobiansOf(pim), computed where pim still has its steps.
+  GyroScaledInertialError(const PreintegratedImu& pim, const Eigen::Vector3d& gravity_world,
+                          const GyroScaleJacobians& scale, const Eigen::Vector3d& integrated_scale);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  PreintegratedImu pim_;  // without its steps
+  Eigen::Vector3d gravity_world_;
+  Eigen::Matrix<double, 9, 9> sqrt_info_;
+  GyroScaleJacobians scale_;
+  Eigen::Vector3d inv_integrated_;  // 1 / (1 + integrated_scale), per axis
+  Eigen::Vector3d integrated_scale_;
 };
 
 // Bias random walk between consecutive bias blocks: r = W (b_j - b_i), W^T W = covariance^-1.

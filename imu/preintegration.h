@@ -74,6 +74,23 @@ SO3d DeltaRotation(const PreintegratedImu& pim, const ImuBias& bias);
 Eigen::Vector3d DeltaVelocity(const PreintegratedImu& pim, const ImuBias& bias);
 Eigen::Vector3d DeltaPosition(const PreintegratedImu& pim, const ImuBias& bias);
 
+// First-order Jacobians of the deltas with respect to a change dk of the gyroscope's per-axis
+// scale-factor error (the gyro reads (1 + k) times the true rate; online calibration,
+// docs/calibration.md): the rates re-scaled by 1 / (1 + k + dk) give, around dk = 0,
+//   delta_R Exp(rotation dk),  delta_v + velocity dk,  delta_p + position dk
+// (in the steps' frame; replayed from pim.steps at pim.bias, so a pim without steps gives 0).
+struct GyroScaleJacobians {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d velocity = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d position = Eigen::Matrix3d::Zero();
+};
+GyroScaleJacobians GyroScaleJacobiansOf(const PreintegratedImu& pim);
+
+// Multiplies every step's gyro sample and the linearisation bias's gyro part by `factor` per
+// axis, then re-integrates: moves a preintegration from one gyro scale correction to another
+// (factor = (1 + k_old) / (1 + k_new)). A factor of exactly one leaves pim untouched.
+void RescaleGyro(const Eigen::Vector3d& factor, PreintegratedImu* pim);
+
 // Re-integrates every stored step at `bias` (it becomes the linearisation point).
 void Reintegrate(const ImuBias& bias, PreintegratedImu* pim);
 

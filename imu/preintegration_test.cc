@@ -136,6 +136,55 @@ TEST_P(PreintegrationSchemes, BiasJacobiansMatchNumericDifferences) {
   EXPECT_GT(pim.J_p_bg.norm(), 0.05);
 }
 
+TEST_P(PreintegrationSchemes, GyroScaleJacobiansMatchRescaledReintegration) {
+  // The gyro reads (1 + k) times the rate: the Jacobians give the deltas of rates divided by
+  // 1 + dk, which RescaleGyro(1 / (1 + dk)) integrates exactly.
+  const HelixMotion motion;
+  const std::int64_t t0 = 0, t1 = kSecond;
+  const ImuBias b0(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));
+  const PreintegratedImu pim =
+      Integrate(SampleImu(motion, t0, t1, 5'000'000, b0, {}, nullptr), t0, t1, b0, GetParam());
+  const GyroScaleJacobians j = GyroScaleJacobiansOf(pim);
+  const double h = 1e-6;
+  Eigen::Matrix3d n_R, n_v, n_p;
+  for (int i = 0; i < 3; ++i) {
+    PreintegratedImu plus = pim, minus = pim;
+    Vec3 fp = Vec3::Ones(), fm = Vec3::Ones();
+    fp(i) = 1.0 / (1.0 + h);
+    fm(i) = 1.0 / (1.0 - h);
+    RescaleGyro(fp, &plus);
+    RescaleGyro(fm, &minus);
+    // RescaleGyro also scales the linearisation bias; compare at the original bias.
+    n_R.col(i) = (DeltaRotation(minus, b0).Inverse() * DeltaRotation(plus, b0)).Log() / (2 * h);
+    n_v.col(i) = (DeltaVelocity(plus, b0) - DeltaVelocity(minus, b0)) / (2 * h);
+    n_p.col(i) = (DeltaPosition(plus, b0) - DeltaPosition(minus, b0)) / (2 * h);
+  }
+  EXPECT_LT((n_R - j.rotation).norm(), 1e-5 * (1 + j.rotation.norm())) << j.rotation;
+  EXPECT_LT((n_v - j.velocity).norm(), 1e-4 * (1 + j.velocity.norm())) << j.velocity;
+  EXPECT_LT((n_p - j.position).norm(), 1e-4 * (1 + j.position.norm())) << j.position;
+  // Over a second of the helix's turning a 1% scale error is a visible rotation.
+  EXPECT_GT(j.rotation.norm(), 0.1);
+  EXPECT_GT(j.velocity.norm(), 0.1);
+}
+
+TEST(Preintegration, RescaleGyroByOneChangesNothingAndRejectsBadFactors) {
+  const HelixMotion motion;
+  const ImuBias b0(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));
+  const PreintegratedImu pim =
+      Integrate(SampleImu(motion, 0, kSecond, 5'000'000, b0, {}, nullptr), 0, kSecond, b0,
+                ImuIntegrationScheme::kMidpoint);
+  PreintegratedImu same = pim;
+  RescaleGyro(Vec3::Ones(), &same);
+  EXPECT_EQ(same.delta_v, pim.delta_v);
+  EXPECT_EQ(same.covariance, pim.covariance);
+  PreintegratedImu scaled = pim;
+  RescaleGyro(Vec3(1.01, 1.0, 1.0), &scaled);
+  EXPECT_NEAR(scaled.bias.gyro.x(), 1.01 * b0.gyro.x(), 1e-15);
+  EXPECT_GT((scaled.delta_R.Inverse() * pim.delta_R).Angle(), 1e-4);
+  EXPECT_THROW(RescaleGyro(Vec3(1.0, 0.0, 1.0), &scaled), Error);
+  EXPECT_THROW(RescaleGyro(Vec3(1.0, std::nan(""), 1.0), &scaled), Error);
+}
+
 TEST(Preintegration, FirstOrderBiasCorrectionApproximatesReintegration) {
   const HelixMotion motion;
   const std::int64_t t0 = 0, t1 = kSecond / 2;

@@ -87,15 +87,45 @@ std::string Join(const std::vector<double>& values) {
 
 }  // namespace
 
-std::string EurocCameraSensorYaml(const EurocCameraSensor& c, const std::string& comment) {
-  // EuRoC's layout: T_BS rows continued under the opening bracket.
-  const Eigen::Matrix4d m = c.body_from_camera.Matrix();
+namespace {
+
+// EuRoC's layout: T_BS rows continued under the opening bracket.
+std::string TbsYaml(const SE3d& body_from_sensor) {
+  const Eigen::Matrix4d m = body_from_sensor.Matrix();
   std::string t_bs = "T_BS:\n  cols: 4\n  rows: 4\n  data: [";
   for (int r = 0; r < 4; ++r) {
     if (r > 0) t_bs += ",\n         ";
     for (int col = 0; col < 4; ++col) t_bs += (col > 0 ? ", " : "") + Real(m(r, col));
   }
-  t_bs += "]\n";
+  return t_bs + "]\n";
+}
+
+}  // namespace
+
+std::string EurocImuSensorYaml(const EurocImuSensor& imu, const std::string& comment) {
+  std::string text = fmt::format(
+      "%YAML:1.0\n# General sensor definitions.\nsensor_type: imu\ncomment: {}\n\n"
+      "# Sensor extrinsics wrt. the body-frame.\n{}\n"
+      "rate_hz: {}\n\n# inertial sensor noise model parameters (static)\n"
+      "gyroscope_noise_density: {}     # [ rad / s / sqrt(Hz) ]   ( gyro \"white noise\" )\n"
+      "gyroscope_random_walk: {}       # [ rad / s^2 / sqrt(Hz) ] ( gyro bias diffusion )\n"
+      "accelerometer_noise_density: {}  # [ m / s^2 / sqrt(Hz) ]   ( accel \"white noise\" )\n"
+      "accelerometer_random_walk: {}    # [ m / s^3 / sqrt(Hz) ].  ( accel bias diffusion )\n",
+      comment, TbsYaml(imu.body_from_imu), Real(imu.rate_hz), Real(imu.gyroscope_noise_density),
+      Real(imu.gyroscope_random_walk), Real(imu.accelerometer_noise_density),
+      Real(imu.accelerometer_random_walk));
+  if (!imu.gyroscope_scale_error.isZero()) {
+    text += fmt::format(
+        "# pkslam: the gyroscope reads (1 + k) times the true rate about each axis\n"
+        "gyroscope_scale_error: [{}, {}, {}]\n",
+        Real(imu.gyroscope_scale_error.x()), Real(imu.gyroscope_scale_error.y()),
+        Real(imu.gyroscope_scale_error.z()));
+  }
+  return text + "\n";
+}
+
+std::string EurocCameraSensorYaml(const EurocCameraSensor& c, const std::string& comment) {
+  const std::string t_bs = TbsYaml(c.body_from_camera);
   const std::vector<double> distortion =
       c.distortion_coefficients.empty() ? std::vector<double>{0.0, 0.0, 0.0, 0.0}
                                         : c.distortion_coefficients;
@@ -125,6 +155,17 @@ EurocImuSensor ReadEurocImuSensor(const std::filesystem::path& sensor_yaml) {
   imu.gyroscope_random_walk = PositiveDouble(yaml, "gyroscope_random_walk");
   imu.accelerometer_noise_density = PositiveDouble(yaml, "accelerometer_noise_density");
   imu.accelerometer_random_walk = PositiveDouble(yaml, "accelerometer_random_walk");
+  if (yaml.Has("gyroscope_scale_error")) {
+    const std::vector<double> k = yaml.DoubleSequence("gyroscope_scale_error", 3);
+    for (int i = 0; i < 3; ++i) {
+      if (!(std::abs(k[i]) <= 0.1)) {
+        yaml.Fail("gyroscope_scale_error",
+                  fmt::format("{} is not a scale-factor error (a fraction within [-0.1, 0.1])",
+                              k[i]));
+      }
+      imu.gyroscope_scale_error[i] = k[i];
+    }
+  }
   return imu;
 }
 

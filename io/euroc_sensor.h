@@ -32,6 +32,9 @@ struct EurocImuSensor {
   double gyroscope_random_walk = 0;        // [rad/s^2/sqrt(Hz)]
   double accelerometer_noise_density = 0;  // [m/s^2/sqrt(Hz)]
   double accelerometer_random_walk = 0;    // [m/s^3/sqrt(Hz)]
+  // pkslam's key gyroscope_scale_error (optional, not in EuRoC's files): the gyro reads
+  // (1 + k) times the true rate per axis (written by pkslam's calibration estimates).
+  Eigen::Vector3d gyroscope_scale_error = Eigen::Vector3d::Zero();
 };
 
 // Parse and validate (positive rate and size, known models, coefficient counts, rigid T_BS).
@@ -42,5 +45,7 @@ EurocImuSensor ReadEurocImuSensor(const std::filesystem::path& sensor_yaml);
 // A camera's sensor.yaml in EuRoC's layout (%YAML:1.0 header, T_BS rows under the bracket);
 // timeshift_cam_imu only when not 0. Doubles are written with every digit.
 std::string EurocCameraSensorYaml(const EurocCameraSensor& camera, const std::string& comment);
+// An IMU's sensor.yaml in EuRoC's layout; gyroscope_scale_error only when not 0.
+std::string EurocImuSensorYaml(const EurocImuSensor& imu, const std::string& comment);
 
 }  // namespace pkslam

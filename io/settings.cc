@@ -196,6 +196,17 @@ Settings ReadOrbSlam3Settings(const std::filesystem::path& file) {
       }
       s.time_offset_s = *offset;
     }
+    const char* scale_keys[3] = {"IMU.GyroScaleX", "IMU.GyroScaleY", "IMU.GyroScaleZ"};
+    for (int i = 0; i < 3; ++i) {
+      if (const auto k = yaml.OptionalDouble(scale_keys[i])) {
+        if (!(std::abs(*k) <= 0.1)) {
+          yaml.Fail(scale_keys[i],
+                    fmt::format("must be within [-0.1, 0.1] (a fraction: 0.002 is 0.2%), found {}",
+                                *k));
+        }
+        s.gyro_scale[i] = *k;
+      }
+    }
   }
   if (yaml.Has("RGBD.DepthMapFactor")) s.depth_map_factor = Positive(yaml, "RGBD.DepthMapFactor");
   if (yaml.Has("RGBD.DepthNoise")) s.depth_noise_k = Positive(yaml, "RGBD.DepthNoise");

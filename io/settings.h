@@ -69,6 +69,9 @@ struct Settings {
   // IMU.TimeOffset [s] (pkslam; optional, default 0): the image stamped t was taken at IMU time
   // t + time_offset_s (Kalibr's timeshift_cam_imu). ORB-SLAM3 has no such key and ignores it.
   double time_offset_s = 0.0;
+  // IMU.GyroScaleX/Y/Z (pkslam; optional, default 0): the gyroscope's per-axis scale-factor error
+  // (fraction: it reads 1 + k times the true rate). ORB-SLAM3 has no such keys and ignores them.
+  Eigen::Vector3d gyro_scale = Eigen::Vector3d::Zero();
   // RGBD.DepthMapFactor: depth image value per metre (TUM: 5000). Optional.
   std::optional<double> depth_map_factor;
   // RGBD.DepthNoise (pkslam): k of the depth noise sigma_z = k z^2 [1/m]; optional, default

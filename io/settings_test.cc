@@ -188,8 +188,11 @@ TEST_F(SettingsFiles, RoundTripKannalaBrandtAndRectified) {
       SE3d(SO3d::Exp(Eigen::Vector3d(1.2, 0.1, -0.4)), Eigen::Vector3d(0.04, -0.03, 0.02));
   kb.imu = ImuNoise{0.004, 0.05, 4.4e-5, 0.00172, 200};
   kb.orb = {1500, 1.25, 9, 19, 6};
+  kb.gyro_scale = Eigen::Vector3d(0.001, -0.0048, 0.0);
   WriteOrbSlam3Settings(kb, dir_ / "kb.yaml");
-  ExpectSettingsNear(ReadOrbSlam3Settings(dir_ / "kb.yaml"), kb, 1e-15);
+  const Settings kb_back = ReadOrbSlam3Settings(dir_ / "kb.yaml");
+  ExpectSettingsNear(kb_back, kb, 1e-15);
+  EXPECT_EQ(kb_back.gyro_scale, kb.gyro_scale);
 
   Settings rectified;
   rectified.rectified_stereo = true;
@@ -222,6 +225,8 @@ TEST_F(SettingsFiles, MissingOrMalformedKeysNameKeyFileAndLine) {
               HasSubstr("key 'Camera.width': must be a positive integer"));
   EXPECT_THAT(ReadError(Edited("IMU.NoiseAcc: 2.0e-03\n", "")),
               HasSubstr("key 'IMU.NoiseAcc': missing (required)"));
+  EXPECT_THAT(ReadError(Edited("IMU.Frequency: 200.0", "IMU.Frequency: 200.0\nIMU.GyroScaleY: 0.5")),
+              HasSubstr("key 'IMU.GyroScaleY': must be within [-0.1, 0.1] (a fraction"));
   EXPECT_THAT(ReadError(Edited("Stereo.T_c1_c2", "Stereo.T_c1_c2_typo")),
               HasSubstr("key 'Stereo.T_c1_c2': missing (required with Camera2.*)"));
   EXPECT_THAT(ReadError(Edited("0.9999972564774497,", "1.5,")),

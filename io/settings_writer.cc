@@ -118,6 +118,12 @@ void WriteOrbSlam3Settings(const Settings& s, const std::filesystem::path& file)
       w.Comment("pkslam: the image stamped t was taken at IMU time t + TimeOffset (s)");
       w.RealKey("IMU.TimeOffset", s.time_offset_s);
     }
+    if (!s.gyro_scale.isZero()) {
+      w.Comment("pkslam: the gyroscope reads (1 + GyroScale) times the true rate, per IMU axis");
+      w.RealKey("IMU.GyroScaleX", s.gyro_scale.x());
+      w.RealKey("IMU.GyroScaleY", s.gyro_scale.y());
+      w.RealKey("IMU.GyroScaleZ", s.gyro_scale.z());
+    }
     w.Blank();
   }
   if (s.depth_noise_k) {

@@ -1,6 +1,7 @@
 #include "mapping/calibration_apply.h"
 
 #include "core/util/error.h"
+#include "imu/preintegration.h"
 #include "estimators/optim/point_refinement.h"
 #include "map_model/estimation/bundle_collect.h"
 #include "map_model/keyframe.h"
@@ -11,9 +12,36 @@
 #include "mapping/inertial_bundle.h"
 
 namespace pkslam {
+namespace {
+
+// Per axis, (1 + k_from) / (1 + k_to): what moves a gyro sample corrected for scale error
+// k_from to one corrected for k_to.
+Eigen::Vector3d GyroRescale(const RigCalibration& from, const RigCalibration& to) {
+  return (Eigen::Vector3d::Ones() + from.gyro_scale)
+      .cwiseQuotient(Eigen::Vector3d::Ones() + to.gyro_scale);
+}
+
+// A keyframe's preintegration and gyro bias moved to a new gyro scale correction.
+void RescaleKeyFrameGyro(const Eigen::Vector3d& factor, KeyFrame* kf) {
+  if (kf->imu.from_previous) RescaleGyro(factor, &*kf->imu.from_previous);
+  kf->imu.state.bias.gyro = kf->imu.state.bias.gyro.cwiseProduct(factor);
+}
+
+}  // namespace
 
 void MoveToCalibration(Atlas* atlas, const RigCalibration& calibration, const RigSetup& setup) {
   const RigSetup old = atlas->rig_setup();
+  const Eigen::Vector3d gyro_factor = GyroRescale(atlas->calibration(), calibration);
+  if (gyro_factor != Eigen::Vector3d::Ones()) {
+    // The chain's preintegrations were integrated with the old correction (tracking corrects
+    // each sample as it integrates it: Tracker::SetGyroScale).
+    for (Map* map : atlas->maps()) {
+      for (const auto& [id, kf] : map->keyframes()) RescaleKeyFrameGyro(gyro_factor, kf.get());
+      for (const auto& [id, kf] : map->retired_keyframes()) {
+        RescaleKeyFrameGyro(gyro_factor, kf.get());
+      }
+    }
+  }
   if (old.rig != nullptr) {
     // The body keeps its place: the tracking camera moves by new_from_old.
     const SE3d new_from_old = setup.rig->body_from_camera.Inverse() * old.rig->body_from_camera;
@@ -58,6 +86,8 @@ int RefinePointsToCalibration(Atlas* atlas, MapId map_id) {
 
 void ApplyCalibration(Atlas* atlas, Map* map, const CalibrationBundleProblem& problem,
                       const CalibrationBundleResult& result, const RigSetup& setup) {
+  // The adjustment's gyro biases are those of rates corrected with the problem's scale.
+  const Eigen::Vector3d gyro_factor = GyroRescale(problem.initial, result.estimate);
   MoveToCalibration(atlas, result.estimate, setup);
   if (map == nullptr) return;
   const InertialBundleProblem& bundle = problem.bundle;
@@ -74,6 +104,7 @@ void ApplyCalibration(Atlas* atlas, Map* map, const CalibrationBundleProblem& pr
   }
   written.velocities = result.bundle.velocities;
   written.biases = result.bundle.biases;
+  for (ImuBias& b : written.biases) b.gyro = b.gyro.cwiseProduct(gyro_factor);
   MergeGlobalBundle(
       map, bundle.visual,
       [&] {

@@ -6,6 +6,7 @@
 #include <shared_mutex>
 
 #include "core/camera/test_cameras.h"
+#include "imu/preintegration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
@@ -99,6 +100,44 @@ TEST_F(CalibrationApplyTest, MovingToAnEstimateKeepsPhysicalPixelsAndBodies) {
     EXPECT_NEAR(raw_right.x(), raw_right_before[i].x(), 0.05);
   }
   EXPECT_GT(stereo, 50);
+}
+
+TEST_F(CalibrationApplyTest, AGyroScaleEstimateMovesTheChainsPreintegrationsAndBiases) {
+  // A chain whose samples were corrected with no scale error; the estimate says the gyro reads
+  // 0.5% fast about y: every keyframe's preintegration is re-integrated from samples divided by
+  // 1.005 (and its gyro bias, a term of the same samples, with them).
+  PreintegratedImu pim = StartPreintegration(ImuBias(Eigen::Vector3d(0.01, -0.02, 0.0), {}),
+                                             ImuNoise{});
+  for (int i = 0; i < 40; ++i) {
+    IntegrateMeasurement(Eigen::Vector3d(0.1, 9.8, 0.2), Eigen::Vector3d(0.3, 0.8, -0.2), 0.005,
+                         &pim);
+  }
+  {
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+    for (std::size_t k = 1; k < map_.keyframes.size(); ++k) {
+      map_.keyframes[k]->imu.from_previous = pim;
+      map_.keyframes[k]->imu.state.bias.gyro = Eigen::Vector3d(0.01, -0.02, 0.0);
+    }
+  }
+  RigCalibration estimate = file_;
+  estimate.gyro_scale = Eigen::Vector3d(0.0, 0.005, 0.0);
+  {
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
+    MoveToCalibration(&atlas_, estimate, setup_);
+  }
+  auto lock = MapReader(atlas_).Lock();
+  EXPECT_EQ(atlas_.calibration().gyro_scale, estimate.gyro_scale);
+  PreintegratedImu expected = pim;
+  RescaleGyro(Eigen::Vector3d(1.0, 1.0 / 1.005, 1.0), &expected);
+  const KeyFrame& kf = *map_.keyframes[4];
+  ASSERT_TRUE(kf.imu.from_previous.has_value());
+  EXPECT_NEAR(kf.imu.from_previous->steps[0].gyro.y(), 0.8 / 1.005, 1e-15);
+  EXPECT_EQ(kf.imu.from_previous->delta_R.quaternion().coeffs(),
+            expected.delta_R.quaternion().coeffs());
+  EXPECT_NEAR(kf.imu.state.bias.gyro.y(), -0.02 / 1.005, 1e-15);
+  // The rotation integrated about y is 0.5% smaller: 40 steps of (0.8 + 0.02) rad/s * 5 ms.
+  EXPECT_NEAR((pim.delta_R.Inverse() * kf.imu.from_previous->delta_R).Angle(),
+              0.164 * 0.005 / 1.005, 1e-5);
 }
 
 TEST_F(CalibrationApplyTest, AnAdjustmentOfAnExactMapMovesLittleAndAppliesCleanly) {

@@ -55,7 +55,7 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
   CalibrationGates g;
   const auto freeze_all = [&](const std::string& reason) {
     for (const char* group : {"intrinsics", "stereo", "imu_rotation", "imu_translation",
-                              "time_offset"}) {
+                              "time_offset", "gyro_scale"}) {
       g.frozen[group] = reason;
     }
     g.free = {};
@@ -108,7 +108,7 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
 
   if (!IsInertial(sensor) || !problem.inertial) {
     if (IsInertial(sensor)) {
-      for (const char* group : {"imu_rotation", "imu_translation", "time_offset"}) {
+      for (const char* group : {"imu_rotation", "imu_translation", "time_offset", "gyro_scale"}) {
         g.frozen[group] = "the map's IMU is not initialised";
       }
     }
@@ -140,6 +140,15 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
     g.frozen["imu_rotation"] =
         fmt::format("rotation about one axis only (second axis {:.3f} rad/s, at least {})",
                     g.second_axis_rate, options.min_rotation_rate);
+  }
+  // The gyro's scale factors need the same turning: about an axis the body never turned, the
+  // prior holds that axis's factor at the file's value.
+  if (!options.gyro_scale) {
+    g.frozen["gyro_scale"] = "held at the file's value (--calibrate-gyro-scale off)";
+  } else if (g.second_axis_rate >= options.min_rotation_rate) {
+    g.free.gyro_scale = true;
+  } else {
+    g.frozen["gyro_scale"] = g.frozen["imu_rotation"];
   }
   if (!options.imu_translation) {
     g.frozen["imu_translation"] = "held at the file's value (--calibrate-lever-arm estimates it)";

@@ -48,6 +48,9 @@ struct OnlineCalibrationOptions {
   // freeing them moved cam0's fx and cx further from the truth (0.6 -> 0.9-1.4 px) and raised
   // mono-inertial ATE (docs/calibration.md, "Parameters left at the file's value").
   bool monocular_intrinsics = false;
+  // Estimate the gyroscope's per-axis scale factor (inertial rigs). On by default: an
+  // unmodelled scale error of the gyro is absorbed by the focal length (calibration_bundle.h).
+  bool gyro_scale = true;
   // Observability gates (DecideFreedom). Camera-IMU rotation: the angular rate about the
   // keyframes' second-most-excited axis (rms, rad/s): rotation about a single axis leaves the
   // rotation about it unobservable. Camera-IMU translation (a lever arm seen only through
@@ -83,7 +86,8 @@ struct OnlineCalibrationOptions {
 // The parameter groups a refinement frees, and why the others stay frozen.
 struct CalibrationGates {
   CalibrationFreedom free;
-  // group ("intrinsics", "stereo", "imu_rotation", "imu_translation", "time_offset") -> reason
+  // group ("intrinsics", "stereo", "imu_rotation", "imu_translation", "time_offset",
+  // "gyro_scale") -> reason
   std::map<std::string, std::string> frozen;
   // The measured motion and coverage the gates compared.
   double second_axis_rate = 0;  // rad/s

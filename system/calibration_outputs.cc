@@ -16,6 +16,7 @@ const std::string& SourceOf(const std::string& name, const CalibrationSources& s
   if (name.rfind("cam1.", 0) == 0 || name.rfind("stereo.", 0) == 0) return s.cam1;
   if (name.rfind("imu.", 0) == 0) return s.imu;
   if (name == "time_offset") return s.time_offset;
+  if (name.rfind("gyro.", 0) == 0) return s.gyro;
   return s.cam0;
 }
 
@@ -38,13 +39,15 @@ EurocCameraSensor SensorOf(const CameraModel& camera, const SE3d& body_from_came
 
 CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings) {
   const std::string f = settings.string();
-  return {f, f, f, f};
+  return {f, f, f, f, f + " (IMU.GyroScaleX/Y/Z; absent: 0)"};
 }
 
 CalibrationSources SourcesFromEurocDataset(const std::filesystem::path& dataset) {
   const std::string cam0 = (dataset / "mav0" / "cam0" / "sensor.yaml").string();
   const std::string cam1 = (dataset / "mav0" / "cam1" / "sensor.yaml").string();
-  return {cam0, cam1, cam0 + " (T_BS)", cam0 + " (timeshift_cam_imu; absent: 0)"};
+  const std::string imu = (dataset / "mav0" / "imu0" / "sensor.yaml").string();
+  return {cam0, cam1, cam0 + " (T_BS)", cam0 + " (timeshift_cam_imu; absent: 0)",
+          imu + " (gyroscope_scale_error; absent: 0)"};
 }
 
 std::vector<std::string> CalibrationWarnings(const CalibrationReport& report,
@@ -151,6 +154,17 @@ void WriteCalibrationFiles(const CalibrationReport& report, const Settings& sett
                         EurocCameraSensorYaml(SensorOf(e.cameras[c], body_from_camera, rate,
                                                        c == 0 ? shift : 0.0),
                                               comment + fmt::format(", cam{}", c)));
+  }
+  if (IsInertial(report.sensor) && settings.imu) {
+    EurocImuSensor imu;
+    imu.rate_hz = settings.imu->rate_hz;
+    imu.gyroscope_noise_density = settings.imu->gyro_noise_density;
+    imu.gyroscope_random_walk = settings.imu->gyro_random_walk;
+    imu.accelerometer_noise_density = settings.imu->accel_noise_density;
+    imu.accelerometer_random_walk = settings.imu->accel_random_walk;
+    imu.gyroscope_scale_error = e.gyro_scale;
+    std::filesystem::create_directories(dir / "imu0");
+    WriteFileAtomically(dir / "imu0" / "sensor.yaml", EurocImuSensorYaml(imu, comment + ", imu0"));
   }
   WriteOrbSlam3Settings(SettingsWithCalibration(settings, e), dir / "settings.yaml");
 }

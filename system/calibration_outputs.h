@@ -33,7 +33,7 @@ struct CalibrationReport {
 // Where each parameter group came from, for the warnings: the settings file, or a EuRoC
 // dataset's sensor.yaml files.
 struct CalibrationSources {
-  std::string cam0, cam1, imu, time_offset;
+  std::string cam0, cam1, imu, time_offset, gyro;
 };
 CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings);
 CalibrationSources SourcesFromEurocDataset(const std::filesystem::path& dataset);
@@ -50,7 +50,9 @@ void WriteCalibrationJson(const CalibrationReport& report,
                           const std::vector<std::string>& warnings, JsonWriter* json);
 
 // OUT/calibration/{cam0,cam1}/sensor.yaml (EuRoC; cam0's with timeshift_cam_imu for inertial
-// sensors) and OUT/calibration/settings.yaml (ORB-SLAM3 v1.0, `settings` with the estimate).
+// sensors), for inertial sensors OUT/calibration/imu0/sensor.yaml (with pkslam's
+// gyroscope_scale_error) and OUT/calibration/settings.yaml (ORB-SLAM3 v1.0, `settings` with the
+// estimate).
 void WriteCalibrationFiles(const CalibrationReport& report, const Settings& settings,
                            const std::filesystem::path& out_dir);
 

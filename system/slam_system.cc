@@ -79,6 +79,8 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   tracker_->EnableTrace(options_.trace);
   time_offset_s_ = IsInertial(options_.sensor) ? file_calibration_.time_offset_s : 0.0;
   tracker_->SetTimeOffset(time_offset_s_);
+  tracker_->SetGyroScale(IsInertial(options_.sensor) ? file_calibration_.gyro_scale
+                                                     : Eigen::Vector3d::Zero());
   tracker_->EnableFrameTracks(options_.frame_tracks);
   if (!options_.no_loop) {
     LocalMapper* mapper = mapper_.get();
@@ -299,6 +301,8 @@ void SlamSystem::SyncCalibration() {
   setup_ = std::move(setup);
   time_offset_s_ = IsInertial(options_.sensor) ? calibration.time_offset_s : 0.0;
   tracker_->SetTimeOffset(time_offset_s_);
+  tracker_->SetGyroScale(IsInertial(options_.sensor) ? calibration.gyro_scale
+                                                     : Eigen::Vector3d::Zero());
 }
 
 TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {

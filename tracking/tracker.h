@@ -125,6 +125,9 @@ class Tracker {
   // The camera-IMU time offset the caller shifted the next frames' stamps by (recorded in their
   // FrameImu / KeyFrameImu for the calibration BA).
   void SetTimeOffset(double seconds) { time_offset_s_ = seconds; }
+  // The gyroscope's per-axis scale-factor error (RigCalibration::gyro_scale): samples are
+  // divided by 1 + k as they are integrated.
+  void SetGyroScale(const Eigen::Vector3d& k) { gyro_scale_ = k; }
   // A new calibration estimate (online calibration) moved the map's keyframes to `setup`'s rig:
   // frames are built with it from now on, and what tracking keeps of earlier frames (the last
   // frame, the monocular initialisation frame, the motion model, the records' poses relative to
@@ -220,6 +223,7 @@ class Tracker {
   std::vector<FrameRecord> records_;
   bool trace_enabled_ = false;
   double time_offset_s_ = 0.0;
+  Eigen::Vector3d gyro_scale_ = Eigen::Vector3d::Zero();
   bool frame_tracks_enabled_ = false;
   std::vector<TraceRow> trace_;
   SelectorDecision last_decision_;

@@ -64,7 +64,12 @@ std::optional<PreintegratedImu> Tracker::PreintegrateBetween(std::int64_t t0_ns,
   if (first != q.begin()) --first;
   auto last = std::lower_bound(q.begin(), q.end(), t1_ns,
                                [](const ImuMeasurement& m, std::int64_t t) { return m.t_ns < t; });
-  const std::vector<ImuMeasurement> samples(first, last + 1);
+  std::vector<ImuMeasurement> samples(first, last + 1);
+  if (!gyro_scale_.isZero()) {
+    const Eigen::Vector3d inverse = Eigen::Vector3d::Ones().cwiseQuotient(
+        Eigen::Vector3d::Ones() + gyro_scale_);
+    for (ImuMeasurement& m : samples) m.gyro = m.gyro.cwiseProduct(inverse);
+  }
   PreintegratedImu pim = StartPreintegration(bias, *rig_->imu);
   IntegrateSamples(samples, t0_ns, t1_ns, &pim);
   return pim;

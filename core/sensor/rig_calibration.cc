@@ -63,6 +63,9 @@ void CheckSameRig(const RigCalibration& file, const RigCalibration& estimate) {
   PKSLAM_CHECK_OPTION(std::abs(file.time_offset_s - estimate.time_offset_s) <= 0.05, "calibration",
                       "time offset {} s, expected {} s (within 50 ms)", estimate.time_offset_s,
                       file.time_offset_s);
+  PKSLAM_CHECK_OPTION((file.gyro_scale - estimate.gyro_scale).cwiseAbs().maxCoeff() <= 0.05,
+                      "calibration", "gyro scale error differs by {:.2f}% (within 5%)",
+                      100.0 * (file.gyro_scale - estimate.gyro_scale).cwiseAbs().maxCoeff());
 }
 
 RigSetup BuildRig(const RigCalibration& calibration, const RigShape& shape) {

@@ -39,6 +39,10 @@ struct RigCalibration {
   // Camera-IMU time offset (s): the image stamped t was taken at IMU time t + time_offset_s
   // (Kalibr's timeshift_cam_imu convention: t_imu = t_cam + shift).
   double time_offset_s = 0.0;
+  // The gyroscope's per-axis scale-factor error (fraction): it reads (1 + gyro_scale) times the
+  // true rate about each IMU axis, so its samples are divided by 1 + gyro_scale before they are
+  // integrated. Calibration files do not state it (0); online calibration estimates it.
+  Eigen::Vector3d gyro_scale = Eigen::Vector3d::Zero();
 
   bool stereo() const { return cameras.size() >= 2; }
   SE3d body_from_cam1() const { return body_from_cam0 * cam1_from_cam0.Inverse(); }
@@ -69,8 +73,8 @@ struct RigSetup {
 
 // Whether `estimate` can be a calibration of the rig `file` describes, not of another camera:
 // same cameras and image sizes, focal lengths within 3%, principal points within 20 px,
-// extrinsics within 3 deg and 3 cm, time offsets within 50 ms (several times the error of a
-// bad calibration, far below the difference between two rigs). Throws OptionError naming the
+// extrinsics within 3 deg and 3 cm, time offsets within 50 ms, gyro scale errors within 5%
+// (several times the error of a bad calibration, far below the difference between two rigs). Throws OptionError naming the
 // first difference.
 void CheckSameRig(const RigCalibration& file, const RigCalibration& estimate);
 

@@ -2,9 +2,16 @@
 // estimates the rig's calibration (docs/calibration.md): each camera's intrinsics (fx, fy, cx,
 // cy, k1, k2; the right camera's fy and cy stay, as its vertical coordinate is not measured),
 // the stereo extrinsic's rotation about the y and z axes (its translation is the map's scale
-// and its rotation about x moves only rows: both stay), the camera-IMU extrinsic cam0_from_body
-// and the camera-IMU time offset, each held to the calibration file's value by a Gaussian
-// prior.
+// and its rotation about x moves only rows: both stay), the camera-IMU extrinsic cam0_from_body,
+// the camera-IMU time offset and the gyroscope's per-axis scale factor, each held to the
+// calibration file's value by a Gaussian prior.
+//
+// The gyro's scale factor belongs here because it is what an unmodelled one turns into
+// otherwise: the camera's rotation is seen twice, in the images (through the focal length) and
+// by the gyro (through its scale), and a scale error of the gyro pulls the focal length by the
+// same fraction (a 0.48% error about the IMU's y axis, cam0's x, held cam0's fy 1.3 px low on a
+// realistic V1_02 replay; docs/calibration.md). The inertial edges take it to first order
+// (imu/imu_factors.h GyroScaledInertialError).
 //
 // Why a separate, whole-map adjustment rather than free calibration blocks in local BA: a
 // 10-keyframe window barely sees a camera-IMU rotation or a time offset (they need the motion of
@@ -42,6 +49,7 @@
 
 #include "core/sensor/rig_calibration.h"
 #include "estimators/inertial/inertial_bundle.h"
+#include "imu/preintegration.h"
 
 namespace pkslam {
 
@@ -59,6 +67,8 @@ struct CalibrationPriorOptions {
   double imu_rotation_deg = 0.35;     // cam0_from_body, per axis
   double imu_translation_mm = 8.0;
   double time_offset_ms = 2.0;
+  // The gyroscope's per-axis scale-factor error (%): 0.1-0.5% for MEMS gyros (docs/realism.md).
+  double gyro_scale_pct = 0.5;
 
   void Check() const;
 };
@@ -70,10 +80,11 @@ struct CalibrationFreedom {
   bool imu_rotation = false;
   bool imu_translation = false;
   bool time_offset = false;
+  bool gyro_scale = false;
 
   bool Any() const {
     return intrinsics[0] || intrinsics[1] || stereo_extrinsic || imu_rotation || imu_translation ||
-           time_offset;
+           time_offset || gyro_scale;
   }
 };
 
@@ -116,6 +127,9 @@ struct CalibrationBundleProblem {
   // bias-corrected) and the time offset its stamp was shifted by.
   std::vector<Eigen::Vector3d> angular_velocity;
   std::vector<double> time_offset_applied;
+  // Per bundle.edges entry: GyroScaleJacobiansOf its preintegration (the edges' copies carry no
+  // steps). Empty: computed from the edges' own steps (hand-made problems).
+  std::vector<GyroScaleJacobians> gyro_scale_jacobians;
   // The calibration the keyframes' measurements were taken with (the starting point) and the
   // calibration file's (the prior's mean).
   RigCalibration initial;
@@ -131,8 +145,8 @@ struct CalibrationBundleProblem {
 // cam1's position in cam0): r* the rotation vector of R_estimate R_file^T (deg), t* the
 // translation difference (mm), both in the parent frame's axes (body, cam0).
 struct CalibrationParameter {
-  std::string name;  // cam0.fx, cam1.k1, stereo.rx, imu.tz, time_offset_ms, ...
-  std::string unit;  // px, "", deg, mm, ms
+  std::string name;  // cam0.fx, cam1.k1, stereo.rx, imu.tz, time_offset, gyro.sx, ...
+  std::string unit;  // px, "", deg, mm, ms, %
   double file = 0;   // the prior's mean
   double estimate = 0;
   double sigma = 0;        // posterior 1-sigma (0 when not computed or not free)

@@ -33,7 +33,7 @@ class State {
       : kf_(num_kf),
         points_(num_points),
         data_(static_cast<std::size_t>((kBodyPoseBlockSize + 9) * num_kf + 3 * num_points +
-                                       2 * kCalibIntrinsicsSize + 2 * kCalibExtrinsicSize + 1 + 3),
+                                       2 * kCalibIntrinsicsSize + 2 * kCalibExtrinsicSize + 1 + 3 + 3),
               0.0) {}
   double* pose(int i) { return data_.data() + kBodyPoseBlockSize * i; }
   double* v(int i) { return data_.data() + kBodyPoseBlockSize * kf_ + 3 * i; }
@@ -47,6 +47,8 @@ class State {
   double* offset() { return cam1_from_cam0() + kCalibExtrinsicSize; }
   // A constant zero velocity for keyframes without inertial blocks.
   double* no_velocity() { return offset() + 1; }
+  // The gyro's per-axis scale-factor error (RigCalibration::gyro_scale).
+  double* gyro_scale() { return no_velocity() + 3; }
 
  private:
   int kf_;
@@ -103,6 +105,10 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
     index += 6;
     if (problem.free.time_offset) {
       entries.push_back({s->offset(), index, Eigen::MatrixXd::Constant(1, 1, 1e3)});
+    }
+    index += 1;
+    if (problem.free.gyro_scale) {
+      entries.push_back({s->gyro_scale(), index, Eigen::MatrixXd::Identity(3, 3) * 100.0});
     }
   }
   if (entries.empty()) return true;
@@ -165,6 +171,7 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
   PoseToBlock(problem.initial.body_from_cam0.Inverse(), s.cam0_from_body());
   PoseToBlock(problem.initial.cam1_from_cam0, s.cam1_from_cam0());
   *s.offset() = problem.initial.time_offset_s;
+  Eigen::Map<Eigen::Vector3d>(s.gyro_scale()) = problem.initial.gyro_scale;
 
   // cam1's fy and cy follow cam0's at the file's differences (CalibratedRightError).
   const Eigen::Vector2d vertical_offset =
@@ -200,6 +207,9 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
     result.estimate.body_from_cam0 = PoseFromBlock(s.cam0_from_body()).Inverse();
     result.estimate.cam1_from_cam0 = PoseFromBlock(s.cam1_from_cam0());
     result.estimate.time_offset_s = *s.offset();
+    if (problem.inertial) {
+      result.estimate.gyro_scale = Eigen::Map<const Eigen::Vector3d>(s.gyro_scale());
+    }
     result.parameters = CalibrationParameters(problem.prior, result.estimate, problem.free,
                                               options.prior, problem.inertial);
   };
@@ -284,6 +294,13 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
   } else {
     ceres_problem.SetParameterBlockConstant(s.offset());
   }
+  const bool gyro_scale_free = problem.inertial && problem.free.gyro_scale;
+  if (gyro_scale_free) {
+    ceres_problem.AddResidualBlock(
+        new EuclideanPriorError(problem.prior.gyro_scale,
+                                Eigen::Vector3d::Constant(sig.gyro_scale_pct * 1e-2)),
+        nullptr, s.gyro_scale());
+  }
 
   // Keyframes and the inertial chain.
   std::vector<std::uint8_t> pose_added(static_cast<std::size_t>(num_kf), 0);
@@ -303,12 +320,29 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
     ceres_problem.AddParameterBlock(s.ba(i), 3);
   };
   if (problem.inertial) {
-    for (const auto& e : problem.bundle.edges) {
+    PKSLAM_CHECK(problem.gyro_scale_jacobians.empty() ||
+                     problem.gyro_scale_jacobians.size() == problem.bundle.edges.size(),
+                 "calibration BA: {} gyro scale Jacobians for {} inertial edges",
+                 problem.gyro_scale_jacobians.size(), problem.bundle.edges.size());
+    for (std::size_t edge = 0; edge < problem.bundle.edges.size(); ++edge) {
+      const auto& e = problem.bundle.edges[edge];
       add_inertial(e.from);
       add_inertial(e.to);
-      ceres_problem.AddResidualBlock(
-          new InertialError(e.preintegration, problem.bundle.gravity_world), nullptr,
-          {s.pose(e.from), s.v(e.from), s.bg(e.from), s.ba(e.from), s.pose(e.to), s.v(e.to)});
+      if (gyro_scale_free) {
+        ceres_problem.AddResidualBlock(
+            new GyroScaledInertialError(e.preintegration, problem.bundle.gravity_world,
+                                        problem.gyro_scale_jacobians.empty()
+                                            ? GyroScaleJacobiansOf(e.preintegration)
+                                            : problem.gyro_scale_jacobians[edge],
+                                        problem.initial.gyro_scale),
+            nullptr,
+            {s.pose(e.from), s.v(e.from), s.bg(e.from), s.ba(e.from), s.pose(e.to), s.v(e.to),
+             s.gyro_scale()});
+      } else {
+        ceres_problem.AddResidualBlock(
+            new InertialError(e.preintegration, problem.bundle.gravity_world), nullptr,
+            {s.pose(e.from), s.v(e.from), s.bg(e.from), s.ba(e.from), s.pose(e.to), s.v(e.to)});
+      }
       ceres_problem.AddResidualBlock(BiasRandomWalkError::Gyro(e.preintegration).release(),
                                      nullptr, s.bg(e.from), s.bg(e.to));
       ceres_problem.AddResidualBlock(BiasRandomWalkError::Accel(e.preintegration).release(),
@@ -407,6 +441,7 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
   for (double* block : {s.cam0_from_body(), s.cam1_from_cam0(), s.offset(), s.no_velocity()}) {
     ordering->AddElementToGroup(block, 1);
   }
+  if (gyro_scale_free) ordering->AddElementToGroup(s.gyro_scale(), 1);
   solver_options.linear_solver_ordering = ordering;
   AbortCallback abort_callback(abort, work, &ceres_problem, options.min_iterations_before_abort);
   solver_options.callbacks.push_back(&abort_callback);

@@ -57,7 +57,8 @@ void CalibrationPriorOptions::Check() const {
         std::pair{"calibration.prior.stereo_translation_mm", stereo_translation_mm},
         std::pair{"calibration.prior.imu_rotation_deg", imu_rotation_deg},
         std::pair{"calibration.prior.imu_translation_mm", imu_translation_mm},
-        std::pair{"calibration.prior.time_offset_ms", time_offset_ms}}) {
+        std::pair{"calibration.prior.time_offset_ms", time_offset_ms},
+        std::pair{"calibration.prior.gyro_scale_pct", gyro_scale_pct}}) {
     PKSLAM_CHECK_OPTION(value > 0 && std::isfinite(value), name, "{} (a positive sigma)", value);
   }
 }
@@ -97,6 +98,12 @@ std::vector<CalibrationParameter> CalibrationParameters(const RigCalibration& pr
                  free.imu_translation, sigmas.imu_rotation_deg, sigmas.imu_translation_mm, &out);
     out.push_back({"time_offset", "ms", prior.time_offset_s * 1e3, estimate.time_offset_s * 1e3,
                    0.0, sigmas.time_offset_ms, free.time_offset});
+    const char* axes[3] = {"x", "y", "z"};
+    for (int i = 0; i < 3; ++i) {
+      out.push_back({fmt::format("gyro.s{}", axes[i]), "%", prior.gyro_scale[i] * 100.0,
+                     estimate.gyro_scale[i] * 100.0, 0.0, sigmas.gyro_scale_pct,
+                     free.gyro_scale});
+    }
   }
   return out;
 }

@@ -280,6 +280,7 @@ CalibrationRecord ToCalibrationRecord(const RigCalibration& calibration) {
   r.body_from_cam0 = calibration.body_from_cam0;
   r.cam1_from_cam0 = calibration.cam1_from_cam0;
   r.time_offset_s = calibration.time_offset_s;
+  for (int i = 0; i < 3; ++i) r.gyro_scale[i] = calibration.gyro_scale[i];
   return r;
 }
 
@@ -292,6 +293,7 @@ RigCalibration FromCalibrationRecord(const CalibrationRecord& record) {
   c.body_from_cam0 = record.body_from_cam0;
   c.cam1_from_cam0 = record.cam1_from_cam0;
   c.time_offset_s = record.time_offset_s;
+  c.gyro_scale = Eigen::Vector3d(record.gyro_scale[0], record.gyro_scale[1], record.gyro_scale[2]);
   return c;
 }
 

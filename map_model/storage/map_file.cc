@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <cereal/archives/portable_binary.hpp>
+#include <cereal/types/array.hpp>
 #include <cereal/types/optional.hpp>
 #include <cereal/types/string.hpp>
 #include <cereal/types/utility.hpp>
@@ -181,7 +182,10 @@ void WriteMapFile(const std::filesystem::path& file, const AtlasRecord& record) 
   {
     cereal::PortableBinaryOutputArchive archive(payload_stream);
     archive(record);
-    archive(record.calibration);  // version 2
+    archive(record.calibration);             // version 2
+    std::array<double, 3> gyro_scale{};
+    if (record.calibration) gyro_scale = record.calibration->gyro_scale;
+    archive(gyro_scale);  // version 3
   }
   const std::string payload = payload_stream.str();
   std::string out;
@@ -230,6 +234,11 @@ AtlasRecord ReadMapFile(const std::filesystem::path& file) {
     cereal::PortableBinaryInputArchive archive(payload_stream);
     archive(record);
     if (version >= 2) archive(record.calibration);
+    if (version >= 3) {
+      std::array<double, 3> gyro_scale{};
+      archive(gyro_scale);
+      if (record.calibration) record.calibration->gyro_scale = gyro_scale;
+    }
   } catch (const std::exception& e) {
     throw InputError(file, fmt::format("map file payload does not decode: {}", e.what()));
   }

@@ -115,6 +115,8 @@ struct CalibrationRecord {
   SE3d body_from_cam0;
   SE3d cam1_from_cam0;
   double time_offset_s = 0;
+  // RigCalibration::gyro_scale (version 3; zero in older files).
+  std::array<double, 3> gyro_scale{};
   // Keyframes tracked with a non-zero time offset (KeyFrameImu::time_offset_s).
   std::vector<std::pair<KeyFrameId, double>> keyframe_time_offsets;
 };

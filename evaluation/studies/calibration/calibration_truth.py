@@ -7,7 +7,8 @@ RUN is a `pkslam run` / `pkslam calibrate` output folder (its stats.json "calibr
 SEQ the `pkslam simulate` folder it ran on: SEQ/truth/ holds the rendering calibration and
 SEQ/truth/realism_draw.yaml the errors written into the sequence's files. The parameters are
 those of docs/calibration.md (intrinsics in px; the changes of body_from_cam0 and cam0_from_cam1
-from the file as rotation vector in deg and translation in mm; time offset in ms). Prints, per parameter: file - truth,
+from the file as rotation vector in deg and translation in mm; time offset in ms; the gyro's
+per-axis scale-factor error in %). Prints, per parameter: file - truth,
 estimate - truth, the estimate's sigma, and whether it was freed. With several runs, the median
 over them of |estimate - truth|.
 """
@@ -97,6 +98,12 @@ def truth_parameters(seq):
         t_c1c0_file = t_c1c0 @ exp_se3(stereo_error)
         change("stereo", np.linalg.inv(t_c1c0), np.linalg.inv(t_c1c0_file))
     out["time_offset"] = float(draw.get("camera_imu_offset_ms", 0.0))
+    # The gyro reads M w (+ bias, g-sensitivity, noise): its per-axis scale-factor error is
+    # diag(M) - 1, in % (the off-diagonal misalignment is not estimated).
+    if "imu_gyro_matrix" in draw:
+        m = np.array(draw["imu_gyro_matrix"], float)
+        for i, a in enumerate("xyz"):
+            out[f"gyro.s{a}"] = (m[i, i] - 1.0) * 100.0
     return out
 
 
