@@ -3,9 +3,9 @@
 
     python3 evaluation/calibration_plot.py RUN/stats.json OUT.png [--title TEXT]
 
-Four panels against the data time of each adjustment: intrinsics (estimate - file, px), the
-rotation of the stereo and camera-IMU extrinsics (deg), their translation (mm) and the
-camera-IMU time offset (ms). The final estimate is drawn at the end with its 1-sigma bar when
+Five panels against the data time of each adjustment: intrinsics (estimate - file, px), the
+rotation of the stereo and camera-IMU extrinsics (deg), their translation (mm), the camera-IMU
+time offset (ms) and the gyro's per-axis scale-factor error (%). The final estimate is drawn at the end with its 1-sigma bar when
 the run computed sigmas. Used by `pkslam calibrate` (DIR/calibration_history.png), the bench
 report and docs/calibration.md.
 """
@@ -23,11 +23,14 @@ def groups(name):
         return 2
     if name == "time_offset":
         return 3
+    if name.startswith("gyro.s"):
+        return 4
     return None  # distortion: too small to share an axis with pixels
 
 
 TITLES = ["intrinsics: estimate - file [px]", "extrinsic rotation change [deg]",
-          "extrinsic translation change [mm]", "camera-IMU time offset [ms]"]
+          "extrinsic translation change [mm]", "camera-IMU time offset [ms]",
+          "gyro scale-factor error [%]"]
 
 
 def main(argv):
@@ -47,8 +50,10 @@ def main(argv):
 
     final = {p["name"]: p for p in calibration["parameters"]}
     history = [h for h in calibration["history"] if h.get("applied")]
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
-    axes = axes.ravel()
+    fig, grid = plt.subplots(2, 3, figsize=(15, 7), sharex=True)
+    grid = grid.ravel()
+    grid[5].axis("off")
+    axes = grid[:5]
     t_end = max([h["span_s"] for h in history] + [1.0]) * 1.08
     for name, p in final.items():
         g = groups(name)
@@ -56,7 +61,7 @@ def main(argv):
             continue
         ax = axes[g]
         ts = [h["span_s"] for h in history if name in h["estimate"]]
-        base = p["file"] if g == 0 else 0.0
+        base = p["file"] if g in (0, 4) else 0.0
         ys = [h["estimate"][name] - base for h in history if name in h["estimate"]]
         line, = ax.plot(ts, ys, marker="o", ms=3, label=name)
         ax.errorbar([t_end], [p["estimate"] - base], yerr=[p.get("sigma", 0.0)], fmt="s",
@@ -65,9 +70,9 @@ def main(argv):
         ax.set_title(title, fontsize=10)
         ax.axhline(0.0, color="grey", lw=0.8)
         ax.grid(alpha=0.3)
-        if ax.lines:
+        if any(not line.get_label().startswith("_") for line in ax.lines):
             ax.legend(fontsize=7, ncol=2)
-    for ax in axes[2:]:
+    for ax in axes[2:]:  # the bottom row
         ax.set_xlabel("data time of the map at the adjustment [s] (square: final, 1 sigma)")
     fig.suptitle(args.title or "calibration estimates while mapping", fontsize=11)
     fig.tight_layout()

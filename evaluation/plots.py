@@ -285,11 +285,13 @@ def segment_boxes(index, rows, roots):
 def online_calibration(index, rows, roots):
     """Per dataset and sensor, every online-calibration run's estimates over the flight
     (stats.json calibration.history, applied adjustments): time offset, camera-IMU rotation change,
-    cam0 fx change and the disparity offset change (cam0.cx - cam1.cx) against the file."""
+    cam0 fx change, the disparity offset change (cam0.cx - cam1.cx) against the file and the
+    gyro's scale-factor error (the largest axis, signed)."""
     panels = [("time_offset", "time offset [ms]", None),
               ("imu_rotation", "camera-IMU rotation change [deg]", None),
               ("cam0.fx", "cam0 fx - file [px]", None),
-              ("disparity", "(cam0.cx - cam1.cx) - file [px]", None)]
+              ("disparity", "(cam0.cx - cam1.cx) - file [px]", None),
+              ("gyro_scale", "gyro scale error, largest axis [%]", None)]
     for dataset, sensor, sub, configs in run_groups(rows):
         series = []
         for r in sub:
@@ -315,12 +317,15 @@ def online_calibration(index, rows, roots):
                     return (e["cam0.cx"] - e["cam1.cx"]) - (file["cam0.cx"] - file["cam1.cx"])
                 if key == "cam0.fx":
                     return e.get(key, float("nan")) - file.get(key, 0.0)
+                if key == "gyro_scale":
+                    k = [e[f"gyro.s{a}"] for a in "xyz" if f"gyro.s{a}" in e]
+                    return max(k, key=abs) if k else float("nan")
                 return e.get(key, float("nan"))
             series.append((f"{r['config']} seed {r['seed']}",
                            t, {k: [value(h["estimate"], k) for h in steps] for k, _, _ in panels}))
         if not series:
             continue
-        fig, axes = plt.subplots(1, len(panels), figsize=(15, 3.4))
+        fig, axes = plt.subplots(1, len(panels), figsize=(18, 3.4))
         for ax, (key, label, _) in zip(axes, panels):
             for name, t, values in series:
                 ax.plot(t, values[key], marker="o", ms=3, label=name)

@@ -102,6 +102,33 @@ std::string TbsYaml(const SE3d& body_from_sensor) {
 
 }  // namespace
 
+EurocCameraSensor EurocCameraSensorOf(const CameraModel& camera, const SE3d& body_from_camera,
+                                      double rate_hz, double timeshift_cam_imu) {
+  EurocCameraSensor s;
+  s.body_from_camera = body_from_camera;
+  s.rate_hz = rate_hz;
+  s.width = camera.width();
+  s.height = camera.height();
+  s.camera_model = "pinhole";
+  s.intrinsics = {camera.fx(), camera.fy(), camera.cx(), camera.cy()};
+  s.distortion_model =
+      camera.type() == CameraType::kKannalaBrandt8 ? "equidistant" : "radial-tangential";
+  s.distortion_coefficients = camera.distortion();
+  s.timeshift_cam_imu = timeshift_cam_imu;
+  return s;
+}
+
+EurocImuSensor EurocImuSensorOf(const ImuNoise& noise, const Eigen::Vector3d& gyroscope_scale_error) {
+  EurocImuSensor imu;
+  imu.rate_hz = noise.rate_hz;
+  imu.gyroscope_noise_density = noise.gyro_noise_density;
+  imu.gyroscope_random_walk = noise.gyro_random_walk;
+  imu.accelerometer_noise_density = noise.accel_noise_density;
+  imu.accelerometer_random_walk = noise.accel_random_walk;
+  imu.gyroscope_scale_error = gyroscope_scale_error;
+  return imu;
+}
+
 std::string EurocImuSensorYaml(const EurocImuSensor& imu, const std::string& comment) {
   std::string text = fmt::format(
       "%YAML:1.0\n# General sensor definitions.\nsensor_type: imu\ncomment: {}\n\n"

@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "core/camera/camera_model.h"
 #include "core/geometry/se3.h"
+#include "core/imu/imu_types.h"
 
 namespace pkslam {
 
@@ -36,6 +38,15 @@ struct EurocImuSensor {
   // (1 + k) times the true rate per axis (written by pkslam's calibration estimates).
   Eigen::Vector3d gyroscope_scale_error = Eigen::Vector3d::Zero();
 };
+
+// A camera's description from a camera model: pinhole, its intrinsics, "equidistant" for a
+// Kannala-Brandt model and "radial-tangential" otherwise; timeshift_cam_imu as given.
+EurocCameraSensor EurocCameraSensorOf(const CameraModel& camera, const SE3d& body_from_camera,
+                                      double rate_hz, double timeshift_cam_imu = 0.0);
+// An IMU at the body frame (T_BS identity, as EuRoC's) with `noise`'s densities and rate.
+EurocImuSensor EurocImuSensorOf(const ImuNoise& noise,
+                                const Eigen::Vector3d& gyroscope_scale_error =
+                                    Eigen::Vector3d::Zero());
 
 // Parse and validate (positive rate and size, known models, coefficient counts, rigid T_BS).
 // Throws InputError naming the file and key.

@@ -106,7 +106,8 @@ TEST_F(CalibrationApplyTest, AGyroScaleEstimateMovesTheChainsPreintegrationsAndB
   // A chain whose samples were corrected with no scale error; the estimate says the gyro reads
   // 0.5% fast about y: every keyframe's preintegration is re-integrated from samples divided by
   // 1.005 (and its gyro bias, a term of the same samples, with them).
-  PreintegratedImu pim = StartPreintegration(ImuBias(Eigen::Vector3d(0.01, -0.02, 0.0), {}),
+  PreintegratedImu pim = StartPreintegration(
+      ImuBias(Eigen::Vector3d(0.01, -0.02, 0.0), Eigen::Vector3d::Zero()),
                                              ImuNoise{});
   for (int i = 0; i < 40; ++i) {
     IntegrateMeasurement(Eigen::Vector3d(0.1, 9.8, 0.2), Eigen::Vector3d(0.3, 0.8, -0.2), 0.005,

@@ -144,7 +144,7 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
   // The gyro's scale factors need the same turning: about an axis the body never turned, the
   // prior holds that axis's factor at the file's value.
   if (!options.gyro_scale) {
-    g.frozen["gyro_scale"] = "held at the file's value (--calibrate-gyro-scale off)";
+    g.frozen["gyro_scale"] = "held at the file's value (--calibrate-hold-gyro-scale)";
   } else if (g.second_axis_rate >= options.min_rotation_rate) {
     g.free.gyro_scale = true;
   } else {

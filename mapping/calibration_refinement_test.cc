@@ -48,6 +48,13 @@ TEST(DecideFreedomTest, ATurningStereoInertialFlightFreesAllButTheLeverArm) {
   OnlineCalibrationOptions lever;
   lever.imu_translation = true;
   EXPECT_TRUE(DecideFreedom(p, Sensor::kStereoInertial, lever).free.imu_translation);
+  // The gyro's scale factors are estimated with the rotation unless held.
+  EXPECT_TRUE(g.free.gyro_scale);
+  OnlineCalibrationOptions held;
+  held.gyro_scale = false;
+  const CalibrationGates h = DecideFreedom(p, Sensor::kStereoInertial, held);
+  EXPECT_FALSE(h.free.gyro_scale);
+  EXPECT_NE(h.frozen.at("gyro_scale").find("--calibrate-hold-gyro-scale"), std::string::npos);
 }
 
 TEST(DecideFreedomTest, RotationAboutOneAxisLeavesTheCameraImuRotationFrozen) {
@@ -57,6 +64,8 @@ TEST(DecideFreedomTest, RotationAboutOneAxisLeavesTheCameraImuRotationFrozen) {
   EXPECT_FALSE(g.free.imu_rotation);
   ASSERT_EQ(g.frozen.count("imu_rotation"), 1u);
   EXPECT_NE(g.frozen.at("imu_rotation").find("one axis"), std::string::npos);
+  EXPECT_FALSE(g.free.gyro_scale);  // nor the gyro's scale about the other axes
+  EXPECT_EQ(g.frozen.at("gyro_scale"), g.frozen.at("imu_rotation"));
   EXPECT_TRUE(g.free.time_offset);  // the images move
 }
 
@@ -80,7 +89,7 @@ TEST(DecideFreedomTest, SensorsWithoutScaleOrWithDepthFreezeEverything) {
   for (Sensor s : {Sensor::kMonocular, Sensor::kRgbd}) {
     const CalibrationGates g = DecideFreedom(p, s, {});
     EXPECT_FALSE(g.free.Any());
-    EXPECT_EQ(g.frozen.size(), 5u);
+    EXPECT_EQ(g.frozen.size(), 6u);
   }
 }
 

@@ -132,19 +132,9 @@ std::string MatrixYaml(const Eigen::Matrix4d& m) {
 }
 
 std::string CameraYaml(const CameraRig& c) {
-  const CameraModel& cam = c.camera;
-  EurocCameraSensor sensor;
-  sensor.body_from_camera = c.body_from_camera;
-  sensor.rate_hz = c.rate_hz;
-  sensor.width = cam.width();
-  sensor.height = cam.height();
-  sensor.camera_model = "pinhole";
-  sensor.intrinsics = {cam.fx(), cam.fy(), cam.cx(), cam.cy()};
-  sensor.distortion_model =
-      cam.type() == CameraType::kKannalaBrandt8 ? "equidistant" : "radial-tangential";
-  sensor.distortion_coefficients = cam.distortion();
   return EurocCameraSensorYaml(
-      sensor, fmt::format("pkslam simulated {} (EuRoC VI-Sensor geometry)", c.name));
+      EurocCameraSensorOf(c.camera, c.body_from_camera, c.rate_hz),
+      fmt::format("pkslam simulated {} (EuRoC VI-Sensor geometry)", c.name));
 }
 
 std::string ImuYaml(const ImuOptions& imu) {

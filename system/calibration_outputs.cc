@@ -20,21 +20,6 @@ const std::string& SourceOf(const std::string& name, const CalibrationSources& s
   return s.cam0;
 }
 
-EurocCameraSensor SensorOf(const CameraModel& camera, const SE3d& body_from_camera, double rate_hz,
-                           double timeshift) {
-  EurocCameraSensor s;
-  s.body_from_camera = body_from_camera;
-  s.rate_hz = rate_hz;
-  s.width = camera.width();
-  s.height = camera.height();
-  s.camera_model = "pinhole";
-  s.intrinsics = {camera.fx(), camera.fy(), camera.cx(), camera.cy()};
-  s.distortion_model = "radial-tangential";
-  s.distortion_coefficients = camera.distortion();
-  s.timeshift_cam_imu = timeshift;
-  return s;
-}
-
 }  // namespace
 
 CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings) {
@@ -151,20 +136,15 @@ void WriteCalibrationFiles(const CalibrationReport& report, const Settings& sett
     const SE3d body_from_camera = c == 0 ? e.body_from_cam0 : e.body_from_cam1();
     std::filesystem::create_directories(dir / fmt::format("cam{}", c));
     WriteFileAtomically(dir / fmt::format("cam{}", c) / "sensor.yaml",
-                        EurocCameraSensorYaml(SensorOf(e.cameras[c], body_from_camera, rate,
-                                                       c == 0 ? shift : 0.0),
+                        EurocCameraSensorYaml(EurocCameraSensorOf(e.cameras[c], body_from_camera, rate,
+                                                                  c == 0 ? shift : 0.0),
                                               comment + fmt::format(", cam{}", c)));
   }
   if (IsInertial(report.sensor) && settings.imu) {
-    EurocImuSensor imu;
-    imu.rate_hz = settings.imu->rate_hz;
-    imu.gyroscope_noise_density = settings.imu->gyro_noise_density;
-    imu.gyroscope_random_walk = settings.imu->gyro_random_walk;
-    imu.accelerometer_noise_density = settings.imu->accel_noise_density;
-    imu.accelerometer_random_walk = settings.imu->accel_random_walk;
-    imu.gyroscope_scale_error = e.gyro_scale;
     std::filesystem::create_directories(dir / "imu0");
-    WriteFileAtomically(dir / "imu0" / "sensor.yaml", EurocImuSensorYaml(imu, comment + ", imu0"));
+    WriteFileAtomically(dir / "imu0" / "sensor.yaml",
+                        EurocImuSensorYaml(EurocImuSensorOf(*settings.imu, e.gyro_scale),
+                                           comment + ", imu0"));
   }
   WriteOrbSlam3Settings(SettingsWithCalibration(settings, e), dir / "settings.yaml");
 }

@@ -222,6 +222,10 @@
       if (e['imu.rx'] !== undefined) {
         parts.push(`camera-IMU rotation ${Math.hypot(...rot).toFixed(3)} deg off the file`);
       }
+      const gyro = ['gyro.sx', 'gyro.sy', 'gyro.sz'].filter((k) => e[k] !== undefined);
+      if (gyro.length) {
+        parts.push(`gyro scale ${gyro.map((k) => `${k.slice(-1)} ${e[k].toFixed(2)}`).join(' ')} %`);
+      }
       for (const k of ['cam0.fx', 'cam0.cx', 'cam1.cx']) {
         if (e[k] !== undefined && D.calibration_file[k] !== undefined) {
           parts.push(`${k} ${(e[k] - D.calibration_file[k]) >= 0 ? '+' : ''}${(e[k] - D.calibration_file[k]).toFixed(2)} px`);

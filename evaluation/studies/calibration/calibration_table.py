@@ -38,6 +38,7 @@ PARAMETER_GROUPS = [
     ('cam0 focal (px)', ['cam0.fx', 'cam0.fy'], 0.2),
     ('cam1 focal (px)', ['cam1.fx'], 0.2),
     ('cam0 principal point (px)', ['cam0.cx', 'cam0.cy'], None),
+    ('gyro scale factor (%, per axis)', ['gyro.sx', 'gyro.sy', 'gyro.sz'], None),
 ]
 
 

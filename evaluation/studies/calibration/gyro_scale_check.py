@@ -1,0 +1,124 @@
+#!/usr/bin/env python3
+"""Is an IMU axis error what biases online calibration? Correct a replay's IMU by the truth and see.
+
+    python3 evaluation/studies/calibration/gyro_scale_check.py SEQ OUT [--pkslam BIN]
+        [--sensor stereo-inertial] [--seed 1] [--variants none,gyro,gyro-diagonal,gyro+accel]
+        [-- extra pkslam run arguments]
+
+SEQ is a `pkslam simulate --realism euroc` folder (SEQ/truth/realism_draw.yaml holds the drawn
+gyro and accelerometer axis matrices M: the IMU reads M w). For each variant, OUT/VARIANT/ is a
+copy of SEQ whose imu0/data.csv has the samples corrected by the truth (the images are
+symbolic links, SEQ is not modified):
+  none            the samples as recorded
+  gyro            gyro samples multiplied by M_g^-1 (scale and misalignment removed)
+  gyro-diagonal   gyro samples divided by diag(M_g) (the per-axis scale factor only)
+  gyro+accel      gyro by M_g^-1 and accelerometer by M_a^-1
+then `pkslam run --calibrate online` on it, and prints the ATE and the calibration estimates
+against the truth (calibration_truth.py). The biases, g-sensitivity and noise stay. With
+--calibrate-hold-gyro-scale among the extra arguments this is the experiment that found the gyro
+scale behind cam0's fy bias (docs/calibration.md, "The gyro's scale factor").
+"""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import yaml
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
+sys.path.insert(0, HERE)
+import calibration_truth  # noqa: E402
+
+VARIANTS = ("none", "gyro", "gyro-diagonal", "gyro+accel")
+
+
+def corrected_copy(seq, out, variant, draw):
+    """OUT: SEQ with links to everything but imu0/data.csv, which is rewritten."""
+    os.makedirs(os.path.join(out, "mav0", "imu0"), exist_ok=True)
+    for name in os.listdir(seq):
+        if name != "mav0" and not os.path.exists(os.path.join(out, name)):
+            os.symlink(os.path.abspath(os.path.join(seq, name)), os.path.join(out, name))
+    for name in os.listdir(os.path.join(seq, "mav0")):
+        target = os.path.join(out, "mav0", name)
+        if name != "imu0" and not os.path.exists(target):
+            os.symlink(os.path.abspath(os.path.join(seq, "mav0", name)), target)
+    shutil.copy(os.path.join(seq, "mav0", "imu0", "sensor.yaml"),
+                os.path.join(out, "mav0", "imu0", "sensor.yaml"))
+    mg = np.array(draw["imu_gyro_matrix"], float)
+    ma = np.array(draw["imu_accel_matrix"], float)
+    gyro_fix = {"none": np.eye(3), "gyro": np.linalg.inv(mg),
+                "gyro-diagonal": np.diag(1.0 / np.diag(mg)),
+                "gyro+accel": np.linalg.inv(mg)}[variant]
+    accel_fix = np.linalg.inv(ma) if variant == "gyro+accel" else np.eye(3)
+    with open(os.path.join(seq, "mav0", "imu0", "data.csv")) as f:
+        lines = f.read().splitlines()
+    rows = [lines[0]]
+    for line in lines[1:]:
+        v = line.split(",")
+        g = gyro_fix @ np.array(v[1:4], float)
+        a = accel_fix @ np.array(v[4:7], float)
+        rows.append(",".join([v[0]] + [repr(float(x)) for x in g] + [repr(float(x)) for x in a]))
+    with open(os.path.join(out, "mav0", "imu0", "data.csv"), "w") as f:
+        f.write("\n".join(rows) + "\n")
+
+
+def ate(pkslam, seq, run):
+    text = subprocess.run([pkslam, "eval", "--gt",
+                           os.path.join(seq, "mav0", "state_groundtruth_estimate0", "data.csv"),
+                           "--est", os.path.join(run, "trajectory_body.txt")],
+                          capture_output=True, text=True, check=True).stdout
+    for line in text.splitlines():
+        if line.startswith("ATE [m]"):
+            return float(line.split()[2])
+    raise RuntimeError(f"no ATE line from pkslam eval for {run}")
+
+
+def main():
+    argv = sys.argv[1:]
+    extra = []
+    if "--" in argv:
+        extra = argv[argv.index("--") + 1:]
+        argv = argv[:argv.index("--")]
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("seq")
+    ap.add_argument("out")
+    ap.add_argument("--pkslam", default=os.path.join(REPO, "build", "bin", "pkslam"))
+    ap.add_argument("--sensor", default="stereo-inertial")
+    ap.add_argument("--seed", default="1")
+    ap.add_argument("--variants", default=",".join(VARIANTS))
+    args = ap.parse_args(argv)
+    variants = args.variants.split(",")
+    for v in variants:
+        if v not in VARIANTS:
+            ap.error(f"unknown variant {v!r} (one of {', '.join(VARIANTS)})")
+    with open(os.path.join(args.seq, "truth", "realism_draw.yaml")) as f:
+        draw = yaml.safe_load(f.read().replace("%YAML:1.0", ""))
+    if "imu_gyro_matrix" not in draw:
+        sys.exit(f"{args.seq}/truth/realism_draw.yaml: no imu_gyro_matrix (not a euroc-preset render)")
+    truth = calibration_truth.truth_parameters(args.seq)
+    print(f"{'variant':15s} {'ATE [mm]':>9s} {'fx-truth':>9s} {'fy-truth':>9s} "
+          f"{'td-truth ms':>11s} {'gyro sy-truth %':>15s}")
+    for v in variants:
+        folder = os.path.join(args.out, v)
+        corrected_copy(args.seq, os.path.join(folder, "seq"), v, draw)
+        run = os.path.join(folder, "run")
+        with open(os.path.join(folder, "run.log"), "w") as log:
+            subprocess.run([args.pkslam, "run", "--dataset", os.path.join(folder, "seq"),
+                            "--sensor", args.sensor, "--calibrate", "online", "--seed", args.seed,
+                            "--out", run, "--quiet"] + extra, stdout=log, stderr=log, check=True)
+        est = calibration_truth.run_parameters(run)
+
+        def err(name):
+            return est[name]["estimate"] - truth[name] if name in est else float("nan")
+        # A corrected IMU has no scale error left: the truth of the gyro's scale is then 0.
+        gyro_truth = 0.0 if v != "none" else truth.get("gyro.sy", 0.0)
+        gyro = est["gyro.sy"]["estimate"] - gyro_truth if "gyro.sy" in est else float("nan")
+        print(f"{v:15s} {ate(args.pkslam, args.seq, run) * 1e3:9.2f} {err('cam0.fx'):9.3f} "
+              f"{err('cam0.fy'):9.3f} {err('time_offset'):11.3f} {gyro:15.3f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
