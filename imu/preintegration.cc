@@ -49,17 +49,82 @@ PreintegratedImu StartPreintegration(const ImuBias& bias, const ImuNoise& noise,
   return pim;
 }
 
+void IntegrateMeasurement(const Vec3& accel, const Vec3& gyro, double dt, PreintegratedImu* pim) {
+  PKSLAM_CHECK(dt > 0 && std::isfinite(dt), "integration step dt = {}", dt);
+  PKSLAM_CHECK(accel.allFinite() && gyro.allFinite(), "non-finite IMU measurement");
+  PreintegratedImu& p = *pim;
+  p.steps.push_back({accel, gyro, dt});
+
+  const Vec3 a = accel - p.bias.accel;
+  const Vec3 w = gyro - p.bias.gyro;
+  const Vec3 w_dt = w * dt;
+  const SO3d step_R = SO3d::Exp(w_dt);
+  const Mat3 step_Rt = step_R.Matrix().transpose();
+  const Mat3 jr_dt = SO3d::RightJacobian(w_dt) * dt;
+  const double dt2 = dt * dt;
+  // R_s = dR H rotates the step's specific force; H is the half-step rotation (midpoint) or I.
+  const bool midpoint = p.scheme == ImuIntegrationScheme::kMidpoint;
+  const Mat3 half_R = midpoint ? SO3d::Exp(0.5 * w_dt).Matrix() : Mat3::Identity();
+  const Mat3 r_s = p.delta_R.Matrix() * half_R;
+  const Vec3 acc_i = r_s * a;  // specific force in the interval's first body frame
+  // Linearisation of R_s a: w.r.t. dphi (dR <- dR Exp(dphi)) it is -R_s hat(a) H^T dphi; w.r.t.
+  // a change dw of w (gyro noise or -d b_g) it is -R_s hat(a) Jr(w dt / 2) dt / 2 dw.
+  const Mat3 d_acc_dphi = -r_s * SO3d::Hat(a) * half_R.transpose();
+  const Mat3 d_acc_dw =
+      midpoint ? Mat3(-r_s * SO3d::Hat(a) * SO3d::RightJacobian(0.5 * w_dt) * (0.5 * dt))
+               : Mat3::Zero();
+
+  p.average_accel = (p.dt * p.average_accel + acc_i * dt) / (p.dt + dt);
+  p.average_gyro = (p.dt * p.average_gyro + w * dt) / (p.dt + dt);
+
+  // Position first (uses the old velocity), then velocity.
+  p.delta_p += p.delta_v * dt + 0.5 * acc_i * dt2;
+  p.delta_v += acc_i * dt;
+
+  // Error-state transition of [dphi, dv, dp] and the input matrix of the noise [n_g, n_a]
+  // (measurement = truth + noise; signs follow from dphi_{k+1} = E^T dphi_k - Jr dt n_g).
+  Eigen::Matrix<double, 9, 9> A = Eigen::Matrix<double, 9, 9>::Identity();
+  A.block<3, 3>(0, 0) = step_Rt;
+  A.block<3, 3>(3, 0) = d_acc_dphi * dt;
+  A.block<3, 3>(6, 0) = 0.5 * d_acc_dphi * dt2;
+  A.block<3, 3>(6, 3) = Mat3::Identity() * dt;
+  Eigen::Matrix<double, 9, 6> B = Eigen::Matrix<double, 9, 6>::Zero();
+  B.block<3, 3>(0, 0) = -jr_dt;
+  B.block<3, 3>(3, 0) = -d_acc_dw * dt;
+  B.block<3, 3>(6, 0) = -0.5 * d_acc_dw * dt2;
+  B.block<3, 3>(3, 3) = -r_s * dt;
+  B.block<3, 3>(6, 3) = -0.5 * r_s * dt2;
+  const Eigen::Matrix<double, 9, 9> c9 = p.covariance.topLeftCorner<9, 9>();
+  p.covariance.topLeftCorner<9, 9>() =
+      A * c9 * A.transpose() + B * DiscreteMeasurementCovariance(p.noise) * B.transpose();
+  p.covariance.bottomRightCorner<6, 6>() += BiasRandomWalkCovariance(p.noise, dt);
+
+  // Bias Jacobians: a bias change d b enters as w <- w - d b_g, a <- a - d b_a, so the same
+  // linearisation applies (position first: it uses the old velocity Jacobians and J_R_bg).
+  const Mat3 d_acc_dbg = d_acc_dphi * p.J_R_bg - d_acc_dw;
+  p.J_p_ba += p.J_v_ba * dt - 0.5 * r_s * dt2;
+  p.J_p_bg += p.J_v_bg * dt + 0.5 * d_acc_dbg * dt2;
+  p.J_v_ba -= r_s * dt;
+  p.J_v_bg += d_acc_dbg * dt;
+  p.J_R_bg = step_Rt * p.J_R_bg - jr_dt;
+
+  p.delta_R = p.delta_R * step_R;
+  p.dt += dt;
+}
+
 namespace {
 
-// One step's linearisation, shared by the integration and the gyro-scale Jacobians.
+// What the gyro-scale Jacobians need of one step's linearisation. IntegrateMeasurement spells
+// the same lines out itself: computed through this function they changed the last bits of a
+// mono-inertial run's keyframes (evaluation/studies/refactor/compare_builds.sh), and
+// `--calibrate off` keeps its results bit for bit. GyroScaleJacobiansMatchRescaledReintegration
+// (preintegration_test.cc) checks the two agree.
 struct StepLinearisation {
-  SO3d step_R;       // Exp(w dt)
-  Mat3 step_Rt;      // its transpose
-  Mat3 jr_dt;        // Jr(w dt) dt
-  Mat3 r_s;          // rotates the step's specific force into the interval's first frame
-  Vec3 acc_i;        // r_s a
-  Mat3 d_acc_dphi;   // d(R_s a) / d dphi
-  Mat3 d_acc_dw;     // d(R_s a) / d w
+  SO3d step_R;      // Exp(w dt)
+  Mat3 step_Rt;     // its transpose
+  Mat3 jr_dt;       // Jr(w dt) dt
+  Mat3 d_acc_dphi;  // d(R_s a) / d dphi
+  Mat3 d_acc_dw;    // d(R_s a) / d w
 };
 
 StepLinearisation LineariseStep(const SO3d& delta_R, const Vec3& a, const Vec3& w, double dt,
@@ -69,69 +134,16 @@ StepLinearisation LineariseStep(const SO3d& delta_R, const Vec3& a, const Vec3& 
   m.step_R = SO3d::Exp(w_dt);
   m.step_Rt = m.step_R.Matrix().transpose();
   m.jr_dt = SO3d::RightJacobian(w_dt) * dt;
-  // R_s = dR H rotates the step's specific force; H is the half-step rotation (midpoint) or I.
   const bool midpoint = scheme == ImuIntegrationScheme::kMidpoint;
   const Mat3 half_R = midpoint ? SO3d::Exp(0.5 * w_dt).Matrix() : Mat3::Identity();
-  m.r_s = delta_R.Matrix() * half_R;
-  m.acc_i = m.r_s * a;
-  // Linearisation of R_s a: w.r.t. dphi (dR <- dR Exp(dphi)) it is -R_s hat(a) H^T dphi; w.r.t.
-  // a change dw of w (gyro noise or -d b_g) it is -R_s hat(a) Jr(w dt / 2) dt / 2 dw.
-  m.d_acc_dphi = -m.r_s * SO3d::Hat(a) * half_R.transpose();
-  m.d_acc_dw = midpoint ? Mat3(-m.r_s * SO3d::Hat(a) * SO3d::RightJacobian(0.5 * w_dt) * (0.5 * dt))
+  const Mat3 r_s = delta_R.Matrix() * half_R;
+  m.d_acc_dphi = -r_s * SO3d::Hat(a) * half_R.transpose();
+  m.d_acc_dw = midpoint ? Mat3(-r_s * SO3d::Hat(a) * SO3d::RightJacobian(0.5 * w_dt) * (0.5 * dt))
                         : Mat3::Zero();
   return m;
 }
 
 }  // namespace
-
-void IntegrateMeasurement(const Vec3& accel, const Vec3& gyro, double dt, PreintegratedImu* pim) {
-  PKSLAM_CHECK(dt > 0 && std::isfinite(dt), "integration step dt = {}", dt);
-  PKSLAM_CHECK(accel.allFinite() && gyro.allFinite(), "non-finite IMU measurement");
-  PreintegratedImu& p = *pim;
-  p.steps.push_back({accel, gyro, dt});
-
-  const Vec3 a = accel - p.bias.accel;
-  const Vec3 w = gyro - p.bias.gyro;
-  const StepLinearisation m = LineariseStep(p.delta_R, a, w, dt, p.scheme);
-  const double dt2 = dt * dt;
-
-  p.average_accel = (p.dt * p.average_accel + m.acc_i * dt) / (p.dt + dt);
-  p.average_gyro = (p.dt * p.average_gyro + w * dt) / (p.dt + dt);
-
-  // Position first (uses the old velocity), then velocity.
-  p.delta_p += p.delta_v * dt + 0.5 * m.acc_i * dt2;
-  p.delta_v += m.acc_i * dt;
-
-  // Error-state transition of [dphi, dv, dp] and the input matrix of the noise [n_g, n_a]
-  // (measurement = truth + noise; signs follow from dphi_{k+1} = E^T dphi_k - Jr dt n_g).
-  Eigen::Matrix<double, 9, 9> A = Eigen::Matrix<double, 9, 9>::Identity();
-  A.block<3, 3>(0, 0) = m.step_Rt;
-  A.block<3, 3>(3, 0) = m.d_acc_dphi * dt;
-  A.block<3, 3>(6, 0) = 0.5 * m.d_acc_dphi * dt2;
-  A.block<3, 3>(6, 3) = Mat3::Identity() * dt;
-  Eigen::Matrix<double, 9, 6> B = Eigen::Matrix<double, 9, 6>::Zero();
-  B.block<3, 3>(0, 0) = -m.jr_dt;
-  B.block<3, 3>(3, 0) = -m.d_acc_dw * dt;
-  B.block<3, 3>(6, 0) = -0.5 * m.d_acc_dw * dt2;
-  B.block<3, 3>(3, 3) = -m.r_s * dt;
-  B.block<3, 3>(6, 3) = -0.5 * m.r_s * dt2;
-  const Eigen::Matrix<double, 9, 9> c9 = p.covariance.topLeftCorner<9, 9>();
-  p.covariance.topLeftCorner<9, 9>() =
-      A * c9 * A.transpose() + B * DiscreteMeasurementCovariance(p.noise) * B.transpose();
-  p.covariance.bottomRightCorner<6, 6>() += BiasRandomWalkCovariance(p.noise, dt);
-
-  // Bias Jacobians: a bias change d b enters as w <- w - d b_g, a <- a - d b_a, so the same
-  // linearisation applies (position first: it uses the old velocity Jacobians and J_R_bg).
-  const Mat3 d_acc_dbg = m.d_acc_dphi * p.J_R_bg - m.d_acc_dw;
-  p.J_p_ba += p.J_v_ba * dt - 0.5 * m.r_s * dt2;
-  p.J_p_bg += p.J_v_bg * dt + 0.5 * d_acc_dbg * dt2;
-  p.J_v_ba -= m.r_s * dt;
-  p.J_v_bg += d_acc_dbg * dt;
-  p.J_R_bg = m.step_Rt * p.J_R_bg - m.jr_dt;
-
-  p.delta_R = p.delta_R * m.step_R;
-  p.dt += dt;
-}
 
 GyroScaleJacobians GyroScaleJacobiansOf(const PreintegratedImu& pim) {
   // A change dk of the scale factors changes each step's rate by -diag(gyro) dk (the step's
