@@ -76,21 +76,29 @@ std::uint32_t BagWriter::AddConnection(std::string topic, const RosMessageType& 
   return static_cast<std::uint32_t>(connections_.size() - 1);
 }
 
+// A connection record's header and data (in the chunk where the connection first writes, and
+// again after the chunks).
+std::pair<std::string, std::string> BagWriter::ConnectionRecord(std::uint32_t id,
+                                                                const Connection& c) {
+  std::string header;
+  AppendField(&header, "op", OpField(BagOp::kConnection));
+  AppendField(&header, "conn", U32Bytes(id));
+  AppendField(&header, "topic", c.topic);
+  std::string data;
+  AppendField(&data, "topic", c.topic);
+  AppendField(&data, "type", c.type.name);
+  AppendField(&data, "md5sum", c.type.md5sum);
+  AppendField(&data, "message_definition", c.type.definition);
+  return {std::move(header), std::move(data)};
+}
+
 void BagWriter::Write(std::uint32_t connection, std::int64_t t_ns, std::string_view message) {
   PKSLAM_CHECK(!closed_ && connection < connections_.size(), "connection {} of {}", connection,
                connections_.size());
   const std::string time = TimeBytes(t_ns);  // OptionError before anything is changed
   Connection& c = connections_[connection];
   if (!c.recorded) {
-    std::string header;
-    AppendField(&header, "op", OpField(BagOp::kConnection));
-    AppendField(&header, "conn", U32Bytes(connection));
-    AppendField(&header, "topic", c.topic);
-    std::string data;
-    AppendField(&data, "topic", c.topic);
-    AppendField(&data, "type", c.type.name);
-    AppendField(&data, "md5sum", c.type.md5sum);
-    AppendField(&data, "message_definition", c.type.definition);
+    const auto [header, data] = ConnectionRecord(connection, c);
     AppendSized(&chunk_, header);
     AppendSized(&chunk_, data);
     c.recorded = true;
@@ -150,17 +158,9 @@ void BagWriter::Close() {
   if (closed_) return;
   FlushChunk();
   const std::uint64_t index_pos = position_;
+  // The format repeats every connection record after the chunks (the reader's index).
   for (std::uint32_t id = 0; id < connections_.size(); ++id) {
-    const Connection& c = connections_[id];
-    std::string header;
-    AppendField(&header, "op", OpField(BagOp::kConnection));
-    AppendField(&header, "conn", U32Bytes(id));
-    AppendField(&header, "topic", c.topic);
-    std::string data;
-    AppendField(&data, "topic", c.topic);
-    AppendField(&data, "type", c.type.name);
-    AppendField(&data, "md5sum", c.type.md5sum);
-    AppendField(&data, "message_definition", c.type.definition);
+    const auto [header, data] = ConnectionRecord(id, connections_[id]);
     WriteRecord(header, data);
   }
   for (const ChunkInfo& info : chunk_infos_) {

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <utility>
 #include <string_view>
 #include <vector>
 
@@ -58,6 +59,8 @@ class BagWriter {
     RosMessageType type;
     bool recorded = false;  // its connection record is in a chunk already
   };
+  static std::pair<std::string, std::string> ConnectionRecord(std::uint32_t id,
+                                                              const Connection& c);
   struct ChunkInfo {
     std::uint64_t chunk_pos = 0;
     std::int64_t start_ns = 0;
