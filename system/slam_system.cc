@@ -321,6 +321,9 @@ TrackResult SlamSystem::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, st
 
 TrackResult SlamSystem::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
   SyncCalibration();
+  if (setup_.undistortion) {
+    return tracker_->TrackMonocular(setup_.undistortion->Undistort(image), ImuClock(t_ns));
+  }
   return tracker_->TrackMonocular(image, ImuClock(t_ns));
 }
 

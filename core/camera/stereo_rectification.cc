@@ -46,12 +46,21 @@ RectifyingTransforms ComputeRectifyingTransforms(const CameraModel& left, const 
   RectifyingTransforms t;
   cv::Mat q;
   if (left.type() == CameraType::kKannalaBrandt8) {
-    // Kannala-Brandt with 4 coefficients is OpenCV's fisheye model (Kalibr's "equidistant");
-    // balance 0 keeps the central view both cameras see, as alpha 0 does for pinhole rigs.
-    cv::fisheye::stereoRectify(left.CvK(), left.CvDistortion(), right.CvK(), right.CvDistortion(),
-                               size, rotation, translation, t.r1, t.r2, t.p1, t.p2, q,
-                               cv::CALIB_ZERO_DISPARITY, size, /*balance=*/0.0,
-                               /*fov_scale=*/1.0);
+    // Kannala-Brandt with 4 coefficients is OpenCV's fisheye model (Kalibr's "equidistant").
+    // Balance 0 alone would fit everything both lenses see into the image: for TUM-VI's 191 px
+    // lenses a focal length of 62 px, a third of the resolution where the features are. The
+    // second call scales the view (fov_scale divides the focal length) to the lenses' own focal
+    // length, keeping the central part of the field; the rim beyond it is not tracked.
+    const auto rectify = [&](double fov_scale) {
+      cv::fisheye::stereoRectify(left.CvK(), left.CvDistortion(), right.CvK(),
+                                 right.CvDistortion(), size, rotation, translation, t.r1, t.r2,
+                                 t.p1, t.p2, q, cv::CALIB_ZERO_DISPARITY, size,
+                                 /*balance=*/0.0, fov_scale);
+    };
+    rectify(1.0);
+    const double wide_focal = t.p1.at<double>(0, 0);
+    const double lens_focal = std::min(left.fx(), right.fx());
+    if (wide_focal > 0 && wide_focal < lens_focal) rectify(wide_focal / lens_focal);
   } else {
     cv::stereoRectify(left.CvK(), left.CvDistortion(), right.CvK(), right.CvDistortion(), size,
                       rotation, translation, t.r1, t.r2, t.p1, t.p2, q, cv::CALIB_ZERO_DISPARITY,

@@ -154,6 +154,8 @@ TEST(StereoRectificationTest, FisheyePairRectifiesOntoRows) {
   const StereoRectification rect(cam, cam, right_from_left);
   EXPECT_EQ(rect.rectified_camera().type(), CameraType::kPinhole);
   EXPECT_NEAR(rect.baseline(), right_from_left.translation().norm(), 1e-9);
+  // The lens's own focal length, not the 60-odd px of a view holding the whole field.
+  EXPECT_NEAR(rect.rectified_camera().fx(), cam.fx(), 1e-6 * cam.fx());
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> xy(-0.8, 0.8), z(1.5, 6.0);
   int checked = 0;

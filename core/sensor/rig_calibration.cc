@@ -90,6 +90,12 @@ RigSetup BuildRig(const RigCalibration& calibration, const RigShape& shape) {
       rig->baseline = setup.rectification->baseline();
       rig->body_from_camera = setup.rectification->BodyFromRectLeft(body_from_cam0);
     }
+  } else if (calibration.cameras[0].type() == CameraType::kKannalaBrandt8 &&
+             !IsRgbd(shape.sensor)) {
+    // The view keeps the fisheye's orientation: body_from_camera is the fisheye's.
+    setup.undistortion.emplace(calibration.cameras[0]);
+    rig->camera = setup.undistortion->pinhole_camera();
+    rig->body_from_camera = body_from_cam0;
   } else {
     rig->camera = calibration.cameras[0];
     rig->body_from_camera = body_from_cam0;
@@ -100,11 +106,11 @@ RigSetup BuildRig(const RigCalibration& calibration, const RigShape& shape) {
     }
   }
   if (rig->camera.type() != CameraType::kPinhole) {
-    // Tracking, matching and BA work on undistorted keypoints of an ideal pinhole; a fisheye
-    // image cannot be undistorted to one beyond 90 degrees.
+    // Tracking, matching and BA work on undistorted keypoints of an ideal pinhole; an RGB-D
+    // fisheye's depth image would have to be warped with it.
     throw OptionError(
-        "the SLAM pipeline supports pinhole (radial-tangential) cameras; "
-        "Kannala-Brandt fisheye is supported by the camera model only");
+        "RGB-D needs a pinhole (radial-tangential) camera; a Kannala-Brandt fisheye is tracked "
+        "monocular or stereo only");
   }
   rig->UpdateDerived();
   rig->bf = rig->fx * rig->baseline;
@@ -115,6 +121,7 @@ RigSetup BuildRig(const RigCalibration& calibration, const RigShape& shape) {
 
 std::optional<Eigen::Vector2d> RawLeftPixel(const RigSetup& setup, const Eigen::Vector2d& uv) {
   if (setup.rectification) return setup.rectification->UnrectifyLeftPixel(uv);
+  if (setup.undistortion) return setup.undistortion->DistortPixel(uv);
   return Distorted(setup.rig->camera, uv);
 }
 
@@ -126,6 +133,7 @@ std::optional<Eigen::Vector2d> RawRightPixel(const RigSetup& setup, const Eigen:
 std::optional<Eigen::Vector2d> TrackingLeftPixel(const RigSetup& setup,
                                                  const Eigen::Vector2d& raw) {
   if (setup.rectification) return setup.rectification->RectifyLeftPixel(raw);
+  if (setup.undistortion) return setup.undistortion->UndistortPixel(raw);
   return Undistorted(setup.rig->camera, raw);
 }
 
@@ -173,7 +181,7 @@ std::optional<RawMeasurement> MakeRawMeasurement(const RigSetup& setup, const Ei
                                                  const Eigen::Vector2d& raw_keypoint) {
   RawMeasurement m;
   const double sqrt_info = std::sqrt(inv_sigma2);
-  if (setup.rectification) {
+  if (setup.rectification || setup.undistortion) {
     const auto raw = RawLeftPixel(setup, uv);
     if (!raw) return std::nullopt;
     const auto j = TrackingJacobian(

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/camera/camera_model.h"
+#include "core/camera/fisheye_undistortion.h"
 #include "core/camera/stereo_rectification.h"
 #include "core/geometry/se3.h"
 #include "core/imu/imu_types.h"
@@ -69,6 +70,8 @@ struct RigSetup {
   std::shared_ptr<const CameraRig> rig;
   // Set when stereo images must be rectified before tracking.
   std::optional<StereoRectification> rectification;
+  // Set when a monocular fisheye's images must be undistorted to a pinhole view before tracking.
+  std::optional<FisheyeUndistortion> undistortion;
 };
 
 // Whether `estimate` can be a calibration of the rig `file` describes, not of another camera:
@@ -78,8 +81,9 @@ struct RigSetup {
 // first difference.
 void CheckSameRig(const RigCalibration& file, const RigCalibration& estimate);
 
-// Throws OptionError for calibrations the pipeline cannot track with (fisheye tracking camera,
-// stereo without a second camera, a vertical or swapped stereo pair).
+// Throws OptionError for calibrations the pipeline cannot track with (an RGB-D fisheye, stereo
+// without a second camera, a vertical or swapped stereo pair). A monocular fisheye is tracked in
+// its pinhole view (FisheyeUndistortion), a fisheye pair rectified (StereoRectification).
 RigSetup BuildRig(const RigCalibration& calibration, const RigShape& shape);
 
 // Keypoint measurements of one setup expressed in another's image coordinates (same sensor):
@@ -115,7 +119,8 @@ std::optional<Eigen::Vector2d> TrackingRightPixel(const RigSetup& setup,
 // whitened error in the image the keypoint was measured in; for a stereo match (u_right >= 0) the
 // raw cam1 pixel of (u_right, v) and w_right = sqrt(inv_sigma2) * d(u_right)/d(raw right pixel),
 // the rectified right coordinate being the only part of it the matcher measured. Monocular
-// keypoints are measured in the raw image: W_left = sqrt(inv_sigma2) * I.
+// keypoints are measured in the raw image: W_left = sqrt(inv_sigma2) * I (a fisheye's, found in
+// its pinhole view, are whitened like rectified ones).
 struct RawMeasurement {
   Eigen::Vector2d left = Eigen::Vector2d::Zero();
   Eigen::Matrix2d left_whitening = Eigen::Matrix2d::Identity();
@@ -123,8 +128,8 @@ struct RawMeasurement {
   Eigen::Vector2d right = Eigen::Vector2d::Zero();
   Eigen::RowVector2d right_whitening = Eigen::RowVector2d::Zero();
 };
-// nullopt when a pixel cannot be unmapped. `raw_keypoint`: the keypoint as extracted (monocular:
-// the raw pixel, used as is).
+// nullopt when a pixel cannot be unmapped. `raw_keypoint`: the keypoint as extracted (monocular
+// pinhole: the raw pixel, used as is; unused when the setup rectifies or undistorts).
 std::optional<RawMeasurement> MakeRawMeasurement(const RigSetup& setup, const Eigen::Vector2d& uv,
                                                  double u_right, double inv_sigma2,
                                                  const Eigen::Vector2d& raw_keypoint);

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/camera/test_cameras.h"
 #include "core/util/error.h"
 
@@ -96,6 +98,40 @@ TEST(RigCalibrationTest, MonocularPixelsAreUndistortedRawKeypoints) {
   const auto back = RawLeftPixel(setup, *un);
   ASSERT_TRUE(back.has_value());
   EXPECT_LT((*back - raw).norm(), 1e-6);
+}
+
+// A single fisheye is tracked in its pinhole view: keypoints found there go through their raw
+// fisheye pixel, and the calibration adjustment whitens them like rectified ones.
+TEST(RigCalibrationTest, MonocularFisheyeIsTrackedInItsPinholeView) {
+  RigCalibration c;
+  c.cameras = {testing::TumViKb8()};
+  const RigSetup setup = BuildRig(c, Shape(Sensor::kMonocularInertial));
+  ASSERT_TRUE(setup.undistortion.has_value());
+  EXPECT_EQ(setup.rig->camera.type(), CameraType::kPinhole);
+  EXPECT_FALSE(setup.rig->camera.HasDistortion());
+  const Eigen::Vector3d p_camera(0.3, -0.2, 1.0);
+  const auto raw = testing::TumViKb8().Project(p_camera);
+  ASSERT_TRUE(raw.has_value());
+  const auto tracked = TrackingLeftPixel(setup, *raw);
+  ASSERT_TRUE(tracked.has_value());
+  // The view keeps the fisheye's frame: the point projects there through the rig's pinhole.
+  EXPECT_LT((*tracked - *setup.rig->camera.Project(p_camera)).norm(), 1e-6);
+  const auto back = RawLeftPixel(setup, *tracked);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_LT((*back - *raw).norm(), 1e-6);
+  // The raw measurement is the fisheye pixel, whitened by d(pinhole pixel)/d(raw pixel), which
+  // off the axis stretches the view (the pinhole's magnification grows with the angle).
+  const auto m = MakeRawMeasurement(setup, *tracked, -1.0, 1.0, *tracked);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_LT((m->left - *raw).norm(), 1e-6);
+  EXPECT_GT(m->left_whitening.norm(), std::sqrt(2.0) * 1.01);
+  EXPECT_FALSE(m->has_right);
+}
+
+TEST(RigCalibrationTest, RejectsAnRgbdFisheye) {
+  RigCalibration c;
+  c.cameras = {testing::TumViKb8()};
+  EXPECT_THROW(BuildRig(c, Shape(Sensor::kRgbd)), OptionError);
 }
 
 TEST(RigCalibrationTest, RejectsStereoWithoutASecondCamera) {
