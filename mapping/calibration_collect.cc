@@ -140,10 +140,13 @@ CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertia
     problem.time_offset_applied.push_back(kf->imu.time_offset_s);
   }
   // The edges' copies carry no steps: the gyro scale's Jacobians come from the keyframes'.
-  for (const auto& e : problem.bundle.edges) {
-    const KeyFrame& to = *keyframes[static_cast<std::size_t>(e.to)];
-    problem.gyro_scale_jacobians.push_back(
-        to.imu.from_previous ? GyroScaleJacobiansOf(*to.imu.from_previous) : GyroScaleJacobians{});
+  if (options.gyro_scale_jacobians) {
+    for (const auto& e : problem.bundle.edges) {
+      const KeyFrame& to = *keyframes[static_cast<std::size_t>(e.to)];
+      problem.gyro_scale_jacobians.push_back(to.imu.from_previous
+                                                 ? GyroScaleJacobiansOf(*to.imu.from_previous)
+                                                 : GyroScaleJacobians{});
+    }
   }
   // Physical measurements; an observation that cannot be mapped back is dropped.
   std::vector<BundleProblem::ObservationState> observations;

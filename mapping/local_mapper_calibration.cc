@@ -41,6 +41,7 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
     if (IsInertial(rig_->sensor) && !inertial) return;
     CalibrationCollectOptions collect;
     collect.max_observations_per_keyframe = o.max_observations_per_keyframe;
+    collect.gyro_scale_jacobians = o.gyro_scale;
     setup = atlas_->rig_setup();
     problem = CollectCalibrationBundle(kf.get(), inertial, setup, atlas_->calibration(),
                                        calibration_prior_, collect);

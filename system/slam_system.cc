@@ -127,6 +127,7 @@ void SlamSystem::FinishCalibration() {
         IsInertial(options_.sensor) && map->imu_status().inertial_ba1_done;
     CalibrationCollectOptions collect;
     collect.max_observations_per_keyframe = o.final_max_observations_per_keyframe;
+    collect.gyro_scale_jacobians = o.gyro_scale;
     setup = atlas_.rig_setup();
     problem = CollectCalibrationBundle(newest, inertial, setup, atlas_.calibration(),
                                        file_calibration_, collect);
@@ -344,6 +345,7 @@ CalibrationBundleResult SlamSystem::RefineCalibration(const CalibrationFreedom& 
     KeyFrame* newest = map->keyframes().rbegin()->second.get();
     CalibrationCollectOptions collect;
     collect.max_observations_per_keyframe = max_observations_per_keyframe;
+    collect.gyro_scale_jacobians = free.gyro_scale;
     problem = CollectCalibrationBundle(newest, IsInertial(options_.sensor), setup_,
                                        file_calibration_, file_calibration_, collect);
   }

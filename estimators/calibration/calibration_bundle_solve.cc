@@ -499,6 +499,20 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
   }
   write_result();
   if (options.covariance && !result.bundle.visual.aborted && problem.free.Any()) {
+    // A point the outlier pass left with three residuals or fewer tells nothing about the other
+    // parameters (its own three coordinates absorb them), and with fewer than three it has no
+    // position (no residual at all: three zero columns, which made Ceres' QR refuse the whole
+    // covariance on every machine-hall replay). Removing it with its residuals leaves the
+    // calibration's marginal covariance as it is; the solve is done.
+    std::vector<int> rows_left(static_cast<std::size_t>(num_points), 0);
+    for (int i = 0; i < num_obs; ++i) {
+      const ObsBlocks& b = blocks[static_cast<std::size_t>(i)];
+      const int p = visual.observations[i].point_index;
+      rows_left[p] += (b.left != nullptr ? 2 : 0) + (b.right != nullptr ? 1 : 0);
+    }
+    for (int p = 0; p < num_points; ++p) {
+      if (point_added[p] && rows_left[p] <= 3) ceres_problem.RemoveParameterBlock(s.point(p));
+    }
     result.covariance_ok =
         FillSigmas(&ceres_problem, &s, problem, options.num_threads, &result.parameters);
     if (!result.covariance_ok) {
