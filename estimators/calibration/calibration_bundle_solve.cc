@@ -7,6 +7,8 @@
 #include <ceres/solver.h>
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -60,10 +62,24 @@ void CopyArray(const std::array<double, kCalibIntrinsicsSize>& a, double* out) {
   std::copy(a.begin(), a.end(), out);
 }
 
+// The stereo extrinsic's held tangent axes ([rho; phi] of cam1_from_cam0): the baseline and the
+// rotation about x (see the prior below).
+constexpr std::array<bool, 6> kStereoHeldAxes = {true, true, true, true, false, false};
+
+// The camera-IMU extrinsic's held axes: the translation (rho of cam0_from_body: the camera's
+// position in the body stays) unless the lever arm is free, the rotation unless it is free.
+std::array<bool, 6> ImuHeldAxes(const CalibrationFreedom& free) {
+  const bool t = !free.imu_translation;
+  const bool r = !free.imu_rotation;
+  return {t, t, t, r, r, r};
+}
+
 // The marginal covariance of the free calibration blocks (tangent space), written into the
 // parameters' sigmas. False when Ceres cannot compute it (rank-deficient Jacobian).
 bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundleProblem& problem,
-                int num_threads, std::vector<CalibrationParameter>* parameters) {
+                int num_threads, const Eigen::MatrixXd& imu_expansion,
+                const Eigen::MatrixXd& stereo_expansion,
+                std::vector<CalibrationParameter>* parameters) {
   // A block's tangent covariance C maps to the reported scalars as J C J^T (report-ordered J).
   struct Entry {
     double* block;
@@ -93,14 +109,16 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
   if (problem.initial.stereo()) {
     if (problem.free.stereo_extrinsic) {
       entries.push_back({s->cam1_from_cam0(), index,
-                         extrinsic_j(PoseFromBlock(s->cam1_from_cam0()).Inverse())});
+                         extrinsic_j(PoseFromBlock(s->cam1_from_cam0()).Inverse()) *
+                             stereo_expansion});
     }
     index += 6;
   }
   if (problem.inertial) {
     if (problem.free.imu_rotation || problem.free.imu_translation) {
       entries.push_back({s->cam0_from_body(), index,
-                         extrinsic_j(PoseFromBlock(s->cam0_from_body()).Inverse())});
+                         extrinsic_j(PoseFromBlock(s->cam0_from_body()).Inverse()) *
+                             imu_expansion});
     }
     index += 6;
     if (problem.free.time_offset) {
@@ -245,43 +263,46 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
         nullptr, block);
     if (!problem.free.intrinsics[c]) ceres_problem.SetParameterBlockConstant(block);
   }
-  ceres_problem.AddParameterBlock(s.cam0_from_body(), kCalibExtrinsicSize, &extrinsic_manifold);
-  ceres_problem.AddParameterBlock(s.cam1_from_cam0(), kCalibExtrinsicSize, &extrinsic_manifold);
+  // Held axes of the free extrinsics stay put through their manifold (HeldAxes).
+  const bool imu_free =
+      problem.inertial && (problem.free.imu_rotation || problem.free.imu_translation);
+  const bool stereo_free = stereo && problem.free.stereo_extrinsic;
+  const std::array<bool, 6> imu_held = ImuHeldAxes(problem.free);
+  SE3LeftSubsetManifold imu_manifold(imu_free ? imu_held : std::array<bool, 6>{});
+  SE3LeftSubsetManifold stereo_manifold(kStereoHeldAxes);
+  ceres_problem.AddParameterBlock(
+      s.cam0_from_body(), kCalibExtrinsicSize,
+      imu_free ? static_cast<ceres::Manifold*>(&imu_manifold) : &extrinsic_manifold);
+  ceres_problem.AddParameterBlock(
+      s.cam1_from_cam0(), kCalibExtrinsicSize,
+      stereo_free ? static_cast<ceres::Manifold*>(&stereo_manifold) : &extrinsic_manifold);
   ceres_problem.AddParameterBlock(s.offset(), 1);
   ceres_problem.AddParameterBlock(s.no_velocity(), 3);
   ceres_problem.SetParameterBlockConstant(s.no_velocity());
-  const bool imu_free =
-      problem.inertial && (problem.free.imu_rotation || problem.free.imu_translation);
   if (imu_free) {
-    // A rotation-only (translation-only) freedom holds the other part at the prior through a
-    // prior 1000 times tighter (one block, one manifold; tight enough to keep it, loose enough
-    // to keep the system well conditioned).
-    // The frozen part is held where it is now, the free part drawn to the file's value.
-    const double frozen = 1e-3;
+    // A rotation-only (translation-only) freedom holds the other part where it is now through
+    // the block's manifold; the free part is drawn to the file's value.
     const SE3d file = problem.prior.body_from_cam0.Inverse();
     const SE3d now = problem.initial.body_from_cam0.Inverse();
     const SE3d mean(problem.free.imu_rotation ? file.so3() : now.so3(),
                     problem.free.imu_translation ? file.translation() : now.translation());
     ceres_problem.AddResidualBlock(
-        new ExtrinsicPriorError(
-            mean,
-            sig.imu_translation_mm * 1e-3 * (problem.free.imu_translation ? 1.0 : frozen),
-            sig.imu_rotation_deg / kRadToDeg * (problem.free.imu_rotation ? 1.0 : frozen)),
+        new ExtrinsicPriorError(mean, sig.imu_translation_mm * 1e-3,
+                                sig.imu_rotation_deg / kRadToDeg),
         nullptr, s.cam0_from_body());
   } else {
     ceres_problem.SetParameterBlockConstant(s.cam0_from_body());
   }
-  if (stereo && problem.free.stereo_extrinsic) {
-    // Only the rotation about the cameras' y and z axes: the baseline is the map's scale (with an
-    // IMU, the accelerometers' scale factors pull it; the file's baseline is the better-known),
-    // and the rotation about x moves the right image's rows, which the matcher does not measure.
-    // Those are held at the file's value by a prior 1000 times tighter.
-    const double frozen = 1e-3;
-    const double t = sig.stereo_translation_mm * 1e-3 * frozen;
+  if (stereo_free) {
+    // Only the rotation about the cameras' y and z axes (kStereoHeldAxes): the baseline is the
+    // map's scale (with an IMU, the accelerometers' scale factors pull it; the file's baseline is
+    // the better-known), and the rotation about x moves the right image's rows, which the
+    // matcher does not measure.
+    const double t = sig.stereo_translation_mm * 1e-3;
     const double r = sig.stereo_rotation_deg / kRadToDeg;
     ceres_problem.AddResidualBlock(
         new ExtrinsicPriorError(problem.prior.cam1_from_cam0,
-                                (Eigen::Matrix<double, 6, 1>() << t, t, t, r * frozen, r, r).finished()),
+                                (Eigen::Matrix<double, 6, 1>() << t, t, t, r, r, r).finished()),
         nullptr, s.cam1_from_cam0());
   } else {
     ceres_problem.SetParameterBlockConstant(s.cam1_from_cam0());
@@ -510,14 +531,33 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
       const int p = visual.observations[i].point_index;
       rows_left[p] += (b.left != nullptr ? 2 : 0) + (b.right != nullptr ? 1 : 0);
     }
+    // A far point seen without stereo from nearby keyframes has almost no depth information:
+    // numerically a null direction to Ceres' rank test (its tolerance is relative to the
+    // Jacobian's largest column). A 100 m prior on each point's position removes those
+    // directions and adds no information worth the name about anything else.
+    constexpr double kPointPriorSigmaM = 100.0;
     for (int p = 0; p < num_points; ++p) {
-      if (point_added[p] && rows_left[p] <= 3) ceres_problem.RemoveParameterBlock(s.point(p));
+      if (!point_added[p]) continue;
+      if (rows_left[p] <= 3) {
+        ceres_problem.RemoveParameterBlock(s.point(p));
+        continue;
+      }
+      ceres_problem.AddResidualBlock(
+          new EuclideanPriorError(Eigen::Map<const Eigen::Vector3d>(s.point(p)),
+                                  Eigen::Vector3d::Constant(kPointPriorSigmaM)),
+          nullptr, s.point(p));
     }
+    const auto start = std::chrono::steady_clock::now();
     result.covariance_ok =
-        FillSigmas(&ceres_problem, &s, problem, options.num_threads, &result.parameters);
-    if (!result.covariance_ok) {
-      PKSLAM_LOG_DEBUG("calibration bundle adjustment: covariance not computable");
-    }
+        FillSigmas(&ceres_problem, &s, problem, options.num_threads,
+                   imu_free ? imu_manifold.Expansion() : Eigen::MatrixXd::Identity(6, 6),
+                   stereo_free ? stereo_manifold.Expansion() : Eigen::MatrixXd::Identity(6, 6),
+                   &result.parameters);
+    PKSLAM_LOG_DEBUG("calibration bundle adjustment: covariance {} in {:.0f} ms",
+                     result.covariance_ok ? "computed" : "not computable",
+                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                               start)
+                         .count());
   }
   return result;
 }

@@ -1,6 +1,9 @@
 #include "estimators/optim/se3_manifold.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
+
+#include "core/util/error.h"
 
 namespace pkslam {
 
@@ -53,6 +56,60 @@ bool SE3LeftManifold::MinusJacobian(const double* /*x*/, double* jacobian) const
   Eigen::Map<Eigen::Matrix<double, 6, 7, Eigen::RowMajor>> j(jacobian);
   j.setZero();
   j.leftCols<6>().setIdentity();
+  return true;
+}
+
+SE3LeftSubsetManifold::SE3LeftSubsetManifold(const std::array<bool, 6>& held) {
+  for (int i = 0; i < 6; ++i) {
+    if (!held[static_cast<std::size_t>(i)]) free_.push_back(i);
+  }
+  PKSLAM_CHECK(!free_.empty(), "SE3LeftSubsetManifold: every axis held (hold the block instead)");
+}
+
+Eigen::MatrixXd SE3LeftSubsetManifold::Expansion() const {
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(6, TangentSize());
+  for (int c = 0; c < TangentSize(); ++c) e(free_[static_cast<std::size_t>(c)], c) = 1.0;
+  return e;
+}
+
+bool SE3LeftSubsetManifold::Plus(const double* x, const double* delta,
+                                 double* x_plus_delta) const {
+  Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int c = 0; c < TangentSize(); ++c) d[free_[static_cast<std::size_t>(c)]] = delta[c];
+  PoseToBlock(SE3d::Exp(d) * PoseFromBlock(x), x_plus_delta);
+  return true;
+}
+
+bool SE3LeftSubsetManifold::PlusJacobian(const double* /*x*/, double* jacobian) const {
+  const int k = TangentSize();
+  std::fill(jacobian, jacobian + kPoseBlockSize * k, 0.0);
+  for (int c = 0; c < k; ++c) jacobian[free_[static_cast<std::size_t>(c)] * k + c] = 1.0;
+  return true;
+}
+
+bool SE3LeftSubsetManifold::RightMultiplyByPlusJacobian(const double* /*x*/, int num_rows,
+                                                        const double* ambient_matrix,
+                                                        double* tangent_matrix) const {
+  const int k = TangentSize();
+  for (int r = 0; r < num_rows; ++r) {
+    for (int c = 0; c < k; ++c) {
+      tangent_matrix[r * k + c] =
+          ambient_matrix[r * kPoseBlockSize + free_[static_cast<std::size_t>(c)]];
+    }
+  }
+  return true;
+}
+
+bool SE3LeftSubsetManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
+  const Eigen::Matrix<double, 6, 1> full = (PoseFromBlock(y) * PoseFromBlock(x).Inverse()).Log();
+  for (int c = 0; c < TangentSize(); ++c) y_minus_x[c] = full[free_[static_cast<std::size_t>(c)]];
+  return true;
+}
+
+bool SE3LeftSubsetManifold::MinusJacobian(const double* /*x*/, double* jacobian) const {
+  const int k = TangentSize();
+  std::fill(jacobian, jacobian + k * kPoseBlockSize, 0.0);
+  for (int c = 0; c < k; ++c) jacobian[c * kPoseBlockSize + free_[static_cast<std::size_t>(c)]] = 1.0;
   return true;
 }
 

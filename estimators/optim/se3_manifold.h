@@ -21,6 +21,8 @@
 #include <ceres/manifold.h>
 
 #include <Eigen/Core>
+#include <array>
+#include <vector>
 
 #include "core/geometry/se3.h"
 
@@ -47,6 +49,35 @@ class SE3LeftManifold final : public ceres::Manifold {
   bool Minus(const double* y, const double* x, double* y_minus_x) const override;
   // The constant [I6 0] (6 x 7, row-major).
   bool MinusJacobian(const double* x, double* jacobian) const override;
+};
+
+// SE3LeftManifold with some tangent axes held: Plus(T, d) = Exp(E d) * T, where E (6 x k) picks
+// the free axes of [rho; phi]. Holding a block's axes exactly this way, rather than by a prior
+// a thousand times tighter, keeps the Jacobian's columns of one scale: Ceres' covariance (sparse
+// QR, whose rank tolerance grows with the largest column) found the calibration adjustment's
+// Jacobian rank-deficient on every machine-hall replay with such a prior in it. With rho held, a
+// block X = parent_from_child only turns (Exp(phi) X), and the translation of its inverse, the
+// parent's origin in the child frame (for cam0_from_body, the camera's position in the body),
+// stays exactly where it is. The same [I6; 0] convention as SE3LeftManifold.
+class SE3LeftSubsetManifold final : public ceres::Manifold {
+ public:
+  // held[i]: tangent axis i of [rho; phi] does not move. At least one axis must stay free.
+  explicit SE3LeftSubsetManifold(const std::array<bool, 6>& held);
+
+  int AmbientSize() const override { return kPoseBlockSize; }
+  int TangentSize() const override { return static_cast<int>(free_.size()); }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool RightMultiplyByPlusJacobian(const double* x, int num_rows, const double* ambient_matrix,
+                                   double* tangent_matrix) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+
+  // The 6 x k matrix E mapping the free tangent to the full [rho; phi].
+  Eigen::MatrixXd Expansion() const;
+
+ private:
+  std::vector<int> free_;  // indices of the free axes, ascending
 };
 
 }  // namespace pkslam

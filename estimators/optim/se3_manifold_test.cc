@@ -119,5 +119,53 @@ TEST(SE3LeftManifold, JacobiansFollowTheI6Convention) {
   EXPECT_TRUE(tangent == product);
 }
 
+// Holding rho: the block only turns, so the parent's origin in the child frame stays put.
+TEST(SE3LeftSubsetManifold, HeldTranslationKeepsTheInverseTranslation) {
+  std::mt19937 rng(11);
+  const SE3LeftSubsetManifold manifold({true, true, true, false, false, false});
+  ASSERT_EQ(manifold.TangentSize(), 3);
+  const Block x = RandomPoseBlock(rng);
+  const Eigen::Vector3d delta = RandomTangent<3>(rng, 0.3);
+  Block moved;
+  ASSERT_TRUE(manifold.Plus(x.data(), delta.data(), moved.data()));
+  const SE3d before = PoseFromBlock(x.data());
+  const SE3d after = PoseFromBlock(moved.data());
+  EXPECT_LT((after.Inverse().translation() - before.Inverse().translation()).norm(), 1e-12);
+  // The rotation moved by exactly the free part, as SE3LeftManifold would with rho = 0.
+  Vec6 full = Vec6::Zero();
+  full.tail<3>() = delta;
+  EXPECT_LT(((after * before.Inverse()).Log() - full).norm(), 1e-12);
+  Eigen::Vector3d back;
+  ASSERT_TRUE(manifold.Minus(moved.data(), x.data(), back.data()));
+  EXPECT_LT((back - delta).norm(), 1e-12);
+}
+
+TEST(SE3LeftSubsetManifold, JacobiansSelectTheFreeAxes) {
+  std::mt19937 rng(13);
+  // The stereo extrinsic's freedom: rotation about y and z only.
+  const SE3LeftSubsetManifold manifold({true, true, true, true, false, false});
+  const int k = manifold.TangentSize();
+  ASSERT_EQ(k, 2);
+  const Block x = RandomPoseBlock(rng);
+  Eigen::Matrix<double, 7, Eigen::Dynamic, Eigen::RowMajor> plus(7, k);
+  Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> minus(k, 7);
+  ASSERT_TRUE(manifold.PlusJacobian(x.data(), plus.data()));
+  ASSERT_TRUE(manifold.MinusJacobian(x.data(), minus.data()));
+  EXPECT_TRUE((minus * plus).isIdentity(0.0));
+  const Eigen::MatrixXd e = manifold.Expansion();
+  EXPECT_TRUE(plus.topRows<6>() == e);
+  EXPECT_EQ(e(4, 0), 1.0);
+  EXPECT_EQ(e(5, 1), 1.0);
+  Eigen::Matrix<double, 3, 7, Eigen::RowMajor> ambient;
+  for (int i = 0; i < ambient.size(); ++i) ambient.data()[i] = i + 1.0;
+  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> tangent(3, k);
+  ASSERT_TRUE(manifold.RightMultiplyByPlusJacobian(x.data(), 3, ambient.data(), tangent.data()));
+  EXPECT_TRUE(tangent == ambient * plus);
+}
+
+TEST(SE3LeftSubsetManifold, RefusesToHoldEveryAxis) {
+  EXPECT_ANY_THROW(SE3LeftSubsetManifold({true, true, true, true, true, true}));
+}
+
 }  // namespace
 }  // namespace pkslam
