@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -74,8 +75,127 @@ std::array<bool, 6> ImuHeldAxes(const CalibrationFreedom& free) {
   return {t, t, t, r, r, r};
 }
 
+bool ImuExtrinsicFree(const CalibrationBundleProblem& problem) {
+  return problem.inertial && (problem.free.imu_rotation || problem.free.imu_translation);
+}
+
+bool StereoExtrinsicFree(const CalibrationBundleProblem& problem) {
+  return problem.initial.stereo() && problem.free.stereo_extrinsic;
+}
+
+// The calibration blocks' manifolds (Ceres borrows them: they outlive the problem). Held axes of
+// the free extrinsics stay put through their manifold; a block that is not free is constant, and
+// its manifold holds nothing.
+struct CalibrationManifolds {
+  explicit CalibrationManifolds(const CalibrationBundleProblem& problem)
+      : imu(ImuExtrinsicFree(problem) ? ImuHeldAxes(problem.free) : std::array<bool, 6>{}),
+        stereo(StereoExtrinsicFree(problem) ? kStereoHeldAxes : std::array<bool, 6>{}) {}
+  // The right camera's fy and cy stay: the stereo matcher measures only its u coordinate.
+  ceres::SubsetManifold right_intrinsics{kCalibIntrinsicsSize, {1, 3}};
+  SE3LeftSubsetManifold imu;
+  SE3LeftSubsetManifold stereo;
+};
+
+// The calibration blocks (intrinsics, extrinsics, time offset) with their priors around the
+// file's values (`sig`: their sigmas); blocks the freedom does not free are constant.
+void AddCalibrationBlocks(const CalibrationBundleProblem& problem,
+                          const CalibrationPriorOptions& sig, CalibrationManifolds* m,
+                          ceres::Problem* ceres_problem, State* s) {
+  for (std::size_t c = 0; c < problem.initial.cameras.size() && c < 2; ++c) {
+    double* block = s->intrinsics(static_cast<int>(c));
+    ceres_problem->AddParameterBlock(block, kCalibIntrinsicsSize,
+                                    c == 1 ? &m->right_intrinsics : nullptr);
+    const auto mean = IntrinsicsBlock(problem.prior.cameras[c]);
+    Eigen::VectorXd sigma(kCalibIntrinsicsSize);
+    sigma << sig.focal_px, sig.focal_px, sig.principal_point_px, sig.principal_point_px, sig.k1,
+        sig.k2;
+    ceres_problem->AddResidualBlock(
+        new EuclideanPriorError(Eigen::Map<const Eigen::VectorXd>(mean.data(), kCalibIntrinsicsSize),
+                                sigma),
+        nullptr, block);
+    if (!problem.free.intrinsics[c]) ceres_problem->SetParameterBlockConstant(block);
+  }
+  ceres_problem->AddParameterBlock(s->cam0_from_body(), kCalibExtrinsicSize, &m->imu);
+  ceres_problem->AddParameterBlock(s->cam1_from_cam0(), kCalibExtrinsicSize, &m->stereo);
+  ceres_problem->AddParameterBlock(s->offset(), 1);
+  ceres_problem->AddParameterBlock(s->no_velocity(), 3);
+  ceres_problem->SetParameterBlockConstant(s->no_velocity());
+  if (ImuExtrinsicFree(problem)) {
+    // A rotation-only (translation-only) freedom holds the other part where it is now through
+    // the block's manifold; the free part is drawn to the file's value.
+    const SE3d file = problem.prior.body_from_cam0.Inverse();
+    const SE3d now = problem.initial.body_from_cam0.Inverse();
+    const SE3d mean(problem.free.imu_rotation ? file.so3() : now.so3(),
+                    problem.free.imu_translation ? file.translation() : now.translation());
+    ceres_problem->AddResidualBlock(
+        new ExtrinsicPriorError(mean, sig.imu_translation_mm * 1e-3,
+                                sig.imu_rotation_deg / kRadToDeg),
+        nullptr, s->cam0_from_body());
+  } else {
+    ceres_problem->SetParameterBlockConstant(s->cam0_from_body());
+  }
+  if (StereoExtrinsicFree(problem)) {
+    // Only the rotation about the cameras' y and z axes (kStereoHeldAxes): the baseline is the
+    // map's scale (with an IMU, the accelerometers' scale factors pull it; the file's baseline is
+    // the better-known), and the rotation about x moves the right image's rows, which the
+    // matcher does not measure.
+    const double t = sig.stereo_translation_mm * 1e-3;
+    const double r = sig.stereo_rotation_deg / kRadToDeg;
+    ceres_problem->AddResidualBlock(
+        new ExtrinsicPriorError(problem.prior.cam1_from_cam0,
+                                (Eigen::Matrix<double, 6, 1>() << t, t, t, r, r, r).finished()),
+        nullptr, s->cam1_from_cam0());
+  } else {
+    ceres_problem->SetParameterBlockConstant(s->cam1_from_cam0());
+  }
+  if (problem.inertial && problem.free.time_offset) {
+    ceres_problem->AddResidualBlock(
+        new EuclideanPriorError(Eigen::VectorXd::Constant(1, problem.prior.time_offset_s),
+                                Eigen::VectorXd::Constant(1, sig.time_offset_ms * 1e-3)),
+        nullptr, s->offset());
+  } else {
+    ceres_problem->SetParameterBlockConstant(s->offset());
+  }
+  if (problem.inertial && problem.free.gyro_scale) {
+    ceres_problem->AddResidualBlock(
+        new EuclideanPriorError(problem.prior.gyro_scale,
+                                Eigen::Vector3d::Constant(sig.gyro_scale_pct * 1e-2)),
+        nullptr, s->gyro_scale());
+  }
+}
+
+// Before the covariance (the solve is done), the points whose directions Ceres' sparse QR would
+// take for null ones, so that it refuses the whole covariance (every machine-hall replay did):
+// - a point the outlier pass left with three residuals or fewer (`rows_left`) tells nothing
+//   about the other parameters (its own three coordinates absorb them), and with fewer than
+//   three it has no position at all; it leaves the problem with its residuals, which keeps the
+//   calibration's marginal covariance as it is;
+// - a far point seen without stereo from nearby keyframes has almost no depth, numerically a
+//   null direction (the rank tolerance is relative to the Jacobian's largest column); a 100 m
+//   prior on every point's position removes those and tells nothing worth the name about
+//   anything else.
+void RemoveNuisanceNullDirections(const std::vector<int>& rows_left,
+                                  const std::vector<std::uint8_t>& point_added,
+                                  ceres::Problem* ceres_problem, State* s) {
+  constexpr double kPointPriorSigmaM = 100.0;
+  for (std::size_t p = 0; p < rows_left.size(); ++p) {
+    if (!point_added[p]) continue;
+    double* point = s->point(static_cast<int>(p));
+    if (rows_left[p] <= 3) {
+      ceres_problem->RemoveParameterBlock(point);
+      continue;
+    }
+    ceres_problem->AddResidualBlock(
+        new EuclideanPriorError(Eigen::Map<const Eigen::Vector3d>(point),
+                                Eigen::Vector3d::Constant(kPointPriorSigmaM)),
+        nullptr, point);
+  }
+}
+
 // The marginal covariance of the free calibration blocks (tangent space), written into the
 // parameters' sigmas. False when Ceres cannot compute it (rank-deficient Jacobian).
+// `imu_expansion`, `stereo_expansion`: the extrinsic blocks' free tangent axes
+// (SE3LeftSubsetManifold::Expansion).
 bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundleProblem& problem,
                 int num_threads, const Eigen::MatrixXd& imu_expansion,
                 const Eigen::MatrixXd& stereo_expansion,
@@ -239,89 +359,14 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
 
   ceres::Problem ceres_problem(ProblemOptions({.loss_functions = true, .fast_removal = true}));
   BodyPoseManifold pose_manifold;
-  SE3LeftManifold extrinsic_manifold;
-  // The right camera's fy and cy stay: the stereo matcher measures only its u coordinate.
-  ceres::SubsetManifold right_intrinsics_manifold(kCalibIntrinsicsSize, {1, 3});
   ceres::HuberLoss huber_left(std::sqrt(options.chi2_left));
   ceres::HuberLoss huber_right(std::sqrt(options.chi2_right));
   ceres::LossFunctionWrapper loss_left(&huber_left, ceres::DO_NOT_TAKE_OWNERSHIP);
   ceres::LossFunctionWrapper loss_right(&huber_right, ceres::DO_NOT_TAKE_OWNERSHIP);
 
-  // Calibration blocks and their priors.
-  const CalibrationPriorOptions& sig = options.prior;
-  for (std::size_t c = 0; c < problem.initial.cameras.size() && c < 2; ++c) {
-    double* block = s.intrinsics(static_cast<int>(c));
-    ceres_problem.AddParameterBlock(block, kCalibIntrinsicsSize,
-                                    c == 1 ? &right_intrinsics_manifold : nullptr);
-    const auto mean = IntrinsicsBlock(problem.prior.cameras[c]);
-    Eigen::VectorXd sigma(kCalibIntrinsicsSize);
-    sigma << sig.focal_px, sig.focal_px, sig.principal_point_px, sig.principal_point_px, sig.k1,
-        sig.k2;
-    ceres_problem.AddResidualBlock(
-        new EuclideanPriorError(Eigen::Map<const Eigen::VectorXd>(mean.data(), kCalibIntrinsicsSize),
-                                sigma),
-        nullptr, block);
-    if (!problem.free.intrinsics[c]) ceres_problem.SetParameterBlockConstant(block);
-  }
-  // Held axes of the free extrinsics stay put through their manifold (HeldAxes).
-  const bool imu_free =
-      problem.inertial && (problem.free.imu_rotation || problem.free.imu_translation);
-  const bool stereo_free = stereo && problem.free.stereo_extrinsic;
-  const std::array<bool, 6> imu_held = ImuHeldAxes(problem.free);
-  SE3LeftSubsetManifold imu_manifold(imu_free ? imu_held : std::array<bool, 6>{});
-  SE3LeftSubsetManifold stereo_manifold(kStereoHeldAxes);
-  ceres_problem.AddParameterBlock(
-      s.cam0_from_body(), kCalibExtrinsicSize,
-      imu_free ? static_cast<ceres::Manifold*>(&imu_manifold) : &extrinsic_manifold);
-  ceres_problem.AddParameterBlock(
-      s.cam1_from_cam0(), kCalibExtrinsicSize,
-      stereo_free ? static_cast<ceres::Manifold*>(&stereo_manifold) : &extrinsic_manifold);
-  ceres_problem.AddParameterBlock(s.offset(), 1);
-  ceres_problem.AddParameterBlock(s.no_velocity(), 3);
-  ceres_problem.SetParameterBlockConstant(s.no_velocity());
-  if (imu_free) {
-    // A rotation-only (translation-only) freedom holds the other part where it is now through
-    // the block's manifold; the free part is drawn to the file's value.
-    const SE3d file = problem.prior.body_from_cam0.Inverse();
-    const SE3d now = problem.initial.body_from_cam0.Inverse();
-    const SE3d mean(problem.free.imu_rotation ? file.so3() : now.so3(),
-                    problem.free.imu_translation ? file.translation() : now.translation());
-    ceres_problem.AddResidualBlock(
-        new ExtrinsicPriorError(mean, sig.imu_translation_mm * 1e-3,
-                                sig.imu_rotation_deg / kRadToDeg),
-        nullptr, s.cam0_from_body());
-  } else {
-    ceres_problem.SetParameterBlockConstant(s.cam0_from_body());
-  }
-  if (stereo_free) {
-    // Only the rotation about the cameras' y and z axes (kStereoHeldAxes): the baseline is the
-    // map's scale (with an IMU, the accelerometers' scale factors pull it; the file's baseline is
-    // the better-known), and the rotation about x moves the right image's rows, which the
-    // matcher does not measure.
-    const double t = sig.stereo_translation_mm * 1e-3;
-    const double r = sig.stereo_rotation_deg / kRadToDeg;
-    ceres_problem.AddResidualBlock(
-        new ExtrinsicPriorError(problem.prior.cam1_from_cam0,
-                                (Eigen::Matrix<double, 6, 1>() << t, t, t, r, r, r).finished()),
-        nullptr, s.cam1_from_cam0());
-  } else {
-    ceres_problem.SetParameterBlockConstant(s.cam1_from_cam0());
-  }
-  if (problem.inertial && problem.free.time_offset) {
-    ceres_problem.AddResidualBlock(
-        new EuclideanPriorError(Eigen::VectorXd::Constant(1, problem.prior.time_offset_s),
-                                Eigen::VectorXd::Constant(1, sig.time_offset_ms * 1e-3)),
-        nullptr, s.offset());
-  } else {
-    ceres_problem.SetParameterBlockConstant(s.offset());
-  }
+  CalibrationManifolds manifolds(problem);
+  AddCalibrationBlocks(problem, options.prior, &manifolds, &ceres_problem, &s);
   const bool gyro_scale_free = problem.inertial && problem.free.gyro_scale;
-  if (gyro_scale_free) {
-    ceres_problem.AddResidualBlock(
-        new EuclideanPriorError(problem.prior.gyro_scale,
-                                Eigen::Vector3d::Constant(sig.gyro_scale_pct * 1e-2)),
-        nullptr, s.gyro_scale());
-  }
 
   // Keyframes and the inertial chain.
   std::vector<std::uint8_t> pose_added(static_cast<std::size_t>(num_kf), 0);
@@ -520,39 +565,17 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
   }
   write_result();
   if (options.covariance && !result.bundle.visual.aborted && problem.free.Any()) {
-    // A point the outlier pass left with three residuals or fewer tells nothing about the other
-    // parameters (its own three coordinates absorb them), and with fewer than three it has no
-    // position (no residual at all: three zero columns, which made Ceres' QR refuse the whole
-    // covariance on every machine-hall replay). Removing it with its residuals leaves the
-    // calibration's marginal covariance as it is; the solve is done.
     std::vector<int> rows_left(static_cast<std::size_t>(num_points), 0);
     for (int i = 0; i < num_obs; ++i) {
       const ObsBlocks& b = blocks[static_cast<std::size_t>(i)];
-      const int p = visual.observations[i].point_index;
-      rows_left[p] += (b.left != nullptr ? 2 : 0) + (b.right != nullptr ? 1 : 0);
+      rows_left[visual.observations[i].point_index] +=
+          (b.left != nullptr ? 2 : 0) + (b.right != nullptr ? 1 : 0);
     }
-    // A far point seen without stereo from nearby keyframes has almost no depth information:
-    // numerically a null direction to Ceres' rank test (its tolerance is relative to the
-    // Jacobian's largest column). A 100 m prior on each point's position removes those
-    // directions and adds no information worth the name about anything else.
-    constexpr double kPointPriorSigmaM = 100.0;
-    for (int p = 0; p < num_points; ++p) {
-      if (!point_added[p]) continue;
-      if (rows_left[p] <= 3) {
-        ceres_problem.RemoveParameterBlock(s.point(p));
-        continue;
-      }
-      ceres_problem.AddResidualBlock(
-          new EuclideanPriorError(Eigen::Map<const Eigen::Vector3d>(s.point(p)),
-                                  Eigen::Vector3d::Constant(kPointPriorSigmaM)),
-          nullptr, s.point(p));
-    }
+    RemoveNuisanceNullDirections(rows_left, point_added, &ceres_problem, &s);
     const auto start = std::chrono::steady_clock::now();
-    result.covariance_ok =
-        FillSigmas(&ceres_problem, &s, problem, options.num_threads,
-                   imu_free ? imu_manifold.Expansion() : Eigen::MatrixXd::Identity(6, 6),
-                   stereo_free ? stereo_manifold.Expansion() : Eigen::MatrixXd::Identity(6, 6),
-                   &result.parameters);
+    result.covariance_ok = FillSigmas(&ceres_problem, &s, problem, options.num_threads,
+                                      manifolds.imu.Expansion(), manifolds.stereo.Expansion(),
+                                      &result.parameters);
     PKSLAM_LOG_DEBUG("calibration bundle adjustment: covariance {} in {:.0f} ms",
                      result.covariance_ok ? "computed" : "not computable",
                      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
