@@ -26,6 +26,44 @@ endif()
 target_compile_definitions(pkslam_options INTERFACE
   PKSLAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}" PKSLAM_VERSION="${PROJECT_VERSION}")
 
+# pkslam_unity_sources(OUT_VAR TARGET SOURCES...): the sources in batches of
+# PKSLAM_UNITY_BATCH, each batch one generated file in the build tree that includes them by
+# their path from the repository root (test and benchmark executables: their files share the
+# heavy headers, gtest, Eigen, OpenCV, Ceres, which then are parsed once a batch instead of once
+# a file; this halves their compile time). CMake's own UNITY_BUILD would include them by
+# absolute path, which ccache (CCACHE_BASEDIR) cannot share between clones. A batch's files
+# share one translation unit, so their file-local names (anonymous namespaces) must differ.
+# tests/layering/check_thread_safety.py analyses the batches (compile_commands.json lists them,
+# not the files in them).
+function(pkslam_unity_sources out target)
+  if(PKSLAM_UNITY_BATCH LESS_EQUAL 1)
+    set(${out} ${ARGN} PARENT_SCOPE)
+    return()
+  endif()
+  set(batches "")
+  set(content "")
+  set(count 0)
+  set(index 0)
+  list(LENGTH ARGN total)
+  set(seen 0)
+  foreach(source IN LISTS ARGN)
+    get_filename_component(absolute ${source} ABSOLUTE)
+    file(RELATIVE_PATH relative ${PROJECT_SOURCE_DIR} ${absolute})
+    string(APPEND content "#include \"${relative}\"\n")
+    math(EXPR count "${count} + 1")
+    math(EXPR seen "${seen} + 1")
+    if(count EQUAL PKSLAM_UNITY_BATCH OR seen EQUAL total)
+      set(batch ${CMAKE_CURRENT_BINARY_DIR}/unity/${target}_${index}.cc)
+      file(CONFIGURE OUTPUT ${batch} CONTENT "// Generated (pkslam_unity_sources).\n${content}")
+      list(APPEND batches ${batch})
+      set(content "")
+      set(count 0)
+      math(EXPR index "${index} + 1")
+    endif()
+  endforeach()
+  set(${out} ${batches} PARENT_SCOPE)
+endfunction()
+
 # pkslam_library(NAME SOURCES ... DEPS ... [TESTS ...] [TEST_DEPS ...] [BENCHMARKS ...])
 # One static library per folder; the folder's *_test.cc files form one gtest executable
 # NAME_test registered with CTest (label = folder name), *_benchmark.cc files one
@@ -39,7 +77,8 @@ function(pkslam_library NAME)
     get_filename_component(ARG_LABEL ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   endif()
   if(ARG_TESTS AND PKSLAM_BUILD_TESTS)
-    add_executable(${NAME}_test ${ARG_TESTS})
+    pkslam_unity_sources(test_sources ${NAME}_test ${ARG_TESTS})
+    add_executable(${NAME}_test ${test_sources})
     target_link_libraries(${NAME}_test PRIVATE ${NAME} ${ARG_TEST_DEPS} pkslam_testsupport
                           pkslam_options GTest::gtest GTest::gmock GTest::gtest_main)
     set_target_properties(${NAME}_test PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
@@ -48,7 +87,8 @@ function(pkslam_library NAME)
                          WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
   endif()
   if(ARG_BENCHMARKS AND PKSLAM_BUILD_BENCHMARKS)
-    add_executable(${NAME}_benchmark ${ARG_BENCHMARKS})
+    pkslam_unity_sources(benchmark_sources ${NAME}_benchmark ${ARG_BENCHMARKS})
+    add_executable(${NAME}_benchmark ${benchmark_sources})
     target_link_libraries(${NAME}_benchmark PRIVATE ${NAME} ${ARG_TEST_DEPS} pkslam_testsupport
                           pkslam_options benchmark::benchmark benchmark::benchmark_main)
     set_target_properties(${NAME}_benchmark PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/benchmarks)

@@ -11,17 +11,17 @@
 namespace pkslam::dense {
 namespace {
 
-constexpr int kW = 80, kH = 60;
+constexpr int kSmallW = 80, kSmallH = 60;
 
-CameraModel Camera() { return CameraModel::Pinhole(kW, kH, 60, 60, 39.5, 29.5); }
+CameraModel SmallCamera() { return CameraModel::Pinhole(kSmallW, kSmallH, 60, 60, 39.5, 29.5); }
 
 // Depth map of the plane z_world = wall_z seen by a camera at (x, 0, 0) looking along +z.
-cv::Mat WallDepth(float wall_z) { return cv::Mat(kH, kW, CV_32FC1, cv::Scalar(wall_z)); }
+cv::Mat WallDepth(float wall_z) { return cv::Mat(kSmallH, kSmallW, CV_32FC1, cv::Scalar(wall_z)); }
 
 SE3d CameraAt(double x) { return SE3d(SO3d(), Eigen::Vector3d(x, 0, 0)); }  // world_from_camera
 
 TEST(DepthConsistencyTest, AgreeingViewsConfirmAndAverage) {
-  const CameraModel camera = Camera();
+  const CameraModel camera = SmallCamera();
   const cv::Mat rays = RayTable(camera);
   const cv::Mat mine = WallDepth(2.01f);  // 1 cm too far
   const cv::Mat a = WallDepth(1.99f), b = WallDepth(2.0f);
@@ -31,27 +31,27 @@ TEST(DepthConsistencyTest, AgreeingViewsConfirmAndAverage) {
   o.tolerance_rel = 0.02;
   const ConsistencyResult r =
       FilterByConsistency(mine, CameraAt(0), neighbours, rays, camera, 1, o);
-  EXPECT_EQ(r.candidates, kW * kH);
+  EXPECT_EQ(r.candidates, kSmallW * kSmallH);
   // The centre sees the wall in both neighbours: the mean of 2.01, 1.99, 2.00.
   EXPECT_NEAR(r.depth.at<float>(30, 40), 2.0f, 1e-4);
   // The outermost columns project outside one neighbour (0.1 m = 3 px at 2 m), still confirmed
   // by the other: with min_views 2 every pixel survives.
-  EXPECT_EQ(r.kept, kW * kH);
+  EXPECT_EQ(r.kept, kSmallW * kSmallH);
   EXPECT_NEAR(r.depth.at<float>(30, 0), 0.5f * (2.01f + 2.0f), 1e-4);  // only b sees column 0
   // Three views needed: the columns only one neighbour sees go (strict filter), or stay
   // unaveraged as unconfirmed (nothing contradicts them).
   o.min_views = 3;
   const ConsistencyResult loose =
       FilterByConsistency(mine, CameraAt(0), neighbours, rays, camera, 1, o);
-  EXPECT_EQ(loose.kept, kW * kH);
+  EXPECT_EQ(loose.kept, kSmallW * kSmallH);
   EXPECT_GT(loose.unconfirmed, 0);
   EXPECT_EQ(loose.depth.at<float>(30, 0), 2.01f);
   EXPECT_EQ(loose.views.at<std::uint8_t>(30, 0), 1);
   o.keep_unconfirmed = false;
   const ConsistencyResult r3 =
       FilterByConsistency(mine, CameraAt(0), neighbours, rays, camera, 1, o);
-  EXPECT_LT(r3.kept, kW * kH);
-  EXPECT_GT(r3.kept, kW * kH * 3 / 4);
+  EXPECT_LT(r3.kept, kSmallW * kSmallH);
+  EXPECT_GT(r3.kept, kSmallW * kSmallH * 3 / 4);
   EXPECT_EQ(r3.depth.at<float>(30, 0), 0.0f);
   EXPECT_GT(r3.depth.at<float>(30, 40), 0.0f);
   // Averaging off: the own depth stays.
@@ -64,7 +64,7 @@ TEST(DepthConsistencyTest, AgreeingViewsConfirmAndAverage) {
 }
 
 TEST(DepthConsistencyTest, DisagreeingOrMissingDepthsDoNotConfirm) {
-  const CameraModel camera = Camera();
+  const CameraModel camera = SmallCamera();
   const cv::Mat rays = RayTable(camera);
   cv::Mat mine = WallDepth(2.0f);
   mine.at<float>(10, 10) = 2.5f;     // an outlier no other view supports
@@ -80,7 +80,7 @@ TEST(DepthConsistencyTest, DisagreeingOrMissingDepthsDoNotConfirm) {
   const std::vector<DepthView> views = {{&good, CameraAt(0.05).Inverse()},
                                         {&holes, CameraAt(-0.05).Inverse()}};
   const ConsistencyResult r = FilterByConsistency(mine, CameraAt(0), views, rays, camera, 1, o);
-  EXPECT_EQ(r.candidates, kW * kH - 1);
+  EXPECT_EQ(r.candidates, kSmallW * kSmallH - 1);
   EXPECT_EQ(r.depth.at<float>(10, 10), 0.0f);
   EXPECT_EQ(r.depth.at<float>(20, 20), 0.0f);
   EXPECT_NEAR(r.depth.at<float>(30, 40), 2.0f, 1e-5);
@@ -91,19 +91,19 @@ TEST(DepthConsistencyTest, DisagreeingOrMissingDepthsDoNotConfirm) {
   // min_views 1 keeps every depth without neighbours; pixel_step thins the grid.
   o.min_views = 1;
   const ConsistencyResult all = FilterByConsistency(mine, CameraAt(0), {}, rays, camera, 2, o);
-  EXPECT_EQ(all.kept, (kW / 2) * (kH / 2) - 1);  // (20, 20) is on the grid and has no depth
+  EXPECT_EQ(all.kept, (kSmallW / 2) * (kSmallH / 2) - 1);  // (20, 20) is on the grid and has no depth
   EXPECT_EQ(all.depth.at<float>(11, 11), 0.0f);
 }
 
 TEST(DepthConsistencyTest, UncontradictedSingleViewDepthsAreKeptUnconfirmed) {
-  const CameraModel camera = Camera();
+  const CameraModel camera = SmallCamera();
   const cv::Mat rays = RayTable(camera);
   cv::Mat mine = WallDepth(2.0f);
   mine.at<float>(10, 60) = 1.6f;  // in front of the wall: the neighbour sees through it
   mine.at<float>(12, 70) = 2.5f;  // behind the wall that the neighbour sees on i's ray
   // The neighbour sees the wall except in its left half (a hole: no evidence either way).
   cv::Mat other = WallDepth(2.0f);
-  other(cv::Rect(0, 0, kW / 2, kH)).setTo(0.0f);
+  other(cv::Rect(0, 0, kSmallW / 2, kSmallH)).setTo(0.0f);
   const std::vector<DepthView> views = {{&other, CameraAt(0.05).Inverse()}};
   ConsistencyOptions o;
   o.tolerance_rel = 0.02;
@@ -128,13 +128,13 @@ TEST(DepthConsistencyTest, UncontradictedSingleViewDepthsAreKeptUnconfirmed) {
 }
 
 TEST(DepthConsistencyTest, GenuineOcclusionDoesNotContradict) {
-  const CameraModel camera = Camera();
+  const CameraModel camera = SmallCamera();
   const cv::Mat rays = RayTable(camera);
   // View i sees the wall at 2 m everywhere; view j (1 m to the side) has a post at 1 m in
   // front of part of the wall, which i does not see (it is off i's lines of sight there).
   const cv::Mat mine = WallDepth(2.0f);
   cv::Mat other = WallDepth(2.0f);
-  other(cv::Rect(30, 0, 10, kH)).setTo(1.0f);
+  other(cv::Rect(30, 0, 10, kSmallH)).setTo(1.0f);
   const std::vector<DepthView> views = {{&other, CameraAt(1.0).Inverse()}};
   ConsistencyOptions o;
   o.tolerance_rel = 0.02;
@@ -144,7 +144,7 @@ TEST(DepthConsistencyTest, GenuineOcclusionDoesNotContradict) {
 }
 
 TEST(DepthConsistencyTest, DeferRatioLeavesASurfaceToTheCloserView) {
-  const CameraModel camera = Camera();
+  const CameraModel camera = SmallCamera();
   const cv::Mat rays = RayTable(camera);
   const cv::Mat mine = WallDepth(3.0f);
   const cv::Mat closer = WallDepth(1.5f);  // 1.5 m nearer the wall
@@ -153,7 +153,7 @@ TEST(DepthConsistencyTest, DeferRatioLeavesASurfaceToTheCloserView) {
   ConsistencyOptions o;
   o.tolerance_rel = 0.02;
   const ConsistencyResult kept = FilterByConsistency(mine, CameraAt(0), views, rays, camera, 1, o);
-  EXPECT_GT(kept.kept, kW * kH / 5);  // the centre, which the closer view also sees
+  EXPECT_GT(kept.kept, kSmallW * kSmallH / 5);  // the centre, which the closer view also sees
   EXPECT_EQ(kept.deferred, 0);
   o.defer_ratio = 1.5;
   const ConsistencyResult deferred =
@@ -166,14 +166,14 @@ TEST(DepthConsistencyTest, DeferRatioLeavesASurfaceToTheCloserView) {
 }
 
 TEST(DepthConsistencyTest, AveragingShrinksIndependentNoise) {
-  const CameraModel camera = Camera();
+  const CameraModel camera = SmallCamera();
   const cv::Mat rays = RayTable(camera);
   std::mt19937 rng(5);
   std::normal_distribution<float> noise(0.0f, 0.01f);
   auto noisy = [&] {
     cv::Mat d = WallDepth(2.0f);
-    for (int r = 0; r < kH; ++r) {
-      for (int c = 0; c < kW; ++c) d.at<float>(r, c) += noise(rng);
+    for (int r = 0; r < kSmallH; ++r) {
+      for (int c = 0; c < kSmallW; ++c) d.at<float>(r, c) += noise(rng);
     }
     return d;
   };
@@ -187,21 +187,21 @@ TEST(DepthConsistencyTest, AveragingShrinksIndependentNoise) {
   const ConsistencyResult r = FilterByConsistency(mine, CameraAt(0), views, rays, camera, 1, o);
   double before = 0, after = 0;
   int n = 0;
-  for (int row = 0; row < kH; ++row) {
-    for (int c = 0; c < kW; ++c) {
+  for (int row = 0; row < kSmallH; ++row) {
+    for (int c = 0; c < kSmallW; ++c) {
       if (r.depth.at<float>(row, c) <= 0) continue;
       before += std::pow(mine.at<float>(row, c) - 2.0, 2);
       after += std::pow(r.depth.at<float>(row, c) - 2.0, 2);
       ++n;
     }
   }
-  ASSERT_GT(n, kW * kH / 2);
+  ASSERT_GT(n, kSmallW * kSmallH / 2);
   // Seven independent estimates: the RMS error drops by about sqrt(7).
   EXPECT_LT(std::sqrt(after / n), 0.5 * std::sqrt(before / n));
 }
 
 TEST(DepthConsistencyTest, BadInputThrows) {
-  const CameraModel camera = Camera();
+  const CameraModel camera = SmallCamera();
   const cv::Mat rays = RayTable(camera);
   const cv::Mat d = WallDepth(2.0f);
   ConsistencyOptions o;

@@ -14,7 +14,7 @@ constexpr double kDegToRad = M_PI / 180.0;
 using Pairs = std::vector<PosePairIndices>;
 
 // Poses along x, 0.25 m apart (exact in binary, so the tolerance edges are exact too).
-std::vector<SE3d> Line(std::size_t count, double step = 0.25) {
+std::vector<SE3d> EvenLine(std::size_t count, double step = 0.25) {
   std::vector<SE3d> poses;
   for (std::size_t k = 0; k < count; ++k) {
     poses.emplace_back(SO3d(), Eigen::Vector3d(step * static_cast<double>(k), 0, 0));
@@ -53,7 +53,7 @@ Pairs BruteForcePairs(const std::vector<double>& d, double length, double fracti
 TEST(SegmentErrors, PairsSpanTheLengthAlongTheReferencePath) {
   // 9 poses, 2 m: each start with 1 m of path left pairs with the pose 4 steps on; from 1.25 m
   // the nearest end (2.0 m) misses 2.25 m by 0.25 > 0.2 m.
-  const std::vector<SE3d> line = Line(9);
+  const std::vector<SE3d> line = EvenLine(9);
   const auto segments = ComputeSegmentErrors(line, line, Lengths({1.0}));
   ASSERT_EQ(segments.size(), 1u);
   EXPECT_EQ(segments[0].pairs, (Pairs{{0, 4}, {1, 5}, {2, 6}, {3, 7}, {4, 8}}));
@@ -80,7 +80,7 @@ TEST(SegmentErrors, PairSelectionEqualsTheLiteralScan) {
 }
 
 TEST(SegmentErrors, ScaleErrorIsAPercentOfTheLength) {
-  const std::vector<SE3d> ref = Line(9);
+  const std::vector<SE3d> ref = EvenLine(9);
   std::vector<SE3d> est;
   for (const SE3d& pose : ref) est.emplace_back(pose.so3(), 1.1 * pose.translation());
   const SegmentErrors s = ComputeSegmentErrors(ref, est, Lengths({1.0})).front();
@@ -94,7 +94,7 @@ TEST(SegmentErrors, ScaleErrorIsAPercentOfTheLength) {
 }
 
 TEST(SegmentErrors, HeadingDriftIsYawAndTiltDriftIsGravity) {
-  const std::vector<SE3d> ref = Line(9);
+  const std::vector<SE3d> ref = EvenLine(9);
   std::vector<SE3d> yawing;
   std::vector<SE3d> tilting;
   for (std::size_t k = 0; k < ref.size(); ++k) {
@@ -126,7 +126,7 @@ TEST(SegmentErrors, DefaultLengthsAreRpgsFractionsTruncatedToCentimetres) {
   ASSERT_EQ(lengths.size(), expected.size());
   for (std::size_t k = 0; k < lengths.size(); ++k) EXPECT_NEAR(lengths[k], expected[k], 1e-9);
 
-  const auto segments = ComputeSegmentErrors(Line(41), Line(41), SegmentErrorOptions{});
+  const auto segments = ComputeSegmentErrors(EvenLine(41), EvenLine(41), SegmentErrorOptions{});
   ASSERT_EQ(segments.size(), 5u);  // 10 m path: 1, 2, 3, 4, 5 m
   EXPECT_DOUBLE_EQ(segments[4].length_m, 5.0);
   // Starts before 6 m (0..23) find an end within 1 m (20%) of 5 m further.
@@ -134,7 +134,7 @@ TEST(SegmentErrors, DefaultLengthsAreRpgsFractionsTruncatedToCentimetres) {
 }
 
 TEST(SegmentErrors, ALengthLongerThanThePathHasNoPairs) {
-  const auto segments = ComputeSegmentErrors(Line(9), Line(9), Lengths({1.0, 5.0}));
+  const auto segments = ComputeSegmentErrors(EvenLine(9), EvenLine(9), Lengths({1.0, 5.0}));
   ASSERT_EQ(segments.size(), 2u);
   EXPECT_FALSE(segments[0].empty());
   EXPECT_TRUE(segments[1].empty());

@@ -12,12 +12,12 @@ namespace {
 using testing::RandomTangent;
 using Vec3 = Eigen::Vector3d;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
-using Block = Eigen::Matrix<double, 7, 1>;
+using BodyPose7 = Eigen::Matrix<double, 7, 1>;
 
 TEST(BodyPoseManifold, BlockLayoutMatchesCoreOptim) {
   // (qx, qy, qz, qw, tx, ty, tz): the layout of estimators/optim's pose blocks.
   const SE3d pose(SO3d::Exp(Vec3(0.1, 0.2, 0.3)), Vec3(1, 2, 3));
-  Block x;
+  BodyPose7 x;
   BodyPoseToBlock(pose, x.data());
   EXPECT_DOUBLE_EQ(x(0), pose.quaternion().x());
   EXPECT_DOUBLE_EQ(x(3), pose.quaternion().w());
@@ -30,10 +30,10 @@ TEST(BodyPoseManifold, PlusIsRightPerturbationAndMinusInvertsIt) {
   std::mt19937 rng(1);
   const BodyPoseManifold manifold;
   for (int i = 0; i < 50; ++i) {
-    Block x;
+    BodyPose7 x;
     BodyPoseToBlock(SE3d::Exp(RandomTangent<6>(rng, 2.0)), x.data());
     const Vec6 delta = RandomTangent<6>(rng, 0.5);
-    Block y;
+    BodyPose7 y;
     ASSERT_TRUE(manifold.Plus(x.data(), delta.data(), y.data()));
     const SE3d expected = BodyPoseFromBlock(x.data()) * SE3d::Exp(delta);
     EXPECT_LT((BodyPoseFromBlock(y.data()).Matrix() - expected.Matrix()).norm(), 1e-12);
@@ -41,7 +41,7 @@ TEST(BodyPoseManifold, PlusIsRightPerturbationAndMinusInvertsIt) {
     const Vec3 body_x = BodyPoseFromBlock(x.data()).so3() * Vec3::UnitX();
     Vec6 along_x = Vec6::Zero();
     along_x(0) = 1e-3;
-    Block z;
+    BodyPose7 z;
     manifold.Plus(x.data(), along_x.data(), z.data());
     EXPECT_LT(((z.tail<3>() - x.tail<3>()) / 1e-3 - body_x).norm(), 1e-9);
     Vec6 back;
@@ -52,7 +52,7 @@ TEST(BodyPoseManifold, PlusIsRightPerturbationAndMinusInvertsIt) {
 
 TEST(BodyPoseManifold, JacobiansAreTheIdentityPadding) {
   const BodyPoseManifold manifold;
-  Block x;
+  BodyPose7 x;
   BodyPoseToBlock(SE3d(), x.data());
   Eigen::Matrix<double, 7, 6, Eigen::RowMajor> plus;
   manifold.PlusJacobian(x.data(), plus.data());

@@ -17,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-const fs::path kTestData = fs::path(PKSLAM_SOURCE_DIR) / "io" / "testdata";
+const fs::path kLegacyTestData = fs::path(PKSLAM_SOURCE_DIR) / "io" / "testdata";
 
 void ExpectSameCameras(const Settings& a, const Settings& b) {
   EXPECT_TRUE(SameCalibration(a.camera1, b.camera1))
@@ -34,8 +34,8 @@ void ExpectSameCameras(const Settings& a, const Settings& b) {
 // ORB-SLAM2's stereo file holds the rectification, not the extrinsic: the extrinsic it implies
 // is the v1.0 file's to float precision of the rectification (1e-9 m, 1e-9 rad here).
 TEST(LegacySettings, Orbslam2StereoReadsAsTheV1File) {
-  const Settings legacy = ReadOrbSlam3Settings(kTestData / "orbslam2_euroc_stereo.yaml");
-  const Settings v1 = ReadOrbSlam3Settings(kTestData / "euroc_stereo_inertial.yaml");
+  const Settings legacy = ReadOrbSlam3Settings(kLegacyTestData / "orbslam2_euroc_stereo.yaml");
+  const Settings v1 = ReadOrbSlam3Settings(kLegacyTestData / "euroc_stereo_inertial.yaml");
   ExpectSameCameras(legacy, v1);
   ASSERT_TRUE(legacy.right_from_left);
   const SE3d diff = *legacy.right_from_left * v1.right_from_left->Inverse();
@@ -46,8 +46,8 @@ TEST(LegacySettings, Orbslam2StereoReadsAsTheV1File) {
 }
 
 TEST(LegacySettings, Orbslam3V04MonoInertialReadsAsTheV1File) {
-  const Settings legacy = ReadOrbSlam3Settings(kTestData / "orbslam3_v04_euroc_mono_inertial.yaml");
-  const Settings v1 = ReadOrbSlam3Settings(kTestData / "euroc_stereo_inertial.yaml");
+  const Settings legacy = ReadOrbSlam3Settings(kLegacyTestData / "orbslam3_v04_euroc_mono_inertial.yaml");
+  const Settings v1 = ReadOrbSlam3Settings(kLegacyTestData / "euroc_stereo_inertial.yaml");
   EXPECT_TRUE(SameCalibration(legacy.camera1, v1.camera1));
   EXPECT_FALSE(legacy.camera2);
   ASSERT_TRUE(legacy.body_from_cam0 && legacy.imu);
@@ -58,8 +58,8 @@ TEST(LegacySettings, Orbslam3V04MonoInertialReadsAsTheV1File) {
 }
 
 TEST(LegacySettings, Orbslam2RgbdReadsAsTheV1File) {
-  const Settings legacy = ReadOrbSlam3Settings(kTestData / "orbslam2_tum_fr1_rgbd.yaml");
-  const Settings v1 = ReadOrbSlam3Settings(kTestData / "tum_fr1_rgbd.yaml");
+  const Settings legacy = ReadOrbSlam3Settings(kLegacyTestData / "orbslam2_tum_fr1_rgbd.yaml");
+  const Settings v1 = ReadOrbSlam3Settings(kLegacyTestData / "tum_fr1_rgbd.yaml");
   ExpectSameCameras(legacy, v1);
   EXPECT_EQ(legacy.depth_map_factor, v1.depth_map_factor);
   ASSERT_TRUE(legacy.stereo_baseline_m);
@@ -72,7 +72,7 @@ TEST(LegacySettings, ConvertedFileReadsTheSame) {
   const fs::path dir = testing::MakeTempDir("settings_legacy_convert");
   for (const char* name : {"orbslam2_euroc_stereo.yaml", "orbslam3_v04_euroc_mono_inertial.yaml",
                            "orbslam2_tum_fr1_rgbd.yaml"}) {
-    const Settings legacy = ReadOrbSlam3Settings(kTestData / name);
+    const Settings legacy = ReadOrbSlam3Settings(kLegacyTestData / name);
     WriteOrbSlam3Settings(legacy, dir / name);
     const Settings again = ReadOrbSlam3Settings(dir / name);
     ExpectSameCameras(again, legacy);
@@ -81,7 +81,7 @@ TEST(LegacySettings, ConvertedFileReadsTheSame) {
   }
 }
 
-std::string ReadError(const fs::path& file) {
+std::string ReadLegacyError(const fs::path& file) {
   try {
     ReadOrbSlam3Settings(file);
   } catch (const InputError& e) {
@@ -93,19 +93,19 @@ std::string ReadError(const fs::path& file) {
 TEST(LegacySettings, MissingKeysGetAHint) {
   const fs::path dir = testing::MakeTempDir("settings_legacy_hints");
   std::stringstream text;
-  text << std::ifstream(kTestData / "orbslam2_tum_fr1_rgbd.yaml").rdbuf();
+  text << std::ifstream(kLegacyTestData / "orbslam2_tum_fr1_rgbd.yaml").rdbuf();
   const std::string no_size =
       std::regex_replace(text.str(), std::regex("Camera\\.(width|height): [0-9]+\n"), "");
   std::ofstream(dir / "no_size.yaml") << no_size;
-  EXPECT_THAT(ReadError(dir / "no_size.yaml"), HasSubstr("add Camera.width and Camera.height"));
+  EXPECT_THAT(ReadLegacyError(dir / "no_size.yaml"), HasSubstr("add Camera.width and Camera.height"));
   std::ofstream(dir / "no_version.yaml") << "%YAML:1.0\nCamera1.fx: 500\n";
-  EXPECT_THAT(ReadError(dir / "no_version.yaml"), HasSubstr("pkslam settings convert"));
+  EXPECT_THAT(ReadLegacyError(dir / "no_version.yaml"), HasSubstr("pkslam settings convert"));
   std::ofstream(dir / "no_tbc.yaml") << "%YAML:1.0\nCamera.fx: 458\nCamera.fy: 457\nCamera.cx: "
                                         "367\nCamera.cy: 248\nCamera.width: 752\nCamera.height: "
                                         "480\nCamera.fps: 20\nIMU.NoiseGyro: 1e-4\nIMU.NoiseAcc: "
                                         "2e-3\nIMU.GyroWalk: 2e-5\nIMU.AccWalk: 3e-3\n"
                                         "IMU.Frequency: 200\n";
-  EXPECT_THAT(ReadError(dir / "no_tbc.yaml"), HasSubstr("Tbc"));
+  EXPECT_THAT(ReadLegacyError(dir / "no_tbc.yaml"), HasSubstr("Tbc"));
 }
 
 }  // namespace

@@ -16,7 +16,7 @@ namespace pkslam {
 namespace {
 
 constexpr int kNumKeyFrames = 30;
-constexpr std::int64_t kKeyFramePeriodNs = 50'000'000;  // synthetic map keyframes, 20 Hz
+constexpr std::int64_t kCullingPeriodNs = 50'000'000;  // synthetic map keyframes, 20 Hz
 
 class InertialCullingTest : public ::testing::Test {
  protected:
@@ -24,12 +24,12 @@ class InertialCullingTest : public ::testing::Test {
     rig_ = testing::MakeStereoRig(Sensor::kStereoInertial);
     map_ = testing::MakeMap(&atlas_, testing::MakeScene(400, 5), rig_,
                             testing::MakeForwardPath(kNumKeyFrames, 0.15, 4), {});
-    samples_ = testing::SampleImu(testing::HelixMotion(), 0, kKeyFramePeriodNs * kNumKeyFrames,
+    samples_ = testing::SampleImu(testing::HelixMotion(), 0, kCullingPeriodNs * kNumKeyFrames,
                                   5'000'000, bias_, noise_, nullptr);
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (int k = 0; k < kNumKeyFrames; ++k) {
       KeyFrame* kf = map_.keyframes[k].get();
-      ASSERT_EQ(kf->t_ns(), k * kKeyFramePeriodNs);
+      ASSERT_EQ(kf->t_ns(), k * kCullingPeriodNs);
       kf->imu.state.bias = bias_;
       if (k == 0) continue;
       KeyFrame* previous = map_.keyframes[k - 1].get();

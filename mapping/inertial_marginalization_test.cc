@@ -26,8 +26,8 @@
 namespace pkslam {
 namespace {
 
-constexpr int kNumKeyFrames = 16;
-constexpr std::int64_t kKeyFramePeriodNs = 50'000'000;
+constexpr int kChainKeyFrames = 16;
+constexpr std::int64_t kChainPeriodNs = 50'000'000;
 
 // A synthetic stereo-inertial map whose keyframes form a temporal chain with valid states.
 class MarginalizationMapTest : public ::testing::Test {
@@ -35,12 +35,12 @@ class MarginalizationMapTest : public ::testing::Test {
   void SetUp() override {
     rig_ = testing::MakeStereoRig(Sensor::kStereoInertial);
     map_ = testing::MakeMap(&atlas_, testing::MakeScene(400, 5), rig_,
-                            testing::MakeForwardPath(kNumKeyFrames, 0.15, 4), {});
+                            testing::MakeForwardPath(kChainKeyFrames, 0.15, 4), {});
     const auto samples =
-        testing::SampleImu(testing::HelixMotion(), 0, kKeyFramePeriodNs * kNumKeyFrames, 5'000'000,
+        testing::SampleImu(testing::HelixMotion(), 0, kChainPeriodNs * kChainKeyFrames, 5'000'000,
                            bias_, noise_, nullptr);
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    for (int k = 0; k < kNumKeyFrames; ++k) {
+    for (int k = 0; k < kChainKeyFrames; ++k) {
       KeyFrame* kf = map_.keyframes[k].get();
       kf->imu.state.bias = bias_;
       kf->imu.state.valid = true;
@@ -51,8 +51,8 @@ class MarginalizationMapTest : public ::testing::Test {
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
   Map* map() { return kf(0)->map(); }
-  KeyFrame* newest() { return kf(kNumKeyFrames - 1); }
-  KeyFrame* anchor() { return kf(kNumKeyFrames - 1 - options_.window); }
+  KeyFrame* newest() { return kf(kChainKeyFrames - 1); }
+  KeyFrame* anchor() { return kf(kChainKeyFrames - 1 - options_.window); }
   // A prior at the anchor's current state, stamped with the map.
   void GiveAnchorPrior(double information) {
     InertialStatePrior prior;
@@ -140,7 +140,7 @@ TEST_F(MarginalizationMapTest, SolveMarginalisesTheAnchorOntoTheNextKeyFrame) {
   EXPECT_GE(es.eigenvalues().minCoeff(), -1e-9 * es.eigenvalues().maxCoeff());
   // The anchor's reprojections fix its pose, the edge carries that to the next pose.
   EXPECT_GT((r.next_prior->information.topLeftCorner<6, 6>().trace()), 1.0);
-  KeyFrame* next = kf(kNumKeyFrames - options_.window);
+  KeyFrame* next = kf(kChainKeyFrames - options_.window);
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     ApplyInertialBundle(map(), p, r);

@@ -20,7 +20,7 @@ namespace {
 
 enum SceneKind { kBox = 0, kPlane = 1, kRotation = 2 };
 
-double Median(std::vector<double> v) {
+double UpperMedian(std::vector<double> v) {
   if (v.empty()) return 0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
@@ -113,7 +113,7 @@ void BM_TwoViewSweep(benchmark::State& state) {
         const Eigen::Vector3d& truth = scene.points_world[p1[i]];
         rel.push_back((num / den * r->points[i] - truth).norm() / truth.norm());
       }
-      points.push_back(Median(rel));
+      points.push_back(UpperMedian(rel));
     }
   }
   state.counters["accepted"] = static_cast<double>(accepted) / kTrials;
@@ -124,13 +124,13 @@ void BM_TwoViewSweep(benchmark::State& state) {
     state.counters["no:" + name] = count;
   }
   state.counters["homography"] = static_cast<double>(homography) / kTrials;
-  state.counters["rot_med_deg"] = Median(rot);
+  state.counters["rot_med_deg"] = UpperMedian(rot);
   state.counters["rot_max_deg"] = rot.empty() ? 0 : *std::max_element(rot.begin(), rot.end());
-  state.counters["trans_med_deg"] = Median(trans);
+  state.counters["trans_med_deg"] = UpperMedian(trans);
   state.counters["trans_max_deg"] =
       trans.empty() ? 0 : *std::max_element(trans.begin(), trans.end());
-  state.counters["point_err_med"] = Median(points);
-  state.counters["oracle_trans_med_deg"] = Median(oracle_trans);
+  state.counters["point_err_med"] = UpperMedian(points);
+  state.counters["oracle_trans_med_deg"] = UpperMedian(oracle_trans);
   state.counters["oracle_trans_max_deg"] =
       oracle_trans.empty() ? 0 : *std::max_element(oracle_trans.begin(), oracle_trans.end());
 }

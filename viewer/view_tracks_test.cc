@@ -21,7 +21,7 @@ constexpr double kError = 0.01;                     // m
 // A hand-made flight of body poses at 20 Hz, turning and climbing, each pose held for two
 // stamps. An error of +kError then -kError along z on each pair leaves the alignment exact (the
 // error has no cross-covariance with the path), so the ATE is kError on every pose.
-Trajectory Flight(double error) {
+Trajectory TracksFlight(double error) {
   Trajectory t;
   for (int k = 0; k < 40; ++k) {
     const double s = 0.1 * (k / 2);
@@ -50,10 +50,10 @@ const SE3d& BodyFromCamera() {
 
 TEST(AlignToGroundTruth, HandMadeErrorGivesItsAte) {
   const AlignedEstimate a =
-      AlignToGroundTruth(Flight(0), InOtherWorld(Flight(kError)), AlignmentMethod::kSE3);
+      AlignToGroundTruth(TracksFlight(0), InOtherWorld(TracksFlight(kError)), AlignmentMethod::kSE3);
   EXPECT_NEAR(a.ate_rmse_m, kError, 1e-9);
   ASSERT_EQ(a.poses.size(), 40u);
-  const Trajectory truth = Flight(0);
+  const Trajectory truth = TracksFlight(0);
   for (std::size_t i = 0; i < a.poses.size(); ++i) {
     EXPECT_NEAR(a.poses[i].ate_m, kError, 1e-9);
     // Back in the ground truth's world.
@@ -67,8 +67,8 @@ TEST(AlignToGroundTruth, HandMadeErrorGivesItsAte) {
 TEST(LoadTrajectoryTrack, BodyPosesMovedIntoTheRunsCamera) {
   const auto dir = testing::MakeTempDir("view_track_body");
   WriteRigidTransform(BodyFromCamera(), dir / "body_from_camera.txt", "body_from_camera");
-  WriteTrajectory(InOtherWorld(Flight(kError)), dir / "f_peer.txt", TrajectoryFormat::kOrbSlam3);
-  const Trajectory camera_truth = ChangeSensorFrame(Flight(0), BodyFromCamera());
+  WriteTrajectory(InOtherWorld(TracksFlight(kError)), dir / "f_peer.txt", TrajectoryFormat::kOrbSlam3);
+  const Trajectory camera_truth = ChangeSensorFrame(TracksFlight(0), BodyFromCamera());
 
   ViewTrajectoryFile file{dir / "f_peer.txt", "", TrajectorySensorFrame::kBody};
   const ViewTrack body = LoadTrajectoryTrack(file, camera_truth, /*shown_in_camera=*/true, dir,
@@ -89,10 +89,10 @@ TEST(LoadTrajectoryTrack, BodyPosesMovedIntoTheRunsCamera) {
   EXPECT_GT(camera.ate_rmse_m, kError + 0.005);
 
   // Camera poses against a body-frame comparison go the other way through the extrinsic.
-  WriteTrajectory(InOtherWorld(ChangeSensorFrame(Flight(kError), BodyFromCamera())),
+  WriteTrajectory(InOtherWorld(ChangeSensorFrame(TracksFlight(kError), BodyFromCamera())),
                   dir / "camera.txt", TrajectoryFormat::kTum);
   file.file = dir / "camera.txt";
-  EXPECT_NEAR(LoadTrajectoryTrack(file, Flight(0), /*shown_in_camera=*/false, dir,
+  EXPECT_NEAR(LoadTrajectoryTrack(file, TracksFlight(0), /*shown_in_camera=*/false, dir,
                                   AlignmentMethod::kSE3)
                   .ate_rmse_m,
               kError, 1e-9);
@@ -100,11 +100,11 @@ TEST(LoadTrajectoryTrack, BodyPosesMovedIntoTheRunsCamera) {
 
 TEST(LoadTrajectoryTrack, MissingFilesAreNamed) {
   const auto dir = testing::MakeTempDir("view_track_missing");
-  WriteTrajectory(Flight(0), dir / "f.txt", TrajectoryFormat::kTum);
+  WriteTrajectory(TracksFlight(0), dir / "f.txt", TrajectoryFormat::kTum);
   ViewTrajectoryFile file{dir / "absent.txt", "", TrajectorySensorFrame::kBody};
   auto message = [&] {
     try {
-      LoadTrajectoryTrack(file, Flight(0), true, dir, AlignmentMethod::kSE3);
+      LoadTrajectoryTrack(file, TracksFlight(0), true, dir, AlignmentMethod::kSE3);
     } catch (const InputError& e) {
       return std::string(e.what());
     }

@@ -46,7 +46,7 @@ PoseCase MakeCase(int outlier_every, std::uint64_t seed) {
   return c;
 }
 
-double CentreError(const SE3d& a, const SE3d& b) {
+double SolvedCentreError(const SE3d& a, const SE3d& b) {
   return (a.Inverse().translation() - b.Inverse().translation()).norm();
 }
 
@@ -57,7 +57,7 @@ TEST(SolvePoseTest, RecoversThePoseAndFlagsTheMovedObservations) {
   const SE3d start =
       SE3d(SO3d::Exp(Eigen::Vector3d(0.0, 0.03, 0.0)), Eigen::Vector3d(0.05, 0.0, 0.0)) * c.truth;
   const SE3d got = SolvePose(c.camera, start, &c.correspondences, PoseOptimizerOptions{});
-  EXPECT_LT(CentreError(got, c.truth), 0.01);
+  EXPECT_LT(SolvedCentreError(got, c.truth), 0.01);
   EXPECT_LT((got.so3().Inverse() * c.truth.so3()).Log().norm(), 0.2 * M_PI / 180.0);
   int wrong = 0;
   for (std::size_t i = 0; i < c.correspondences.size(); ++i) {

@@ -14,7 +14,7 @@ using testing::MakeSim3Problem;
 using testing::Sim3Problem;
 using testing::Sim3ProblemOptions;
 
-double RotationErrorDeg(const Sim3d& a, const Sim3d& b) {
+double Sim3RotationErrorDeg(const Sim3d& a, const Sim3d& b) {
   return (a.so3().Inverse() * b.so3()).Log().norm() * 180.0 / M_PI;
 }
 
@@ -32,11 +32,11 @@ TEST(OptimizeSim3Test, ConvergesFromADisturbedModelAndFlagsWrongMatches) {
   po.outlier_fraction = 0.25;
   const Sim3Problem p = MakeSim3Problem(po);
   const Sim3d initial = Disturb(p.camera1_from_camera2, false);
-  ASSERT_GT(RotationErrorDeg(initial, p.camera1_from_camera2), 1.5);
+  ASSERT_GT(Sim3RotationErrorDeg(initial, p.camera1_from_camera2), 1.5);
   const auto r = OptimizeSim3(p.matches, p.camera, p.camera, initial, {});
   ASSERT_GT(r.num_inliers, 0);
   EXPECT_NEAR(r.camera1_from_camera2.scale(), 0.8, 0.008);
-  EXPECT_LT(RotationErrorDeg(r.camera1_from_camera2, p.camera1_from_camera2), 0.2);
+  EXPECT_LT(Sim3RotationErrorDeg(r.camera1_from_camera2, p.camera1_from_camera2), 0.2);
   EXPECT_LT((r.camera1_from_camera2.translation() - p.camera1_from_camera2.translation()).norm(),
             0.02);
   int true_positive = 0, false_positive = 0, true_inliers = 0;
@@ -60,7 +60,7 @@ TEST(OptimizeSim3Test, FixedScaleStaysFixed) {
       OptimizeSim3(p.matches, p.camera, p.camera, Disturb(p.camera1_from_camera2, true), options);
   ASSERT_GT(r.num_inliers, 0);
   EXPECT_EQ(r.camera1_from_camera2.scale(), 1.0);
-  EXPECT_LT(RotationErrorDeg(r.camera1_from_camera2, p.camera1_from_camera2), 0.2);
+  EXPECT_LT(Sim3RotationErrorDeg(r.camera1_from_camera2, p.camera1_from_camera2), 0.2);
 }
 
 TEST(OptimizeSim3Test, FailsWhenTooFewPairsSurviveTheFirstRound) {

@@ -47,6 +47,15 @@ def users(repo):
                                                                  for h in headers))
 
 
+def unity_members(path):
+    """The repository-relative sources a generated batch file includes."""
+    members = []
+    for line in open(path):
+        if line.startswith('#include "'):
+            members.append(line.split('"')[1])
+    return members
+
+
 def clang_command(entry, source):
     args = shlex.split(entry["command"]) if "command" in entry else list(entry["arguments"])
     out, skip = ["clang++"], False
@@ -123,18 +132,28 @@ def main():
         print(f"{db_path}: missing (configure with CMAKE_EXPORT_COMPILE_COMMANDS=ON)")
         return 1
     db = {os.path.realpath(e["file"]): e for e in json.load(open(db_path))}
+    wanted = users(repo)
     jobs = []
-    for rel in users(repo):
+    for rel in wanted:
         path = os.path.join(repo, rel)
         if path in db:
             jobs.append((rel, db[path]))
+    # Test and benchmark files are compiled in batches (cmake/PkslamHelpers.cmake,
+    # pkslam_unity_sources): a batch that includes a user is analysed whole, its files at once.
+    for path, entry in db.items():
+        if os.sep + "unity" + os.sep not in path:
+            continue
+        included = unity_members(path)
+        if any(rel in wanted for rel in included):
+            jobs.append((f"{os.path.relpath(path, build)} ({', '.join(included)})", entry))
     if not jobs:
         print("no source uses", HEADER)
         return 1
 
     def run(job):
         rel, entry = job
-        cmd = clang_command(entry, os.path.realpath(os.path.join(repo, rel)))
+        cmd = clang_command(entry, os.path.realpath(os.path.join(entry["directory"],
+                                                                  entry["file"])))
         r = subprocess.run(cmd, cwd=entry["directory"], capture_output=True, text=True)
         return rel, r.returncode, r.stderr
 
