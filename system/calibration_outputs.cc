@@ -78,6 +78,12 @@ void WriteCalibrationJson(const CalibrationReport& report,
   json->Member("mode", report.online ? "online" : "off");
   json->Member("covariance", report.covariance_ok);
   json->Member("note", report.note);
+  json->Key("final_timing").BeginObject();
+  json->Member("collect_ms", report.final_timing.collect_ms);
+  json->Member("solve_ms", report.final_timing.solve_ms);
+  json->Member("covariance_ms", report.final_timing.covariance_ms);
+  json->Member("apply_ms", report.final_timing.apply_ms);
+  json->EndObject();
   json->Key("parameters").BeginArray();
   for (const CalibrationParameter& p : report.parameters) {
     json->BeginObject();

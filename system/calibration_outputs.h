@@ -28,6 +28,15 @@ struct CalibrationReport {
   std::map<std::string, std::string> frozen;
   std::vector<CalibrationRefinementStat> history;
   std::string note;  // why the final adjustment was not applied ("" when it was, or off)
+  // Wall time of the final adjustment after the last frame (0 without one): gathering the
+  // map, the solve (its covariance included) and moving the map to the estimate. It is the part
+  // of online calibration's cost that comes after the data (docs/calibration.md, "Cost").
+  struct FinalTiming {
+    double collect_ms = 0.0;
+    double solve_ms = 0.0;
+    double covariance_ms = 0.0;
+    double apply_ms = 0.0;
+  } final_timing;
 };
 
 // Where each parameter group came from, for the warnings: the settings file, or a EuRoC

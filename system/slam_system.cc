@@ -113,8 +113,16 @@ void SlamSystem::Shutdown() {
   if (options_.mapping.calibration.enabled) FinishCalibration();
 }
 
+namespace {
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+}  // namespace
+
 void SlamSystem::FinishCalibration() {
   const OnlineCalibrationOptions& o = options_.mapping.calibration;
+  const auto collect_start = std::chrono::steady_clock::now();
   CalibrationBundleProblem problem;
   RigSetup setup;
   {
@@ -131,6 +139,7 @@ void SlamSystem::FinishCalibration() {
     problem = CollectCalibrationBundle(newest, inertial, setup, atlas_.calibration(),
                                        file_calibration_, collect);
   }
+  final_timing_.collect_ms = MsSince(collect_start);
   PKSLAM_LOG_INFO("final calibration adjustment: {} keyframes, {} observations, {} inertial edges{}",
                   problem.bundle.visual.keyframes.size(), problem.raw.size(),
                   problem.bundle.edges.size(), problem.inertial ? "" : " (visual only)");
@@ -143,6 +152,8 @@ void SlamSystem::FinishCalibration() {
   ba.num_threads = options_.mapping.ba.num_threads;
   ba.prior = o.prior;
   CalibrationBundleResult result = SolveCalibrationBundle(problem, ba);
+  final_timing_.solve_ms = result.solve_ms;
+  final_timing_.covariance_ms = result.covariance_ms;
   if (result.bundle.visual.iterations == 0) return;
   if (const auto why = ImplausibleEstimate(problem, result.estimate, o,
                                            o.final_max_step_prior_sigmas)) {
@@ -159,6 +170,7 @@ void SlamSystem::FinishCalibration() {
     PKSLAM_LOG_WARN("final calibration estimate rejected: {}", e.what());
     return;
   }
+  const auto apply_start = std::chrono::steady_clock::now();
   {
     // Only the calibration moves (the bodies stay where mapping left them): the adjustment's
     // keyframe poses are not written back. On the MH_01 true-calibration replay they scattered
@@ -170,6 +182,11 @@ void SlamSystem::FinishCalibration() {
   RefinePointsToCalibration(&atlas_, problem.bundle.visual.map_id);
   // Tracking has ended: its records follow the keyframes here.
   SyncCalibration();
+  final_timing_.apply_ms = MsSince(apply_start);
+  PKSLAM_LOG_INFO("final calibration adjustment: gathered in {:.0f} ms, solved in {:.0f} ms "
+                  "(covariance {:.0f} ms), applied in {:.0f} ms",
+                  final_timing_.collect_ms, final_timing_.solve_ms, final_timing_.covariance_ms,
+                  final_timing_.apply_ms);
   final_calibration_ = std::move(result);
 }
 
@@ -195,6 +212,7 @@ CalibrationReport SlamSystem::calibration_report() const {
     if (!report.history.empty()) report.frozen = report.history.back().gates.frozen;
   }
   report.note = final_note_;
+  report.final_timing = final_timing_;
   return report;
 }
 

@@ -168,6 +168,7 @@ class SlamSystem {
   std::optional<CalibrationBundleResult> final_calibration_;
   CalibrationGates final_gates_;
   std::string final_note_;  // why the final adjustment was not applied (reported)
+  CalibrationReport::FinalTiming final_timing_;  // the final adjustment's wall time (reported)
   void FinishCalibration();
   // The camera-IMU time offset applied to frame stamps (inertial sensors): frames are tracked on
   // the IMU clock, stamp + offset.

@@ -138,6 +138,12 @@ TEST_F(CalibrationCli, OnlineRunReportsAndWritesTheEstimate) {
   // The final estimate carries sigmas; the time offset (file 0, rendered +1 ms) was freed and
   // moved towards the truth, further than its sigma.
   EXPECT_TRUE(c["covariance"].as<bool>());
+  // The final adjustment's wall time: a solve that includes its covariance, then the move.
+  const YAML::Node timing = c["final_timing"];
+  EXPECT_GT(timing["solve_ms"].as<double>(), 0.0);
+  EXPECT_GT(timing["covariance_ms"].as<double>(), 0.0);
+  EXPECT_LT(timing["covariance_ms"].as<double>(), timing["solve_ms"].as<double>());
+  EXPECT_GT(timing["apply_ms"].as<double>(), 0.0);
   YAML::Node offset;
   ASSERT_NE(FindParameter(c["parameters"], "time_offset", &offset), nullptr);
   EXPECT_TRUE(offset["free"].as<bool>());
@@ -179,6 +185,7 @@ TEST_F(CalibrationCli, OffReportsTheFileAndWritesItBack) {
   const YAML::Node c = ReadJsonFile(Dir() / "off/stats.json")["calibration"];
   EXPECT_EQ(c["mode"].as<std::string>(), "off");
   EXPECT_EQ(c["history"].size(), 0u);
+  EXPECT_EQ(c["final_timing"]["solve_ms"].as<double>(), 0.0);
   for (const YAML::Node& p : c["parameters"]) {
     EXPECT_FALSE(p["free"].as<bool>());
     // Extrinsic entries are Log(estimate * file^-1): zero up to rounding.

@@ -164,6 +164,9 @@ struct CalibrationBundleResult {
   std::vector<CalibrationParameter> parameters;
   bool covariance_ok = false;
   int outliers = 0;
+  // Wall time of the whole solve and of its covariance (0 when not computed), for the reports.
+  double solve_ms = 0.0;
+  double covariance_ms = 0.0;
 };
 
 // The scalar parameters of `estimate` against `prior` (sigma left 0).

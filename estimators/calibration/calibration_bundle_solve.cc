@@ -279,6 +279,7 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
 CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& problem,
                                                const CalibrationBundleOptions& options,
                                                const std::atomic<bool>* abort, WorkMeter* work) {
+  const auto solve_start = std::chrono::steady_clock::now();
   options.Check();
   const BundleProblem& visual = problem.bundle.visual;
   PKSLAM_CHECK(problem.raw.size() == visual.observations.size(),
@@ -576,12 +577,15 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
     result.covariance_ok = FillSigmas(&ceres_problem, &s, problem, options.num_threads,
                                       manifolds.imu.Expansion(), manifolds.stereo.Expansion(),
                                       &result.parameters);
+    result.covariance_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count();
     PKSLAM_LOG_DEBUG("calibration bundle adjustment: covariance {} in {:.0f} ms",
-                     result.covariance_ok ? "computed" : "not computable",
-                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
-                                                               start)
-                         .count());
+                     result.covariance_ok ? "computed" : "not computable", result.covariance_ms);
   }
+  result.solve_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - solve_start)
+          .count();
   return result;
 }
 

@@ -3,7 +3,7 @@
 # than `off` on the same render): `pkslam run` with --calibrate off and online, one process at a
 # time (nothing else should run: the wall clock is what is measured), unpaced, on each render
 # given; prints wall time, real-time factor (sequence duration / wall time), process CPU and
-# local mapping's CPU from stats.json, and the online / off ratios.
+# local mapping's CPU from stats.json, the online / off ratios, and the final adjustment's time.
 #   evaluation/studies/calibration/cost.sh PKSLAM OUT RENDER...   (RENDER: render.sh's folders)
 set -euo pipefail
 if [ $# -lt 3 ]; then sed -n '2,7p' "$0"; exit 2; fi
@@ -27,5 +27,11 @@ off, on = rows
 print("%-24s %-7s %8.2f %6.2f %8.2f %8.2f" % (sys.argv[3], "ratio", on["wall_time_s"] / off["wall_time_s"],
       on["realtime_factor"] / off["realtime_factor"], on["process_cpu_s"] / off["process_cpu_s"],
       on["local_mapping_cpu_s"] / off["local_mapping_cpu_s"]))
+t = on["calibration"].get("final_timing")
+if t:  # the final adjustment after the last frame (stats.json since 2026-11-29)
+    final_s = (t["collect_ms"] + t["solve_ms"] + t["apply_ms"]) / 1e3
+    print("%-24s final adjustment %.1f s (covariance %.1f s); online without it: RTF ratio %.2f"
+          % (sys.argv[3], final_s, t["covariance_ms"] / 1e3,
+             off["wall_time_s"] / (on["wall_time_s"] - final_s)))
 PY
 done
