@@ -24,11 +24,12 @@ inline Eigen::Vector2f BoxUv(const Eigen::Vector3f& p, const Eigen::Vector3f& ha
 }  // namespace intersect_detail
 
 // Ray/shape test in the shape's local frame. o/d are local; d need not be unit (t is in
-// units of d). Returns false on a miss or a hit not in (t_min, *t); on a hit sets *t, the
-// face, its (u, v) in metres and the local normal facing the ray.
-inline bool IntersectLocal(const Shape& shape, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
-                           float t_min, float* t, int* face, Eigen::Vector2f* uv,
-                           Eigen::Vector3f* normal_local) {
+// units of d). Returns false on a miss or a hit not in (t_min, *t); on a hit sets *t and the
+// face. The surface there (SurfaceAtLocal) is left for the caller to compute once it knows the
+// nearest hit: the renderer tests several shapes per ray, and a cylinder's (u, v) costs an
+// atan2.
+inline bool HitLocal(const Shape& shape, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+                     float t_min, float* t, int* face) {
   const Eigen::Vector3f& h = shape.half;
   switch (shape.type) {
     case ShapeType::kRoom: {
@@ -45,12 +46,7 @@ inline bool IntersectLocal(const Shape& shape, const Eigen::Vector3f& o, const E
       }
       if (!(best > t_min && best < *t)) return false;
       *t = best;
-      const bool positive = d[axis] > 0.0f;
-      *face = 2 * axis + (positive ? 1 : 0);
-      const Eigen::Vector3f p = o + best * d;
-      *uv = intersect_detail::BoxUv(p, h, axis);
-      *normal_local = Eigen::Vector3f::Zero();
-      (*normal_local)[axis] = positive ? -1.0f : 1.0f;
+      *face = 2 * axis + (d[axis] > 0.0f ? 1 : 0);
       return true;
     }
     case ShapeType::kBox: {
@@ -74,11 +70,7 @@ inline bool IntersectLocal(const Shape& shape, const Eigen::Vector3f& o, const E
       }
       if (t_near > t_far || !(t_near > t_min && t_near < *t)) return false;
       *t = t_near;
-      const bool from_negative = d[axis] > 0.0f;  // entering through the -axis face
-      *face = 2 * axis + (from_negative ? 0 : 1);
-      *uv = intersect_detail::BoxUv(o + t_near * d, h, axis);
-      *normal_local = Eigen::Vector3f::Zero();
-      (*normal_local)[axis] = from_negative ? -1.0f : 1.0f;
+      *face = 2 * axis + (d[axis] > 0.0f ? 0 : 1);  // 0: entering through the -axis face
       return true;
     }
     case ShapeType::kCylinder: {
@@ -96,11 +88,6 @@ inline bool IntersectLocal(const Shape& shape, const Eigen::Vector3f& o, const E
           if (ts > t_min && ts < *t && std::abs(z) <= h.z()) {
             *t = ts;
             *face = 0;
-            const float x = o.x() + ts * d.x();
-            const float y = o.y() + ts * d.y();
-            const float angle = std::atan2(y, x) + std::numbers::pi_v<float>;
-            *uv = Eigen::Vector2f(angle * r, z + h.z());
-            *normal_local = Eigen::Vector3f(x / r, y / r, 0.0f);
             hit = true;
           }
         }
@@ -114,8 +101,6 @@ inline bool IntersectLocal(const Shape& shape, const Eigen::Vector3f& o, const E
         if (tc > t_min && tc < *t && x * x + y * y <= r * r) {
           *t = tc;
           *face = d.z() > 0.0f ? 1 : 2;
-          *uv = Eigen::Vector2f(x + r, y + r);
-          *normal_local = Eigen::Vector3f(0.0f, 0.0f, d.z() > 0.0f ? -1.0f : 1.0f);
           hit = true;
         }
       }
@@ -130,12 +115,65 @@ inline bool IntersectLocal(const Shape& shape, const Eigen::Vector3f& o, const E
       if (std::abs(x) > h.x() || std::abs(y) > h.y()) return false;
       *t = tq;
       *face = 0;
-      *uv = Eigen::Vector2f(x + h.x(), y + h.y());
-      *normal_local = Eigen::Vector3f(0.0f, 0.0f, d.z() > 0.0f ? -1.0f : 1.0f);
       return true;
     }
   }
   return false;
+}
+
+// The surface where HitLocal's ray (o, d) meets the shape at t on `face`: its (u, v) in metres
+// and the local normal facing the ray. The same arithmetic as the hit test, so the point is
+// the one it found.
+inline void SurfaceAtLocal(const Shape& shape, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+                           float t, int face, Eigen::Vector2f* uv, Eigen::Vector3f* normal_local) {
+  const Eigen::Vector3f& h = shape.half;
+  switch (shape.type) {
+    case ShapeType::kRoom:
+    case ShapeType::kBox: {
+      const int axis = face / 2;
+      *uv = intersect_detail::BoxUv(o + t * d, h, axis);
+      *normal_local = Eigen::Vector3f::Zero();
+      // Odd faces are on the axis' positive side. Room (seen from inside): its normal points
+      // back in; box: out.
+      const bool positive_side = face % 2 == 1;
+      const bool inward = shape.type == ShapeType::kRoom;
+      (*normal_local)[axis] = positive_side == inward ? -1.0f : 1.0f;
+      return;
+    }
+    case ShapeType::kCylinder: {
+      const float r = h.x();
+      const float x = o.x() + t * d.x();
+      const float y = o.y() + t * d.y();
+      if (face == 0) {
+        const float z = o.z() + t * d.z();
+        const float angle = std::atan2(y, x) + std::numbers::pi_v<float>;
+        *uv = Eigen::Vector2f(angle * r, z + h.z());
+        *normal_local = Eigen::Vector3f(x / r, y / r, 0.0f);
+      } else {
+        *uv = Eigen::Vector2f(x + r, y + r);
+        *normal_local = Eigen::Vector3f(0.0f, 0.0f, d.z() > 0.0f ? -1.0f : 1.0f);
+      }
+      return;
+    }
+    case ShapeType::kQuad: {
+      const float x = o.x() + t * d.x();
+      const float y = o.y() + t * d.y();
+      *uv = Eigen::Vector2f(x + h.x(), y + h.y());
+      *normal_local = Eigen::Vector3f(0.0f, 0.0f, d.z() > 0.0f ? -1.0f : 1.0f);
+      return;
+    }
+  }
+  *uv = Eigen::Vector2f::Zero();  // not reached (every shape type returns above)
+  *normal_local = Eigen::Vector3f::Zero();
+}
+
+// HitLocal and, on a hit, SurfaceAtLocal.
+inline bool IntersectLocal(const Shape& shape, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+                           float t_min, float* t, int* face, Eigen::Vector2f* uv,
+                           Eigen::Vector3f* normal_local) {
+  if (!HitLocal(shape, o, d, t_min, t, face)) return false;
+  SurfaceAtLocal(shape, o, d, *t, *face, uv, normal_local);
+  return true;
 }
 
 }  // namespace pkslam::sim

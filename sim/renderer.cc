@@ -270,14 +270,14 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
                 for (const FrameShape* f : candidates) {
                   if (f->near >= t) break;  // sorted: no later shape can be hit sooner
                   const Eigen::Vector3f d = f->local_from_camera * rc;
-                  if (IntersectLocal(scene_.shapes[f->index], f->origin_local, d, 1e-4f, &t, &face,
-                                     &uv, &n_local)) {
+                  if (HitLocal(scene_.shapes[f->index], f->origin_local, d, 1e-4f, &t, &face)) {
                     best = f;
                     d_best = d;
                   }
                 }
                 if (best == nullptr) continue;
                 const Shape& shape = scene_.shapes[best->index];
+                SurfaceAtLocal(shape, best->origin_local, d_best, t, face, &uv, &n_local);
                 const Material& mat = scene_.materials[shape.material[face]];
                 const MipTexture& tex = scene_.textures[mat.texture];
                 const float cos_inc = std::max(std::abs(n_local.dot(d_best)), 0.05f);

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+
 #include "core/util/error.h"
 #include "sim/intersect.h"
 #include "sim/scene_builder.h"
@@ -155,6 +158,62 @@ TEST(Scene, IntersectionsAndDistancesAgree) {
     ASSERT_TRUE(scene.Intersect(from, dir.normalized(), 100.0f, &hit));
     const Eigen::Vector3f p = from + hit.t * dir.normalized();
     EXPECT_NEAR(SignedDistance(scene.shapes[hit.shape], p), 0.0f, 2e-4f);
+  }
+}
+
+// The renderer tests shapes with HitLocal and asks the nearest one for its surface
+// (SurfaceAtLocal): for every shape type the surface is where the hit is, its normal faces the
+// ray, and (u, v) lie on the face.
+TEST(Scene, HitThenSurfaceFacesTheRayOnEveryShapeType) {
+  for (const ShapeType type :
+       {ShapeType::kRoom, ShapeType::kBox, ShapeType::kCylinder, ShapeType::kQuad}) {
+    Shape shape;
+    shape.type = type;
+    shape.half = type == ShapeType::kCylinder ? Eigen::Vector3f(0.4f, 0.4f, 0.7f)
+                 : type == ShapeType::kQuad   ? Eigen::Vector3f(0.6f, 0.5f, 0.0f)
+                                              : Eigen::Vector3f(0.6f, 0.5f, 0.7f);
+    int hits = 0;
+    for (int i = 0; i < 400; ++i) {
+      // Rays from a sphere of radius 2 towards points near the centre (the room: from inside).
+      const Eigen::Vector3f on_sphere(std::cos(0.7f * i) * std::sin(0.3f * i + 0.2f),
+                                      std::sin(0.7f * i) * std::sin(0.3f * i + 0.2f),
+                                      std::cos(0.3f * i + 0.2f));
+      const Eigen::Vector3f o = type == ShapeType::kRoom ? Eigen::Vector3f(0.1f, -0.2f, 0.05f)
+                                                         : Eigen::Vector3f(2.0f * on_sphere);
+      const Eigen::Vector3f target(0.3f * std::sin(1.3f * i), 0.3f * std::cos(0.9f * i),
+                                   0.3f * std::sin(0.5f * i));
+      const Eigen::Vector3f d =
+          type == ShapeType::kRoom ? Eigen::Vector3f(on_sphere) : Eigen::Vector3f(target - o);
+      float t = 100.0f;
+      int face = -1;
+      if (!HitLocal(shape, o, d, 1e-4f, &t, &face)) continue;
+      ++hits;
+      Eigen::Vector2f uv;
+      Eigen::Vector3f n;
+      SurfaceAtLocal(shape, o, d, t, face, &uv, &n);
+      EXPECT_NEAR(n.norm(), 1.0f, 1e-5f);
+      EXPECT_LT(n.dot(d), 0.0f) << "shape type " << static_cast<int>(type) << ", face " << face;
+      EXPECT_GE(face, 0);
+      EXPECT_LT(face, shape.num_faces());
+      EXPECT_GE(uv.x(), -1e-4f);
+      EXPECT_GE(uv.y(), -1e-4f);
+      const float u_max = type == ShapeType::kCylinder && face == 0
+                              ? 2.0f * std::numbers::pi_v<float> * shape.half.x()
+                              : 2.0f * shape.half.maxCoeff();
+      EXPECT_LE(uv.x(), u_max + 1e-4f);
+      EXPECT_LE(uv.y(), 2.0f * shape.half.maxCoeff() + 1e-4f);
+      // IntersectLocal is the two in one call.
+      float t2 = 100.0f;
+      int face2 = -1;
+      Eigen::Vector2f uv2;
+      Eigen::Vector3f n2;
+      ASSERT_TRUE(IntersectLocal(shape, o, d, 1e-4f, &t2, &face2, &uv2, &n2));
+      EXPECT_EQ(t2, t);
+      EXPECT_EQ(face2, face);
+      EXPECT_EQ(uv2, uv);
+      EXPECT_EQ(n2, n);
+    }
+    EXPECT_GT(hits, 100) << "shape type " << static_cast<int>(type);
   }
 }
 
