@@ -7,6 +7,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/wall_time.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/map.h"
@@ -15,13 +16,6 @@
 #include "mapping/inertial_bundle.h"
 
 namespace pkslam {
-namespace {
-
-double MsSince(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
-
-}  // namespace
 
 void LoopClosingOptions::Check() const {
   verifier.Check();
@@ -135,7 +129,7 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
   std::optional<CommonRegion> region = Detect(kf, &verification_ms);
   {
     MutexLock lock(mutex_);
-    stats_.detection_ms.push_back(MsSince(start));
+    stats_.detection_ms.push_back(WallMsSince(start));
     ++stats_.keyframes;
   }
   if (!region) return;
@@ -169,7 +163,7 @@ void LoopClosing::Process(const KeyFramePtr& kf) {
   Map* corrected = merge ? MergeMaps(*region, &event) : CorrectLoop(*region, &event);
   if (corrected == nullptr) return;
   last_loop_kf_id_ = event.query;
-  event.correction_ms = MsSince(correct_start);
+  event.correction_ms = WallMsSince(correct_start);
   PKSLAM_LOG_INFO(
       "{} at t = {:.3f} s: keyframe {} (map {}) <-> keyframe {} (map {}), {} matches, "
       "keyframe moved {:.3f} m, {:.1f} ms",
@@ -213,7 +207,7 @@ std::optional<CommonRegion> LoopClosing::Detect(const KeyFramePtr& kf, double* v
     std::vector<MapPointPtr> matched;
     const Sim3d carried = CarryOver(*pending, *kf);
     const int n = CountRegionMatches(*pending, *kf, carried, options_.verifier, &matched);
-    *verification_ms += MsSince(t);
+    *verification_ms += WallMsSince(t);
     if (n >= options_.verifier.min_confirmation_matches) {
       pending->query = kf;
       pending->query_camera_from_world = carried;
@@ -253,7 +247,7 @@ std::optional<CommonRegion> LoopClosing::Detect(const KeyFramePtr& kf, double* v
         region->confirmations +=
             ConfirmByCovisibles(*region, options_.confirming_covisibles, options_.verifier);
       }
-      *verification_ms += MsSince(t);
+      *verification_ms += WallMsSince(t);
       {
         MutexLock stats_lock(mutex_);
         ++stats_.tested_candidates;
@@ -355,7 +349,7 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
     }
     ReleaseMapping();
   }
-  const double ms = MsSince(start);
+  const double ms = WallMsSince(start);
   {
     MutexLock lock(mutex_);
     if (applied) {

@@ -8,6 +8,7 @@
 
 #include "core/util/cpu_time.h"
 #include "core/util/log.h"
+#include "core/util/wall_time.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/map_editor.h"
@@ -18,13 +19,6 @@
 #include "mapping/triangulation.h"
 
 namespace pkslam {
-namespace {
-
-double MsSince(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
-
-}  // namespace
 
 void LocalMapper::ProcessNext() {
   KeyFramePtr kf;
@@ -65,7 +59,7 @@ void LocalMapper::ProcessNext() {
       if (!IsInertial(rig_->sensor) || !LocalInertialBundleAdjustment(kf)) {
         LocalBundleAdjustment(kf);
       }
-      ba_ms = MsSince(ba_start);
+      ba_ms = WallMsSince(ba_start);
       ba_cpu_ms = 1e3 * (ThreadCpuSeconds() - ba_cpu_start);
     }
     PaceToTracker();
@@ -78,7 +72,7 @@ void LocalMapper::ProcessNext() {
   PaceToTracker();
   {
     MutexLock lock(mutex_);
-    stats_.keyframe_ms.push_back(MsSince(start));
+    stats_.keyframe_ms.push_back(WallMsSince(start));
     stats_.ba_ms.push_back(ba_ms);
     stats_.keyframe_cpu_ms.push_back(1e3 * (ThreadCpuSeconds() - cpu_start));
     stats_.ba_cpu_ms.push_back(ba_cpu_ms);

@@ -11,6 +11,7 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/output_file.h"
+#include "core/util/wall_time.h"
 #include "io/point_cloud.h"
 #include "keyframe/selector_factory.h"
 #include "map_model/keyframe.h"
@@ -113,13 +114,6 @@ void SlamSystem::Shutdown() {
   if (options_.mapping.calibration.enabled) FinishCalibration();
 }
 
-namespace {
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-}  // namespace
-
 void SlamSystem::FinishCalibration() {
   const OnlineCalibrationOptions& o = options_.mapping.calibration;
   const auto collect_start = std::chrono::steady_clock::now();
@@ -139,7 +133,7 @@ void SlamSystem::FinishCalibration() {
     problem = CollectCalibrationBundle(newest, inertial, setup, atlas_.calibration(),
                                        file_calibration_, collect);
   }
-  final_timing_.collect_ms = MsSince(collect_start);
+  final_timing_.collect_ms = WallMsSince(collect_start);
   PKSLAM_LOG_INFO("final calibration adjustment: {} keyframes, {} observations, {} inertial edges{}",
                   problem.bundle.visual.keyframes.size(), problem.raw.size(),
                   problem.bundle.edges.size(), problem.inertial ? "" : " (visual only)");
@@ -182,7 +176,7 @@ void SlamSystem::FinishCalibration() {
   RefinePointsToCalibration(&atlas_, problem.bundle.visual.map_id);
   // Tracking has ended: its records follow the keyframes here.
   SyncCalibration();
-  final_timing_.apply_ms = MsSince(apply_start);
+  final_timing_.apply_ms = WallMsSince(apply_start);
   PKSLAM_LOG_INFO("final calibration adjustment: gathered in {:.0f} ms, solved in {:.0f} ms "
                   "(covariance {:.0f} ms), applied in {:.0f} ms",
                   final_timing_.collect_ms, final_timing_.solve_ms, final_timing_.covariance_ms,

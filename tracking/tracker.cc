@@ -8,6 +8,7 @@
 #include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/wall_time.h"
 #include "map_model/keyframe.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
@@ -17,10 +18,6 @@
 namespace pkslam {
 namespace {
 
-double MsSince(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
-
 // CPU and wall time of building a frame (for its FrameRecord).
 struct BuildTimer {
   double cpu_start = ThreadCpuSeconds();
@@ -28,7 +25,7 @@ struct BuildTimer {
 
   void Stop(double* cpu_ms, double* wall_ms) const {
     *cpu_ms = 1e3 * (ThreadCpuSeconds() - cpu_start);
-    *wall_ms = MsSince(wall_start);
+    *wall_ms = WallMsSince(wall_start);
   }
 };
 
@@ -161,7 +158,7 @@ TrackResult Tracker::Track(Frame frame) {
     const auto wait_start = std::chrono::steady_clock::now();
     const bool emulated = mapping_->EmulatesLive();
     const bool idle_at_frame = emulated && mapping_->AcceptsKeyFramesAt(current_.t_ns());
-    frame_wait_ms = MsSince(wait_start);
+    frame_wait_ms = WallMsSince(wait_start);
     {
       auto lock = MapReader(*atlas_).Lock();
       if (imu_) SyncWithInertialMapLocked(/*correct_current=*/false);  // the world tracked in

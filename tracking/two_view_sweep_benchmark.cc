@@ -11,6 +11,7 @@
 #include <random>
 #include <string>
 
+#include "core/util/quantile.h"
 #include "estimators/two_view/two_view_refine.h"
 #include "map_model/testing/synthetic_map.h"
 #include "tracking/two_view_initializer.h"
@@ -19,12 +20,6 @@ namespace pkslam {
 namespace {
 
 enum SceneKind { kBox = 0, kPlane = 1, kRotation = 2 };
-
-double UpperMedian(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 void BM_TwoViewSweep(benchmark::State& state) {
   const auto kind = static_cast<SceneKind>(state.range(0));
@@ -113,7 +108,7 @@ void BM_TwoViewSweep(benchmark::State& state) {
         const Eigen::Vector3d& truth = scene.points_world[p1[i]];
         rel.push_back((num / den * r->points[i] - truth).norm() / truth.norm());
       }
-      points.push_back(UpperMedian(rel));
+      points.push_back(Quantile(rel, 0.5).value_or(0.0));
     }
   }
   state.counters["accepted"] = static_cast<double>(accepted) / kTrials;
@@ -124,13 +119,13 @@ void BM_TwoViewSweep(benchmark::State& state) {
     state.counters["no:" + name] = count;
   }
   state.counters["homography"] = static_cast<double>(homography) / kTrials;
-  state.counters["rot_med_deg"] = UpperMedian(rot);
+  state.counters["rot_med_deg"] = Quantile(rot, 0.5).value_or(0.0);
   state.counters["rot_max_deg"] = rot.empty() ? 0 : *std::max_element(rot.begin(), rot.end());
-  state.counters["trans_med_deg"] = UpperMedian(trans);
+  state.counters["trans_med_deg"] = Quantile(trans, 0.5).value_or(0.0);
   state.counters["trans_max_deg"] =
       trans.empty() ? 0 : *std::max_element(trans.begin(), trans.end());
-  state.counters["point_err_med"] = UpperMedian(points);
-  state.counters["oracle_trans_med_deg"] = UpperMedian(oracle_trans);
+  state.counters["point_err_med"] = Quantile(points, 0.5).value_or(0.0);
+  state.counters["oracle_trans_med_deg"] = Quantile(oracle_trans, 0.5).value_or(0.0);
   state.counters["oracle_trans_max_deg"] =
       oracle_trans.empty() ? 0 : *std::max_element(oracle_trans.begin(), oracle_trans.end());
 }

@@ -14,6 +14,7 @@
 #include "core/features/orb_extractor.h"
 #include "core/features/synthetic_texture.h"
 #include "core/util/error.h"
+#include "core/util/quantile.h"
 #include "tests/support/test_data.h"
 
 namespace pkslam {
@@ -69,11 +70,6 @@ std::optional<double> TrueDisparity(double u_left, double v, double margin) {
   return solutions == 1 ? found : std::nullopt;
 }
 
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 // Median |disparity error| over matched left keypoints with a known disparity, and how many.
 std::pair<double, int> MedianDisparityError(const OrbFeatures& left, const StereoMatches& m) {
   std::vector<double> errors;
@@ -83,7 +79,7 @@ std::pair<double, int> MedianDisparityError(const OrbFeatures& left, const Stere
     if (truth && m.depth[i] > 0.0f) errors.push_back(std::abs(kp.pt.x - m.u_right[i] - *truth));
   }
   if (errors.empty()) return {1e9, 0};
-  return {Median(errors), static_cast<int>(errors.size())};
+  return {Quantile(errors, 0.5).value(), static_cast<int>(errors.size())};
 }
 
 class StereoMatcherTest : public ::testing::Test {
@@ -125,10 +121,10 @@ TEST_F(StereoMatcherTest, RecoversSubPixelDisparityAndDepth) {
   }
   ASSERT_GT(with_truth, 600);
   ASSERT_GT(errors.size(), 0.6 * with_truth);
-  const double median_error = Median(errors);
+  const double median_error = Quantile(errors, 0.5).value();
   EXPECT_LT(median_error, 0.1);
   // Well below what integer disparities would give: the parabola fit is doing its job.
-  EXPECT_LT(median_error, 0.5 * Median(integer_rounding));
+  EXPECT_LT(median_error, 0.5 * Quantile(integer_rounding, 0.5).value());
   EXPECT_LT(gross, 0.02 * errors.size());
   // Depth within 1% for the median point (depth error ~ disparity error / disparity).
   std::vector<double> depth_rel;
@@ -139,9 +135,9 @@ TEST_F(StereoMatcherTest, RecoversSubPixelDisparityAndDepth) {
       depth_rel.push_back(std::abs(m.depth[i] - kBf / *truth) / (kBf / *truth));
     }
   }
-  EXPECT_LT(Median(depth_rel), 0.01);
+  EXPECT_LT(Quantile(depth_rel, 0.5).value(), 0.01);
   RecordProperty("median_disparity_error_px", std::to_string(median_error));
-  RecordProperty("median_depth_rel_error", std::to_string(Median(depth_rel)));
+  RecordProperty("median_depth_rel_error", std::to_string(Quantile(depth_rel, 0.5).value()));
   RecordProperty("matched_of_with_truth",
                  std::to_string(errors.size()) + "/" + std::to_string(with_truth));
   RecordProperty("gross_over_1px", std::to_string(gross));
@@ -278,7 +274,7 @@ TEST(StereoMatcher, RealRectifiedEurocPair) {
   RecordProperty("euroc_matches",
                  std::to_string(m.num_matches) + "/" + std::to_string(left.keypoints.size()));
   ASSERT_GT(m.num_matches, 0.4 * left.keypoints.size());
-  const double median_depth = Median(depths);
+  const double median_depth = Quantile(depths, 0.5).value();
   RecordProperty("euroc_median_depth_m", std::to_string(median_depth));
   EXPECT_GT(median_depth, 1.0);
   EXPECT_LT(median_depth, 8.0);

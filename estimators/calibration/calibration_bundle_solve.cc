@@ -16,6 +16,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/wall_time.h"
 #include "estimators/calibration/calibration_bundle.h"
 #include "estimators/calibration/calibration_residuals.h"
 #include "estimators/optim/ceres_setup.h"
@@ -577,15 +578,11 @@ CalibrationBundleResult SolveCalibrationBundle(const CalibrationBundleProblem& p
     result.covariance_ok = FillSigmas(&ceres_problem, &s, problem, options.num_threads,
                                       manifolds.imu.Expansion(), manifolds.stereo.Expansion(),
                                       &result.parameters);
-    result.covariance_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-            .count();
+    result.covariance_ms = WallMsSince(start);
     PKSLAM_LOG_DEBUG("calibration bundle adjustment: covariance {} in {:.0f} ms",
                      result.covariance_ok ? "computed" : "not computable", result.covariance_ms);
   }
-  result.solve_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - solve_start)
-          .count();
+  result.solve_ms = WallMsSince(solve_start);
   return result;
 }
 
