@@ -1,5 +1,4 @@
 // Solve phase of the calibration bundle adjustment: Ceres on a copy of the collected state.
-#include <ceres/covariance.h>
 #include <ceres/loss_function.h>
 #include <ceres/manifold.h>
 #include <ceres/ordered_groups.h>
@@ -12,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/util/error.h"
@@ -20,6 +20,7 @@
 #include "estimators/calibration/calibration_bundle.h"
 #include "estimators/calibration/calibration_residuals.h"
 #include "estimators/optim/ceres_setup.h"
+#include "estimators/optim/marginal_covariance.h"
 #include "estimators/optim/se3_manifold.h"
 #include "imu/imu_factors.h"
 #include "imu/imu_manifolds.h"
@@ -165,14 +166,15 @@ void AddCalibrationBlocks(const CalibrationBundleProblem& problem,
   }
 }
 
-// Before the covariance (the solve is done), the points whose directions Ceres' sparse QR would
-// take for null ones, so that it refuses the whole covariance (every machine-hall replay did):
+// Before the covariance (the solve is done), the points whose directions the covariance's rank
+// check would take for null ones, so that it refuses the whole covariance (every machine-hall
+// replay did when the covariance came from Ceres' sparse QR):
 // - a point the outlier pass left with three residuals or fewer (`rows_left`) tells nothing
 //   about the other parameters (its own three coordinates absorb them), and with fewer than
 //   three it has no position at all; it leaves the problem with its residuals, which keeps the
 //   calibration's marginal covariance as it is;
 // - a far point seen without stereo from nearby keyframes has almost no depth, numerically a
-//   null direction (the rank tolerance is relative to the Jacobian's largest column); a 100 m
+//   null direction (the rank tolerance is relative to the largest direction); a 100 m
 //   prior on every point's position removes those and tells nothing worth the name about
 //   anything else.
 void RemoveNuisanceNullDirections(const std::vector<int>& rows_left,
@@ -206,7 +208,7 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
     double* block;
     int first;          // index of its first scalar in `parameters`
     Eigen::MatrixXd j;  // reported scalars x block tangent (units included)
-    bool ambient = false;  // intrinsics: Ceres' ambient covariance (frozen coordinates: 0)
+    bool ambient = false;  // intrinsics: ambient covariance (frozen coordinates: 0)
   };
   std::vector<Entry> entries;
   int index = 0;
@@ -251,21 +253,17 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
     }
   }
   if (entries.empty()) return true;
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::SPARSE_QR;
+  std::vector<const double*> blocks;
+  for (const Entry& e : entries) blocks.push_back(e.block);
+  MarginalCovarianceOptions options;
   options.num_threads = num_threads;
-  options.apply_loss_function = true;
-  ceres::Covariance covariance(options);
-  std::vector<std::pair<const double*, const double*>> pairs;
-  for (const Entry& e : entries) pairs.emplace_back(e.block, e.block);
-  if (!covariance.Compute(pairs, ceres_problem)) return false;
+  const std::optional<MarginalCovariance> covariance =
+      ComputeMarginalCovariance(ceres_problem, blocks, options);
+  if (!covariance) return false;
   for (const Entry& e : entries) {
-    const int n = static_cast<int>(e.j.cols());
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(n, n);
-    if (!(e.ambient ? covariance.GetCovarianceMatrix({e.block}, m.data())
-                    : covariance.GetCovarianceMatrixInTangentSpace({e.block}, m.data()))) {
-      return false;
-    }
+    const Eigen::MatrixXd tangent = covariance->Block(e.block);
+    const Eigen::MatrixXd m =
+        e.ambient ? AmbientCovariance(*ceres_problem, e.block, tangent) : tangent;
     const Eigen::MatrixXd reported = e.j * m * e.j.transpose();
     for (int i = 0; i < reported.rows(); ++i) {
       CalibrationParameter& p = (*parameters)[static_cast<std::size_t>(e.first + i)];

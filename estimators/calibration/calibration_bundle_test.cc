@@ -19,7 +19,7 @@ constexpr double kDeg = M_PI / 180.0;
 // a cloud of points; images are rendered with `truth` (the image stamped t shows the body at
 // IMU time t + truth.time_offset_s), measured like the tracker measures them in images rectified
 // with `file`, and the keyframe states sit at the stamps (no offset applied).
-struct Scene {
+struct CalibrationScene {
   RigCalibration truth;
   RigCalibration file;
   CalibrationBundleProblem problem;
@@ -58,8 +58,8 @@ RigCalibration Miscalibrated(const RigCalibration& truth) {
   return c;
 }
 
-Scene MakeScene(bool stereo, bool inertial, double pixel_noise, unsigned seed) {
-  Scene scene;
+CalibrationScene MakeScene(bool stereo, bool inertial, double pixel_noise, unsigned seed) {
+  CalibrationScene scene;
   scene.truth = EurocTruth();
   scene.file = Miscalibrated(scene.truth);
   if (!stereo) {
@@ -204,7 +204,7 @@ double StereoDepthError(const RigCalibration& calibration, const RigCalibration&
 }
 
 // Every free parameter's estimate lies within `k` posterior sigmas of the truth.
-void ExpectWithinSigmas(const CalibrationBundleResult& result, const Scene& scene, double k) {
+void ExpectWithinSigmas(const CalibrationBundleResult& result, const CalibrationScene& scene, double k) {
   const std::vector<CalibrationParameter> truth = CalibrationParameters(
       scene.file, scene.truth, scene.problem.free, {}, scene.problem.inertial);
   ASSERT_EQ(truth.size(), result.parameters.size());
@@ -219,7 +219,7 @@ void ExpectWithinSigmas(const CalibrationBundleResult& result, const Scene& scen
 }
 
 TEST(CalibrationBundleTest, StereoInertialRecoversTheRigFromAMiscalibratedFile) {
-  Scene scene = MakeScene(/*stereo=*/true, /*inertial=*/true, /*pixel_noise=*/0.5, 3);
+  CalibrationScene scene = MakeScene(/*stereo=*/true, /*inertial=*/true, /*pixel_noise=*/0.5, 3);
   scene.problem.free = AllFree(true, true);
   ASSERT_GT(scene.problem.bundle.visual.observations.size(), 5000u);
   const CalibrationBundleResult result = SolveCalibrationBundle(scene.problem, {});
@@ -261,7 +261,7 @@ TEST(CalibrationBundleTest, StereoInertialRecoversTheRigFromAMiscalibratedFile) 
 TEST(CalibrationBundleTest, TheGyroScaleIsEstimatedInsteadOfPullingTheFocalLength) {
   // Held at the file's 0, the gyro's 0.5% pitch-rate error moves cam0's fy; estimated, it
   // leaves fy where the images put it.
-  Scene scene = MakeScene(true, true, 0.5, 8);
+  CalibrationScene scene = MakeScene(true, true, 0.5, 8);
   scene.problem.free = AllFree(true, true);
   const CalibrationBundleResult free = SolveCalibrationBundle(scene.problem, {});
   scene.problem.free.gyro_scale = false;
@@ -278,7 +278,7 @@ TEST(CalibrationBundleTest, TheGyroScaleIsEstimatedInsteadOfPullingTheFocalLengt
 }
 
 TEST(CalibrationBundleTest, FrozenParametersStayAtTheirValue) {
-  Scene scene = MakeScene(true, true, 0.5, 4);
+  CalibrationScene scene = MakeScene(true, true, 0.5, 4);
   scene.problem.free = {};
   scene.problem.free.intrinsics = {true, true};
   const CalibrationBundleResult result = SolveCalibrationBundle(scene.problem, {});
@@ -295,7 +295,7 @@ TEST(CalibrationBundleTest, FrozenParametersStayAtTheirValue) {
 }
 
 TEST(CalibrationBundleTest, StereoWithoutImuRecoversIntrinsicsAndTheStereoExtrinsic) {
-  Scene scene = MakeScene(/*stereo=*/true, /*inertial=*/false, 0.5, 5);
+  CalibrationScene scene = MakeScene(/*stereo=*/true, /*inertial=*/false, 0.5, 5);
   scene.problem.free = AllFree(true, false);
   const CalibrationBundleResult result = SolveCalibrationBundle(scene.problem, {});
   ASSERT_TRUE(result.covariance_ok);
@@ -312,7 +312,7 @@ TEST(CalibrationBundleTest, StereoWithoutImuRecoversIntrinsicsAndTheStereoExtrin
 }
 
 TEST(CalibrationBundleTest, MonoInertialRecoversTimeOffsetAndCameraImuRotation) {
-  Scene scene = MakeScene(/*stereo=*/false, /*inertial=*/true, 0.5, 6);
+  CalibrationScene scene = MakeScene(/*stereo=*/false, /*inertial=*/true, 0.5, 6);
   scene.problem.free = AllFree(false, true);
   const CalibrationBundleResult result = SolveCalibrationBundle(scene.problem, {});
   ASSERT_TRUE(result.covariance_ok);
@@ -327,7 +327,7 @@ TEST(CalibrationBundleTest, MonoInertialRecoversTimeOffsetAndCameraImuRotation) 
 // keyframes (almost no depth) leave the sigmas computable: Ceres' sparse QR refused the whole
 // covariance for such columns on every machine-hall replay.
 TEST(CalibrationBundleTest, StrippedAndDepthlessPointsLeaveTheCovarianceComputable) {
-  Scene scene = MakeScene(/*stereo=*/true, /*inertial=*/true, 0.5, 8);
+  CalibrationScene scene = MakeScene(/*stereo=*/true, /*inertial=*/true, 0.5, 8);
   scene.problem.free = AllFree(true, true);
   BundleProblem& visual = scene.problem.bundle.visual;
   const auto add_point = [&](const Eigen::Vector3d& p_world, const Eigen::Vector2d& offset) {
@@ -359,7 +359,7 @@ TEST(CalibrationBundleTest, StrippedAndDepthlessPointsLeaveTheCovarianceComputab
 }
 
 TEST(CalibrationBundleTest, AbortedBeforeStartReturnsTheInitialCalibration) {
-  Scene scene = MakeScene(true, true, 0.5, 7);
+  CalibrationScene scene = MakeScene(true, true, 0.5, 7);
   scene.problem.free = AllFree(true, true);
   const std::atomic<bool> abort{true};
   const CalibrationBundleResult result = SolveCalibrationBundle(scene.problem, {}, &abort);
