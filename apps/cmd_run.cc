@@ -164,6 +164,11 @@ void RegisterRunCommand(CLI::App& app) {
                 args->options.system.mapping.calibration.gyro_scale,
                 "--calibrate online, inertial: hold the gyroscope's scale factors at the file's "
                 "values (estimated by default; docs/calibration.md)");
+  cmd->add_flag("--calibrate-in-mapping{false}",
+                args->options.system.mapping.calibration.own_thread,
+                "--calibrate online: solve each adjustment inside local mapping's keyframe step, "
+                "holding mapping meanwhile, instead of in a thread of its own (as before "
+                "2026-11-29; always so under --deterministic)");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_flag(
       "--kitti-colour", args->options.kitti_colour,

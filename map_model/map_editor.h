@@ -8,6 +8,7 @@
 //   tracking       kInitialise, kInsertKeyFrame, kReset
 //   local mapping  kProcessKeyFrame, kCullPoints, kCreatePoints, kFuse, kCullKeyFrames,
 //                  kApplyBundle, kApplyInertialBundle, kInertialInitialisation, kCalibration
+//                  (kCalibration also from its calibration thread)
 //   loop closing   kLoopCorrection, kMergeMaps, kGlobalBundle
 //   system         kLoadMap, kCalibration (the file's calibration before the first frame)
 //   tests          kFixture (maps built by hand)

@@ -71,6 +71,7 @@ void LocalMapper::Finish() {
   paced_.notify_all();
   if (thread_.joinable()) {
     thread_.join();
+    StopCalibrationThread();  // the run's final adjustment follows (SlamSystem)
   } else {
     // Never started: drain inline so every keyframe still gets processed.
     while (HasQueued()) ProcessNext();
@@ -215,6 +216,7 @@ void LocalMapper::RequestStop() {
     stop_requested_ = true;
   }
   abort_ba_.store(true);
+  calibration_abort_.store(true);  // a loop correction or merge would discard its result
   wake_.notify_all();
   paced_.notify_all();
 }
@@ -245,6 +247,9 @@ void LocalMapper::Run() {
       wake_.wait(lock);
     }
     if (reset_requested_) {
+      lock.unlock();
+      StopCalibrationThread();  // its map is about to go
+      lock.lock();
       live_free_ns_ = std::numeric_limits<std::int64_t>::min();
       queue_.clear();
       recent_points_.clear();

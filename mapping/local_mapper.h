@@ -203,8 +203,23 @@ class LocalMapper : public MappingBackend {
   // Gravity refinement when due (InertialMappingOptions::gravity_refinement).
   void RefineGravity(const KeyFramePtr& kf);
   // --- online calibration (mapping/local_mapper_calibration.cc) ---
-  // A calibration bundle adjustment of kf's map when due (OnlineCalibrationOptions).
+  // One calibration adjustment: gathered in the keyframe step, then solved and applied.
+  struct CalibrationJob {
+    KeyFramePtr kf;  // the keyframe that triggered it
+    CalibrationBundleProblem problem;
+    CalibrationRefinementStat stat;
+    RigSetup setup;        // the rig it was gathered with
+    int change_index = 0;  // its map's change index then
+  };
+  // A calibration bundle adjustment of kf's map when due (OnlineCalibrationOptions): started in
+  // the calibration thread (own_thread) or run inside the step.
   void RefineCalibration(const KeyFramePtr& kf);
+  // Solves `job` and applies it unless the map moved meanwhile. `abort`: the flag that
+  // interrupts the solve; `work`: the meter it counts on (nullptr: none).
+  void SolveAndApplyCalibration(CalibrationJob job, const std::atomic<bool>* abort,
+                                WorkMeter* work);
+  void JoinCalibrationThread();  // waits for the calibration thread, if any
+  void StopCalibrationThread();  // interrupts it and waits
 
   Atlas* atlas_;
   std::shared_ptr<const CameraRig> rig_;
@@ -267,6 +282,17 @@ class LocalMapper : public MappingBackend {
   // which its next adjustment is due.
   const Map* calibration_map_ = nullptr;
   double calibration_due_s_ = 0;
+  // The calibration thread (OnlineCalibrationOptions::own_thread), one adjustment at a time:
+  // started and joined by the mapping thread; the reset stops it before the queue is cleared,
+  // Finish after the mapping thread has ended. It writes the map under the map's write lock and
+  // the stats and the retry under mutex_; `calibration_running_` is true from its start until
+  // its job has ended, `calibration_abort_` interrupts its solve (RequestStop, reset, Finish).
+  std::thread calibration_thread_;
+  std::atomic<bool> calibration_running_{false};
+  std::atomic<bool> calibration_abort_{false};
+  // Set when an adjustment was not applied because the map moved meanwhile: the span at which
+  // the next keyframe tries again.
+  std::optional<double> calibration_retry_s_ PKSLAM_GUARDED_BY(mutex_);
 
   std::thread thread_;
 };

@@ -1,8 +1,11 @@
 // LocalMapper: online calibration (docs/calibration.md). A calibration bundle adjustment of the
-// whole map when due, solved without the lock and applied like a global BA.
+// whole map when due: gathered in the keyframe step, solved without the lock in a thread of its
+// own while local mapping goes on (inside the step under lockstep and --deterministic), and
+// applied like a global BA.
 #include <fmt/format.h>
 
 #include <chrono>
+#include <string>
 
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -17,12 +20,17 @@ namespace pkslam {
 
 void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
   const OnlineCalibrationOptions& o = options_.calibration;
-  // A queued keyframe comes first; the next one tries again.
-  if (HasQueued()) return;
-  CalibrationBundleProblem problem;
-  CalibrationRefinementStat stat;
-  int change_index = 0;
-  RigSetup setup;
+  // A queued keyframe comes first; the next one tries again. So does an adjustment still solving
+  // in its own thread.
+  if (HasQueued() || calibration_running_.load()) return;
+  JoinCalibrationThread();  // the previous adjustment has ended
+  {
+    MutexLock lock(mutex_);
+    if (calibration_retry_s_) calibration_due_s_ = *calibration_retry_s_;
+    calibration_retry_s_.reset();
+  }
+  CalibrationJob job;
+  job.kf = kf;
   {
     auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return;
@@ -33,8 +41,8 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
     }
     const KeyFrame* origin = map->origin();
     if (origin == nullptr) return;
-    stat.span_s = kf->t_s() - origin->t_s();
-    if (stat.span_s < calibration_due_s_) return;
+    job.stat.span_s = kf->t_s() - origin->t_s();
+    if (job.stat.span_s < calibration_due_s_) return;
     // An inertial map is adjusted with its IMU once its first visual-inertial BA settled the
     // scale and gravity (ORB-SLAM3's VIBA1, about 5 s after the IMU initialisation).
     const bool inertial = IsInertial(rig_->sensor) && map->imu_status().inertial_ba1_done;
@@ -42,17 +50,46 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
     CalibrationCollectOptions collect;
     collect.max_observations_per_keyframe = o.max_observations_per_keyframe;
     collect.gyro_scale_jacobians = o.gyro_scale;
-    setup = atlas_->rig_setup();
-    problem = CollectCalibrationBundle(kf.get(), inertial, setup, atlas_->calibration(),
-                                       calibration_prior_, collect);
-    change_index = map->change_index();
+    job.setup = atlas_->rig_setup();
+    job.problem = CollectCalibrationBundle(kf.get(), inertial, job.setup, atlas_->calibration(),
+                                           calibration_prior_, collect);
+    job.change_index = map->change_index();
   }
-  calibration_due_s_ = stat.span_s * o.growth;
-  stat.t_ns = kf->t_ns();
-  stat.keyframes = static_cast<int>(problem.bundle.visual.keyframes.size());
-  stat.observations = static_cast<int>(problem.raw.size());
-  stat.gates = DecideFreedom(problem, rig_->sensor, o);
-  problem.free = stat.gates.free;
+  calibration_due_s_ = job.stat.span_s * o.growth;
+  job.stat.t_ns = kf->t_ns();
+  job.stat.keyframes = static_cast<int>(job.problem.bundle.visual.keyframes.size());
+  job.stat.observations = static_cast<int>(job.problem.raw.size());
+  job.stat.gates = DecideFreedom(job.problem, rig_->sensor, o);
+  job.problem.free = job.stat.gates.free;
+  if (!o.own_thread || !thread_.joinable()) {
+    // In the keyframe step: its work counts on local mapping's clock and a new keyframe
+    // interrupts it (after `min_iterations`).
+    SolveAndApplyCalibration(std::move(job), &abort_ba_, &work_);
+    return;
+  }
+  calibration_abort_.store(false);
+  calibration_running_.store(true);
+  calibration_thread_ = std::thread([this, job = std::move(job)]() mutable {
+    SolveAndApplyCalibration(std::move(job), &calibration_abort_, nullptr);
+    calibration_running_.store(false);
+  });
+}
+
+void LocalMapper::JoinCalibrationThread() {
+  if (calibration_thread_.joinable()) calibration_thread_.join();
+}
+
+void LocalMapper::StopCalibrationThread() {
+  calibration_abort_.store(true);
+  JoinCalibrationThread();
+}
+
+void LocalMapper::SolveAndApplyCalibration(CalibrationJob job, const std::atomic<bool>* abort,
+                                           WorkMeter* work) {
+  const OnlineCalibrationOptions& o = options_.calibration;
+  CalibrationBundleProblem& problem = job.problem;
+  CalibrationRefinementStat& stat = job.stat;
+  const KeyFramePtr& kf = job.kf;
   const auto start = std::chrono::steady_clock::now();
   const auto finish = [&](const std::string& note) {
     stat.note = note;
@@ -74,7 +111,7 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
   ba.covariance = false;
   ba.min_iterations_before_abort = o.min_iterations;
   ba.prior = o.prior;
-  const CalibrationBundleResult result = SolveCalibrationBundle(problem, ba, &abort_ba_, &work_);
+  const CalibrationBundleResult result = SolveCalibrationBundle(problem, ba, abort, work);
   stat.iterations = result.bundle.visual.iterations;
   stat.initial_cost = result.bundle.visual.initial_cost;
   stat.final_cost = result.bundle.visual.final_cost;
@@ -96,23 +133,36 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
     finish(fmt::format("estimate rejected: {}", e.what()));
     return;
   }
+  std::string note;
   {
     auto lock = MapEditor(atlas_).Write(MapEdit::kCalibration);
     Map* map = kf->map();
-    if (map == nullptr || kf->IsBad() || map->change_index() != change_index ||
-        atlas_->rig_setup().rig != setup.rig) {
-      // A loop correction, merge or another calibration moved the map meanwhile.
+    if (map == nullptr || kf->IsBad() || map->id() != problem.bundle.visual.map_id ||
+        atlas_->rig_setup().rig != job.setup.rig) {
+      // A merge, reset or another calibration replaced the map or the rig meanwhile.
       lock.unlock();
-      calibration_due_s_ = stat.span_s;  // try again with the next keyframe
+      {
+        MutexLock retry_lock(mutex_);
+        calibration_retry_s_ = stat.span_s;  // try again with the next keyframe
+      }
       finish("the map moved meanwhile");
       return;
     }
-    ApplyCalibration(atlas_, map, problem, result, next);
+    if (map->change_index() != job.change_index) {
+      // A loop correction or global BA moved the map's states meanwhile: writing the
+      // adjustment's poses back would undo it. The calibration does not depend on where the
+      // map lies, so the map moves to it with the bodies where they are now, as after the
+      // final adjustment (a solve thrown away here was redone from the next keyframe on: 2-3
+      // of 9 adjustments of a V1_02 replay with loops, 2026-11-29).
+      MoveToCalibration(atlas_, result.estimate, next);
+      note = "calibration only: the map moved meanwhile";
+    } else {
+      ApplyCalibration(atlas_, map, problem, result, next);
+    }
   }
-  rig_ = next.rig;
   RefinePointsToCalibration(atlas_, problem.bundle.visual.map_id);
   stat.applied = true;
-  finish("");
+  finish(note);
   PKSLAM_LOG_INFO(
       "calibration at t = {:.1f} s ({} keyframes, {} observations, {} iterations): time offset "
       "{:.3f} ms",

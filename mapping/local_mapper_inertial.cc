@@ -111,6 +111,10 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
   moving_s_ += step_s;
   const double since =
       o.viba_motion_time ? moving_s_ : static_cast<double>(kf->t_ns() - init_t_ns) * 1e-9;
+  // The steps below move every state of the map (MergeGlobalBundle), which would make a
+  // calibration adjustment solving in its own thread find its map moved and be discarded; they
+  // wait for it to end (a later keyframe runs them).
+  if (calibration_running_.load()) return;
   auto mark = [&](bool second) {
     auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
     if (kf->map() == nullptr) return;

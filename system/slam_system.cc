@@ -53,7 +53,10 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
     options_.loop.num_threads = 1;
     options_.loop.global_ba_options.num_threads = 1;
   }
-  if (options_.mapping_sync == "lockstep") options_.tracking.lockstep = true;
+  if (options_.mapping_sync == "lockstep") {
+    options_.tracking.lockstep = true;
+    options_.mapping.calibration.own_thread = false;
+  }
   options_.tracking.seed = options_.seed;
   options_.loop.seed = options_.seed;
   options_.Check();
