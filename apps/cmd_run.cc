@@ -164,11 +164,13 @@ void RegisterRunCommand(CLI::App& app) {
                 args->options.system.mapping.calibration.gyro_scale,
                 "--calibrate online, inertial: hold the gyroscope's scale factors at the file's "
                 "values (estimated by default; docs/calibration.md)");
-  cmd->add_flag("--calibrate-in-mapping{false}",
-                args->options.system.mapping.calibration.own_thread,
-                "--calibrate online: solve each adjustment inside local mapping's keyframe step, "
-                "holding mapping meanwhile, instead of in a thread of its own (as before "
-                "2026-11-29; always so under --deterministic)");
+  cmd->add_option("--calibrate-thread", args->options.system.calibration_thread,
+                  "--calibrate online: where each adjustment solves: thread (beside local "
+                  "mapping, which goes on meanwhile), step (inside local mapping's keyframe step, "
+                  "holding it), auto (thread for --realtime and live inputs, step for offline "
+                  "runs, which then repeat exactly; always step under --deterministic)")
+      ->check(OneOf({"auto", "thread", "step"}))
+      ->default_str("auto");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_flag(
       "--kitti-colour", args->options.kitti_colour,

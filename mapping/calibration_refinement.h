@@ -40,8 +40,9 @@ struct OnlineCalibrationOptions {
   // after a loop runs beside it: inside the keyframe step an adjustment held local mapping for
   // 0.1-2.5 s, and tracking, which cannot insert keyframes meanwhile, waited for it in the live
   // emulation (docs/calibration.md, "Cost"). Its result is applied unless a loop correction or
-  // merge moved the map meanwhile; keyframes created meanwhile follow their parents. Off under
-  // lockstep and --deterministic (the result would depend on the threads' timing).
+  // merge moved the map meanwhile; keyframes created meanwhile follow their parents. Runs set it
+  // from SystemOptions::calibration_thread: on for live runs, off for the live emulation and
+  // lock-step, where the result would otherwise depend on this machine's timing.
   bool own_thread = true;
   // Too few keyframes tell too little.
   int min_keyframes = 10;

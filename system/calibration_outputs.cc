@@ -78,6 +78,7 @@ void WriteCalibrationJson(const CalibrationReport& report,
   json->Member("mode", report.online ? "online" : "off");
   json->Member("covariance", report.covariance_ok);
   json->Member("note", report.note);
+  json->Member("solved_in", report.solved_in);
   json->Key("final_timing").BeginObject();
   json->Member("collect_ms", report.final_timing.collect_ms);
   json->Member("solve_ms", report.final_timing.solve_ms);

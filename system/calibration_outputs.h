@@ -28,6 +28,9 @@ struct CalibrationReport {
   std::map<std::string, std::string> frozen;
   std::vector<CalibrationRefinementStat> history;
   std::string note;  // why the final adjustment was not applied ("" when it was, or off)
+  // Where the adjustments while mapping solved: "thread" (beside local mapping) or "step"
+  // (inside its keyframe step); "" when off.
+  std::string solved_in;
   // Wall time of the final adjustment after the last frame (0 without one): gathering the
   // map, the solve (its covariance included) and moving the map to the estimate. It is the part
   // of online calibration's cost that comes after the data (docs/calibration.md, "Cost").

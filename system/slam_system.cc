@@ -30,6 +30,10 @@ void SystemOptions::Check() const {
       mapping_sync == "live" || mapping_sync == "lockstep" || mapping_sync == "free",
       "mapping_sync", "'{}' (live|lockstep|free)", mapping_sync);
   PKSLAM_CHECK_OPTION(live_pace > 0 && live_pace <= 100, "live_pace", "{}", live_pace);
+  PKSLAM_CHECK_OPTION(
+      calibration_thread == "auto" || calibration_thread == "thread" ||
+          calibration_thread == "step",
+      "calibration_thread", "'{}' (auto|thread|step)", calibration_thread);
   PKSLAM_CHECK_OPTION(ParseLiveClock(live_clock).has_value(), "live_clock", "'{}' (work|cpu|wall)",
                       live_clock);
   tracking.Check();
@@ -53,10 +57,12 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
     options_.loop.num_threads = 1;
     options_.loop.global_ba_options.num_threads = 1;
   }
-  if (options_.mapping_sync == "lockstep") {
-    options_.tracking.lockstep = true;
-    options_.mapping.calibration.own_thread = false;
-  }
+  if (options_.mapping_sync == "lockstep") options_.tracking.lockstep = true;
+  // Lock-step maps each keyframe before the next frame: the adjustment belongs to its step.
+  options_.mapping.calibration.own_thread =
+      options_.mapping_sync != "lockstep" &&
+      (options_.calibration_thread == "thread" ||
+       (options_.calibration_thread == "auto" && options_.mapping_sync == "free"));
   options_.tracking.seed = options_.seed;
   options_.loop.seed = options_.seed;
   options_.Check();
@@ -190,6 +196,7 @@ void SlamSystem::FinishCalibration() {
 CalibrationReport SlamSystem::calibration_report() const {
   CalibrationReport report;
   report.online = options_.mapping.calibration.enabled;
+  if (report.online) report.solved_in = options_.mapping.calibration.own_thread ? "thread" : "step";
   report.sensor = options_.sensor;
   report.file = file_calibration_;
   {

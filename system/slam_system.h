@@ -38,6 +38,12 @@ struct SystemOptions {
   // mapped before the next frame; forced by `deterministic`), "free" (no coupling: what a
   // live run does, and what --realtime uses).
   std::string mapping_sync = "free";
+  // --calibrate online: where each calibration adjustment solves. "auto": in a thread of its own
+  // beside local mapping when mapping_sync is "free" (live runs: mapping never stops for it),
+  // inside local mapping's keyframe step otherwise (the live emulation paces local mapping, not
+  // that thread, so only in the step do offline runs repeat; docs/calibration.md, "Cost");
+  // "thread" / "step" force one.
+  std::string calibration_thread = "auto";
   // "live": playback speed of the emulated live run (1: frames at their timestamps; 2: twice
   // as fast, so local mapping's work spans twice as much data time).
   double live_pace = 2.0;

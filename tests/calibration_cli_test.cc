@@ -130,6 +130,7 @@ TEST_F(CalibrationCli, OnlineRunReportsAndWritesTheEstimate) {
   const YAML::Node c = ReadJsonFile(out / "stats.json")["calibration"];
   ASSERT_TRUE(c.IsMap());
   EXPECT_EQ(c["mode"].as<std::string>(), "online");
+  EXPECT_EQ(c["solved_in"].as<std::string>(), "step");  // --deterministic
   // Adjustments ran while mapping and at least one moved the map to its estimate.
   ASSERT_GE(c["history"].size(), 1u);
   bool applied = false;
@@ -177,6 +178,22 @@ TEST_F(CalibrationCli, DeterministicOnlineRunsAreIdentical) {
   EXPECT_EQ(testing::ReadFileBytes(Online() / "calibration/settings.yaml"),
             testing::ReadFileBytes(Dir() / "again/calibration/settings.yaml"));
   EXPECT_EQ(testing::ReadFileBytes(OnlineMap()), testing::ReadFileBytes(Dir() / "again.map"));
+}
+
+TEST_F(CalibrationCli, AdjustmentsInTheirOwnThreadAreAppliedAndReported) {
+  // Without --deterministic, which keeps them in local mapping's step, and with the thread asked
+  // for (offline runs default to the step).
+  const auto run = RunPkslam(fmt::format(
+      "--log-level info run --dataset '{}' --sensor stereo-inertial --out '{}' --quiet "
+      "--calibrate online --calibrate-thread thread",
+      Seq().string(), (Dir() / "thread").string()));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const YAML::Node c = ReadJsonFile(Dir() / "thread/stats.json")["calibration"];
+  EXPECT_EQ(c["solved_in"].as<std::string>(), "thread");
+  int applied = 0;
+  for (const YAML::Node& h : c["history"]) applied += h["applied"].as<bool>() ? 1 : 0;
+  EXPECT_GE(applied, 1) << run.output;
+  EXPECT_TRUE(c["covariance"].as<bool>());
 }
 
 TEST_F(CalibrationCli, OffReportsTheFileAndWritesItBack) {
@@ -235,6 +252,9 @@ TEST(CalibrationCliOptions, RejectsAnUnknownModeAndMonocularCalibrate) {
   const auto bad = RunPkslam("run --dataset nowhere --calibrate sometimes");
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_THAT(bad.output, HasSubstr("--calibrate"));
+  const auto where = RunPkslam("run --dataset nowhere --calibrate online --calibrate-thread both");
+  EXPECT_NE(where.exit_code, 0);
+  EXPECT_THAT(where.output, HasSubstr("--calibrate-thread"));
   const auto mono = RunPkslam("calibrate --dataset nowhere --sensor mono");
   EXPECT_NE(mono.exit_code, 0);
   EXPECT_THAT(mono.output, HasSubstr("stereo rig or an IMU"));
