@@ -6,6 +6,7 @@
 #include <shared_mutex>
 
 #include "core/camera/test_cameras.h"
+#include "core/sensor/test_rig_calibration.h"
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
@@ -24,13 +25,7 @@ RigShape StereoShape() {
   return shape;
 }
 
-RigCalibration EurocFile() {
-  RigCalibration c;
-  c.cameras = {testing::EurocCam0(), testing::EurocCam1()};
-  c.body_from_cam0 = testing::EurocBodyFromCam0();
-  c.cam1_from_cam0 = testing::EurocCam1FromCam0();
-  return c;
-}
+RigCalibration EurocFile() { return testing::EurocRigCalibration(); }
 
 // A map built in the rectified camera of the EuRoC calibration, the Atlas holding that
 // calibration.

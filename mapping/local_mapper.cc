@@ -5,6 +5,7 @@
 
 #include "core/util/cpu_time.h"
 #include "core/util/error.h"
+#include "core/util/wall_time.h"
 #include "map_model/keyframe.h"
 
 namespace pkslam {
@@ -178,9 +179,7 @@ bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
       idle_.wait(lock);  // a queued keyframe is about to be taken
     }
   }
-  stats_.live_wait_ms +=
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start)
-          .count();
+  stats_.live_wait_ms += WallMsSince(wait_start);
   return !busy_ && queue_.empty() && !stopped_ && !stop_requested_ && live_free_ns_ <= t_ns;
 }
 

@@ -1,7 +1,7 @@
 // LocalMapper: online calibration (docs/calibration.md). A calibration bundle adjustment of the
-// whole map when due: gathered in the keyframe step, solved without the lock in a thread of its
-// own while local mapping goes on (inside the step under lockstep and --deterministic), and
-// applied like a global BA.
+// whole map when due: gathered in the keyframe step, solved without the lock inside the step or
+// (OnlineCalibrationOptions::own_thread, live runs) in a thread of its own while local mapping
+// goes on, and applied like a global BA.
 #include <fmt/format.h>
 
 #include <chrono>
@@ -9,6 +9,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/wall_time.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
@@ -93,8 +94,7 @@ void LocalMapper::SolveAndApplyCalibration(CalibrationJob job, const std::atomic
   const auto start = std::chrono::steady_clock::now();
   const auto finish = [&](const std::string& note) {
     stat.note = note;
-    stat.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                  .count();
+    stat.ms = WallMsSince(start);
     MutexLock stats_lock(mutex_);
     stats_.calibration_refinements.push_back(stat);
   };

@@ -6,7 +6,7 @@
 #include <memory>
 #include <thread>
 
-#include "core/camera/test_cameras.h"
+#include "core/sensor/test_rig_calibration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map_editor.h"
 #include "map_model/testing/synthetic_map.h"
@@ -22,9 +22,7 @@ using namespace std::chrono_literals;
 class LocalMapperCalibrationTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    file_.cameras = {testing::EurocCam0(), testing::EurocCam1()};
-    file_.body_from_cam0 = testing::EurocBodyFromCam0();
-    file_.cam1_from_cam0 = testing::EurocCam1FromCam0();
+    file_ = testing::EurocRigCalibration();
     shape_.sensor = Sensor::kStereo;
     shape_.pyramid = ScalePyramid(8, 1.2);
     setup_ = BuildRig(file_, shape_);

@@ -7,6 +7,7 @@
 
 #include "core/util/error.h"
 #include "core/util/log.h"
+#include "core/util/wall_time.h"
 #include "estimators/inertial/inertial_initializer.h"
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
@@ -211,8 +212,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
     map->RecordWorldChange({});
     accel_bias = kf->imu.state.bias.accel;
   }
-  stat.ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stat.ms = WallMsSince(start);
   PKSLAM_LOG_INFO(
       "gravity refinement at t = {:.2f} s over {} keyframes (tilt observability {:.2f}): gravity "
       "moved {:.2f} mrad, cost {:.1f} -> {:.1f}, accel bias ({:.4f} {:.4f} {:.4f}), {:.0f} ms{}",
@@ -302,8 +302,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
     if (!refinement) map->mutable_imu_status().imu_init_t_ns = kf->t_ns();
     map->RecordWorldChange({WorldChange::Kind::kTransform, new_from_old, r.scale});
   }
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms = WallMsSince(start);
   PKSLAM_LOG_INFO(
       "IMU {} at t = {:.2f} s over {} keyframes: scale {:.4f}, gyro bias ({:.5f} "
       "{:.5f} {:.5f}), accel bias ({:.4f} {:.4f} {:.4f}), {:.0f} ms",

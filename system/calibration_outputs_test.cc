@@ -3,7 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "core/camera/test_cameras.h"
+#include "core/sensor/test_rig_calibration.h"
 #include "io/euroc_sensor.h"
 #include "tests/support/test_data.h"
 
@@ -18,9 +18,7 @@ CalibrationReport Report() {
   r.online = true;
   r.covariance_ok = true;
   r.sensor = Sensor::kStereoInertial;
-  r.file.cameras = {testing::EurocCam0(), testing::EurocCam1()};
-  r.file.body_from_cam0 = testing::EurocBodyFromCam0();
-  r.file.cam1_from_cam0 = testing::EurocCam1FromCam0();
+  r.file = testing::EurocRigCalibration();
   r.estimate = r.file;
   r.estimate.time_offset_s = 3.0e-3;
   r.estimate.gyro_scale = Eigen::Vector3d(0.001, 0.0048, -0.0011);

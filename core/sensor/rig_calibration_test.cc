@@ -5,18 +5,13 @@
 #include <cmath>
 
 #include "core/camera/test_cameras.h"
+#include "core/sensor/test_rig_calibration.h"
 #include "core/util/error.h"
 
 namespace pkslam {
 namespace {
 
-RigCalibration EurocStereo() {
-  RigCalibration c;
-  c.cameras = {testing::EurocCam0(), testing::EurocCam1()};
-  c.body_from_cam0 = testing::EurocBodyFromCam0();
-  c.cam1_from_cam0 = testing::EurocCam1FromCam0();
-  return c;
-}
+RigCalibration EurocStereo() { return testing::EurocRigCalibration(); }
 
 RigShape Shape(Sensor sensor) {
   RigShape shape;

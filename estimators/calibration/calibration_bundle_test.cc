@@ -6,7 +6,7 @@
 #include <iostream>
 #include <random>
 
-#include "core/camera/test_cameras.h"
+#include "core/sensor/test_rig_calibration.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
 
@@ -27,10 +27,7 @@ struct CalibrationScene {
 };
 
 RigCalibration EurocTruth() {
-  RigCalibration c;
-  c.cameras = {testing::EurocCam0(), testing::EurocCam1()};
-  c.body_from_cam0 = testing::EurocBodyFromCam0();
-  c.cam1_from_cam0 = testing::EurocCam1FromCam0();
+  RigCalibration c = testing::EurocRigCalibration();
   c.time_offset_s = 1.5e-3;
   // The gyro reads 0.5% fast about the IMU's y axis (cam0's x: the camera's pitch), as the
   // realistic replays' gyro does (docs/calibration.md), and a little off about the others.
@@ -204,7 +201,8 @@ double StereoDepthError(const RigCalibration& calibration, const RigCalibration&
 }
 
 // Every free parameter's estimate lies within `k` posterior sigmas of the truth.
-void ExpectWithinSigmas(const CalibrationBundleResult& result, const CalibrationScene& scene, double k) {
+void ExpectWithinSigmas(const CalibrationBundleResult& result, const CalibrationScene& scene,
+                        double k) {
   const std::vector<CalibrationParameter> truth = CalibrationParameters(
       scene.file, scene.truth, scene.problem.free, {}, scene.problem.inertial);
   ASSERT_EQ(truth.size(), result.parameters.size());

@@ -5,7 +5,6 @@
 #include <cholmod.h>
 
 #include <algorithm>
-#include <memory>
 #include <unordered_map>
 
 #include "core/util/error.h"
