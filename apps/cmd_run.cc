@@ -167,8 +167,8 @@ void RegisterRunCommand(CLI::App& app) {
   cmd->add_option("--calibrate-thread", args->options.system.calibration_thread,
                   "--calibrate online: where each adjustment solves: thread (beside local "
                   "mapping, which goes on meanwhile), step (inside local mapping's keyframe step, "
-                  "holding it), auto (thread for --realtime and live inputs, step for offline "
-                  "runs, which then repeat exactly; always step under --deterministic)")
+                  "holding it), auto (thread, paced by the live emulation in offline runs so "
+                  "they repeat; step in lock-step runs such as --deterministic)")
       ->check(OneOf({"auto", "thread", "step"}))
       ->default_str("auto");
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");

@@ -39,10 +39,11 @@ struct OnlineCalibrationOptions {
   // Solve each adjustment in a thread of its own while local mapping goes on, as the global BA
   // after a loop runs beside it: inside the keyframe step an adjustment held local mapping for
   // 0.1-2.5 s, and tracking, which cannot insert keyframes meanwhile, waited for it in the live
-  // emulation (docs/calibration.md, "Cost"). Its result is applied unless a loop correction or
-  // merge moved the map meanwhile; keyframes created meanwhile follow their parents. Runs set it
-  // from SystemOptions::calibration_thread: on for live runs, off for the live emulation and
-  // lock-step, where the result would otherwise depend on this machine's timing.
+  // emulation (docs/calibration.md, "Cost"). Its result is applied (its calibration only if a
+  // loop correction moved the map meanwhile, nothing if a merge replaced it); keyframes created
+  // meanwhile follow their parents. Under the work-clock live emulation local mapping applies
+  // it where its counted work makes it due, so offline runs repeat. Runs set it from
+  // SystemOptions::calibration_thread: off in lock-step, where each keyframe's step ends it.
   bool own_thread = true;
   // Too few keyframes tell too little.
   int min_keyframes = 10;

@@ -215,7 +215,9 @@ void LocalMapper::RequestStop() {
     stop_requested_ = true;
   }
   abort_ba_.store(true);
-  calibration_abort_.store(true);  // a loop correction or merge would discard its result
+  // A merge would discard the adjustment's result. A paced one runs on: where it stopped would
+  // depend on this machine's speed.
+  if (!Paced()) calibration_abort_.store(true);
   wake_.notify_all();
   paced_.notify_all();
 }

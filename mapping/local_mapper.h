@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <future>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -181,6 +182,11 @@ class LocalMapper : public MappingBackend {
   // thread with no map lock held: before each step that changes the map and after each solver
   // iteration (the work meter's pacer). No-op otherwise.
   void PaceToTracker();
+  // PaceToTracker, then a calibration adjustment due by then (ApplyDueCalibration).
+  void StepBoundary() {
+    PaceToTracker();
+    ApplyDueCalibration();
+  }
   // Live emulation: the data time the current keyframe's processing has reached.
   std::int64_t LiveReachedNs() const PKSLAM_REQUIRES(mutex_);
   bool Paced() const { return emulate_live_ && live_clock_ == LiveClock::kWork; }
@@ -211,15 +217,32 @@ class LocalMapper : public MappingBackend {
     RigSetup setup;        // the rig it was gathered with
     int change_index = 0;  // its map's change index then
   };
+  // A solved adjustment waiting to be applied.
+  struct SolvedCalibration {
+    CalibrationJob job;
+    CalibrationBundleResult result;
+    RigSetup next;  // the rig of the estimate (built outside the map lock)
+    std::chrono::steady_clock::time_point start;
+  };
   // A calibration bundle adjustment of kf's map when due (OnlineCalibrationOptions): started in
   // the calibration thread (own_thread) or run inside the step.
   void RefineCalibration(const KeyFramePtr& kf);
-  // Solves `job` and applies it unless the map moved meanwhile. `abort`: the flag that
-  // interrupts the solve; `work`: the meter it counts on (nullptr: none).
-  void SolveAndApplyCalibration(CalibrationJob job, const std::atomic<bool>* abort,
-                                WorkMeter* work);
+  // Solves `job`; nullopt when there is nothing to apply (the stats say why). `abort`: the flag
+  // that interrupts the solve; `work`: the meter it counts on (nullptr: none).
+  std::optional<SolvedCalibration> SolveCalibration(CalibrationJob job,
+                                                    const std::atomic<bool>* abort,
+                                                    WorkMeter* work);
+  // Applies a solved adjustment unless the map or the rig was replaced meanwhile.
+  void ApplySolvedCalibration(SolvedCalibration solved);
+  // Live emulation on the work clock with own_thread: applies the adjustment solving in the
+  // calibration thread once local mapping's data time has passed the data time it was started
+  // at plus its solve's work on the reference machine (waiting for the solve if this machine is
+  // slower), so the run repeats exactly. Mapping thread, at its step boundaries.
+  void ApplyDueCalibration();
+  // Whether an adjustment started and has not ended (paced: not yet applied or dropped).
+  bool CalibrationOutstanding() const;
   void JoinCalibrationThread();  // waits for the calibration thread, if any
-  void StopCalibrationThread();  // interrupts it and waits
+  void StopCalibrationThread();  // interrupts it, waits, and drops a paced result
 
   Atlas* atlas_;
   std::shared_ptr<const CameraRig> rig_;
@@ -286,10 +309,21 @@ class LocalMapper : public MappingBackend {
   // started and joined by the mapping thread; the reset stops it before the queue is cleared,
   // Finish after the mapping thread has ended. It writes the map under the map's write lock and
   // the stats and the retry under mutex_; `calibration_running_` is true from its start until
-  // its job has ended, `calibration_abort_` interrupts its solve (RequestStop, reset, Finish).
+  // its job has ended, `calibration_abort_` interrupts its solve (reset, Finish; RequestStop
+  // unless paced).
   std::thread calibration_thread_;
   std::atomic<bool> calibration_running_{false};
   std::atomic<bool> calibration_abort_{false};
+  // Paced (live emulation on the work clock): the thread only solves, counting on
+  // calibration_work_, and hands the result over through calibration_solved_; the mapping
+  // thread owns the rest and applies it (ApplyDueCalibration). RequestStop does not interrupt
+  // a paced solve (where it stopped would depend on this machine's speed); a loop correction
+  // meanwhile is met by applying the calibration only.
+  WorkMeter calibration_work_;
+  std::future<std::optional<SolvedCalibration>> calibration_solved_;
+  bool calibration_pending_ = false;  // a paced job started, not yet applied or dropped
+  std::int64_t calibration_start_ns_ = 0;  // the data time it started at
+  WorkCounts calibration_work_start_{};    // calibration_work_ then
   // Set when an adjustment was not applied because the map moved meanwhile: the span at which
   // the next keyframe tries again.
   std::optional<double> calibration_retry_s_ PKSLAM_GUARDED_BY(mutex_);

@@ -1,10 +1,14 @@
 // LocalMapper: online calibration (docs/calibration.md). A calibration bundle adjustment of the
 // whole map when due: gathered in the keyframe step, solved without the lock inside the step or
-// (OnlineCalibrationOptions::own_thread, live runs) in a thread of its own while local mapping
-// goes on, and applied like a global BA.
+// (OnlineCalibrationOptions::own_thread) in a thread of its own while local mapping goes on, and
+// applied like a global BA. Under live emulation on the work clock the thread's result is
+// applied by local mapping at the data time its work would have ended on the reference machine
+// (ApplyDueCalibration), so offline runs repeat exactly.
 #include <fmt/format.h>
 
 #include <chrono>
+#include <exception>
+#include <future>
 #include <string>
 
 #include "core/util/error.h"
@@ -23,7 +27,7 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
   const OnlineCalibrationOptions& o = options_.calibration;
   // A queued keyframe comes first; the next one tries again. So does an adjustment still solving
   // in its own thread.
-  if (HasQueued() || calibration_running_.load()) return;
+  if (HasQueued() || CalibrationOutstanding()) return;
   JoinCalibrationThread();  // the previous adjustment has ended
   {
     MutexLock lock(mutex_);
@@ -65,15 +69,70 @@ void LocalMapper::RefineCalibration(const KeyFramePtr& kf) {
   if (!o.own_thread || !thread_.joinable()) {
     // In the keyframe step: its work counts on local mapping's clock and a new keyframe
     // interrupts it (after `min_iterations`).
-    SolveAndApplyCalibration(std::move(job), &abort_ba_, &work_);
+    if (auto solved = SolveCalibration(std::move(job), &abort_ba_, &work_)) {
+      ApplySolvedCalibration(std::move(*solved));
+    }
     return;
   }
   calibration_abort_.store(false);
   calibration_running_.store(true);
-  calibration_thread_ = std::thread([this, job = std::move(job)]() mutable {
-    SolveAndApplyCalibration(std::move(job), &calibration_abort_, nullptr);
-    calibration_running_.store(false);
-  });
+  if (!Paced()) {
+    calibration_thread_ = std::thread([this, job = std::move(job)]() mutable {
+      if (auto solved = SolveCalibration(std::move(job), &calibration_abort_, nullptr)) {
+        ApplySolvedCalibration(std::move(*solved));
+      }
+      calibration_running_.store(false);
+    });
+    return;
+  }
+  {
+    MutexLock lock(mutex_);
+    calibration_start_ns_ = LiveReachedNs();
+  }
+  calibration_work_start_ = calibration_work_.Snapshot();
+  calibration_pending_ = true;
+  std::promise<std::optional<SolvedCalibration>> promise;
+  calibration_solved_ = promise.get_future();
+  calibration_thread_ = std::thread(
+      [this, job = std::move(job), promise = std::move(promise)]() mutable {
+        try {
+          promise.set_value(SolveCalibration(std::move(job), &calibration_abort_,
+                                             &calibration_work_));
+        } catch (...) {
+          promise.set_exception(std::current_exception());  // rethrown on the mapping thread
+        }
+        calibration_running_.store(false);
+      });
+}
+
+bool LocalMapper::CalibrationOutstanding() const {
+  return Paced() ? calibration_pending_ : calibration_running_.load();
+}
+
+void LocalMapper::ApplyDueCalibration() {
+  if (!calibration_pending_) return;
+  while (true) {
+    std::int64_t reached = 0;
+    {
+      MutexLock lock(mutex_);
+      if (stop_requested_ || finish_requested_ || reset_requested_) return;
+      reached = LiveReachedNs();
+    }
+    // Read `done` before the work: once done, the count read after it is the final one.
+    const bool done =
+        calibration_solved_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+    const std::int64_t due =
+        calibration_start_ns_ +
+        DataNs(kReferenceWork.Seconds(calibration_work_.Snapshot() - calibration_work_start_));
+    if (due >= reached) return;  // not due yet: its work so far already reaches past now
+    if (done) break;
+    // Due by now on the reference machine, still solving on this one: wait for its work.
+    calibration_solved_.wait_for(std::chrono::milliseconds(2));
+  }
+  calibration_pending_ = false;
+  std::optional<SolvedCalibration> solved = calibration_solved_.get();
+  JoinCalibrationThread();
+  if (solved) ApplySolvedCalibration(std::move(*solved));
 }
 
 void LocalMapper::JoinCalibrationThread() {
@@ -83,26 +142,38 @@ void LocalMapper::JoinCalibrationThread() {
 void LocalMapper::StopCalibrationThread() {
   calibration_abort_.store(true);
   JoinCalibrationThread();
+  if (!calibration_pending_) return;
+  calibration_pending_ = false;
+  try {
+    if (std::optional<SolvedCalibration> solved = calibration_solved_.get()) {
+      CalibrationRefinementStat& stat = solved->job.stat;
+      stat.note = "not applied: the run ended or reset before it was due";
+      stat.ms = WallMsSince(solved->start);
+      MutexLock lock(mutex_);
+      stats_.calibration_refinements.push_back(stat);
+    }
+  } catch (const std::exception& e) {
+    PKSLAM_LOG_WARN("calibration adjustment failed: {}", e.what());
+  }
 }
 
-void LocalMapper::SolveAndApplyCalibration(CalibrationJob job, const std::atomic<bool>* abort,
-                                           WorkMeter* work) {
+std::optional<LocalMapper::SolvedCalibration> LocalMapper::SolveCalibration(
+    CalibrationJob job, const std::atomic<bool>* abort, WorkMeter* work) {
   const OnlineCalibrationOptions& o = options_.calibration;
   CalibrationBundleProblem& problem = job.problem;
   CalibrationRefinementStat& stat = job.stat;
-  const KeyFramePtr& kf = job.kf;
   const auto start = std::chrono::steady_clock::now();
-  const auto finish = [&](const std::string& note) {
+  const auto finish = [&](const std::string& note) -> std::optional<SolvedCalibration> {
     stat.note = note;
     stat.ms = WallMsSince(start);
     MutexLock stats_lock(mutex_);
     stats_.calibration_refinements.push_back(stat);
+    return std::nullopt;
   };
   if (!problem.free.Any() || problem.empty()) {
     stat.parameters = CalibrationParameters(problem.prior, problem.initial, problem.free,
                                             o.prior, problem.inertial);
-    finish("nothing observable yet");
-    return;
+    return finish("nothing observable yet");
   }
   CalibrationBundleOptions ba;
   ba.iterations_first = o.iterations_first;
@@ -111,28 +182,41 @@ void LocalMapper::SolveAndApplyCalibration(CalibrationJob job, const std::atomic
   ba.covariance = false;
   ba.min_iterations_before_abort = o.min_iterations;
   ba.prior = o.prior;
-  const CalibrationBundleResult result = SolveCalibrationBundle(problem, ba, abort, work);
+  CalibrationBundleResult result = SolveCalibrationBundle(problem, ba, abort, work);
   stat.iterations = result.bundle.visual.iterations;
   stat.initial_cost = result.bundle.visual.initial_cost;
   stat.final_cost = result.bundle.visual.final_cost;
   stat.parameters = result.parameters;
   if (result.bundle.visual.iterations == 0) {
-    finish("interrupted before its first step");
-    return;
+    return finish("interrupted before its first step");
   }
   if (const auto why = ImplausibleEstimate(problem, result.estimate, o, o.max_step_prior_sigmas)) {
     PKSLAM_LOG_WARN("calibration adjustment at t = {:.1f} s not applied: {}", stat.span_s, *why);
-    finish("rejected: " + *why);
-    return;
+    return finish("rejected: " + *why);
   }
   // The new rig (rectification maps) is built outside the lock.
   RigSetup next;
   try {
     next = BuildRig(result.estimate, rig_shape_);
   } catch (const OptionError& e) {
-    finish(fmt::format("estimate rejected: {}", e.what()));
-    return;
+    return finish(fmt::format("estimate rejected: {}", e.what()));
   }
+  return SolvedCalibration{std::move(job), std::move(result), std::move(next), start};
+}
+
+void LocalMapper::ApplySolvedCalibration(SolvedCalibration solved) {
+  const CalibrationBundleProblem& problem = solved.job.problem;
+  CalibrationRefinementStat& stat = solved.job.stat;
+  const KeyFramePtr& kf = solved.job.kf;
+  const CalibrationBundleResult& result = solved.result;
+  const RigSetup& next = solved.next;
+  const CalibrationJob& job = solved.job;
+  const auto finish = [&](const std::string& note) {
+    stat.note = note;
+    stat.ms = WallMsSince(solved.start);
+    MutexLock stats_lock(mutex_);
+    stats_.calibration_refinements.push_back(stat);
+  };
   std::string note;
   {
     auto lock = MapEditor(atlas_).Write(MapEdit::kCalibration);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <thread>
 
@@ -19,34 +20,49 @@ using namespace std::chrono_literals;
 
 // Twelve keyframes of a stereo map built in the rectified camera of the EuRoC calibration,
 // which the Atlas and the mapper's prior hold (12 x 50 ms of data).
-class LocalMapperCalibrationTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    file_ = testing::EurocRigCalibration();
-    shape_.sensor = Sensor::kStereo;
-    shape_.pyramid = ScalePyramid(8, 1.2);
-    setup_ = BuildRig(file_, shape_);
+struct CalibrationMapFixture {
+  CalibrationMapFixture() {
+    file = testing::EurocRigCalibration();
+    shape.sensor = Sensor::kStereo;
+    shape.pyramid = ScalePyramid(8, 1.2);
+    setup = BuildRig(file, shape);
     {
-      auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-      atlas_.SetCalibration(file_, setup_);
+      auto lock = MapEditor(&atlas).Write(MapEdit::kFixture);
+      atlas.SetCalibration(file, setup);
     }
     testing::FrameOptions frames;
     frames.pixel_noise = 0.5;
-    map_ = testing::MakeMap(&atlas_, testing::MakeScene(600, 11), setup_.rig,
-                            testing::MakeForwardPath(12, 0.15, 3), frames);
+    map = testing::MakeMap(&atlas, testing::MakeScene(600, 11), setup.rig,
+                           testing::MakeForwardPath(12, 0.15, 3), frames);
   }
 
-  // A started mapper with online calibration due from the start (0.1 s of data).
-  std::unique_ptr<LocalMapper> StartMapper(bool own_thread) {
+  // A started mapper with online calibration due from the start (0.1 s of data). `paced`: live
+  // emulation on the work clock, tracking far ahead (so pacing never waits for it).
+  std::unique_ptr<LocalMapper> StartMapper(bool own_thread, bool paced = false) {
     LocalMappingOptions options;
     options.cull_keyframes = false;
     options.calibration.enabled = true;
     options.calibration.first_after_s = 0.1;
     options.calibration.own_thread = own_thread;
-    auto mapper = std::make_unique<LocalMapper>(&atlas_, setup_.rig, options);
-    mapper->SetCalibrationPrior(file_, shape_);
+    auto mapper = std::make_unique<LocalMapper>(&atlas, setup.rig, options);
+    mapper->SetCalibrationPrior(file, shape);
+    if (paced) mapper->EmulateLive(true, 1.0, LiveClock::kWork);
     mapper->Start();
+    if (paced) mapper->NoteFrameTime(std::numeric_limits<std::int64_t>::max() / 2);
     return mapper;
+  }
+
+  Atlas atlas;
+  RigCalibration file;
+  RigShape shape;
+  RigSetup setup;
+  testing::SyntheticMap map;
+};
+
+class LocalMapperCalibrationTest : public ::testing::Test {
+ protected:
+  std::unique_ptr<LocalMapper> StartMapper(bool own_thread) {
+    return fixture_.StartMapper(own_thread);
   }
 
   // Waits (up to 60 s) until the mapper has recorded `count` adjustments.
@@ -60,12 +76,33 @@ class LocalMapperCalibrationTest : public ::testing::Test {
     return mapper.stats().calibration_refinements;
   }
 
-  Atlas atlas_;
-  RigCalibration file_;
-  RigShape shape_;
-  RigSetup setup_;
-  testing::SyntheticMap map_;
+  CalibrationMapFixture fixture_;
+  Atlas& atlas_ = fixture_.atlas;
+  testing::SyntheticMap& map_ = fixture_.map;
 };
+
+// Paced (live emulation on the work clock), own thread: the number of keyframe steps local
+// mapping takes before the adjustment started with the first one is applied, -1 if none of 60.
+int KeyFrameStepsUntilPacedApply(int* applied_steps_after) {
+  CalibrationMapFixture f;
+  auto mapper = f.StartMapper(/*own_thread=*/true, /*paced=*/true);
+  const int version = f.atlas.calibration_version();
+  mapper->InsertKeyFrame(f.map.keyframes.back());
+  mapper->WaitUntilIdle();
+  // Started at the step's data time, due only once local mapping's work has passed its own:
+  // not applied within the step that started it, however fast this machine solved it.
+  EXPECT_EQ(f.atlas.calibration_version(), version);
+  int steps = -1;
+  for (int k = 1; k <= 60 && steps < 0; ++k) {
+    mapper->InsertKeyFrame(f.map.keyframes[static_cast<std::size_t>(k % 11)]);
+    mapper->WaitUntilIdle();
+    if (f.atlas.calibration_version() != version) steps = k;
+  }
+  mapper->Finish();
+  const auto adjustments = mapper->stats().calibration_refinements;
+  *applied_steps_after = adjustments.empty() || !adjustments[0].applied ? 0 : 1;
+  return steps;
+}
 
 TEST_F(LocalMapperCalibrationTest, AnAdjustmentInItsOwnThreadIsApplied) {
   auto mapper = StartMapper(/*own_thread=*/true);
@@ -109,6 +146,21 @@ TEST_F(LocalMapperCalibrationTest, AResetOrFinishWhileItSolvesEndsItCleanly) {
   const auto adjustments = mapper->stats().calibration_refinements;
   ASSERT_EQ(adjustments.size(), 1u);  // recorded however it ended
   EXPECT_FALSE(adjustments[0].note.empty() && !adjustments[0].applied);
+}
+
+
+TEST_F(LocalMapperCalibrationTest, PacedTheAdjustmentLandsAtTheSameStepOnAnyMachine) {
+  // Applied by local mapping once its data time passes the start plus the solve's work priced
+  // on the reference machine: the step it lands at depends on counted work only, not on how
+  // fast this machine (or the sanitizers' slowdown) solved it, so two runs agree.
+  int applied_first = 0;
+  int applied_second = 0;
+  const int first = KeyFrameStepsUntilPacedApply(&applied_first);
+  const int second = KeyFrameStepsUntilPacedApply(&applied_second);
+  ASSERT_GT(first, 0) << "the adjustment never landed";
+  EXPECT_EQ(applied_first, 1);
+  EXPECT_EQ(second, first);
+  EXPECT_EQ(applied_second, 1);
 }
 
 }  // namespace

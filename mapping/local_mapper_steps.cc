@@ -33,20 +33,20 @@ void LocalMapper::ProcessNext() {
   const WorkCounts work_start = work_.Snapshot();
   work_.Add(WorkKind::kKeyFrame, 1);
   abort_ba_.store(false);
-  // PaceToTracker (live emulation on the work clock) before every step that changes the map or
+  // StepBoundary (live emulation on the work clock) before every step that changes the map or
   // asks whether tracking queued a keyframe: both then happen at a data time tracking has
-  // reached, as in a live run.
-  PaceToTracker();
+  // reached, as in a live run; so does applying an adjustment solved in the calibration thread.
+  StepBoundary();
   ProcessNewKeyFrame(kf);
   CullRecentPoints(kf);
   CreateNewMapPoints(kf);
   double ba_ms = 0;
   double ba_cpu_ms = 0;
-  PaceToTracker();
+  StepBoundary();
   if (!HasQueued()) {
     SearchInNeighbours(kf);
   }
-  PaceToTracker();
+  StepBoundary();
   if (!HasQueued() && !IsStoppedOrStopRequested()) {
     int keyframes = 0;
     {
@@ -62,14 +62,14 @@ void LocalMapper::ProcessNext() {
       ba_ms = WallMsSince(ba_start);
       ba_cpu_ms = 1e3 * (ThreadCpuSeconds() - ba_cpu_start);
     }
-    PaceToTracker();
+    StepBoundary();
     if (options_.cull_keyframes) CullKeyFrames(kf);
   }
-  PaceToTracker();
+  StepBoundary();
   if (IsInertial(rig_->sensor) && !IsStoppedOrStopRequested()) InertialStep(kf);
-  PaceToTracker();
+  StepBoundary();
   if (options_.calibration.enabled && !IsStoppedOrStopRequested()) RefineCalibration(kf);
-  PaceToTracker();
+  StepBoundary();
   {
     MutexLock lock(mutex_);
     stats_.keyframe_ms.push_back(WallMsSince(start));
@@ -157,7 +157,7 @@ void LocalMapper::CreateNewMapPoints(const KeyFramePtr& kf) {
     }
   }
   if (created.empty()) return;
-  PaceToTracker();
+  PaceToTracker();  // not StepBoundary: the points were triangulated with the present rig
   auto lock = MapEditor(atlas_).Write(MapEdit::kCreatePoints);
   Map* map = kf->map();
   if (kf->IsBad() || map == nullptr) return;
@@ -232,7 +232,7 @@ void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
   }
   if (problem.empty()) return;
   const BundleResult result = SolveBundle(problem, options_.ba, &abort_ba_, &work_);
-  PaceToTracker();
+  PaceToTracker();  // not StepBoundary: the result is written back over the states it read
   auto lock = MapEditor(atlas_).Write(MapEdit::kApplyBundle);
   // A map merged away while the solver ran takes its keyframes with it: nothing to write.
   if (Map* map = atlas_->FindMap(problem.map_id)) ApplyBundle(map, problem, result);

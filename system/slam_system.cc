@@ -60,9 +60,7 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   if (options_.mapping_sync == "lockstep") options_.tracking.lockstep = true;
   // Lock-step maps each keyframe before the next frame: the adjustment belongs to its step.
   options_.mapping.calibration.own_thread =
-      options_.mapping_sync != "lockstep" &&
-      (options_.calibration_thread == "thread" ||
-       (options_.calibration_thread == "auto" && options_.mapping_sync == "free"));
+      options_.mapping_sync != "lockstep" && options_.calibration_thread != "step";
   options_.tracking.seed = options_.seed;
   options_.loop.seed = options_.seed;
   options_.Check();

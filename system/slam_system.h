@@ -39,10 +39,10 @@ struct SystemOptions {
   // live run does, and what --realtime uses).
   std::string mapping_sync = "free";
   // --calibrate online: where each calibration adjustment solves. "auto": in a thread of its own
-  // beside local mapping when mapping_sync is "free" (live runs: mapping never stops for it),
-  // inside local mapping's keyframe step otherwise (the live emulation paces local mapping, not
-  // that thread, so only in the step do offline runs repeat; docs/calibration.md, "Cost");
-  // "thread" / "step" force one.
+  // beside local mapping (which never stops for it), except under "lockstep", where it solves
+  // inside local mapping's keyframe step; under "live" on the work clock the thread is paced,
+  // its result applied where its counted work makes it due, so offline runs repeat
+  // (docs/calibration.md, "When" and "Cost"); "thread" / "step" force one.
   std::string calibration_thread = "auto";
   // "live": playback speed of the emulated live run (1: frames at their timestamps; 2: twice
   // as fast, so local mapping's work spans twice as much data time).
