@@ -5,6 +5,8 @@
 #include <cholmod.h>
 
 #include <algorithm>
+#include <cmath>
+#include <vector>
 #include <unordered_map>
 
 #include "core/util/error.h"
@@ -29,16 +31,27 @@ class Cholmod {
   Cholmod(const Cholmod&) = delete;
   Cholmod& operator=(const Cholmod&) = delete;
 
-  // J^T as CHOLMOD's column-compressed matrix: J's compressed rows are J^T's columns.
+  // J^T as CHOLMOD's column-compressed matrix (J's compressed rows are J^T's columns), with J's
+  // columns scaled to unit norm: the factor then sees D J^T J D (D = the inverse column norms),
+  // whose condition does not depend on the parameters' units (pixels beside metres beside
+  // radians), so the conditioning test below judges observability, not units.
   void SetJacobianTranspose(const ceres::CRSMatrix& j) {
     a_ = cholmod_allocate_sparse(static_cast<size_t>(j.num_cols), static_cast<size_t>(j.num_rows),
                                  j.values.size(), /*sorted=*/0, /*packed=*/1, /*stype=*/0,
                                  CHOLMOD_REAL, &common_);
     PKSLAM_CHECK(a_ != nullptr, "marginal covariance: CHOLMOD could not allocate {} x {} ({} nnz)",
                  j.num_cols, j.num_rows, j.values.size());
+    column_scale_.assign(static_cast<size_t>(j.num_cols), 0.0);
+    for (size_t k = 0; k < j.values.size(); ++k) {
+      column_scale_[static_cast<size_t>(j.cols[k])] += j.values[k] * j.values[k];
+    }
+    for (double& scale : column_scale_) scale = scale > 0 ? 1.0 / std::sqrt(scale) : 1.0;
     std::copy(j.rows.begin(), j.rows.end(), static_cast<int*>(a_->p));
     std::copy(j.cols.begin(), j.cols.end(), static_cast<int*>(a_->i));
-    std::copy(j.values.begin(), j.values.end(), static_cast<double*>(a_->x));
+    auto* values = static_cast<double*>(a_->x);
+    for (size_t k = 0; k < j.values.size(); ++k) {
+      values[k] = j.values[k] * column_scale_[static_cast<size_t>(j.cols[k])];
+    }
     cholmod_sort(a_, &common_);
   }
 
@@ -68,8 +81,11 @@ class Cholmod {
     Eigen::MatrixXd out(k, k);
     for (size_t c = 0; c < k; ++c) {
       for (size_t r = 0; r < k; ++r) {
+        // (J^T J)^-1 = D (D J^T J D)^-1 D.
+        const auto row = static_cast<size_t>(columns[r]);
+        const auto col = static_cast<size_t>(columns[c]);
         out(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
-            x[c * x_->d + static_cast<size_t>(columns[r])];
+            x[c * x_->d + row] * column_scale_[row] * column_scale_[col];
       }
     }
     return 0.5 * (out + out.transpose());  // symmetric up to rounding
@@ -81,6 +97,7 @@ class Cholmod {
   cholmod_factor* l_ = nullptr;
   cholmod_dense* b_ = nullptr;
   cholmod_dense* x_ = nullptr;
+  std::vector<double> column_scale_;  // D: 1 / the norm of each column of J
 };
 
 }  // namespace

@@ -163,6 +163,29 @@ TEST(MarginalCovariance, RankDeficientProblemHasNoCovariance) {
   EXPECT_NEAR(held->Block(&a)(0, 0), 1.0, 1e-12);
 }
 
+// Two independent scalars observed at very different scales: r0 = 1e7 a, r1 = 1e-4 b.
+struct Scaled {
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* r) const {
+    r[0] = 1e7 * (a[0] - T(2.0));
+    r[1] = 1e-4 * (b[0] - T(3.0));
+    return true;
+  }
+};
+
+TEST(MarginalCovariance, UnitsAloneDoNotMakeAProblemIllConditioned) {
+  // J^T J = diag(1e14, 1e-8): its condition number (1e22) is only the units'. Both scalars are
+  // observed; their variances are 1e-14 and 1e8.
+  double a = 2.0, b = 3.0;
+  ceres::Problem problem;
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Scaled, 2, 1, 1>(new Scaled),
+                           nullptr, &a, &b);
+  const auto covariance = ComputeMarginalCovariance(&problem, {&a, &b});
+  ASSERT_TRUE(covariance.has_value());
+  EXPECT_NEAR(covariance->Block(&a)(0, 0) / 1e-14, 1.0, 1e-9);
+  EXPECT_NEAR(covariance->Block(&b)(0, 0) / 1e8, 1.0, 1e-9);
+}
+
 TEST(MarginalCovariance, RejectsBlocksThatAreConstantOrForeign) {
   SmallBundle b;
   EXPECT_THROW(ComputeMarginalCovariance(&b.problem, {b.rotations[0].data()}), Error);
