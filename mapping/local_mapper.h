@@ -20,6 +20,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <thread>
 #include <utility>
@@ -241,6 +242,9 @@ class LocalMapper : public MappingBackend {
   void ApplyDueCalibration();
   // Whether an adjustment started and has not ended (paced: not yet applied or dropped).
   bool CalibrationOutstanding() const;
+  // Adds an adjustment's record to the stats with its note and its wall time since `start`.
+  void RecordCalibration(CalibrationRefinementStat stat, std::string note,
+                         std::chrono::steady_clock::time_point start);
   void JoinCalibrationThread();  // waits for the calibration thread, if any
   void StopCalibrationThread();  // interrupts it, waits, and drops a paced result
 

@@ -135,6 +135,14 @@ void LocalMapper::ApplyDueCalibration() {
   if (solved) ApplySolvedCalibration(std::move(*solved));
 }
 
+void LocalMapper::RecordCalibration(CalibrationRefinementStat stat, std::string note,
+                                    std::chrono::steady_clock::time_point start) {
+  stat.note = std::move(note);
+  stat.ms = WallMsSince(start);
+  MutexLock lock(mutex_);
+  stats_.calibration_refinements.push_back(std::move(stat));
+}
+
 void LocalMapper::JoinCalibrationThread() {
   if (calibration_thread_.joinable()) calibration_thread_.join();
 }
@@ -146,11 +154,8 @@ void LocalMapper::StopCalibrationThread() {
   calibration_pending_ = false;
   try {
     if (std::optional<SolvedCalibration> solved = calibration_solved_.get()) {
-      CalibrationRefinementStat& stat = solved->job.stat;
-      stat.note = "not applied: the run ended or reset before it was due";
-      stat.ms = WallMsSince(solved->start);
-      MutexLock lock(mutex_);
-      stats_.calibration_refinements.push_back(stat);
+      RecordCalibration(std::move(solved->job.stat),
+                        "not applied: the run ended or reset before it was due", solved->start);
     }
   } catch (const std::exception& e) {
     PKSLAM_LOG_WARN("calibration adjustment failed: {}", e.what());
@@ -164,10 +169,7 @@ std::optional<LocalMapper::SolvedCalibration> LocalMapper::SolveCalibration(
   CalibrationRefinementStat& stat = job.stat;
   const auto start = std::chrono::steady_clock::now();
   const auto finish = [&](const std::string& note) -> std::optional<SolvedCalibration> {
-    stat.note = note;
-    stat.ms = WallMsSince(start);
-    MutexLock stats_lock(mutex_);
-    stats_.calibration_refinements.push_back(stat);
+    RecordCalibration(stat, note, start);
     return std::nullopt;
   };
   if (!problem.free.Any() || problem.empty()) {
@@ -211,12 +213,7 @@ void LocalMapper::ApplySolvedCalibration(SolvedCalibration solved) {
   const CalibrationBundleResult& result = solved.result;
   const RigSetup& next = solved.next;
   const CalibrationJob& job = solved.job;
-  const auto finish = [&](const std::string& note) {
-    stat.note = note;
-    stat.ms = WallMsSince(solved.start);
-    MutexLock stats_lock(mutex_);
-    stats_.calibration_refinements.push_back(stat);
-  };
+  const auto finish = [&](const std::string& note) { RecordCalibration(stat, note, solved.start); };
   std::string note;
   {
     auto lock = MapEditor(atlas_).Write(MapEdit::kCalibration);
