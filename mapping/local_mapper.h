@@ -238,7 +238,8 @@ class LocalMapper : public MappingBackend {
   // Live emulation on the work clock with own_thread: applies the adjustment solving in the
   // calibration thread once local mapping's data time has passed the data time it was started
   // at plus its solve's work on the reference machine (waiting for the solve if this machine is
-  // slower), so the run repeats exactly. Mapping thread, at its step boundaries.
+  // slower), so where it lands does not depend on this machine's speed. Mapping thread, at its
+  // step boundaries.
   void ApplyDueCalibration();
   // Whether an adjustment started and has not ended (paced: not yet applied or dropped).
   bool CalibrationOutstanding() const;
