@@ -11,7 +11,8 @@ namespace pkslam {
 class MappingBackend {
  public:
   virtual ~MappingBackend() = default;
-  // Hands a new keyframe (already in the map) over for local mapping.
+  // Hands a new keyframe (already in the map) over for local mapping. Waits while the queue is
+  // full (QueueFull), so call it holding no map lock.
   virtual void InsertKeyFrame(const KeyFramePtr& kf) = 0;
   // Idle and willing to take keyframes now.
   virtual bool AcceptsKeyFrames() const = 0;
@@ -20,6 +21,9 @@ class MappingBackend {
   // Running IMU initialisation.
   virtual bool IsInitializingImu() const = 0;
   virtual int QueueSize() const = 0;
+  // The queue holds its bound (LocalMappingOptions::max_queued_keyframes): tracking declines
+  // keyframes meanwhile; InsertKeyFrame would wait for room (backpressure).
+  virtual bool QueueFull() const = 0;
   // Returns and clears the flag local mapping raises when, before the second inertial
   // refinement and within its first 10 s of motion, the body moved less than 10 cm over its
   // last two keyframe steps (ORB-SLAM3 v0.3's mbBadImu2, which pks-released obeys).

@@ -35,6 +35,8 @@ void LocalMappingOptions::Check() const {
                       culling_observers);
   PKSLAM_CHECK_OPTION(min_found_ratio >= 0 && min_found_ratio < 1, "LocalMapping.min_found_ratio",
                       "{}", min_found_ratio);
+  PKSLAM_CHECK_OPTION(max_queued_keyframes >= 2, "LocalMapping.max_queued_keyframes",
+                      "{} (a map's initialisation inserts two keyframes)", max_queued_keyframes);
   ba.Check();
   inertial.Check();
   calibration.Check();
@@ -59,6 +61,10 @@ void LocalMapper::SetCalibrationPrior(RigCalibration file, RigShape shape) {
 
 void LocalMapper::Start() {
   PKSLAM_CHECK(!thread_.joinable(), "local mapping already started");
+  {
+    MutexLock lock(mutex_);
+    running_ = true;
+  }
   thread_ = std::thread([this] { Run(); });
 }
 
@@ -80,9 +86,22 @@ void LocalMapper::Finish() {
 }
 
 void LocalMapper::InsertKeyFrame(const KeyFramePtr& kf) {
+  if (!thread_.joinable()) {
+    // No thread (tests, lock-step callers that drain it): the caller makes the room.
+    while (QueueSize() >= options_.max_queued_keyframes) ProcessNext();
+  }
   {
     MutexLock lock(mutex_);
+    // Backpressure: tracking declines keyframes while the queue is full (QueueFull), so only a
+    // keyframe it cannot decline waits here, until local mapping takes one (Run notifies idle_
+    // as it does), or a finish or reset makes the wait moot.
+    while (running_ && static_cast<int>(queue_.size()) >= options_.max_queued_keyframes &&
+           !finish_requested_ && !reset_requested_) {
+      idle_.wait(lock);
+    }
     queue_.push_back(kf);
+    stats_.max_queued_keyframes =
+        std::max(stats_.max_queued_keyframes, static_cast<int>(queue_.size()));
     abort_ba_.store(true);  // a running BA yields to the newer keyframe
   }
   wake_.notify_all();
@@ -96,6 +115,11 @@ bool LocalMapper::HasQueued() const {
 int LocalMapper::QueueSize() const {
   MutexLock lock(mutex_);
   return static_cast<int>(queue_.size());
+}
+
+bool LocalMapper::QueueFull() const {
+  MutexLock lock(mutex_);
+  return static_cast<int>(queue_.size()) >= options_.max_queued_keyframes;
 }
 
 bool LocalMapper::IsStoppedOrStopRequested() const {
@@ -206,6 +230,7 @@ void LocalMapper::ResetQueue() {
   reset_requested_ = true;
   wake_.notify_all();
   paced_.notify_all();
+  idle_.notify_all();  // an inserter waiting for room: the queue is about to be dropped
   while (reset_requested_ && !finish_requested_) idle_.wait(lock);
 }
 
@@ -284,6 +309,7 @@ void LocalMapper::Run() {
     if (queue_.empty()) accept_keyframes_.store(true);
     idle_.notify_all();
   }
+  running_ = false;
   accept_keyframes_.store(true);
   idle_.notify_all();
 }

@@ -50,6 +50,13 @@ struct LocalMappingOptions {
   bool cull_keyframes = true;
   // Recent points: culled when found/visible < this ratio.
   double min_found_ratio = 0.25;
+  // The keyframe queue's bound (backpressure, MappingBackend::QueueFull): tracking declines a
+  // keyframe while this many wait, and a keyframe it cannot decline (a new map's first two)
+  // waits for room. ORB-SLAM3's rule already keeps the queue at 3 or fewer (it declines while
+  // three wait, or while mapping is busy for monocular), so in ordinary runs the bound is
+  // never reached; it holds for every selector and for mapping held by loop closing too.
+  // At least 2: a map's initialisation inserts two keyframes at once.
+  int max_queued_keyframes = 8;
   BundleAdjustmentOptions ba;
   // Inertial sensors: IMU initialisation stages and local inertial BA.
   InertialMappingOptions inertial;
@@ -91,6 +98,8 @@ struct LocalMappingStats {
   // Live emulation: total wall ms tracking waited in AcceptsKeyFramesAt.
   double live_wait_ms = 0;
   int ba_aborted = 0;
+  // The longest the keyframe queue was (at most LocalMappingOptions::max_queued_keyframes).
+  int max_queued_keyframes = 0;
   // Local inertial BAs whose anchor carried a marginalisation prior / was fixed.
   int inertial_ba_with_prior = 0;
   int inertial_ba_fixed_anchor = 0;
@@ -146,6 +155,7 @@ class LocalMapper : public MappingBackend {
   bool IsInitializingImu() const override { return initializing_imu_.load(); }
   bool TakeSlowMotionFlag() override { return slow_motion_.exchange(false); }
   int QueueSize() const override;
+  bool QueueFull() const override;
   void InterruptBundleAdjustment() override { abort_ba_.store(true); }
   void WaitUntilIdle() override;
   bool AcceptsKeyFramesAt(std::int64_t t_ns) override;
@@ -257,7 +267,10 @@ class LocalMapper : public MappingBackend {
   mutable Mutex mutex_;  // guards the members marked PKSLAM_GUARDED_BY(mutex_)
   ConditionVariable wake_;
   ConditionVariable idle_;
+  // Bounded by options_.max_queued_keyframes (InsertKeyFrame, QueueFull).
   std::deque<KeyFramePtr> queue_ PKSLAM_GUARDED_BY(mutex_);
+  // The thread runs (from Start until Run returns): an insert into a full queue waits for it.
+  bool running_ PKSLAM_GUARDED_BY(mutex_) = false;
   bool busy_ PKSLAM_GUARDED_BY(mutex_) = false;
   // Live emulation: the switch and pace are set before Start() and read-only afterwards; the
   // data-clock time at which the last finished keyframe's processing ends, and the data-clock

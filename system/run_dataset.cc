@@ -75,6 +75,7 @@ void RunSummary::Count(const TrackResult& result) {
   if (result.new_keyframe) {
     ++keyframe_reasons[result.keyframe_reason.empty() ? "unnamed" : result.keyframe_reason];
   }
+  if (result.keyframe_declined_queue_full) ++keyframes_declined_queue_full;
   if (result.selector_decided) ++selector_decisions;
   for (const auto& criterion : result.criteria_held) ++criteria_held[criterion];
 }

@@ -84,6 +84,8 @@ struct RunSummary {
   std::string dataset_fingerprint;  // io/dataset_fingerprint.h
   // Keyframes created, per reason: the selector rule that fired, or "initialisation".
   std::map<std::string, int> keyframe_reasons;
+  // Keyframes the selector wanted while local mapping's queue was full (declined).
+  int keyframes_declined_queue_full = 0;
   // Frames the selector decided on, and on how many of them each criterion held
   // (TrackResult::criteria_held).
   int selector_decisions = 0;

@@ -386,6 +386,10 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
               static_cast<int>(std::count_if(records.begin(), records.end(),
                                              [](const FrameRecord& r) { return r.keyframe; })));
   json.Member("keyframes_culled", mapping.keyframes_culled);
+  // The keyframe queue's bound (LocalMappingOptions::max_queued_keyframes): its longest length
+  // and the keyframes tracking declined because it was full.
+  json.Member("max_queued_keyframes", mapping.max_queued_keyframes);
+  json.Member("keyframes_declined_queue_full", summary->keyframes_declined_queue_full);
   // Which rule of the selector created how many keyframes ("initialisation": a map's first
   // keyframe(s), not a selector decision).
   json.Key("keyframe_reasons").BeginObject();

@@ -220,6 +220,12 @@ TrackResult Tracker::Track(Frame frame) {
           last_decision_.interrupt_local_ba = true;
           last_decision_.reason += ";starving";
         }
+        if (last_decision_.insert && mapping_->QueueFull()) {
+          // Backpressure (LocalMappingOptions::max_queued_keyframes): whatever the selector
+          // says, no keyframe while local mapping has a full queue.
+          last_decision_.insert = false;
+          result.keyframe_declined_queue_full = true;
+        }
         if (trace_enabled_) {
           trace_.push_back({current_.t_ns(), current_.id(), last_decision_,
                             selector_input.FramesSinceLastKeyFrame()});

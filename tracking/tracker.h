@@ -69,6 +69,8 @@ struct TrackResult {
   // held (PKS: criterion1 = D_c > Th, criterion2 = ECOG > |COG|).
   bool selector_decided = false;
   std::vector<std::string> criteria_held;
+  // The selector wanted a keyframe but local mapping's queue was full (MappingBackend::QueueFull).
+  bool keyframe_declined_queue_full = false;
 };
 
 class Tracker {
