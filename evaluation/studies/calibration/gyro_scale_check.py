@@ -2,7 +2,8 @@
 """Is an IMU axis error what biases online calibration? Correct a replay's IMU by the truth and see.
 
     python3 evaluation/studies/calibration/gyro_scale_check.py SEQ OUT [--pkslam BIN]
-        [--sensor stereo-inertial] [--seed 1] [--variants none,gyro,gyro-diagonal,gyro+accel]
+        [--sensor stereo-inertial] [--seed 1]
+        [--variants none,gyro,gyro-diagonal,gyro+accel,accel,accel-diagonal]
         [-- extra pkslam run arguments]
 
 SEQ is a `pkslam simulate --realism euroc` folder (SEQ/truth/realism_draw.yaml holds the drawn
@@ -13,12 +14,16 @@ symbolic links, SEQ is not modified):
   gyro            gyro samples multiplied by M_g^-1 (scale and misalignment removed)
   gyro-diagonal   gyro samples divided by diag(M_g) (the per-axis scale factor only)
   gyro+accel      gyro by M_g^-1 and accelerometer by M_a^-1
-then `pkslam run --calibrate online` on it, and prints the ATE and the calibration estimates
-against the truth (calibration_truth.py). The biases, g-sensitivity and noise stay. With
+  accel           accelerometer samples by M_a^-1 only
+  accel-diagonal  accelerometer samples divided by diag(M_a) (its per-axis scale factor only)
+then `pkslam run --calibrate online` on it, and prints the ATE (SE(3) alignment), the scale a
+Sim(3) alignment finds (the map's scale error) and the calibration estimates against the truth
+(calibration_truth.py). The biases, g-sensitivity and noise stay. With
 --calibrate-hold-gyro-scale among the extra arguments this is the experiment that found the gyro
 scale behind cam0's fy bias (docs/calibration.md, "The gyro's scale factor").
 """
 import argparse
+import json
 import os
 import shutil
 import subprocess
@@ -32,7 +37,7 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 sys.path.insert(0, HERE)
 import calibration_truth  # noqa: E402
 
-VARIANTS = ("none", "gyro", "gyro-diagonal", "gyro+accel")
+VARIANTS = ("none", "gyro", "gyro-diagonal", "gyro+accel", "accel", "accel-diagonal")
 
 
 def corrected_copy(seq, out, variant, draw):
@@ -51,8 +56,10 @@ def corrected_copy(seq, out, variant, draw):
     ma = np.array(draw["imu_accel_matrix"], float)
     gyro_fix = {"none": np.eye(3), "gyro": np.linalg.inv(mg),
                 "gyro-diagonal": np.diag(1.0 / np.diag(mg)),
-                "gyro+accel": np.linalg.inv(mg)}[variant]
-    accel_fix = np.linalg.inv(ma) if variant == "gyro+accel" else np.eye(3)
+                "gyro+accel": np.linalg.inv(mg), "accel": np.eye(3),
+                "accel-diagonal": np.eye(3)}[variant]
+    accel_fix = {"gyro+accel": np.linalg.inv(ma), "accel": np.linalg.inv(ma),
+                 "accel-diagonal": np.diag(1.0 / np.diag(ma))}.get(variant, np.eye(3))
     with open(os.path.join(seq, "mav0", "imu0", "data.csv")) as f:
         lines = f.read().splitlines()
     rows = [lines[0]]
@@ -65,15 +72,16 @@ def corrected_copy(seq, out, variant, draw):
         f.write("\n".join(rows) + "\n")
 
 
-def ate(pkslam, seq, run):
-    text = subprocess.run([pkslam, "eval", "--gt",
-                           os.path.join(seq, "mav0", "state_groundtruth_estimate0", "data.csv"),
-                           "--est", os.path.join(run, "trajectory_body.txt")],
-                          capture_output=True, text=True, check=True).stdout
-    for line in text.splitlines():
-        if line.startswith("ATE [m]"):
-            return float(line.split()[2])
-    raise RuntimeError(f"no ATE line from pkslam eval for {run}")
+def ate(pkslam, seq, run, align="se3"):
+    """ATE rmse (m) and the alignment's scale."""
+    out = os.path.join(run, f"ate_{align}.json")
+    subprocess.run([pkslam, "eval", "--gt",
+                    os.path.join(seq, "mav0", "state_groundtruth_estimate0", "data.csv"),
+                    "--est", os.path.join(run, "trajectory_body.txt"), "--align", align,
+                    "--segments", "none", "--json", out], capture_output=True, check=True)
+    with open(out) as f:
+        result = json.load(f)
+    return result["ate"]["rmse"], result["scale"]
 
 
 def main():
@@ -99,8 +107,8 @@ def main():
     if "imu_gyro_matrix" not in draw:
         sys.exit(f"{args.seq}/truth/realism_draw.yaml: no imu_gyro_matrix (not a euroc-preset render)")
     truth = calibration_truth.truth_parameters(args.seq)
-    print(f"{'variant':15s} {'ATE [mm]':>9s} {'fx-truth':>9s} {'fy-truth':>9s} "
-          f"{'td-truth ms':>11s} {'gyro sy-truth %':>15s}")
+    print(f"{'variant':15s} {'ATE [mm]':>9s} {'Sim3 scale-1 %':>14s} {'fx-truth':>9s} "
+          f"{'fy-truth':>9s} {'td-truth ms':>11s} {'gyro sy-truth %':>15s}")
     for v in variants:
         folder = os.path.join(args.out, v)
         corrected_copy(args.seq, os.path.join(folder, "seq"), v, draw)
@@ -114,9 +122,11 @@ def main():
         def err(name):
             return est[name]["estimate"] - truth[name] if name in est else float("nan")
         # A corrected IMU has no scale error left: the truth of the gyro's scale is then 0.
-        gyro_truth = 0.0 if v != "none" else truth.get("gyro.sy", 0.0)
+        gyro_truth = 0.0 if v.startswith("gyro") else truth.get("gyro.sy", 0.0)
         gyro = est["gyro.sy"]["estimate"] - gyro_truth if "gyro.sy" in est else float("nan")
-        print(f"{v:15s} {ate(args.pkslam, args.seq, run) * 1e3:9.2f} {err('cam0.fx'):9.3f} "
+        se3, _ = ate(args.pkslam, args.seq, run)
+        _, scale = ate(args.pkslam, args.seq, run, "sim3")
+        print(f"{v:15s} {se3 * 1e3:9.2f} {(scale - 1) * 100:14.3f} {err('cam0.fx'):9.3f} "
               f"{err('cam0.fy'):9.3f} {err('time_offset'):11.3f} {gyro:15.3f}", flush=True)
 
 

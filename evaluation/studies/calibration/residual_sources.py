@@ -186,18 +186,23 @@ def make_dataset(render, out, files):
 
 
 def run_one(pkslam, render, dataset, run_dir):
-    if not os.path.exists(os.path.join(run_dir, 'ate.json')):
+    """ATE (SE(3) alignment, m) and the scale a Sim(3) alignment finds."""
+    if not os.path.exists(os.path.join(run_dir, 'trajectory_body.txt')):
         with open(run_dir + '.log', 'w') as log:
             subprocess.run([pkslam, 'run', '--dataset', dataset, '--sensor', 'stereo-inertial',
                             '--calibrate', 'off', '--seed', run_dir.rsplit('seed', 1)[1],
                             '--out', run_dir, '--quiet'],
                            stdout=log, stderr=subprocess.STDOUT, check=True)
-        gt = os.path.join(render, 'mav0/state_groundtruth_estimate0/data.csv')
-        subprocess.run([pkslam, 'eval', '--gt', gt, '--est',
-                        os.path.join(run_dir, 'trajectory_body.txt'), '--segments', 'none',
-                        '--json', os.path.join(run_dir, 'ate.json')], capture_output=True,
-                       check=True)
-    return json.load(open(os.path.join(run_dir, 'ate.json')))['ate']['rmse']
+    gt = os.path.join(render, 'mav0/state_groundtruth_estimate0/data.csv')
+    out = {}
+    for align in ('se3', 'sim3'):
+        path = os.path.join(run_dir, f'ate_{align}.json')
+        if not os.path.exists(path):
+            subprocess.run([pkslam, 'eval', '--gt', gt, '--est',
+                            os.path.join(run_dir, 'trajectory_body.txt'), '--align', align,
+                            '--segments', 'none', '--json', path], capture_output=True, check=True)
+        out[align] = json.load(open(path))
+    return out['se3']['ate']['rmse'], out['sim3']['scale']
 
 
 def main():
@@ -222,17 +227,19 @@ def main():
         jobs += [(v, dataset, os.path.join(a.out, v, f'seed{s}')) for s in seeds]
     with ThreadPoolExecutor(max_workers=2) as pool:
         ates = list(pool.map(lambda j: run_one(a.pkslam, a.render, j[1], j[2]), jobs))
-    by_variant = {}
-    for (v, _, _), ate in zip(jobs, ates):
+    by_variant, scales = {}, {}
+    for (v, _, _), (ate, scale) in zip(jobs, ates):
         by_variant.setdefault(v, []).append(ate)
+        scales.setdefault(v, []).append(scale)
     print(f'Files: the estimate of {a.run} with one part at the truth; `pkslam run --calibrate off`'
           f' on {a.render}, seeds {a.seeds}.')
-    print('| variant | ATE per seed (mm) | median (mm) |')
-    print('|---|---|---|')
+    print('| variant | ATE per seed (mm) | median (mm) | map scale error, Sim(3) (%) |')
+    print('|---|---|---|---|')
     for v in variants:
         runs = by_variant[v]
         print(f'| {v} | {", ".join(f"{1e3 * x:.2f}" for x in runs)} | '
-              f'{1e3 * statistics.median(runs):.2f} |')
+              f'{1e3 * statistics.median(runs):.2f} | '
+              f'{", ".join(f"{100 * (s - 1):+.3f}" for s in scales[v])} |')
     return 0
 
 
