@@ -5,8 +5,8 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
+#include "core/util/cpu_time.h"
 #include "core/util/error.h"
-#include "rgbd/cpu_time.h"
 
 namespace pkslam::rgbd {
 namespace {

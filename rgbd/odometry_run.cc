@@ -5,13 +5,13 @@
 #include <chrono>
 #include <fstream>
 
+#include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
 #include "core/util/output_file.h"
 #include "core/util/progress.h"
 #include "io/trajectory.h"
-#include "rgbd/cpu_time.h"
 #include "rgbd/voxel_map.h"
 
 namespace pkslam::rgbd {

@@ -6,8 +6,8 @@
 #include <numeric>
 #include <random>
 
+#include "core/util/cpu_time.h"
 #include "core/util/error.h"
-#include "rgbd/cpu_time.h"
 #include "rgbd/kmeans_segmentation.h"
 #include "rgbd/region_growing.h"
 

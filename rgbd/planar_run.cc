@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "core/util/log.h"
@@ -15,7 +16,6 @@
 #include "evaluation/evaluate.h"
 #include "evaluation/statistics.h"
 #include "io/trajectory.h"
-#include "rgbd/cpu_time.h"
 #include "rgbd/voxel_map.h"
 
 namespace pkslam::rgbd {

@@ -22,6 +22,7 @@
 #include "core/features/orb_extractor.h"
 #include "core/features/synthetic_texture.h"
 #include "core/sensor/camera_rig.h"
+#include "core/util/cpu_time.h"
 #include "core/util/quantile.h"
 #include "tracking/frame_builder.h"
 
@@ -42,12 +43,6 @@ constexpr ImageSize kSizes[] = {
     {"tum", 640, 480, 1000, 525.0},
     {"kitti", 1241, 376, 2000, 718.856},
 };
-
-double ProcessCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
 
 double Median(std::vector<double> v) { return Quantile(std::move(v), 0.5).value_or(0.0); }
 

@@ -25,6 +25,7 @@
 #include "core/features/orb_extractor.h"
 #include "core/features/stereo_matcher.h"
 #include "core/features/synthetic_texture.h"
+#include "core/util/cpu_time.h"
 #include "tests/support/test_data.h"
 
 namespace pkslam {
@@ -56,12 +57,6 @@ std::vector<cv::Mat> LoadGrey(const std::vector<std::filesystem::path>& files) {
   images.reserve(files.size());
   for (const auto& f : files) images.push_back(cv::imread(f.string(), cv::IMREAD_GRAYSCALE));
   return images;
-}
-
-double ProcessCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
 double Median(std::vector<double> v) {

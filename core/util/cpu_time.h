@@ -24,6 +24,11 @@ inline double ProcessCpuSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+// Milliseconds of CPU the whole process has used: stage timings of runs on a shared, loaded
+// machine (wall-clock stage times would measure the other jobs; CPU time measures the work,
+// counting the threads OpenCV parallelises a stage over).
+inline double ProcessCpuMs() { return 1e3 * ProcessCpuSeconds(); }
+
 // The calling thread's CPU clock, which other threads of the process may read with
 // ClockSeconds (live emulation measures local mapping's work in its thread's CPU time, so a
 // shared machine's load does not make the emulated machine slower); nullopt if unavailable.
