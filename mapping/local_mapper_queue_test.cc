@@ -42,36 +42,54 @@ struct QueueFixture {
     mapper->SetKeyFrameConsumer([this](const KeyFramePtr&) { ++processed; });
     return mapper;
   }
+
+  // A started mapper held by a stop request (as loop closing holds it), bound 2, and its queue
+  // full with the first two keyframes.
+  std::unique_ptr<LocalMapper> HeldWithFullQueue() {
+    auto mapper = MakeMapper(2);
+    mapper->Start();
+    HoldMapping(mapper.get());
+    mapper->InsertKeyFrame(map.keyframes[0]);
+    mapper->InsertKeyFrame(map.keyframes[1]);
+    return mapper;
+  }
+
+  // Stops a started mapper and waits until it is held.
+  static void HoldMapping(LocalMapper* mapper) {
+    mapper->RequestStop();
+    while (!mapper->IsStopped()) std::this_thread::sleep_for(1ms);
+  }
 };
 
-// Stops a started mapper (as loop closing does) and waits until it is held.
-void HoldMapping(LocalMapper* mapper) {
-  mapper->RequestStop();
-  while (!mapper->IsStopped()) std::this_thread::sleep_for(1ms);
-}
+// Inserts `kf` from a thread of its own (tracking's), noting when the insert has returned.
+struct Inserter {
+  std::atomic<bool> inserted{false};
+  std::thread thread;
+  Inserter(LocalMapper* mapper, KeyFramePtr kf)
+      : thread([this, mapper, kf] {
+          mapper->InsertKeyFrame(kf);
+          inserted = true;
+        }) {}
+};
 
 TEST(LocalMapperQueue, AFullQueueIsReportedAndAnInsertWaitsForRoom) {
   QueueFixture f;
   auto mapper = f.MakeMapper(2);
   mapper->Start();
-  HoldMapping(mapper.get());
+  QueueFixture::HoldMapping(mapper.get());
   mapper->InsertKeyFrame(f.map.keyframes[0]);
   EXPECT_FALSE(mapper->QueueFull());
   mapper->InsertKeyFrame(f.map.keyframes[1]);
   EXPECT_TRUE(mapper->QueueFull());
 
-  std::atomic<bool> inserted{false};
-  std::thread inserter([&] {
-    mapper->InsertKeyFrame(f.map.keyframes[2]);
-    inserted = true;
-  });
+  Inserter inserter(mapper.get(), f.map.keyframes[2]);
   std::this_thread::sleep_for(200ms);
-  EXPECT_FALSE(inserted.load());  // mapping is held: no room
+  EXPECT_FALSE(inserter.inserted.load());  // mapping is held: no room
   EXPECT_EQ(mapper->QueueSize(), 2);
 
   mapper->Release();
-  inserter.join();
-  EXPECT_TRUE(inserted.load());
+  inserter.thread.join();
+  EXPECT_TRUE(inserter.inserted.load());
   mapper->WaitUntilIdle();
   EXPECT_EQ(f.processed.load(), 3);
   EXPECT_EQ(mapper->stats().max_queued_keyframes, 2);
@@ -80,35 +98,23 @@ TEST(LocalMapperQueue, AFullQueueIsReportedAndAnInsertWaitsForRoom) {
 
 TEST(LocalMapperQueue, FinishReleasesAWaitingInserter) {
   QueueFixture f;
-  auto mapper = f.MakeMapper(2);
-  mapper->Start();
-  HoldMapping(mapper.get());
-  mapper->InsertKeyFrame(f.map.keyframes[0]);
-  mapper->InsertKeyFrame(f.map.keyframes[1]);
-  std::thread inserter([&] { mapper->InsertKeyFrame(f.map.keyframes[2]); });
+  auto mapper = f.HeldWithFullQueue();
+  Inserter inserter(mapper.get(), f.map.keyframes[2]);
   std::this_thread::sleep_for(50ms);
   mapper->Finish();  // processes what is queued; the inserter must not wait forever
-  inserter.join();
+  inserter.thread.join();
   EXPECT_GE(f.processed.load(), 2);
 }
 
 TEST(LocalMapperQueue, ResetReleasesAWaitingInserter) {
   QueueFixture f;
-  auto mapper = f.MakeMapper(2);
-  mapper->Start();
-  HoldMapping(mapper.get());
-  mapper->InsertKeyFrame(f.map.keyframes[0]);
-  mapper->InsertKeyFrame(f.map.keyframes[1]);
-  std::atomic<bool> inserted{false};
-  std::thread inserter([&] {
-    mapper->InsertKeyFrame(f.map.keyframes[2]);
-    inserted = true;
-  });
+  auto mapper = f.HeldWithFullQueue();
+  Inserter inserter(mapper.get(), f.map.keyframes[2]);
   std::this_thread::sleep_for(50ms);
-  EXPECT_FALSE(inserted.load());
+  EXPECT_FALSE(inserter.inserted.load());
   std::thread resetter([&] { mapper->ResetQueue(); });
-  inserter.join();  // the reset request releases it
-  EXPECT_TRUE(inserted.load());
+  inserter.thread.join();  // the reset request releases it
+  EXPECT_TRUE(inserter.inserted.load());
   mapper->Release();
   resetter.join();
   mapper->Finish();

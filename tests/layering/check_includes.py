@@ -103,17 +103,9 @@ def owner(libs, path):
     return best
 
 
-def shared_header_names(libs, repo, allowed):
-    """A header name used by two libraries (their own folders, test headers included), unless
+def shared_header_names(by_name, allowed):
+    """A header name used by two libraries (by_name: name -> {library: its header}), unless
     `allowed`; and a name in `allowed` that is not shared."""
-    by_name = {}
-    for name, lib in libs.items():
-        for root, dirs, files in os.walk(os.path.join(repo, lib["folder"])):
-            dirs[:] = [d for d in dirs if d not in SKIP_FOLDERS]
-            for f in files:
-                rel = os.path.relpath(os.path.join(root, f), repo)
-                if f.endswith(".h") and owner(libs, rel) == name:
-                    by_name.setdefault(f, {}).setdefault(name, rel)
     problems = []
     for header, owners in sorted(by_name.items()):
         shared = len(owners) > 1
@@ -140,6 +132,7 @@ def main():
     # only tests, benchmarks or other such headers include.
     includers = {}
     tests = set()
+    headers_by_name = {}  # header file name -> {library: path}, test headers included
     for name, lib in libs.items():
         for root, dirs, files in os.walk(os.path.join(repo, lib["folder"])):
             dirs[:] = [d for d in dirs if d not in SKIP_FOLDERS]
@@ -147,6 +140,8 @@ def main():
                 if not f.endswith((".cc", ".h")):
                     continue
                 rel = os.path.relpath(os.path.join(root, f), repo)
+                if f.endswith(".h") and owner(libs, rel) == name:
+                    headers_by_name.setdefault(f, {}).setdefault(name, rel)
                 if rel in lib["tests"] or f.endswith(("_test.cc", "_benchmark.cc")):
                     tests.add(rel)
                 with open(os.path.join(repo, rel), errors="replace") as fh:
@@ -192,7 +187,7 @@ def main():
                                             + (" (test)" if is_test else ""))
     # The allowance describes this repository (the self-test's repositories have none).
     allowed = SHARED_HEADER_NAMES if os.path.realpath(repo) == own_repo else set()
-    problems += shared_header_names(libs, repo, allowed)
+    problems += shared_header_names(headers_by_name, allowed)
     for p in problems:
         print(p)
     print(f"layering: {checked} files of {len(libs)} libraries checked, {len(problems)} problem(s)")

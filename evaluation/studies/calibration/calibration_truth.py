@@ -51,10 +51,14 @@ def log_se3(m):
     return np.concatenate([np.linalg.solve(v, t), phi])
 
 
+def load_yaml_text(text):
+    """A sensor.yaml's text (OpenCV's "%YAML:1.0" directive dropped) as a dict."""
+    return yaml.safe_load("".join(l for l in text.splitlines(True) if not l.startswith("%")))
+
+
 def load_yaml(path):
     with open(path) as f:
-        text = "".join(l for l in f if not l.startswith("%"))
-    return yaml.safe_load(text)
+        return load_yaml_text(f.read())
 
 
 def t_bs(sensor):

@@ -54,10 +54,9 @@ def corrected_copy(seq, out, variant, draw):
                 os.path.join(out, "mav0", "imu0", "sensor.yaml"))
     mg = np.array(draw["imu_gyro_matrix"], float)
     ma = np.array(draw["imu_accel_matrix"], float)
-    gyro_fix = {"none": np.eye(3), "gyro": np.linalg.inv(mg),
-                "gyro-diagonal": np.diag(1.0 / np.diag(mg)),
-                "gyro+accel": np.linalg.inv(mg), "accel": np.eye(3),
-                "accel-diagonal": np.eye(3)}[variant]
+    # The variants are checked in main(); the ones not named here leave that sensor as recorded.
+    gyro_fix = {"gyro": np.linalg.inv(mg), "gyro-diagonal": np.diag(1.0 / np.diag(mg)),
+                "gyro+accel": np.linalg.inv(mg)}.get(variant, np.eye(3))
     accel_fix = {"gyro+accel": np.linalg.inv(ma), "accel": np.linalg.inv(ma),
                  "accel-diagonal": np.diag(1.0 / np.diag(ma))}.get(variant, np.eye(3))
     with open(os.path.join(seq, "mav0", "imu0", "data.csv")) as f:

@@ -40,7 +40,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from calibration_truth import exp_se3, load_yaml, log_se3, t_bs  # noqa: E402
+from calibration_truth import exp_se3, load_yaml, load_yaml_text, log_se3, t_bs  # noqa: E402
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 VARIANTS = ['est', 'true', 'cam0', 'cam1', 'stereo', 'imu_rot', 'lever', 'time_gyro', 'camera',
@@ -50,11 +50,6 @@ SENSORS = ['cam0', 'cam1', 'imu0']
 
 def parse_tbs(text):
     return t_bs(load_yaml_text(text))
-
-
-def load_yaml_text(text):
-    import yaml
-    return yaml.safe_load(''.join(l for l in text.splitlines(True) if not l.startswith('%')))
 
 
 def with_tbs(text, m):
