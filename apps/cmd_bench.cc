@@ -1,19 +1,23 @@
 // pkslam bench: benchmark suites (datasets x sensors x selectors x sweeps x runs) with
 // reports, resumable runs and scale-out job lists. See evaluation/bench/ and README.md.
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <csignal>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "apps/commands.h"
-#include "core/util/output_guard.h"
+#include "core/util/build_info.h"
 #include "core/util/error.h"
+#include "core/util/output_guard.h"
 #include "evaluation/bench/bench.h"
+#include "evaluation/bench/process.h"
 #include "evaluation/bench/report.h"
 
 namespace pkslam::apps {
@@ -52,6 +56,27 @@ fs::path SelfExecutable() {
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (ec) throw Error("cannot find the pkslam executable (/proc/self/exe); pass --pkslam");
   return exe;
+}
+
+// The commit `pkslam` was built from: this build's own, or what its --version says.
+std::string CommitOf(const fs::path& pkslam) {
+  std::error_code ec;
+  if (fs::equivalent(pkslam, SelfExecutable(), ec)) return BuildCommit();
+  const fs::path log = fs::temp_directory_path() / fmt::format("pkslam-version-{}.txt", getpid());
+  fs::remove(log, ec);
+  std::string commit = "unknown";
+  if (bench::RunProcess({pkslam.string(), "--version"}, log, 30).ok()) {
+    std::ifstream in(log);
+    std::string line;
+    std::getline(in, line);
+    const auto at = line.find("(commit ");
+    if (at != std::string::npos) {
+      const auto start = at + 8;
+      commit = line.substr(start, line.find_first_of(",)", start) - start);
+    }
+  }
+  fs::remove(log, ec);
+  return commit;
 }
 
 void PrintReport(const std::vector<bench::RunResult>& results, const bench::ReportFiles& files,
@@ -107,6 +132,7 @@ void Run(const BenchArgs& a) {
   h.reevaluate = a.reevaluate;
   h.prune_cache = a.prune_cache;
   h.simulator_id = bench::ExecutableId(h.pkslam);
+  h.pkslam_commit = CommitOf(h.pkslam);
   if (!a.emit_jobs.empty()) {
     const auto e = bench::EmitJobs(suite, runs, h);
     std::cout << fmt::format(

@@ -7,13 +7,14 @@
 #include "apps/cli_errors.h"
 #include "apps/cli_outputs.h"
 #include "apps/commands.h"
+#include "core/util/build_info.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"pkslam: keyframe SLAM with photogrammetric keyframe selection (PKS)"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("pkslam ") + PKSLAM_VERSION);
+  app.set_version_flag("--version", pkslam::BuildDescription());
   std::string log_level = "info";
   app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off")
       ->capture_default_str();

@@ -21,8 +21,12 @@ Rules (docs/bench.md "Statistics"):
   otherwise) on log ATE with the observed within-sequence spread, the power of a two-sided 5%
   test at the present run count, and the runs per sequence that would give 80%; a missing
   effect is called "not reproduced" only with at least MIN_RUNS_FOR_VERDICT runs per sequence.
+- One build: the runs of pkslam's configurations must come from one pkslam build (results.csv's
+  pkslam_commit and executable) and each peer's runs from one peer build (peer_build); a file
+  that pools several is refused (exit 3) unless --pool-builds says to analyse it anyway.
 
   /usr/bin/python3 evaluation/bench_statistics.py OUT/results.csv [--md FILE] [--html FILE]
+      [--pool-builds]
 """
 
 import argparse
@@ -36,6 +40,8 @@ from collections import OrderedDict
 
 import numpy as np
 from scipy import stats
+
+import paired_statistics
 
 MIN_COVERAGE = 0.5
 ALPHA = 0.05
@@ -70,9 +76,36 @@ def read_rows(path):
                     "baseline": r["baseline"], "ok": ok, "ate": ate if ok else math.inf,
                     "coverage": coverage if math.isfinite(coverage) else 0.0,
                     "suspect": number(r.get("suspect")),
+                    "build": build_of(r),
+                    "seed": r.get("seed", ""),
                     "index": int(r["index"])})
     out.sort(key=lambda r: r["index"])
     return out
+
+
+def build_of(r):
+    """What made a run: the peer's build for a peer run, else pkslam's commit and executable
+    ("" for files written before results.csv recorded them)."""
+    if r.get("peer_build"):
+        return "peer " + r["peer_build"]
+    commit, executable = r.get("pkslam_commit") or "", r.get("executable") or ""
+    return f"pkslam {commit} (executable {executable})" if commit or executable else ""
+
+
+def pooled_builds(rows):
+    """None when pkslam's configurations share one build and each peer one build; else a one-line
+    reason naming the builds and their run counts."""
+    groups = OrderedDict()  # "pkslam" or the peer configuration -> build -> runs
+    for r in rows:
+        owner = r["config"] if r["build"].startswith("peer ") else "pkslam"
+        counts = groups.setdefault(owner, OrderedDict())
+        counts[r["build"]] = counts.get(r["build"], 0) + 1
+    problems = []
+    for owner, counts in groups.items():
+        if len(counts) > 1:
+            listed = "; ".join(f"{b or 'not recorded'}: {n} runs" for b, n in counts.items())
+            problems.append(f"{owner} runs come from {len(counts)} builds ({listed})")
+    return "; ".join(problems) if problems else None
 
 
 def unique(values):
@@ -199,7 +232,28 @@ def runs_for_power(effect, sigma, strata, target=0.8):
     return math.ceil(2.0 * (z * sigma / effect) ** 2 / strata)
 
 
-def analyse(rows, seed=1):
+def has_pairs(rows):
+    """True when some sequence's seed was run by more than one configuration (run k of every
+    configuration shares its rendering and seed: the paired design)."""
+    seen = {}
+    for r in rows:
+        if r.get("seed", "") == "":
+            continue
+        seen.setdefault((r["dataset"], r["sensor"], r["seed"]), set()).add(r["config"])
+    return any(len(configs) > 1 for configs in seen.values())
+
+
+def analyse(rows, seed=1, pairs=None):
+    """The unpaired tests below, and the paired analysis (paired_statistics.py) when the runs
+    are pairs; `pairs`: the (config, baseline) comparisons, default each one against the suite's
+    baseline."""
+    result = analyse_unpaired(rows, seed)
+    if has_pairs(rows):
+        result["paired"] = paired_statistics.analyse(rows, pairs)
+    return result
+
+
+def analyse_unpaired(rows, seed=1):
     rng = np.random.default_rng(seed)
     result = {"rules": {"min_coverage": MIN_COVERAGE, "alpha": ALPHA}, "outcomes": [],
               "per_sequence": [], "pooled": []}
@@ -379,6 +433,8 @@ def markdown(result):
                   "|" + "---|" * len(header)]
         lines += ["| " + " | ".join(r) + " |" for r in rows]
         lines.append("")
+    if "paired" in result:
+        lines.append(paired_statistics.markdown(result["paired"]))
     return "\n".join(lines) + "\n"
 
 
@@ -392,6 +448,8 @@ def html_fragment(result):
         for r in rows:
             parts.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>")
         parts.append("</table>")
+    if "paired" in result:  # the Markdown tables, preformatted
+        parts.append("<pre>" + html.escape(paired_statistics.markdown(result["paired"])) + "</pre>")
     return "\n".join(parts) + "\n"
 
 
@@ -401,12 +459,31 @@ def main():
     p.add_argument("--md", help="write the Markdown fragment here (default: stdout)")
     p.add_argument("--html", help="write the HTML fragment here")
     p.add_argument("--json", help="write the numbers here")
+    p.add_argument("--compare", action="append", metavar="CONFIG:BASELINE",
+                   help="a paired comparison (repeatable; default: each configuration against "
+                        "the suite's baseline)")
+    p.add_argument("--pool-builds", action="store_true",
+                   help="analyse runs of different builds together (refused by default)")
     a = p.parse_args()
     rows = read_rows(a.results)
     if not rows:
         print("no runs", file=sys.stderr)
         return 1
-    result = analyse(rows)
+    mixed = pooled_builds(rows)
+    if mixed and not a.pool_builds:
+        print(f"bench_statistics.py: {a.results}: {mixed}; analyse one build at a time, or pass "
+              "--pool-builds", file=sys.stderr)
+        return 3
+    pairs = None
+    if a.compare:
+        try:
+            pairs = [tuple(c.split(":", 1)) for c in a.compare]
+        except ValueError:
+            pairs = []
+        if any(len(c) != 2 or not all(c) for c in pairs):
+            print("bench_statistics.py: --compare takes CONFIG:BASELINE", file=sys.stderr)
+            return 2
+    result = analyse(rows, pairs=pairs)
     md = markdown(result)
     if a.md:
         with open(a.md, "w") as f:

@@ -188,5 +188,65 @@ class BenchStatisticsTest(unittest.TestCase):
         self.assertIn("Holm", md)
 
 
+class BuildProvenanceTest(unittest.TestCase):
+    HEADER = ("index,dataset,sensor,config,baseline,status,ate_m,coverage,sweep_param,"
+              "pkslam_commit,executable,peer_build\n")
+
+    def write(self, lines):
+        import tempfile
+        d = tempfile.mkdtemp(prefix="bench_statistics_builds")
+        path = os.path.join(d, "results.csv")
+        with open(path, "w") as f:
+            f.write(self.HEADER + "".join(lines))
+        return path
+
+    def row(self, i, config, commit="c1", executable="e1", peer=""):
+        return f"{i},A,stereo-inertial,{config},orbslam3,ok,0.01,1,,{commit},{executable},{peer}\n"
+
+    def test_one_pkslam_build_and_one_build_per_peer_pass(self):
+        path = self.write([self.row(0, "orbslam3"), self.row(1, "pks"),
+                           self.row(2, "peer", peer="ORB-SLAM3 v1.0 060181f"),
+                           self.row(3, "peer", peer="ORB-SLAM3 v1.0 060181f"),
+                           self.row(4, "authors", peer="pks: PKS a6a7dc5")])
+        self.assertIsNone(bs.pooled_builds(bs.read_rows(path)))
+
+    def test_two_pkslam_builds_are_named_with_their_run_counts(self):
+        path = self.write([self.row(0, "orbslam3"), self.row(1, "pks"),
+                           self.row(2, "pks", commit="c2", executable="e2")])
+        mixed = bs.pooled_builds(bs.read_rows(path))
+        self.assertIn("pkslam runs come from 2 builds", mixed)
+        self.assertIn("pkslam c1 (executable e1): 2 runs", mixed)
+        self.assertIn("pkslam c2 (executable e2): 1 runs", mixed)
+
+    def test_a_peer_of_two_builds_and_unrecorded_runs_beside_recorded_ones(self):
+        path = self.write([self.row(0, "peer", peer="v1.0 a"), self.row(1, "peer", peer="v1.0 b"),
+                           self.row(2, "pks"), self.row(3, "pks", commit="", executable="")])
+        mixed = bs.pooled_builds(bs.read_rows(path))
+        self.assertIn("peer runs come from 2 builds", mixed)
+        self.assertIn("not recorded: 1 runs", mixed)
+
+    def test_files_without_provenance_are_one_unknown_build(self):
+        import tempfile
+        d = tempfile.mkdtemp(prefix="bench_statistics_old")
+        path = os.path.join(d, "results.csv")
+        with open(path, "w") as f:
+            f.write("index,dataset,sensor,config,baseline,status,ate_m,coverage,sweep_param\n"
+                    "0,A,stereo-inertial,orbslam3,orbslam3,ok,0.01,1,\n"
+                    "1,A,stereo-inertial,pks,orbslam3,ok,0.01,1,\n")
+        self.assertIsNone(bs.pooled_builds(bs.read_rows(path)))
+
+    def test_main_refuses_pooled_builds_unless_told(self):
+        path = self.write([self.row(i, c, commit=f"c{i % 2}") for i, c in
+                           enumerate(["orbslam3", "pks"] * 3)])
+        argv = sys.argv
+        try:
+            sys.argv = ["bench_statistics.py", path, "--md", os.devnull]
+            self.assertEqual(bs.main(), 3)
+            sys.argv += ["--pool-builds"]
+            self.assertEqual(bs.main(), 0)
+        finally:
+            sys.argv = argv
+
+
 if __name__ == "__main__":
     unittest.main()

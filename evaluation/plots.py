@@ -547,6 +547,16 @@ def statistics_fragments(out, results_path):
     rows = bench_statistics.read_rows(results_path)
     if not rows:
         return
+    mixed = bench_statistics.pooled_builds(rows)
+    if mixed:  # the report says why, instead of tests over runs of different programs
+        text = (f"Not computed: {mixed}. Run `bench_statistics.py --pool-builds` to analyse "
+                "them together anyway.\n")
+        with open(os.path.join(out, "statistics.md"), "w") as f:
+            f.write(text)
+        with open(os.path.join(out, "statistics.html"), "w") as f:
+            import html
+            f.write(f"<p>{html.escape(text)}</p>\n")
+        return
     result = bench_statistics.analyse(rows)
     with open(os.path.join(out, "statistics.md"), "w") as f:
         f.write(bench_statistics.markdown(result))

@@ -43,6 +43,9 @@ SelectorDecision OrbSlam3Selector::Decide(const SelectorInput& in) {
   no.reason = "no";
 
   if (auto exit = CommonSafetyExits(in, options_.imu_uninitialised_interval_s)) return *exit;
+  if (in.local_mapping_initializing && options_.no_keyframe_while_imu_initialises) {
+    return SelectorDecision::No("imu-initialising");
+  }
   const int max_frames =
       options_.max_frames > 0 ? options_.max_frames : static_cast<int>(in.fps + 0.5);
 

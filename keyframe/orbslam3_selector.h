@@ -1,5 +1,6 @@
 // ORB-SLAM3 v1.0's keyframe rule (Tracking::NeedNewKeyFrame), see
-// ../shared/docs/ORBSLAM3_FACTS.md "Keyframe decision".
+// ../shared/docs/ORBSLAM3_FACTS.md "Keyframe decision"; with `no_keyframe_while_imu_initialises`
+// the rule of v0.3, the revision the PKS authors' code derives from.
 #pragma once
 
 #include "keyframe/keyframe_selector.h"
@@ -18,6 +19,10 @@ struct OrbSlam3SelectorOptions {
   // Close-point rule: insert when tracked close < this and untracked close > the next.
   int close_tracked_max = 100;
   int close_untracked_min = 70;
+  // ORB-SLAM3 v0.3 (and the PKS authors' code built on it) takes no keyframe while local
+  // mapping initialises the IMU; v1.0 dropped that exit (and inserts then, as when idle).
+  // Everything else of NeedNewKeyFrame is the same in the two revisions.
+  bool no_keyframe_while_imu_initialises = false;
 
   void Check() const;
 };

@@ -132,6 +132,27 @@ TEST(OrbSlam3Selector, SafetyExits) {
   EXPECT_EQ(s.Decide(in).reason, "after-reloc");
 }
 
+// While local mapping initialises the IMU, v1.0 inserts (as when idle) and v0.3 declines.
+TEST(OrbSlam3Selector, ImuInitialisationExitOnlyInTheV03Reading) {
+  SelectorInput in = StereoInput();
+  in.sensor = Sensor::kStereoInertial;
+  in.imu_initialized = true;
+  in.local_mapping_idle = false;
+  in.local_mapping_initializing = true;
+  in.t_ns = in.last_keyframe_t_ns + 500'000'000;  // c3 holds
+  OrbSlam3Selector v10;
+  EXPECT_TRUE(v10.Decide(in).insert);
+  OrbSlam3SelectorOptions o;
+  o.no_keyframe_while_imu_initialises = true;
+  OrbSlam3Selector v03(o);
+  const auto d = v03.Decide(in);
+  EXPECT_FALSE(d.insert);
+  EXPECT_EQ(d.reason, "imu-initialising");
+  in.local_mapping_initializing = false;
+  in.local_mapping_idle = true;
+  EXPECT_TRUE(v03.Decide(in).insert);
+}
+
 TEST(OrbSlam3SelectorOptions, CheckRejectsBadValues) {
   OrbSlam3SelectorOptions o;
   o.inertial_interval_s = 0;

@@ -69,6 +69,7 @@ std::unique_ptr<KeyframeSelector> MakeKeyframeSelector(
     reader.Read("inertial_interval", &o.inertial_interval_s);
     reader.Read("close_tracked_max", &o.close_tracked_max);
     reader.Read("close_untracked_min", &o.close_untracked_min);
+    reader.Read("no_keyframe_while_imu_initialises", &o.no_keyframe_while_imu_initialises);
     reader.RejectUnknown();
     return std::make_unique<OrbSlam3Selector>(o);
   }

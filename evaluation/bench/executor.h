@@ -33,6 +33,9 @@ struct HarnessOptions {
   // Part of every cache key (ExecutableId of `pkslam`): a rebuilt simulator may render the same
   // command line differently, so its renders are never mistaken for an older build's.
   std::string simulator_id;
+  // The commit of `pkslam` (BuildCommit of that build), recorded in every result with the
+  // executable's id, the machine's cores, `jobs` and the time (results.h "Provenance").
+  std::string pkslam_commit;
 
   void Check() const;
 };

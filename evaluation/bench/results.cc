@@ -38,6 +38,12 @@ long long ParseInt(const std::string& s, const fs::path& file, std::size_t line,
   return static_cast<long long>(v);
 }
 
+// An integer column that may be empty (0).
+long long ParseOptionalInt(const std::string& s, const fs::path& file, std::size_t line,
+                           const std::string& column) {
+  return s.empty() ? 0 : ParseInt(s, file, line, column);
+}
+
 }  // namespace
 
 std::string PrimaryAlignment(const std::string& sensor, const std::string& suite_choice) {
@@ -102,7 +108,13 @@ std::vector<std::string> ResultColumns() {
           "mapping_cpu_s",
           "degraded",
           "keyframe_reasons",
-          "suspect"};
+          "suspect",
+          "pkslam_commit",
+          "executable",
+          "peer_build",
+          "cores",
+          "jobs",
+          "finished_utc"};
 }
 
 std::string CsvField(const std::string& text) {
@@ -189,7 +201,13 @@ std::string ResultCsvRow(const RunResult& r) {
                                       Num(r.mapping_cpu_s),
                                       Num(r.degraded),
                                       CsvField(r.keyframe_reasons),
-                                      Num(r.suspect)};
+                                      Num(r.suspect),
+                                      CsvField(r.pkslam_commit),
+                                      CsvField(r.executable),
+                                      CsvField(r.peer_build),
+                                      r.cores > 0 ? std::to_string(r.cores) : "",
+                                      r.jobs > 0 ? std::to_string(r.jobs) : "",
+                                      CsvField(r.finished_utc)};
   std::string out;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (i > 0) out.push_back(',');
@@ -272,13 +290,23 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
                           &r.realtime_factor, &r.p95_tracking_ms,   &r.mapping_ms_per_kf,
                           &r.cpu_s,           &r.peak_memory_mib,   &r.sequence_s,
                           &r.mapping_cpu_s,   &r.degraded};
-    // Then keyframe_reasons (text) and suspect, the columns added last.
-    PKSLAM_CHECK(required + std::size(optional) + 2 == columns.size(), "optional columns");
+    // Then keyframe_reasons (text), suspect, and the six provenance columns, added last.
+    constexpr std::size_t kLater = 8;
+    PKSLAM_CHECK(required + std::size(optional) + kLater == columns.size(), "optional columns");
     for (std::size_t k = 0; k < std::size(optional) && required + k < header.size(); ++k) {
       *optional[k] = ParseDouble(next(), file, n, header[required + k]);
     }
-    if (header.size() > columns.size() - 2) r.keyframe_reasons = next();
-    if (header.size() == columns.size()) r.suspect = ParseDouble(next(), file, n, "suspect");
+    const auto has = [&](std::size_t later) {  // later: index among the last kLater columns
+      return header.size() > columns.size() - kLater + later;
+    };
+    if (has(0)) r.keyframe_reasons = next();
+    if (has(1)) r.suspect = ParseDouble(next(), file, n, "suspect");
+    if (has(2)) r.pkslam_commit = next();
+    if (has(3)) r.executable = next();
+    if (has(4)) r.peer_build = next();
+    if (has(5)) r.cores = static_cast<int>(ParseOptionalInt(next(), file, n, "cores"));
+    if (has(6)) r.jobs = static_cast<int>(ParseOptionalInt(next(), file, n, "jobs"));
+    if (has(7)) r.finished_utc = next();
     out.push_back(std::move(r));
   }
   return out;

@@ -64,6 +64,14 @@ struct RunResult {
   // 1: the run's own signals call its estimate suspect (stats.json "estimate", or for runs
   // written before it, a loss for good in loop_closing.new_map_or_reset_times_s); NaN: unknown.
   double suspect = kNaN;
+  // Provenance (empty in files written before it): what made the run, so statistics never
+  // pool different builds unknowingly (evaluation/bench_statistics.py).
+  std::string pkslam_commit;  // the commit of the pkslam that ran it (peers: that evaluated it)
+  std::string executable;     // ExecutableId of that pkslam executable
+  std::string peer_build;     // peers: the first line of the run folder's peer_build.txt
+  int cores = 0;              // hardware threads of the machine
+  int jobs = 0;               // runs the bench executed at once
+  std::string finished_utc;   // when the run finished (ISO 8601, UTC)
 };
 
 // The headline alignment of a run: `suite_choice` when "se3"/"sim3"; for "auto" "sim3" for

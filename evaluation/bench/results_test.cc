@@ -88,6 +88,9 @@ TEST(ResultsCsv, RoundTripsEveryField) {
   EXPECT_TRUE(std::isnan(back[1].ate_m));
 }
 
+// The provenance columns, the last ones added.
+constexpr int kProvenance = 6;
+
 // result.csv of `r` as written by a version without the last `dropped` columns.
 std::vector<RunResult> ReadWithoutTrailingColumns(const RunResult& r, int dropped,
                                                   const std::string& name) {
@@ -118,7 +121,8 @@ RunResult MeasuredRun() {
 // collected bench must not run them again).
 TEST(ResultsCsv, ReadsFilesWithoutTheDenseColumn) {
   // dense_points, the bias errors, the 5 speed columns and the 5 study columns came later.
-  const auto back = ReadWithoutTrailingColumns(MeasuredRun(), 13, "bench_results_legacy");
+  const auto back =
+      ReadWithoutTrailingColumns(MeasuredRun(), 13 + kProvenance, "bench_results_legacy");
   ASSERT_EQ(back.size(), 1u);
   EXPECT_TRUE(back[0].ok);
   EXPECT_DOUBLE_EQ(back[0].ate_m, 0.01);
@@ -127,7 +131,8 @@ TEST(ResultsCsv, ReadsFilesWithoutTheDenseColumn) {
 }
 
 TEST(ResultsCsv, ReadsFilesWithoutTheSpeedColumns) {
-  const auto back = ReadWithoutTrailingColumns(MeasuredRun(), 10, "bench_results_no_speed");
+  const auto back =
+      ReadWithoutTrailingColumns(MeasuredRun(), 10 + kProvenance, "bench_results_no_speed");
   ASSERT_EQ(back.size(), 1u);
   EXPECT_DOUBLE_EQ(back[0].dense_points, 5);  // the older optional columns still read
   EXPECT_DOUBLE_EQ(back[0].gyro_bias_err_pct, 7);
@@ -135,14 +140,16 @@ TEST(ResultsCsv, ReadsFilesWithoutTheSpeedColumns) {
   EXPECT_TRUE(std::isnan(back[0].cpu_s));
   EXPECT_TRUE(std::isnan(back[0].peak_memory_mib));
   // Only the speed columns a file has are read: with realtime_factor, without cpu_s.
-  const auto partial = ReadWithoutTrailingColumns(MeasuredRun(), 9, "bench_results_part_speed");
+  const auto partial =
+      ReadWithoutTrailingColumns(MeasuredRun(), 9 + kProvenance, "bench_results_part_speed");
   EXPECT_DOUBLE_EQ(partial[0].realtime_factor, 2.5);
   EXPECT_TRUE(std::isnan(partial[0].cpu_s));
 }
 
 TEST(ResultsCsv, SpeedColumnsTrailTheOlderOptionalOnes) {
   const auto columns = ResultColumns();
-  const std::vector<std::string> tail(columns.end() - 11, columns.end());
+  const std::vector<std::string> tail(columns.end() - 11 - kProvenance,
+                                      columns.end() - kProvenance);
   EXPECT_EQ(tail,
             (std::vector<std::string>{"accel_bias_err_pct", "realtime_factor", "p95_tracking_ms",
                                       "mapping_ms_per_kf", "cpu_s", "peak_memory_mib", "sequence_s",
@@ -163,13 +170,44 @@ TEST(ResultsCsv, StudyColumnsRoundTripAndOlderFilesLackThem) {
   EXPECT_EQ(back[0].keyframe_reasons, "camera=3 forced+imu=2 time=40");
   EXPECT_DOUBLE_EQ(back[0].suspect, 1.0);
   // Files from before the suspect column keep their keyframe reasons.
-  const auto no_suspect = ReadWithoutTrailingColumns(r, 1, "bench_results_no_suspect");
+  const auto no_suspect =
+      ReadWithoutTrailingColumns(r, 1 + kProvenance, "bench_results_no_suspect");
   EXPECT_EQ(no_suspect[0].keyframe_reasons, "camera=3 forced+imu=2 time=40");
   EXPECT_TRUE(std::isnan(no_suspect[0].suspect));
-  const auto older = ReadWithoutTrailingColumns(r, 5, "bench_results_no_study");
+  const auto older = ReadWithoutTrailingColumns(r, 5 + kProvenance, "bench_results_no_study");
   EXPECT_DOUBLE_EQ(older[0].cpu_s, 12.0);
   EXPECT_TRUE(std::isnan(older[0].sequence_s));
   EXPECT_TRUE(older[0].keyframe_reasons.empty());
+}
+
+TEST(ResultsCsv, ProvenanceRoundTripsAndOlderFilesLackIt) {
+  RunResult r = MeasuredRun();
+  r.pkslam_commit = "0ba4feb1c2d3e4f5a6b7c8d9e0f1a2b3c4d5e6f7-dirty";
+  r.executable = "89ab01cd23ef4567";
+  r.peer_build = "pks a6a7dc5 libORB_SLAM3.so=1234abcd";
+  r.cores = 2;
+  r.jobs = 1;
+  r.finished_utc = "2026-11-30T01:02:03Z";
+  const auto columns = ResultColumns();
+  EXPECT_EQ(std::vector<std::string>(columns.end() - kProvenance, columns.end()),
+            (std::vector<std::string>{"pkslam_commit", "executable", "peer_build", "cores", "jobs",
+                                      "finished_utc"}));
+  const auto back = ReadWithoutTrailingColumns(r, 0, "bench_results_provenance");
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].pkslam_commit, r.pkslam_commit);
+  EXPECT_EQ(back[0].executable, r.executable);
+  EXPECT_EQ(back[0].peer_build, r.peer_build);
+  EXPECT_EQ(back[0].cores, 2);
+  EXPECT_EQ(back[0].jobs, 1);
+  EXPECT_EQ(back[0].finished_utc, r.finished_utc);
+  // Files from before provenance: the suspect column is the last, the provenance empty.
+  const auto older = ReadWithoutTrailingColumns(r, kProvenance, "bench_results_no_provenance");
+  EXPECT_DOUBLE_EQ(older[0].ate_m, 0.01);
+  EXPECT_TRUE(older[0].pkslam_commit.empty());
+  EXPECT_EQ(older[0].cores, 0);
+  // Unknown counts are written empty and read back as 0.
+  r.cores = 0;
+  EXPECT_EQ(ReadWithoutTrailingColumns(r, 0, "bench_results_no_cores")[0].cores, 0);
 }
 
 TEST(ResultsCsv, MalformedFilesNameTheLine) {
