@@ -1,6 +1,7 @@
 #include "evaluation/bench/peer_import.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -131,6 +132,10 @@ void ImportPeerRun(const fs::path& run_dir, const fs::path& dataset, const std::
   json.Member("frames_in_trajectory", tracked);
   json.Member("lost_frames", std::max(frames - tracked, 0));
   json.Member("keyframes", static_cast<int>(keyframes.poses.size()));
+  // Keyframes the peer created (culled ones too), when its script wrote the count: the
+  // selector's rate, which the final map's count hides behind culling.
+  const double created = NumberAfter(run_dir / "keyframes_created.txt", "");
+  if (std::isfinite(created)) json.Member("keyframes_created", static_cast<int>(created));
   json.Member("map_points", 0);
   // The peer's wall time (/usr/bin/time) includes loading ORB-SLAM3's text vocabulary
   // (seconds), which pkslam's (its frame loop) does not. Its example program, unpaced, does

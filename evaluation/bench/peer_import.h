@@ -7,6 +7,8 @@
 //   kf_tum.txt       the keyframes, same frame and format (optional)
 //   track_times.txt  "t_frame_s tracking_s" per frame (optional)
 //   summary.txt      key=value words, wall_s=... peak_rss_mb=... (optional)
+//   keyframes_created.txt  the number of keyframes it created, culled ones too (optional)
+//   peer_build.txt   one line naming the peer's build (optional; results.csv's peer_build)
 //   time.txt         /usr/bin/time -v of the peer process: user and system time (optional)
 // What is written: trajectory_body.txt (inertial sensors) or trajectory.txt plus
 // body_from_camera.txt (visual sensors: cam0's T_BS from the dataset, the extrinsic the peer

@@ -66,6 +66,18 @@ TEST(PeerImport, InertialRunBecomesABodyTrajectoryWithStats) {
   EXPECT_DOUBLE_EQ(stats["median_tracking_ms"].as<double>(), 20.0);
 }
 
+// The count of keyframes the peer created, when its script wrote one (the v0.3 peers do).
+TEST(PeerImport, KeyframesCreatedAreImportedWhenThePeerCountedThem) {
+  const PeerRun p = MakePeerRun("peer_import_created");
+  ImportPeerRun(p.run, p.dataset, "stereo-inertial");
+  EXPECT_FALSE(YAML::LoadFile((p.run / "stats.json").string())["keyframes_created"]);
+  std::ofstream(p.run / "keyframes_created.txt") << "7\n";
+  ImportPeerRun(p.run, p.dataset, "stereo-inertial");
+  const YAML::Node stats = YAML::LoadFile((p.run / "stats.json").string());
+  EXPECT_EQ(stats["keyframes_created"].as<int>(), 7);
+  EXPECT_EQ(stats["keyframes"].as<int>(), 1);  // the final map's
+}
+
 // The peer's speed in the keys `pkslam run` uses, so the speed table holds both systems.
 TEST(PeerImport, SpeedStatsMatchPkslamRunKeys) {
   const PeerRun p = MakePeerRun("peer_import_speed");

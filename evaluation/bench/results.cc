@@ -109,6 +109,7 @@ std::vector<std::string> ResultColumns() {
           "degraded",
           "keyframe_reasons",
           "suspect",
+          "keyframes_created",
           "pkslam_commit",
           "executable",
           "peer_build",
@@ -202,6 +203,7 @@ std::string ResultCsvRow(const RunResult& r) {
                                       Num(r.degraded),
                                       CsvField(r.keyframe_reasons),
                                       Num(r.suspect),
+                                      Num(r.keyframes_created),
                                       CsvField(r.pkslam_commit),
                                       CsvField(r.executable),
                                       CsvField(r.peer_build),
@@ -290,8 +292,9 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
                           &r.realtime_factor, &r.p95_tracking_ms,   &r.mapping_ms_per_kf,
                           &r.cpu_s,           &r.peak_memory_mib,   &r.sequence_s,
                           &r.mapping_cpu_s,   &r.degraded};
-    // Then keyframe_reasons (text), suspect, and the six provenance columns, added last.
-    constexpr std::size_t kLater = 8;
+    // Then keyframe_reasons (text), suspect, keyframes_created and the six provenance columns,
+    // added last.
+    constexpr std::size_t kLater = 9;
     PKSLAM_CHECK(required + std::size(optional) + kLater == columns.size(), "optional columns");
     for (std::size_t k = 0; k < std::size(optional) && required + k < header.size(); ++k) {
       *optional[k] = ParseDouble(next(), file, n, header[required + k]);
@@ -301,12 +304,13 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
     };
     if (has(0)) r.keyframe_reasons = next();
     if (has(1)) r.suspect = ParseDouble(next(), file, n, "suspect");
-    if (has(2)) r.pkslam_commit = next();
-    if (has(3)) r.executable = next();
-    if (has(4)) r.peer_build = next();
-    if (has(5)) r.cores = static_cast<int>(ParseOptionalInt(next(), file, n, "cores"));
-    if (has(6)) r.jobs = static_cast<int>(ParseOptionalInt(next(), file, n, "jobs"));
-    if (has(7)) r.finished_utc = next();
+    if (has(2)) r.keyframes_created = ParseDouble(next(), file, n, "keyframes_created");
+    if (has(3)) r.pkslam_commit = next();
+    if (has(4)) r.executable = next();
+    if (has(5)) r.peer_build = next();
+    if (has(6)) r.cores = static_cast<int>(ParseOptionalInt(next(), file, n, "cores"));
+    if (has(7)) r.jobs = static_cast<int>(ParseOptionalInt(next(), file, n, "jobs"));
+    if (has(8)) r.finished_utc = next();
     out.push_back(std::move(r));
   }
   return out;

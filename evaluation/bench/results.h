@@ -64,6 +64,8 @@ struct RunResult {
   // 1: the run's own signals call its estimate suspect (stats.json "estimate", or for runs
   // written before it, a loss for good in loop_closing.new_map_or_reset_times_s); NaN: unknown.
   double suspect = kNaN;
+  // Keyframes created (culled ones too): stats.json keyframes_created; peers that count them.
+  double keyframes_created = kNaN;
   // Provenance (empty in files written before it): what made the run, so statistics never
   // pool different builds unknowingly (evaluation/bench_statistics.py).
   std::string pkslam_commit;  // the commit of the pkslam that ran it (peers: that evaluated it)

@@ -88,8 +88,8 @@ TEST(ResultsCsv, RoundTripsEveryField) {
   EXPECT_TRUE(std::isnan(back[1].ate_m));
 }
 
-// The provenance columns, the last ones added.
-constexpr int kProvenance = 6;
+// keyframes_created and the provenance columns, the last ones added.
+constexpr int kProvenance = 7;
 
 // result.csv of `r` as written by a version without the last `dropped` columns.
 std::vector<RunResult> ReadWithoutTrailingColumns(const RunResult& r, int dropped,
@@ -188,10 +188,11 @@ TEST(ResultsCsv, ProvenanceRoundTripsAndOlderFilesLackIt) {
   r.cores = 2;
   r.jobs = 1;
   r.finished_utc = "2026-11-30T01:02:03Z";
+  r.keyframes_created = 195;
   const auto columns = ResultColumns();
   EXPECT_EQ(std::vector<std::string>(columns.end() - kProvenance, columns.end()),
-            (std::vector<std::string>{"pkslam_commit", "executable", "peer_build", "cores", "jobs",
-                                      "finished_utc"}));
+            (std::vector<std::string>{"keyframes_created", "pkslam_commit", "executable",
+                                      "peer_build", "cores", "jobs", "finished_utc"}));
   const auto back = ReadWithoutTrailingColumns(r, 0, "bench_results_provenance");
   ASSERT_EQ(back.size(), 1u);
   EXPECT_EQ(back[0].pkslam_commit, r.pkslam_commit);
@@ -200,10 +201,12 @@ TEST(ResultsCsv, ProvenanceRoundTripsAndOlderFilesLackIt) {
   EXPECT_EQ(back[0].cores, 2);
   EXPECT_EQ(back[0].jobs, 1);
   EXPECT_EQ(back[0].finished_utc, r.finished_utc);
+  EXPECT_DOUBLE_EQ(back[0].keyframes_created, 195);
   // Files from before provenance: the suspect column is the last, the provenance empty.
   const auto older = ReadWithoutTrailingColumns(r, kProvenance, "bench_results_no_provenance");
   EXPECT_DOUBLE_EQ(older[0].ate_m, 0.01);
   EXPECT_TRUE(older[0].pkslam_commit.empty());
+  EXPECT_TRUE(std::isnan(older[0].keyframes_created));
   EXPECT_EQ(older[0].cores, 0);
   // Unknown counts are written empty and read back as 0.
   r.cores = 0;

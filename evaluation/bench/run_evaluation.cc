@@ -41,6 +41,7 @@ struct StatsJson {
   double degraded = kNaN;
   double suspect = kNaN;
   std::string keyframe_reasons;  // "reason=count ..."
+  double keyframes_created = kNaN;
 };
 
 // realtime_factor from stats.json, else sequence_duration_s / wall time. A factor <= 0 is
@@ -71,6 +72,7 @@ StatsJson ReadStats(const fs::path& file) {
   StatsJson s;
   s.frames = get("frames", 0);
   s.keyframes = get("keyframes", 0);
+  s.keyframes_created = optional("keyframes_created");
   s.map_points = get("map_points", 0);
   s.lost_frames = get("lost_frames", 0);
   s.wall_s = get("wall_time_s", 0.0);
@@ -190,6 +192,7 @@ void EvaluateRun(const RunFiles& files, RunResult* result) {
   result->degraded = stats.degraded;
   result->suspect = stats.suspect;
   result->keyframe_reasons = stats.keyframe_reasons;
+  result->keyframes_created = stats.keyframes_created;
 
   const fs::path gt_file =
       files.ground_truth ? *files.ground_truth : FindGroundTruth(files.dataset);
