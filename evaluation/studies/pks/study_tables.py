@@ -9,10 +9,15 @@ Reads REPORT/results.csv (one row per run) and the analysis of evaluation/bench_
      "estimate"), coverage, keyframes in
      the final map, CPU time and mapping CPU time (means over runs);
   3. keyframes created per rule (mean per run), the reason counts;
-  4. the pooled significance sentences.
+  4. the pooled significance sentences;
+  5. when run k of every configuration replays the same rendering (round 2, issue 39): the
+     paired analysis of evaluation/paired_statistics.py (--compare CONFIG:BASELINE, repeatable);
+  6. --rate-pairs A:B,...: keyframes created per minute of A beside B's per sequence (e.g.
+     pkslam's pks-released beside the authors' binary), and whether A is within 10% of B.
 
   /usr/bin/python3 evaluation/studies/pks/study_tables.py REPORT/results.csv \
-      [--datasets real_MH_01_easy,real_V1_01_easy] > tables.md
+      [--datasets real_MH_01_easy,real_V1_01_easy] [--compare pks-authors:orbslam3-v03-peer] \
+      [--rate-pairs pks-released:pks-authors] > tables.md
 """
 
 import argparse
@@ -113,12 +118,62 @@ def reason_table(rows, sensors, configs, top=6):
     return lines
 
 
+RATE_TOLERANCE = 0.10  # issue 39: pks-released's rate within 10% of the authors' binary
+
+
+def created_per_minute(rows):
+    """Mean over runs of keyframes created per minute of sequence (NaN without the counts)."""
+    rates = [num(r["raw"].get("keyframes_created")) / (num(r["raw"].get("sequence_s")) / 60.0)
+             for r in rows]
+    rates = [v for v in rates if math.isfinite(v)]
+    return sum(rates) / len(rates) if rates else math.nan
+
+
+def rate_table(rows, datasets, sensors, pairs):
+    lines = ["| sequence | sensor | configuration | keyframes created / min | beside | ratio | "
+             "within 10% |", "|---|---|---|---|---|---|---|"]
+    for sensor in sensors:
+        for dataset in datasets:
+            for a, b in pairs:
+                ra = created_per_minute([r for r in rows if (r["dataset"], r["sensor"],
+                                                             r["config"]) == (dataset, sensor, a)])
+                rb = created_per_minute([r for r in rows if (r["dataset"], r["sensor"],
+                                                             r["config"]) == (dataset, sensor, b)])
+                if not (math.isfinite(ra) or math.isfinite(rb)):
+                    continue
+                ratio = ra / rb if math.isfinite(ra) and math.isfinite(rb) and rb > 0 else math.nan
+                within = ("yes" if abs(ratio - 1) <= RATE_TOLERANCE + 1e-9 else "**no**") \
+                    if math.isfinite(ratio) else "—"
+                lines.append(f"| {short(dataset)} | {sensor} | {a} | {ra:.1f} | {b} {rb:.1f} | "
+                             f"{ratio:.2f} | {within} |")
+    return lines
+
+
+def pairs_argument(text, parser):
+    if not text:
+        return []
+    try:
+        pairs = [tuple(p.split(":", 1)) for p in text.split(",")]
+    except ValueError:
+        pairs = []
+    if not pairs or any(len(p) != 2 or not all(p) for p in pairs):
+        parser.error("expected A:B[,C:D...]")
+    return pairs
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("results", help="REPORT/results.csv of pkslam bench --collect")
     parser.add_argument("--datasets", default="",
                         help="comma-separated datasets to keep (default: all)")
+    parser.add_argument("--compare", action="append", default=[], metavar="CONFIG:BASELINE",
+                        help="a paired comparison (repeatable; default: each configuration "
+                             "against the suite's baseline)")
+    parser.add_argument("--rate-pairs", default="", metavar="A:B,...",
+                        help="keyframe rates of A beside B per sequence")
     args = parser.parse_args()
+    compare = pairs_argument(",".join(args.compare), parser)
+    rate_pairs = pairs_argument(args.rate_pairs, parser)
     try:
         rows = bench_statistics.read_rows(args.results)
     except (OSError, ValueError) as e:
@@ -132,7 +187,7 @@ def main():
         rows = [r for r in rows if r["dataset"] in keep]
     if not rows:
         sys.exit(f"study_tables: {args.results}: no runs left")
-    result = bench_statistics.analyse(rows)
+    result = bench_statistics.analyse(rows, pairs=compare or None)
     datasets = bench_statistics.unique(r["dataset"] for r in rows)
     sensors = bench_statistics.unique(r["sensor"] for r in rows)
     configs = bench_statistics.unique(r["config"] for r in rows)
@@ -147,6 +202,12 @@ def main():
     out += reason_table(rows, sensors, configs)
     out += ["", "**Pooled** (stratified permutation test, Holm over the configurations)", ""]
     out += ["- " + e["sentence"] for e in result["pooled"]]
+    if "paired" in result:
+        out += ["", bench_statistics.paired_statistics.markdown(result["paired"])]
+    if rate_pairs:
+        out += ["", "**Keyframe rates** (keyframes created, culled ones too, per minute of "
+                "sequence; mean over runs)", ""]
+        out += rate_table(rows, datasets, sensors, rate_pairs)
     print("\n".join(out))
 
 

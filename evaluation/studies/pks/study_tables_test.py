@@ -13,7 +13,7 @@ import unittest
 HERE = os.path.dirname(os.path.abspath(__file__))
 FIELDS = ["index", "dataset", "sensor", "config", "baseline", "status", "ate_m",
           "ate_se3_rmse_m", "coverage", "keyframes", "cpu_s", "mapping_cpu_s",
-          "keyframe_reasons", "sweep_param"]
+          "keyframe_reasons", "sweep_param", "seed", "keyframes_created", "sequence_s"]
 
 
 def write_results(path):
@@ -30,7 +30,8 @@ def write_results(path):
                     "ate_se3_rmse_m": "" if failed else 0.020, "coverage": 0.1 if failed else 1,
                     "keyframes": 100 if config == "pks" else 50, "cpu_s": 10, "mapping_cpu_s": 4,
                     "keyframe_reasons": ("imu=6 time=2" if config == "pks" else "c1b+c2=3"),
-                    "sweep_param": ""})
+                    "sweep_param": "", "seed": run + 1,
+                    "keyframes_created": 33 if config == "pks" else 30, "sequence_s": 60})
                 index += 1
     # A sweep row: left out of every table.
     rows.append(dict(rows[0], index=index, config="orbslam3-sweep", sweep_param="min_frames"))
@@ -60,6 +61,17 @@ class StudyTablesTest(unittest.TestCase):
         self.assertNotIn("orbslam3-sweep", text)
         self.assertIn("pks vs orbslam3 (stereo-inertial, 2 sequences", text)
         self.assertIn("fewer than 5 runs per sequence", text)  # 4 runs: no verdict
+
+    def test_paired_analysis_and_keyframe_rates(self):
+        out = self.run_tables("--compare", "pks:orbslam3", "--rate-pairs", "pks:orbslam3")
+        self.assertEqual(out.returncode, 0, out.stderr)
+        text = out.stdout
+        self.assertIn("### Paired analysis", text)
+        self.assertIn("| stereo-inertial | pks vs orbslam3 | 2 | 8 |", text)
+        self.assertIn("| MH_01 | stereo-inertial | pks | 33.0 | orbslam3 30.0 | 1.10 | yes |",
+                      text)
+        bad = self.run_tables("--rate-pairs", "pks")
+        self.assertNotEqual(bad.returncode, 0)
 
     def test_dataset_filter_and_empty_selection(self):
         out = self.run_tables("--datasets", "real_MH_01_easy")
