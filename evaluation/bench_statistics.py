@@ -44,8 +44,8 @@ from scipy import stats
 import paired_statistics
 
 MIN_COVERAGE = 0.5
-ALPHA = 0.05
-PAPER_RATIO = {"stereo-inertial": 1 - 0.181, "mono-inertial": 1 - 0.204}
+ALPHA = paired_statistics.ALPHA
+PAPER_RATIO = paired_statistics.PAPER_RATIO
 BOOTSTRAP = 5000
 # Fewer successful runs per sequence and configuration than this: the spread (and so the power)
 # is too poorly known to call a missing effect "not reproduced".
@@ -108,8 +108,7 @@ def pooled_builds(rows):
     return "; ".join(problems) if problems else None
 
 
-def unique(values):
-    return list(OrderedDict.fromkeys(values))
+unique = paired_statistics.unique
 
 
 def rank_biserial(a, b):
@@ -189,16 +188,7 @@ def identical(strata):
     return all(g.size > 1 and np.all(g == g[0]) for g in groups)
 
 
-def holm(pvalues):
-    """Holm-adjusted p-values (same order)."""
-    order = sorted(range(len(pvalues)), key=lambda i: pvalues[i])
-    adjusted = [math.nan] * len(pvalues)
-    running = 0.0
-    m = len(pvalues)
-    for rank, i in enumerate(order):
-        running = max(running, min(1.0, (m - rank) * pvalues[i]))
-        adjusted[i] = running
-    return adjusted
+holm = paired_statistics.holm  # one Holm for both analyses
 
 
 def log_spread(strata):
