@@ -32,7 +32,8 @@ def parse_libraries(repo):
         dirs[:] = [d for d in dirs if d not in SKIP_FOLDERS and not d.startswith("build")]
         if "CMakeLists.txt" not in files:
             continue
-        text = open(os.path.join(root, "CMakeLists.txt")).read()
+        with open(os.path.join(root, "CMakeLists.txt")) as fh:
+            text = fh.read()
         text = re.sub(r"#[^\n]*", "", text)
         for m in re.finditer(r"pkslam_library\(\s*(\w+)(.*?)\)", text, re.S):
             name, body = m.group(1), m.group(2)
@@ -103,6 +104,23 @@ def owner(libs, path):
     return best
 
 
+def header_names(repo, libs):
+    """Header file name -> {library: its path}: every .h below a library's folder, owned by the
+    library whose folder is the longest prefix (test headers included). Also read by
+    evaluation/studies/refactor/structure_counts.py."""
+    by_name = {}
+    for name, lib in libs.items():
+        for root, dirs, files in os.walk(os.path.join(repo, lib["folder"])):
+            dirs[:] = [d for d in dirs if d not in SKIP_FOLDERS]
+            for f in files:
+                if not f.endswith(".h"):
+                    continue
+                rel = os.path.relpath(os.path.join(root, f), repo)
+                if owner(libs, rel) == name:
+                    by_name.setdefault(f, {}).setdefault(name, rel)
+    return by_name
+
+
 def shared_header_names(by_name, allowed):
     """A header name used by two libraries (by_name: name -> {library: its header}), unless
     `allowed`; and a name in `allowed` that is not shared."""
@@ -132,7 +150,6 @@ def main():
     # only tests, benchmarks or other such headers include.
     includers = {}
     tests = set()
-    headers_by_name = {}  # header file name -> {library: path}, test headers included
     for name, lib in libs.items():
         for root, dirs, files in os.walk(os.path.join(repo, lib["folder"])):
             dirs[:] = [d for d in dirs if d not in SKIP_FOLDERS]
@@ -140,8 +157,6 @@ def main():
                 if not f.endswith((".cc", ".h")):
                     continue
                 rel = os.path.relpath(os.path.join(root, f), repo)
-                if f.endswith(".h") and owner(libs, rel) == name:
-                    headers_by_name.setdefault(f, {}).setdefault(name, rel)
                 if rel in lib["tests"] or f.endswith(("_test.cc", "_benchmark.cc")):
                     tests.add(rel)
                 with open(os.path.join(repo, rel), errors="replace") as fh:
@@ -187,7 +202,7 @@ def main():
                                             + (" (test)" if is_test else ""))
     # The allowance describes this repository (the self-test's repositories have none).
     allowed = SHARED_HEADER_NAMES if os.path.realpath(repo) == own_repo else set()
-    problems += shared_header_names(headers_by_name, allowed)
+    problems += shared_header_names(header_names(repo, libs), allowed)
     for p in problems:
         print(p)
     print(f"layering: {checked} files of {len(libs)} libraries checked, {len(problems)} problem(s)")
