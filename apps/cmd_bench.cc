@@ -40,6 +40,7 @@ struct BenchArgs {
   std::string emit_jobs;
   std::vector<std::string> collect;
   std::vector<std::string> run_ids;
+  std::vector<std::string> sensors;
   std::string pkslam;
   std::string python = "/usr/bin/python3";
   int jobs = 1;
@@ -110,7 +111,7 @@ void Run(const BenchArgs& a) {
   if (a.suite.empty()) throw OptionError("a SUITE file is required (or --collect DIR)");
   const bench::Suite suite = bench::ReadSuite(a.suite);
   const auto all = bench::ExpandSuite(suite);
-  const auto runs = bench::SelectRuns(all, a.run_ids);
+  const auto runs = bench::SelectRuns(bench::SelectSensors(all, a.sensors), a.run_ids);
   if (a.list) {
     for (const auto& r : runs) std::cout << r.id << '\n';
     return;
@@ -196,6 +197,9 @@ void RegisterBenchCommand(CLI::App& app) {
   cmd->add_option("--run-id", args->run_ids,
                   "Execute only these runs (ids as --list prints); no report is written: `pkslam "
                   "bench --collect OUT` makes it");
+  cmd->add_option("--sensor", args->sensors,
+                  "Only the runs of these sensors (a study split over sittings, one sensor "
+                  "first; the report covers the runs selected)");
   cmd->add_flag("--retry-failed", args->retry_failed, "Run failed runs again");
   cmd->add_flag("--prune-cache", args->prune_cache,
                 "Render each simulated dataset just before its runs and delete it after them "

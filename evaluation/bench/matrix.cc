@@ -127,4 +127,19 @@ const DatasetSpec& DatasetOf(const Suite& suite, const RunSpec& run) {
   throw Error("run " + run.id + ": dataset not in the suite");
 }
 
+std::vector<RunSpec> SelectSensors(const std::vector<RunSpec>& runs,
+                                   const std::vector<std::string>& sensors) {
+  if (sensors.empty()) return runs;
+  std::vector<RunSpec> out;
+  for (const auto& sensor : sensors) {
+    const bool known =
+        std::any_of(runs.begin(), runs.end(), [&](const RunSpec& r) { return r.sensor == sensor; });
+    if (!known) throw OptionError("--sensor '" + sensor + "': the suite runs no such sensor");
+  }
+  for (const auto& r : runs) {
+    if (std::find(sensors.begin(), sensors.end(), r.sensor) != sensors.end()) out.push_back(r);
+  }
+  return out;
+}
+
 }  // namespace pkslam::bench

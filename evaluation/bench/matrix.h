@@ -42,6 +42,12 @@ std::string FormatNumber(double value);
 // Expands the suite in a fixed order: dataset, sensor, configuration, run.
 std::vector<RunSpec> ExpandSuite(const Suite& suite);
 
+// The runs of these sensors (all when `sensors` is empty), in their order: a study split over
+// sittings, one sensor first (`pkslam bench --sensor`). Throws OptionError for a sensor the
+// suite does not run.
+std::vector<RunSpec> SelectSensors(const std::vector<RunSpec>& runs,
+                                   const std::vector<std::string>& sensors);
+
 // The dataset spec of a run (throws Error when absent).
 const DatasetSpec& DatasetOf(const Suite& suite, const RunSpec& run);
 

@@ -118,6 +118,16 @@ TEST(Suite, ExpandsTheMatrixInOrderWithDistinctSeeds) {
   for (std::size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(runs[i].index, static_cast<int>(i));
 }
 
+TEST(Suite, SensorSelectionKeepsTheOrderAndRejectsUnknownSensors) {
+  const auto runs = ExpandSuite(ParseSuite(kSuite, "dir/suite.yaml"));
+  const auto mono = SelectSensors(runs, {"mono"});
+  ASSERT_EQ(mono.size(), 12u);  // only `real` runs mono
+  EXPECT_EQ(mono.front().id, runs[12].id);
+  for (const auto& r : mono) EXPECT_EQ(r.sensor, "mono");
+  EXPECT_EQ(SelectSensors(runs, {}).size(), runs.size());
+  EXPECT_THROW(SelectSensors(runs, {"rgbd"}), OptionError);
+}
+
 TEST(Suite, SweepsCanBeLimitedToDatasets) {
   const Suite s = ParseSuite(R"(sensors: [stereo]
 runs: 1
