@@ -44,28 +44,16 @@ Eigen::Vector3d ToVector(const std::vector<double>& v, const char* name) {
   return Eigen::Vector3d(v[0], v[1], v[2]);
 }
 
-// The realism options the flags ask for: the preset (euroc for EuRoC-layout replays unless
-// named), sources switched off, sizes overridden.
+// The realism options the flags ask for (sim::ResolveRealism).
 sim::RealismOptions ResolveRealism(const SimulateArgs& a) {
-  const bool replay = !a.trajectory.empty() && !a.options.rgbd;
-  const sim::RealismPreset preset =
-      a.realism.empty() ? (replay ? sim::RealismPreset::kEuroc : sim::RealismPreset::kIdeal)
-                        : sim::ParseRealismPreset(a.realism);
-  if (preset == sim::RealismPreset::kEuroc && a.options.rgbd) {
-    throw OptionError(
-        "--realism euroc models the EuRoC VI-Sensor (stereo + IMU); use --realism ideal with "
-        "--rgbd");
-  }
-  sim::RealismOptions r = sim::MakeRealism(preset);
-  r.device_seed = a.device_seed;
-  for (const std::string& name : a.realism_off) {
-    if (preset == sim::RealismPreset::kIdeal) {
-      throw OptionError("--realism-off needs --realism euroc (ideal has every source off)");
-    }
-    r.enabled[static_cast<std::size_t>(sim::ParseRealismSource(name))] = false;
-  }
-  for (const std::string& p : a.realism_params) sim::SetRealismParameter(&r, p);
-  return r;
+  sim::RealismRequest request;
+  request.preset = a.realism;
+  request.replay = !a.trajectory.empty();
+  request.rgbd = a.options.rgbd;
+  request.off = a.realism_off;
+  request.params = a.realism_params;
+  request.device_seed = a.device_seed;
+  return sim::ResolveRealism(request);
 }
 
 // The realism preset's appearance, then the sensor flags the user gave on top of it.

@@ -399,4 +399,26 @@ std::string FormatRealismReport(const RealismOptions& options) {
   return text;
 }
 
+RealismOptions ResolveRealism(const RealismRequest& request) {
+  const RealismPreset preset =
+      request.preset.empty()
+          ? (request.replay && !request.rgbd ? RealismPreset::kEuroc : RealismPreset::kIdeal)
+          : ParseRealismPreset(request.preset);
+  if (preset == RealismPreset::kEuroc && request.rgbd) {
+    throw OptionError(
+        "--realism euroc models the EuRoC VI-Sensor (stereo + IMU); use --realism ideal with "
+        "--rgbd");
+  }
+  RealismOptions r = MakeRealism(preset);
+  r.device_seed = request.device_seed;
+  for (const std::string& name : request.off) {
+    if (preset == RealismPreset::kIdeal) {
+      throw OptionError("--realism-off needs --realism euroc (ideal has every source off)");
+    }
+    r.enabled[static_cast<std::size_t>(ParseRealismSource(name))] = false;
+  }
+  for (const std::string& p : request.params) SetRealismParameter(&r, p);
+  return r;
+}
+
 }  // namespace pkslam::sim

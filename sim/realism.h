@@ -105,8 +105,8 @@ struct AppearanceOptions {
   double cam1_relative_gain = 1.0;  // cam1's response relative to cam0's
   double exposure_adapt = 0.3;      // auto-exposure correction per frame (its lag)
   double max_exposure_ms = 0.0;     // > 0: motion blur over the auto-exposure time, capped here
-  double exposure_at_unit_gain_ms = 1.0;  // exposure time the radiance scale 1 needs
-  double gain_flicker_percent = 0.0;      // cam0's frame-to-frame gain change (std, %)
+  double exposure_at_unit_gain_ms = 1.0;   // exposure time the radiance scale 1 needs
+  double gain_flicker_percent = 0.0;       // cam0's frame-to-frame gain change (std, %)
   double cam1_gain_flicker_percent = 0.0;  // cam1's
   double veiling_glare_percent = 0.0;      // share of the light scattered as veiling glare
 
@@ -136,6 +136,20 @@ RealismOptions MakeRealism(RealismPreset preset);
 void SetRealismParameter(RealismOptions* options, const std::string& name, double value);
 // "name=value" form of the above (the CLI's --realism-param).
 void SetRealismParameter(RealismOptions* options, const std::string& assignment);
+
+// What a render asks for (pkslam simulate's --realism, --realism-off, --realism-param,
+// --device-seed; the Python module's simulate()).
+struct RealismRequest {
+  std::string preset;   // "ideal" | "euroc"; empty: euroc for a stereo replay, ideal otherwise
+  bool replay = false;  // a recorded trajectory is replayed
+  bool rgbd = false;    // TUM RGB-D output (no euroc preset: it models the VI-Sensor)
+  std::vector<std::string> off;     // sources switched off (euroc only)
+  std::vector<std::string> params;  // "name=value" size overrides
+  std::uint64_t device_seed = 1;
+};
+
+// The realism options a request resolves to; OptionError naming the flag otherwise.
+RealismOptions ResolveRealism(const RealismRequest& request);
 
 // One line of the realism report: an error source's size and where the size comes from.
 struct RealismEntry {

@@ -47,6 +47,33 @@ TEST(Realism, ParametersAreSetByNameAndChecked) {
 
 std::vector<CameraRig> Rig() { return {EurocCam0(), EurocCam1()}; }
 
+TEST(Realism, RequestsResolveToAPresetWithSourcesOffAndSizesSet) {
+  RealismRequest replay;
+  replay.replay = true;
+  EXPECT_EQ(ResolveRealism(replay).preset, RealismPreset::kEuroc);  // a replay's default
+  RealismRequest random;
+  EXPECT_EQ(ResolveRealism(random).preset, RealismPreset::kIdeal);
+  RealismRequest rgbd = replay;
+  rgbd.rgbd = true;
+  EXPECT_EQ(ResolveRealism(rgbd).preset, RealismPreset::kIdeal);  // euroc models the VI-Sensor
+  rgbd.preset = "euroc";
+  EXPECT_THROW(ResolveRealism(rgbd), OptionError);
+  RealismRequest euroc;
+  euroc.preset = "euroc";
+  euroc.off = {"calibration"};
+  euroc.params = {"timing.camera_imu_offset_ms=2.5"};
+  euroc.device_seed = 9;
+  const RealismOptions r = ResolveRealism(euroc);
+  EXPECT_FALSE(r.On(RealismSource::kCalibration));
+  EXPECT_TRUE(r.On(RealismSource::kImu));
+  EXPECT_EQ(r.timing.camera_imu_offset_ms, 2.5);
+  EXPECT_EQ(r.device_seed, 9u);
+  RealismRequest ideal_off;
+  ideal_off.preset = "ideal";
+  ideal_off.off = {"imu"};
+  EXPECT_THROW(ResolveRealism(ideal_off), OptionError);
+}
+
 TEST(RealismDraw, IdealWritesTheTruth) {
   const RealismDraw d = DrawRealism(MakeRealism(RealismPreset::kIdeal), Rig(), 1);
   ASSERT_EQ(d.written_cameras.size(), 2u);
