@@ -155,6 +155,8 @@ def holm(pvalues):
 
 def verdict(change, p_holm, low, high, paper):
     """The labels of one analysis: direction (or none) and where the paper's effect lies."""
+    if not math.isfinite(low):
+        return ["not computed (too few sequences or pairs)"]
     labels = []
     if math.isfinite(p_holm) and p_holm < ALPHA:
         labels.append("significantly worse" if change > 0 else "significantly better")
@@ -228,7 +230,8 @@ def fmt_p(v):
 def sentence(e):
     """One sentence per comparison, scoped to what ran."""
     f, r = e["fixed"], e["random"]
-    return (f"On realistic renders of {e['sequences']} EuRoC trajectories ({e['sensor']}, "
+    trajectories = "trajectory" if e["sequences"] == 1 else "trajectories"
+    return (f"On realistic renders of {e['sequences']} EuRoC {trajectories} ({e['sensor']}, "
             f"{e['pairs']} paired runs), {e['config']} vs {e['baseline']}: ATE "
             f"{fmt_pct(e['change_pct'])}; these sequences fixed: 95% interval "
             f"[{fmt_pct(f['ci_low_pct'])}, {fmt_pct(f['ci_high_pct'])}], Holm p "

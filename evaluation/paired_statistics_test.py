@@ -112,6 +112,13 @@ class PairedStatisticsTest(unittest.TestCase):
                                100 * (0.023 / 0.036 - 1))
         self.assertTrue(math.isnan(ps.paper_change_pct("stereo", "real_MH_01_easy")))
 
+    def test_one_sequence_has_no_random_sequence_reading(self):
+        rows = paired_rows({"orbslam3": render, "pks": lambda d, k: 0.9 * render(d, k)},
+                           datasets=("real_MH_01_easy",))
+        _, e = self.pooled(rows)
+        self.assertEqual(e["random"]["verdict"], ["not computed (too few sequences or pairs)"])
+        self.assertIn("renders of 1 EuRoC trajectory (", ps.sentence(e))
+
     def test_holm_skips_missing_p_values(self):
         self.assertEqual(ps.holm([0.01, math.nan, 0.04])[0], 0.02)
         self.assertTrue(math.isnan(ps.holm([0.01, math.nan, 0.04])[1]))
