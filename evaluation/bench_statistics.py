@@ -467,10 +467,8 @@ def main():
     pairs = None
     if a.compare:
         try:
-            pairs = [tuple(c.split(":", 1)) for c in a.compare]
+            pairs = paired_statistics.parse_pairs(a.compare)
         except ValueError:
-            pairs = []
-        if any(len(c) != 2 or not all(c) for c in pairs):
             print("bench_statistics.py: --compare takes CONFIG:BASELINE", file=sys.stderr)
             return 2
     result = analyse(rows, pairs=pairs)

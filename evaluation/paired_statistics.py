@@ -167,6 +167,14 @@ def verdict(change, p_holm, low, high, paper):
     return labels
 
 
+def parse_pairs(texts):
+    """["A:B", "C:D,E:F", ...] -> [(A, B), (C, D), (E, F)]; ValueError on anything else."""
+    pairs = [tuple(item.split(":", 1)) for text in texts for item in text.split(",")]
+    if not pairs or any(len(p) != 2 or not all(p) for p in pairs):
+        raise ValueError("expected A:B[,C:D...]")
+    return pairs
+
+
 def comparisons_of(rows, sensor, pairs=None):
     """[(config, baseline)]: the given pairs that ran on this sensor, else every configuration
     against the suite's baseline."""

@@ -10,6 +10,7 @@ plot_keyframes.csv (written by the harness), writes PNGs into --out and an index
 
 import argparse
 import csv
+import html
 import json
 import math
 import os
@@ -554,7 +555,6 @@ def statistics_fragments(out, results_path):
         with open(os.path.join(out, "statistics.md"), "w") as f:
             f.write(text)
         with open(os.path.join(out, "statistics.html"), "w") as f:
-            import html
             f.write(f"<p>{html.escape(text)}</p>\n")
         return
     result = bench_statistics.analyse(rows)
@@ -563,7 +563,6 @@ def statistics_fragments(out, results_path):
     with open(os.path.join(out, "statistics.html"), "w") as f:
         f.write(bench_statistics.html_fragment(result))
     with open(os.path.join(out, "statistics.json"), "w") as f:
-        import json
         json.dump(result, f, indent=1, default=float)
 
 

@@ -251,30 +251,21 @@ fs::path KeepGroundTruth(const fs::path& run_dir, const fs::path& dataset,
   return copy;
 }
 
-// What made a run (results.h "Provenance"): this harness's pkslam, the machine, and for a peer
-// the first line of the peer_build.txt its script wrote.
-void StampProvenance(const HarnessOptions& options, const fs::path& run_dir, bool peer,
-                     RunResult* result) {
-  result->pkslam_commit = options.pkslam_commit;
-  result->executable = options.simulator_id;
-  result->cores = static_cast<int>(std::thread::hardware_concurrency());
-  result->jobs = options.jobs;
-  result->finished_utc = fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::time(nullptr)));
+// What made a run: this harness's pkslam, the machine, and for a peer the first line of the
+// peer_build.txt its script wrote.
+RunProvenance ProvenanceOf(const HarnessOptions& options, const fs::path& run_dir, bool peer) {
+  RunProvenance p;
+  p.pkslam_commit = options.pkslam_commit;
+  p.executable = options.simulator_id;
+  p.cores = static_cast<int>(std::thread::hardware_concurrency());
+  p.jobs = options.jobs;
+  p.finished_utc = fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::time(nullptr)));
   if (peer) {
     std::ifstream in(run_dir / "peer_build.txt");
     std::string line;
-    if (in && std::getline(in, line)) result->peer_build = line;
+    if (in && std::getline(in, line)) p.peer_build = line;
   }
-}
-
-// A re-evaluated run keeps the provenance of the execution that made it.
-void KeepProvenance(const RunResult& done, RunResult* result) {
-  result->pkslam_commit = done.pkslam_commit;
-  result->executable = done.executable;
-  result->peer_build = done.peer_build;
-  result->cores = done.cores;
-  result->jobs = done.jobs;
-  result->finished_utc = done.finished_utc;
+  return p;
 }
 
 }  // namespace
@@ -286,7 +277,7 @@ std::optional<RunResult> ReevaluateRun(const Suite& suite, const RunSpec& run,
   if (!done || !done->ok) return std::nullopt;
   RunResult result = ResultSkeleton(run, suite);
   result.dense_points = done->dense_points;
-  KeepProvenance(*done, &result);
+  result.provenance = done->provenance;  // what ran it, not this harness
   try {
     if (const auto kept = KeptGroundTruth(run_dir)) {
       EvaluateRun({run_dir, run_dir, kept, suite.rpe_delta_m}, &result);
@@ -352,7 +343,7 @@ std::optional<RunResult> ExecuteRun(const Suite& suite, const RunSpec& run,
   std::ofstream(run_dir / "command.txt") << ShellCommand(argv) << '\n';
   const ProcessResult p = RunProcess(argv, log, suite.timeout_s, cancel);
   if (cancel != nullptr && cancel->load()) return std::nullopt;
-  StampProvenance(options, run_dir, peer, &result);
+  result.provenance = ProvenanceOf(options, run_dir, peer);
   if (!p.ok()) {
     result.error =
         fmt::format("{} {}: {}", peer ? run.config : "pkslam run", p.Describe(), LastLine(log));

@@ -34,7 +34,7 @@ struct HarnessOptions {
   // command line differently, so its renders are never mistaken for an older build's.
   std::string simulator_id;
   // The commit of `pkslam` (BuildCommit of that build), recorded in every result with the
-  // executable's id, the machine's cores, `jobs` and the time (results.h "Provenance").
+  // executable's id, the machine's cores, `jobs` and the time (results.h RunProvenance).
   std::string pkslam_commit;
 
   void Check() const;

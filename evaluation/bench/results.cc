@@ -163,53 +163,54 @@ std::string ResultCsvHeader() {
 }
 
 std::string ResultCsvRow(const RunResult& r) {
-  const std::vector<std::string> f = {std::to_string(r.index),
-                                      CsvField(r.run_id),
-                                      CsvField(r.dataset),
-                                      CsvField(r.sensor),
-                                      CsvField(r.config),
-                                      CsvField(r.selector),
-                                      CsvField(r.params),
-                                      CsvField(r.sweep_param),
-                                      Num(r.sweep_value),
-                                      std::to_string(r.seed),
-                                      CsvField(r.baseline),
-                                      r.ok ? "ok" : "failed",
-                                      CsvField(r.error),
-                                      r.alignment,
-                                      Num(r.ate_m),
-                                      Num(r.ate_se3_m),
-                                      Num(r.ate_sim3_m),
-                                      Num(r.scale),
-                                      Num(r.rpe_trans_m),
-                                      Num(r.rpe_rot_deg),
-                                      Num(r.coverage),
-                                      std::to_string(r.frames),
-                                      std::to_string(r.keyframes),
-                                      std::to_string(r.map_points),
-                                      std::to_string(r.lost_frames),
-                                      Num(r.wall_s),
-                                      Num(r.median_tracking_ms),
-                                      Num(r.dense_points),
-                                      Num(r.gyro_bias_err_pct),
-                                      Num(r.accel_bias_err_pct),
-                                      Num(r.realtime_factor),
-                                      Num(r.p95_tracking_ms),
-                                      Num(r.mapping_ms_per_kf),
-                                      Num(r.cpu_s),
-                                      Num(r.peak_memory_mib),
-                                      Num(r.sequence_s),
-                                      Num(r.mapping_cpu_s),
-                                      Num(r.degraded),
-                                      CsvField(r.keyframe_reasons),
-                                      Num(r.suspect),
-                                      Num(r.keyframes_created),
-                                      CsvField(r.pkslam_commit),
-                                      CsvField(r.executable),
-                                      CsvField(r.peer_build),
-                                      r.cores > 0 ? std::to_string(r.cores) : "",
-                                      r.jobs > 0 ? std::to_string(r.jobs) : "",
-                                      CsvField(r.finished_utc)};
+  const std::vector<std::string> f = {
+      std::to_string(r.index),
+      CsvField(r.run_id),
+      CsvField(r.dataset),
+      CsvField(r.sensor),
+      CsvField(r.config),
+      CsvField(r.selector),
+      CsvField(r.params),
+      CsvField(r.sweep_param),
+      Num(r.sweep_value),
+      std::to_string(r.seed),
+      CsvField(r.baseline),
+      r.ok ? "ok" : "failed",
+      CsvField(r.error),
+      r.alignment,
+      Num(r.ate_m),
+      Num(r.ate_se3_m),
+      Num(r.ate_sim3_m),
+      Num(r.scale),
+      Num(r.rpe_trans_m),
+      Num(r.rpe_rot_deg),
+      Num(r.coverage),
+      std::to_string(r.frames),
+      std::to_string(r.keyframes),
+      std::to_string(r.map_points),
+      std::to_string(r.lost_frames),
+      Num(r.wall_s),
+      Num(r.median_tracking_ms),
+      Num(r.dense_points),
+      Num(r.gyro_bias_err_pct),
+      Num(r.accel_bias_err_pct),
+      Num(r.realtime_factor),
+      Num(r.p95_tracking_ms),
+      Num(r.mapping_ms_per_kf),
+      Num(r.cpu_s),
+      Num(r.peak_memory_mib),
+      Num(r.sequence_s),
+      Num(r.mapping_cpu_s),
+      Num(r.degraded),
+      CsvField(r.keyframe_reasons),
+      Num(r.suspect),
+      Num(r.keyframes_created),
+      CsvField(r.provenance.pkslam_commit),
+      CsvField(r.provenance.executable),
+      CsvField(r.provenance.peer_build),
+      r.provenance.cores > 0 ? std::to_string(r.provenance.cores) : "",
+      r.provenance.jobs > 0 ? std::to_string(r.provenance.jobs) : "",
+      CsvField(r.provenance.finished_utc)};
   std::string out;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (i > 0) out.push_back(',');
@@ -305,12 +306,12 @@ std::vector<RunResult> ReadResultsCsv(const fs::path& file) {
     if (has(0)) r.keyframe_reasons = next();
     if (has(1)) r.suspect = ParseDouble(next(), file, n, "suspect");
     if (has(2)) r.keyframes_created = ParseDouble(next(), file, n, "keyframes_created");
-    if (has(3)) r.pkslam_commit = next();
-    if (has(4)) r.executable = next();
-    if (has(5)) r.peer_build = next();
-    if (has(6)) r.cores = static_cast<int>(ParseOptionalInt(next(), file, n, "cores"));
-    if (has(7)) r.jobs = static_cast<int>(ParseOptionalInt(next(), file, n, "jobs"));
-    if (has(8)) r.finished_utc = next();
+    if (has(3)) r.provenance.pkslam_commit = next();
+    if (has(4)) r.provenance.executable = next();
+    if (has(5)) r.provenance.peer_build = next();
+    if (has(6)) r.provenance.cores = static_cast<int>(ParseOptionalInt(next(), file, n, "cores"));
+    if (has(7)) r.provenance.jobs = static_cast<int>(ParseOptionalInt(next(), file, n, "jobs"));
+    if (has(8)) r.provenance.finished_utc = next();
     out.push_back(std::move(r));
   }
   return out;

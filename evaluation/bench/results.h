@@ -14,6 +14,17 @@ namespace pkslam::bench {
 
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// What made a run (empty in files written before it), so statistics never pool different
+// builds unknowingly (evaluation/bench_statistics.py). A re-evaluation keeps it whole.
+struct RunProvenance {
+  std::string pkslam_commit;  // the commit of the pkslam that ran it (peers: that evaluated it)
+  std::string executable;     // ExecutableId of that pkslam executable
+  std::string peer_build;     // peers: the first line of the run folder's peer_build.txt
+  int cores = 0;              // hardware threads of the machine
+  int jobs = 0;               // runs the bench executed at once
+  std::string finished_utc;   // when the run finished (ISO 8601, UTC)
+};
+
 struct RunResult {
   int index = 0;
   std::string run_id;
@@ -66,14 +77,7 @@ struct RunResult {
   double suspect = kNaN;
   // Keyframes created (culled ones too): stats.json keyframes_created; peers that count them.
   double keyframes_created = kNaN;
-  // Provenance (empty in files written before it): what made the run, so statistics never
-  // pool different builds unknowingly (evaluation/bench_statistics.py).
-  std::string pkslam_commit;  // the commit of the pkslam that ran it (peers: that evaluated it)
-  std::string executable;     // ExecutableId of that pkslam executable
-  std::string peer_build;     // peers: the first line of the run folder's peer_build.txt
-  int cores = 0;              // hardware threads of the machine
-  int jobs = 0;               // runs the bench executed at once
-  std::string finished_utc;   // when the run finished (ISO 8601, UTC)
+  RunProvenance provenance;
 };
 
 // The headline alignment of a run: `suite_choice` when "se3"/"sim3"; for "auto" "sim3" for

@@ -182,12 +182,12 @@ TEST(ResultsCsv, StudyColumnsRoundTripAndOlderFilesLackThem) {
 
 TEST(ResultsCsv, ProvenanceRoundTripsAndOlderFilesLackIt) {
   RunResult r = MeasuredRun();
-  r.pkslam_commit = "0ba4feb1c2d3e4f5a6b7c8d9e0f1a2b3c4d5e6f7-dirty";
-  r.executable = "89ab01cd23ef4567";
-  r.peer_build = "pks a6a7dc5 libORB_SLAM3.so=1234abcd";
-  r.cores = 2;
-  r.jobs = 1;
-  r.finished_utc = "2026-11-30T01:02:03Z";
+  r.provenance.pkslam_commit = "0ba4feb1c2d3e4f5a6b7c8d9e0f1a2b3c4d5e6f7-dirty";
+  r.provenance.executable = "89ab01cd23ef4567";
+  r.provenance.peer_build = "pks a6a7dc5 libORB_SLAM3.so=1234abcd";
+  r.provenance.cores = 2;
+  r.provenance.jobs = 1;
+  r.provenance.finished_utc = "2026-11-30T01:02:03Z";
   r.keyframes_created = 195;
   const auto columns = ResultColumns();
   EXPECT_EQ(std::vector<std::string>(columns.end() - kProvenance, columns.end()),
@@ -195,22 +195,22 @@ TEST(ResultsCsv, ProvenanceRoundTripsAndOlderFilesLackIt) {
                                       "peer_build", "cores", "jobs", "finished_utc"}));
   const auto back = ReadWithoutTrailingColumns(r, 0, "bench_results_provenance");
   ASSERT_EQ(back.size(), 1u);
-  EXPECT_EQ(back[0].pkslam_commit, r.pkslam_commit);
-  EXPECT_EQ(back[0].executable, r.executable);
-  EXPECT_EQ(back[0].peer_build, r.peer_build);
-  EXPECT_EQ(back[0].cores, 2);
-  EXPECT_EQ(back[0].jobs, 1);
-  EXPECT_EQ(back[0].finished_utc, r.finished_utc);
+  EXPECT_EQ(back[0].provenance.pkslam_commit, r.provenance.pkslam_commit);
+  EXPECT_EQ(back[0].provenance.executable, r.provenance.executable);
+  EXPECT_EQ(back[0].provenance.peer_build, r.provenance.peer_build);
+  EXPECT_EQ(back[0].provenance.cores, 2);
+  EXPECT_EQ(back[0].provenance.jobs, 1);
+  EXPECT_EQ(back[0].provenance.finished_utc, r.provenance.finished_utc);
   EXPECT_DOUBLE_EQ(back[0].keyframes_created, 195);
   // Files from before provenance: the suspect column is the last, the provenance empty.
   const auto older = ReadWithoutTrailingColumns(r, kProvenance, "bench_results_no_provenance");
   EXPECT_DOUBLE_EQ(older[0].ate_m, 0.01);
-  EXPECT_TRUE(older[0].pkslam_commit.empty());
+  EXPECT_TRUE(older[0].provenance.pkslam_commit.empty());
   EXPECT_TRUE(std::isnan(older[0].keyframes_created));
-  EXPECT_EQ(older[0].cores, 0);
+  EXPECT_EQ(older[0].provenance.cores, 0);
   // Unknown counts are written empty and read back as 0.
-  r.cores = 0;
-  EXPECT_EQ(ReadWithoutTrailingColumns(r, 0, "bench_results_no_cores")[0].cores, 0);
+  r.provenance.cores = 0;
+  EXPECT_EQ(ReadWithoutTrailingColumns(r, 0, "bench_results_no_cores")[0].provenance.cores, 0);
 }
 
 TEST(ResultsCsv, MalformedFilesNameTheLine) {

@@ -149,16 +149,13 @@ def rate_table(rows, datasets, sensors, pairs):
     return lines
 
 
-def pairs_argument(text, parser):
-    if not text:
+def pairs_argument(texts, parser):
+    if not texts:
         return []
     try:
-        pairs = [tuple(p.split(":", 1)) for p in text.split(",")]
-    except ValueError:
-        pairs = []
-    if not pairs or any(len(p) != 2 or not all(p) for p in pairs):
-        parser.error("expected A:B[,C:D...]")
-    return pairs
+        return bench_statistics.paired_statistics.parse_pairs(texts)
+    except ValueError as e:
+        parser.error(str(e))
 
 
 def main():
@@ -172,8 +169,8 @@ def main():
     parser.add_argument("--rate-pairs", default="", metavar="A:B,...",
                         help="keyframe rates of A beside B per sequence")
     args = parser.parse_args()
-    compare = pairs_argument(",".join(args.compare), parser)
-    rate_pairs = pairs_argument(args.rate_pairs, parser)
+    compare = pairs_argument(args.compare, parser)
+    rate_pairs = pairs_argument([args.rate_pairs] if args.rate_pairs else [], parser)
     try:
         rows = bench_statistics.read_rows(args.results)
     except (OSError, ValueError) as e:
