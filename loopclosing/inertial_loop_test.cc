@@ -11,8 +11,8 @@
 #include "estimators/optim/yaw_manifold.h"
 #include "loopclosing/loop_closing.h"
 #include "loopclosing/revisit_fixture.h"
+#include "map_model/estimation/global_bundle_merge.h"
 #include "map_model/map_editor.h"
-#include "mapping/global_bundle.h"
 
 namespace pkslam {
 namespace {

@@ -8,12 +8,12 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/wall_time.h"
+#include "map_model/estimation/global_bundle_merge.h"
+#include "map_model/estimation/inertial_bundle_collect.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
-#include "mapping/global_bundle.h"
-#include "mapping/inertial_bundle.h"
 
 namespace pkslam {
 

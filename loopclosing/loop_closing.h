@@ -9,7 +9,7 @@
 //    initialised: a loop whose transform tilts gravity by more than inertial_max_tilt_rad (or
 //    turns more than inertial_max_yaw_rad) is refused; otherwise it is reduced to yaw +
 //    translation and the 4-DoF essential graph keeps every keyframe's roll and pitch, and
-//    the global BA is the full visual-inertial BA (mapping/inertial_bundle.h);
+//    the global BA is the full visual-inertial BA (map_model/estimation/inertial_bundle_collect.h);
 //  - a merge moves the current map into the recognised map (rigidly / by the Sim3; by yaw +
 //    translation when both maps are gravity-aligned), welds the two sides by fusing points,
 //    re-roots the spanning tree and optimises the essential graph of the merged map (4-DoF

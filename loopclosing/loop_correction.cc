@@ -16,12 +16,12 @@
 #include "estimators/optim/yaw_manifold.h"
 #include "loopclosing/loop_closing.h"
 #include "map_model/estimation/essential_graph_collect.h"
+#include "map_model/estimation/global_bundle_merge.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
-#include "mapping/global_bundle.h"
 
 namespace pkslam {
 namespace {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "core/geometry/sim3.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

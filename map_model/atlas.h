@@ -11,10 +11,10 @@
 
 #include "core/sensor/rig_calibration.h"
 #include "core/util/annotated_mutex.h"
-#include "map_model/ids.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/map.h"
 #include "map_model/map_edit.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

@@ -17,8 +17,8 @@
 #include "core/sensor/camera_rig.h"
 #include "core/sensor/rig_calibration.h"
 #include "map_model/feature_grid.h"
-#include "map_model/ids.h"
-#include "map_model/inertial_state.h"
+#include "map_model/keyframe_inertial.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

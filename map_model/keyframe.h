@@ -21,8 +21,8 @@
 #include "core/sensor/camera_rig.h"
 #include "core/sensor/rig_calibration.h"
 #include "map_model/feature_grid.h"
-#include "map_model/ids.h"
-#include "map_model/inertial_state.h"
+#include "map_model/keyframe_inertial.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 
@@ -121,7 +121,7 @@ class KeyFrame {
   // For a retired keyframe: camera_from_parent at retirement.
   const SE3d& camera_from_parent() const { return camera_from_parent_; }
 
-  // --- online calibration (mapping/calibration_apply.h; Atlas mutex exclusive) ---
+  // --- online calibration (map_model/estimation/calibration_apply.h; Atlas mutex exclusive) ---
   // Moves the keyframe to a new calibration of its rig: `rig` becomes its rig; a live keyframe's
   // keypoints move through `warp` (stereo: re-rectified; monocular: re-undistorted from the raw
   // keypoint) and its stereo depths are recomputed with the new bf; its pose and, if retired,
@@ -131,7 +131,7 @@ class KeyFrame {
   void Recalibrate(std::shared_ptr<const CameraRig> rig, const RigWarp& warp,
                    const SE3d& new_from_old);
 
-  // --- inertial sensors (guarded by the Atlas mutex; map_model/inertial_state.h) ---
+  // --- inertial sensors (guarded by the Atlas mutex; map_model/keyframe_inertial.h) ---
   KeyFrameImu imu;
 
  private:

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "core/bow/bow_vector.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/geometry/so3.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 #include "map_model/world_change.h"
 
 namespace pkslam {
@@ -21,7 +21,7 @@ struct MapImuStatus {
   bool imu_initialized = false;
   bool inertial_ba1_done = false;
   bool inertial_ba2_done = false;
-  // Tilt observability (mapping/gravity_refinement.h) of the chain at the last gravity
+  // Tilt observability (estimators/inertial/gravity_gauge.h) of the chain at the last gravity
   // refinement (0: none yet).
   double gravity_refinement_observability = 0;
   // Time of the first keyframe of the IMU initialisation [ns].

@@ -14,7 +14,7 @@
 
 #include "core/features/descriptor.h"
 #include "core/sensor/scale_pyramid.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

@@ -14,7 +14,7 @@
 // queries, exclusive for the splicing).
 #pragma once
 
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

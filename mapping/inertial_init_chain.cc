@@ -1,8 +1,8 @@
 #include "mapping/inertial_init_chain.h"
 
 #include "imu/preintegration.h"
+#include "map_model/estimation/inertial_bundle_collect.h"
 #include "map_model/keyframe.h"
-#include "mapping/inertial_bundle.h"
 
 namespace pkslam {
 namespace {

@@ -9,8 +9,8 @@
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map_editor.h"
+#include "map_model/testing/imu_chain.h"
 #include "map_model/testing/synthetic_map.h"
-#include "mapping/imu_chain_testing.h"
 
 namespace pkslam {
 namespace {

@@ -14,7 +14,7 @@
 // observable at rest.
 #pragma once
 
-#include "mapping/inertial_bundle.h"
+#include "map_model/estimation/inertial_bundle_collect.h"
 #include "mapping/inertial_culling.h"
 
 namespace pkslam {
@@ -58,7 +58,7 @@ struct InertialMappingOptions {
   double moving_max_interval_s = 1.0;
   // Iterations of the full visual-inertial BA after each stage.
   int full_ba_iterations = 15;
-  // Gravity refinement after VIBA2 (mapping/gravity_refinement.h; not in ORB-SLAM3): a full
+  // Gravity refinement after VIBA2 (estimators/inertial/gravity_gauge.h; not in ORB-SLAM3): a full
   // visual-inertial BA with free roll and pitch once the chain's TiltObservability reaches
   // gravity_refinement_min, and again each time it grew by gravity_refinement_step since the
   // last one; skipped for chains longer than gravity_refinement_max_keyframes (a full BA over

@@ -2,8 +2,6 @@
 // estimators/inertial/marginalization_test.cc): the validity stamps, and Collect / Apply on a
 // synthetic inertial map (the anchor is free with a valid prior, fixed with a stale one, and
 // the solve's marginal lands on the next keyframe).
-#include "mapping/inertial_marginalization.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -15,12 +13,13 @@
 #include "imu/imu_manifolds.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
+#include "map_model/estimation/inertial_bundle_collect.h"
+#include "map_model/estimation/inertial_prior_stamp.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
+#include "map_model/testing/imu_chain.h"
 #include "map_model/testing/synthetic_map.h"
-#include "mapping/imu_chain_testing.h"
-#include "mapping/inertial_bundle.h"
 #include "mapping/inertial_culling.h"
 
 namespace pkslam {

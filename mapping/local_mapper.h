@@ -76,7 +76,7 @@ struct ImuStageSnapshot {
   std::vector<std::pair<std::int64_t, SE3d>> world_from_body;  // chain keyframes, oldest first
 };
 
-// One gravity refinement (mapping/gravity_refinement.h).
+// One gravity refinement (estimators/inertial/gravity_gauge.h).
 struct GravityRefinementStat {
   std::int64_t t_ns = 0;       // the keyframe that triggered it
   int keyframes = 0;           // chain keyframes in the BA

@@ -15,11 +15,11 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/wall_time.h"
+#include "map_model/estimation/calibration_apply.h"
+#include "map_model/estimation/calibration_collect.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
-#include "mapping/calibration_apply.h"
-#include "mapping/calibration_collect.h"
 #include "mapping/local_mapper.h"
 
 namespace pkslam {

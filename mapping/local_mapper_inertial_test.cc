@@ -14,8 +14,8 @@
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
+#include "map_model/testing/imu_chain.h"
 #include "map_model/testing/synthetic_map.h"
-#include "mapping/imu_chain_testing.h"
 #include "mapping/local_mapper.h"
 
 namespace pkslam {

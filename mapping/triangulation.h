@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <optional>
 
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <optional>
 
-#include "sim/trajectory.h"
+#include "sim/motion_trajectory.h"
 #include "sim/vibration.h"
 
 namespace pkslam::sim {

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "core/geometry/se3.h"
+#include "sim/motion_trajectory.h"
 #include "sim/scene.h"
-#include "sim/trajectory.h"
 
 namespace pkslam::sim {
 

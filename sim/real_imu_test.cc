@@ -10,7 +10,7 @@
 
 #include "io/trajectory.h"
 #include "sim/imu_simulator.h"
-#include "sim/trajectory.h"
+#include "sim/motion_trajectory.h"
 #include "tests/support/test_data.h"
 
 namespace pkslam::sim {

@@ -22,11 +22,11 @@
 #include "sim/imu_simulator.h"
 #include "sim/landmark_tracks.h"
 #include "sim/motion_generator.h"
+#include "sim/motion_trajectory.h"
 #include "sim/realism.h"
 #include "sim/renderer.h"
 #include "sim/scene_builder.h"
 #include "sim/sensor_model.h"
-#include "sim/trajectory.h"
 
 namespace pkslam::sim {
 

@@ -15,7 +15,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "sim/trajectory.h"
+#include "sim/motion_trajectory.h"
 
 namespace pkslam::sim {
 

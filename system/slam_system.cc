@@ -14,14 +14,14 @@
 #include "core/util/wall_time.h"
 #include "io/point_cloud.h"
 #include "keyframe/selector_factory.h"
+#include "map_model/estimation/calibration_apply.h"
+#include "map_model/estimation/calibration_collect.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/storage/atlas_storage.h"
 #include "map_model/storage/map_file.h"
-#include "mapping/calibration_apply.h"
-#include "mapping/calibration_collect.h"
 
 namespace pkslam {
 

@@ -3,7 +3,7 @@
 #include <vector>
 
 #include "core/util/error.h"
-#include "tracking/pose_correspondences.h"
+#include "map_model/estimation/frame_correspondences.h"
 
 namespace pkslam {
 

@@ -7,7 +7,7 @@
 #include <optional>
 
 #include "core/imu/imu_types.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 #include "tracking/inertial_pose_optimizer.h"
 
 namespace pkslam {

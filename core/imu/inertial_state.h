@@ -1,7 +1,7 @@
 // The estimated inertial state of a body (value types shared by the estimators and the map
 // model): velocity and biases at one instant, and the Gaussian prior on a keyframe's 15-D state
 // that the local inertial BA's marginalisation leaves (estimators/inertial/marginalization.h).
-// Frames and keyframes carry them through map_model/inertial_state.h.
+// Frames and keyframes carry them through map_model/keyframe_inertial.h.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,8 +32,9 @@ struct InertialStatePrior {
   // In the tangent order [rho, phi, v, b_g, b_a] of InertialStatePriorError (imu/imu_factors.h).
   Eigen::Matrix<double, 15, 15> information = Eigen::Matrix<double, 15, 15>::Zero();
   // A known square root W (W^T W = information) for priors built from one (the gauge of
-  // mapping/gravity_refinement.h); otherwise the factor takes it from an eigen-decomposition,
-  // which for a rank-deficient prior adds rows of rounding-noise weight in arbitrary directions.
+  // estimators/inertial/gravity_gauge.h); otherwise the factor takes it from an
+  // eigen-decomposition, which for a rank-deficient prior adds rows of rounding-noise weight in
+  // arbitrary directions.
   std::optional<Eigen::Matrix<double, 15, 15>> sqrt_information;
   MapId map_id = -1;
   int map_change_index = 0;

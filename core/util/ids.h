@@ -1,6 +1,6 @@
 // Typed ids of the map's objects. They live in the base layer so that estimators (which take
 // and return values, never map objects) and sensor-level code can name keyframes and points;
-// the objects themselves and their shared-pointer aliases are in map_model/ids.h.
+// the objects themselves and their shared-pointer aliases are in map_model/map_ids.h.
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,8 @@
 // Visual-inertial bundle adjustment (ORB-SLAM3's LocalInertialBA and FullInertialBA) in Ceres:
 // the problem and result values and the solve. The map side (collecting a problem from the
-// keyframe chain, applying the result) is mapping/inertial_bundle.h; the phases are those of
-// estimators/optim/bundle_adjustment.h, so the solve runs without the Atlas lock.
+// keyframe chain, applying the result) is map_model/estimation/inertial_bundle_collect.h; the
+// phases are those of estimators/optim/bundle_adjustment.h, so the solve runs without the Atlas
+// lock.
 //
 // States are body poses world_from_body (BodyPoseManifold), velocities and biases; the visual
 // part (points, observations, outlier handling) is a BundleProblem whose keyframe poses are
@@ -18,7 +19,7 @@
 // as that keyframe's prior, used when it becomes the anchor. Other keyframes observing the
 // window's points are fixed, visual only. Full: every chain keyframe, the first pose fixed;
 // optionally one bias pair shared by all with zero-mean priors (the BA right after the
-// inertial-only initialisation). Full with a free tilt (mapping/gravity_refinement.h): the
+// inertial-only initialisation). Full with a free tilt (estimators/inertial/gravity_gauge.h): the
 // first pose carries a position + yaw gauge prior instead, so roll and pitch of the whole map
 // (the gravity direction) are estimated; keyframes off the chain are then free, visual only.
 #pragma once

@@ -1,5 +1,6 @@
 // Marginalisation prior of the local inertial bundle adjustment
-// (estimators/inertial/inertial_bundle.h; collected and applied by mapping/inertial_bundle.h).
+// (estimators/inertial/inertial_bundle.h; collected and applied by
+// map_model/estimation/inertial_bundle_collect.h).
 //
 // After each local window solve the window's anchor (the keyframe just before the free
 // keyframes) is marginalised out of the factors that touch it: its own prior (if it had one), the
@@ -22,7 +23,7 @@
 // The prior of keyframe k summarises only factors of keyframes older than k, so a later window
 // whose anchor is k may use it whatever happened to the keyframes after k. It is dropped when its
 // keyframe is culled (mapping/inertial_culling.h) and ignored once anything moved the map as a
-// whole (mapping/inertial_marginalization.h PriorIsValid).
+// whole (map_model/estimation/inertial_prior_stamp.h PriorIsValid).
 #pragma once
 
 #include <Eigen/Core>

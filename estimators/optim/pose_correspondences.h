@@ -2,7 +2,7 @@
 // correspondence per matched keypoint with its cost function and residual block while it is an
 // inlier, and the per-round re-classification into inliers and outliers. The frame side
 // (collecting them from a Frame, writing the outlier flags back) is
-// tracking/pose_correspondences.h.
+// map_model/estimation/frame_correspondences.h.
 #pragma once
 
 #include <ceres/cost_function.h>

@@ -7,7 +7,7 @@
 #include <unordered_map>
 
 #include "estimators/optim/bundle_adjustment.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

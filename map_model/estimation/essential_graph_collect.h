@@ -4,7 +4,7 @@
 #pragma once
 
 #include "estimators/optim/essential_graph.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

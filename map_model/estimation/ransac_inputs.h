@@ -8,7 +8,7 @@
 #include "core/geometry/pinhole_intrinsics.h"
 #include "estimators/ransac/pnp.h"
 #include "estimators/ransac/sim3_solver.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

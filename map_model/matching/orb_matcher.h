@@ -12,7 +12,7 @@
 #include "core/geometry/se3.h"
 #include "core/geometry/sim3.h"
 #include "map_model/frame.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

@@ -1,4 +1,4 @@
-#include "mapping/global_bundle.h"
+#include "map_model/estimation/global_bundle_merge.h"
 
 #include <gtest/gtest.h>
 

@@ -1,16 +1,16 @@
 // SolveInertialBundle on a synthetic problem: a body on an analytic path observed by a stereo
 // camera, exact IMU with constant biases. From perturbed poses, zero velocities and zero biases
 // the solver must recover the states and the biases.
-#include "mapping/inertial_bundle.h"
+#include "map_model/estimation/inertial_bundle_collect.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 
+#include "estimators/inertial/gravity_gauge.h"
 #include "imu/imu_test_utils.h"
 #include "imu/preintegration.h"
-#include "mapping/gravity_refinement.h"
 
 namespace pkslam {
 namespace {

@@ -10,7 +10,7 @@
 #include <map>
 
 #include "map_model/estimation/bundle_collect.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

@@ -1,12 +1,12 @@
 // The map side of the calibration bundle adjustment (estimators/calibration/calibration_bundle.h):
 // Collect (shared Atlas lock) builds the problem from a whole map with each observation's
-// physical pixels; the solve holds no lock; Apply (mapping/calibration_apply.h) moves the map to
-// the new calibration.
+// physical pixels; the solve holds no lock; Apply (map_model/estimation/calibration_apply.h) moves
+// the map to the new calibration.
 #pragma once
 
 #include "core/sensor/rig_calibration.h"
 #include "estimators/calibration/calibration_bundle.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

@@ -1,4 +1,4 @@
-#include "mapping/calibration_apply.h"
+#include "map_model/estimation/calibration_apply.h"
 
 #include <gtest/gtest.h>
 
@@ -8,12 +8,12 @@
 #include "core/camera/test_cameras.h"
 #include "core/sensor/test_rig_calibration.h"
 #include "imu/preintegration.h"
+#include "map_model/estimation/calibration_collect.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/testing/synthetic_map.h"
-#include "mapping/calibration_collect.h"
 
 namespace pkslam {
 namespace {
@@ -64,9 +64,9 @@ TEST_F(CalibrationApplyTest, MovingToAnEstimateKeepsPhysicalPixelsAndBodies) {
   for (int i = 0; i < kf.size(); ++i) {
     const cv::Point2f p = kf.keypoints_undistorted()[i].pt;
     raw_before.push_back(*RawLeftPixel(setup_, Eigen::Vector2d(p.x, p.y)));
-    raw_right_before.push_back(
-        kf.right_u()[i] >= 0 ? *RawRightPixel(setup_, Eigen::Vector2d(kf.right_u()[i], p.y))
-                             : Eigen::Vector2d::Zero());
+    raw_right_before.push_back(kf.right_u()[i] >= 0
+                                   ? *RawRightPixel(setup_, Eigen::Vector2d(kf.right_u()[i], p.y))
+                                   : Eigen::Vector2d::Zero());
   }
   const SE3d body_before = kf.world_from_body();
   const int version = atlas_.calibration_version();
@@ -89,8 +89,7 @@ TEST_F(CalibrationApplyTest, MovingToAnEstimateKeepsPhysicalPixelsAndBodies) {
     ++stereo;
     // The right column moved with cam1's new cx (0.3 px), and the depth with the new bf.
     EXPECT_NEAR(kf.depth()[i], next.rig->bf / (p.x - kf.right_u()[i]), 1e-3 * kf.depth()[i]);
-    const Eigen::Vector2d raw_right =
-        *RawRightPixel(next, Eigen::Vector2d(kf.right_u()[i], p.y));
+    const Eigen::Vector2d raw_right = *RawRightPixel(next, Eigen::Vector2d(kf.right_u()[i], p.y));
     // The matcher measured the column only: the raw right pixel agrees along the row.
     EXPECT_NEAR(raw_right.x(), raw_right_before[i].x(), 0.05);
   }
@@ -102,8 +101,7 @@ TEST_F(CalibrationApplyTest, AGyroScaleEstimateMovesTheChainsPreintegrationsAndB
   // 0.5% fast about y: every keyframe's preintegration is re-integrated from samples divided by
   // 1.005 (and its gyro bias, a term of the same samples, with them).
   PreintegratedImu pim = StartPreintegration(
-      ImuBias(Eigen::Vector3d(0.01, -0.02, 0.0), Eigen::Vector3d::Zero()),
-                                             ImuNoise{});
+      ImuBias(Eigen::Vector3d(0.01, -0.02, 0.0), Eigen::Vector3d::Zero()), ImuNoise{});
   for (int i = 0; i < 40; ++i) {
     IntegrateMeasurement(Eigen::Vector3d(0.1, 9.8, 0.2), Eigen::Vector3d(0.3, 0.8, -0.2), 0.005,
                          &pim);

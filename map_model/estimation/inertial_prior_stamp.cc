@@ -1,4 +1,4 @@
-#include "mapping/inertial_marginalization.h"
+#include "map_model/estimation/inertial_prior_stamp.h"
 
 #include "map_model/map.h"
 

@@ -1,4 +1,4 @@
-#include "tracking/pose_correspondences.h"
+#include "map_model/estimation/frame_correspondences.h"
 
 #include "core/util/error.h"
 #include "map_model/map_point.h"

@@ -1,18 +1,18 @@
 // Collect and Apply phases of visual-inertial bundle adjustment; the solver is
 // estimators/inertial/inertial_bundle_solve.cc.
-#include "mapping/inertial_bundle.h"
+#include "map_model/estimation/inertial_bundle_collect.h"
 
 #include <algorithm>
 #include <unordered_map>
 #include <unordered_set>
 
 #include "core/util/error.h"
+#include "estimators/inertial/gravity_gauge.h"
 #include "imu/preintegration.h"
+#include "map_model/estimation/inertial_prior_stamp.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_point.h"
-#include "mapping/gravity_refinement.h"
-#include "mapping/inertial_marginalization.h"
 
 namespace pkslam {
 namespace {

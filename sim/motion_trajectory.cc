@@ -1,4 +1,4 @@
-#include "sim/trajectory.h"
+#include "sim/motion_trajectory.h"
 
 #include <algorithm>
 #include <cmath>

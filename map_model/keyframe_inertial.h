@@ -12,7 +12,7 @@
 
 #include "core/imu/imu_types.h"
 #include "core/imu/inertial_state.h"
-#include "map_model/ids.h"
+#include "map_model/map_ids.h"
 
 namespace pkslam {
 

@@ -1,4 +1,4 @@
-#include "mapping/gravity_refinement.h"
+#include "estimators/inertial/gravity_gauge.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

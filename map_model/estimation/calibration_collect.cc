@@ -1,5 +1,5 @@
 // Collect phase of the calibration bundle adjustment.
-#include "mapping/calibration_collect.h"
+#include "map_model/estimation/calibration_collect.h"
 
 #include <algorithm>
 #include <array>
@@ -7,10 +7,10 @@
 
 #include "core/util/error.h"
 #include "map_model/estimation/bundle_collect.h"
+#include "map_model/estimation/inertial_bundle_collect.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_point.h"
-#include "mapping/inertial_bundle.h"
 
 namespace pkslam {
 namespace {
@@ -27,8 +27,10 @@ void Thin(const std::vector<int>& observations_per_point, int max_per_keyframe,
   const double h = std::max(1.0, bounds.max_y - bounds.min_y);
   for (int i = 0; i < static_cast<int>(visual.observations.size()); ++i) {
     const auto& o = visual.observations[i];
-    const int cx = std::clamp(static_cast<int>((o.uv.x() - bounds.min_x) / w * kCells), 0, kCells - 1);
-    const int cy = std::clamp(static_cast<int>((o.uv.y() - bounds.min_y) / h * kCells), 0, kCells - 1);
+    const int cx =
+        std::clamp(static_cast<int>((o.uv.x() - bounds.min_x) / w * kCells), 0, kCells - 1);
+    const int cy =
+        std::clamp(static_cast<int>((o.uv.y() - bounds.min_y) / h * kCells), 0, kCells - 1);
     by_cell[static_cast<std::size_t>((o.keyframe_index * kCells + cy) * kCells + cx)].push_back(i);
   }
   std::vector<std::uint8_t> keep(visual.observations.size(), 0);

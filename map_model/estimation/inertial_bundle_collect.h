@@ -8,7 +8,7 @@
 
 #include "estimators/inertial/inertial_bundle.h"
 #include "map_model/estimation/bundle_collect.h"
-#include "map_model/inertial_state.h"
+#include "map_model/keyframe_inertial.h"
 
 namespace pkslam {
 

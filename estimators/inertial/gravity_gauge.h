@@ -16,7 +16,8 @@
 #include <vector>
 
 #include "core/geometry/so3.h"
-#include "map_model/inertial_state.h"
+#include "core/imu/imu_types.h"
+#include "core/imu/inertial_state.h"
 
 namespace pkslam {
 

@@ -1,15 +1,15 @@
-#include "mapping/calibration_apply.h"
+#include "map_model/estimation/calibration_apply.h"
 
 #include "core/util/error.h"
-#include "imu/preintegration.h"
 #include "estimators/optim/point_refinement.h"
+#include "imu/preintegration.h"
 #include "map_model/estimation/bundle_collect.h"
+#include "map_model/estimation/global_bundle_merge.h"
+#include "map_model/estimation/inertial_bundle_collect.h"
 #include "map_model/keyframe.h"
+#include "map_model/map.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
-#include "map_model/map.h"
-#include "mapping/global_bundle.h"
-#include "mapping/inertial_bundle.h"
 
 namespace pkslam {
 namespace {
@@ -74,7 +74,8 @@ int RefinePointsToCalibration(Atlas* atlas, MapId map_id) {
     if (refined[i] == problem.points[i].position_world) continue;
     const MapPointPtr point = map->MapPointById(problem.points[i].point_id);
     // A point changed meanwhile (local BA, fusion) keeps its newer position.
-    if (point == nullptr || point->IsBad() || point->position() != problem.points[i].position_world) {
+    if (point == nullptr || point->IsBad() ||
+        point->position() != problem.points[i].position_world) {
       continue;
     }
     point->SetPosition(refined[i]);
