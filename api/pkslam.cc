@@ -1,9 +1,11 @@
-// The public API (api/include/pkslam/pkslam.h) over SlamSystem.
+// The public API (api/include/pkslam/pkslam.h) over SlamSystem, the evaluator and the
+// simulator.
 #include "pkslam/pkslam.h"
 
 #include <fmt/format.h>
 
 #include <cmath>
+#include <filesystem>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
@@ -13,6 +15,7 @@
 #include "io/rigid_transform_file.h"
 #include "io/settings.h"
 #include "map_model/keyframe.h"
+#include "sim/simulation_request.h"
 #include "system/run_dataset.h"
 #include "system/slam_system.h"
 
@@ -370,6 +373,46 @@ Evaluation Evaluate(const std::string& ground_truth_file,
                                                  fmt::format("estimate pose {}", i).c_str())});
   }
   return Guard([&] { return EvaluateAgainst(ground_truth_file, est, align, std::nullopt); });
+}
+
+SimulateSummary Simulate(const SimulateOptions& options) {
+  sim::SimulationRequest request;
+  sim::SimulationOptions& o = request.options;
+  o.scene = options.scene;
+  o.output_dir = options.out;
+  o.trajectory = options.trajectory;
+  o.duration_s = options.duration_s;
+  o.start_s = options.start_s;
+  o.seed = options.seed;
+  o.camera = options.camera;
+  o.rgbd = options.rgbd;
+  o.quiet = options.quiet;
+  request.motion = options.motion;
+  request.quality = options.quality;
+  request.realism.preset = options.realism;
+  request.realism.off = options.realism_off;
+  request.realism.params = options.realism_params;
+  request.realism.device_seed = options.device_seed;
+  request.cloud = options.cloud;
+  request.imu_noise = options.imu_noise;
+  if (options.out.empty()) throw std::invalid_argument("out: an output folder is needed");
+  if (!options.trajectory.empty() && !std::filesystem::is_regular_file(options.trajectory)) {
+    throw std::invalid_argument(fmt::format("trajectory: {} is not a file", options.trajectory));
+  }
+  const sim::SimulationSummary s = Guard([&] {
+    try {
+      return sim::Simulate(request);
+    } catch (const OptionError& e) {
+      throw std::invalid_argument(e.what());
+    }
+  });
+  SimulateSummary out;
+  out.layout = s.layout;
+  out.frames = s.frames;
+  out.imu_samples = s.imu_samples;
+  out.duration_s = 1e-9 * static_cast<double>(s.end_ns - s.begin_ns);
+  out.path_length_m = s.path_length_m;
+  return out;
 }
 
 }  // namespace pkslam::api

@@ -9,18 +9,16 @@
 #include "apps/cli_errors.h"
 #include "apps/commands.h"
 #include "core/util/error.h"
-#include "io/kalibr_files.h"
-#include "io/kitti_writer.h"
 #include "sim/scene_description.h"
+#include "sim/simulation_request.h"
 #include "sim/simulator.h"
 
 namespace pkslam::apps {
 namespace {
 
+// The flags; the policy that turns them into options is sim::ResolveSimulation.
 struct SimulateArgs {
-  sim::SimulationOptions options;
-  std::string motion = "medium";
-  std::string quality = "default";
+  sim::SimulationRequest request;
   std::vector<double> blackout;
   std::vector<double> gyro_bias;
   std::vector<double> accel_bias;
@@ -31,10 +29,6 @@ struct SimulateArgs {
   bool no_images = false;
   bool no_auto_exposure = false;
   bool list_scenes = false;
-  std::string realism;                      // empty: euroc for replays, ideal otherwise
-  std::vector<std::string> realism_off;     // sources switched off
-  std::vector<std::string> realism_params;  // NAME=VALUE size overrides
-  std::uint64_t device_seed = 1;
   bool realism_report = false;
 };
 
@@ -44,34 +38,23 @@ Eigen::Vector3d ToVector(const std::vector<double>& v, const char* name) {
   return Eigen::Vector3d(v[0], v[1], v[2]);
 }
 
-// The realism options the flags ask for (sim::ResolveRealism).
-sim::RealismOptions ResolveRealism(const SimulateArgs& a) {
-  sim::RealismRequest request;
-  request.preset = a.realism;
-  request.replay = !a.trajectory.empty();
-  request.rgbd = a.options.rgbd;
-  request.off = a.realism_off;
-  request.params = a.realism_params;
-  request.device_seed = a.device_seed;
-  return sim::ResolveRealism(request);
-}
-
-// The realism preset's appearance, then the sensor flags the user gave on top of it.
-void ApplyAppearanceUnderFlags(const CLI::App& cmd, sim::SimulationOptions* o) {
-  const sim::SensorOptions given = o->sensor;
-  const double given_blur_exposure = o->motion_blur_exposure_s;
-  sim::ApplyAppearance(o->realism.appearance, o);
-  auto keep = [&](const char* flag, double sim::SensorOptions::*field) {
-    if (cmd.count(flag) > 0) o->sensor.*field = given.*field;
-  };
-  keep("--noise", &sim::SensorOptions::read_noise_dn);
-  keep("--blur", &sim::SensorOptions::blur_sigma_px);
-  keep("--vignetting", &sim::SensorOptions::vignetting);
-  keep("--gain-drift", &sim::SensorOptions::gain_drift);
-  if (cmd.count("--motion-blur") > 0) {  // a fixed exposure instead of the auto exposure's
-    o->sensor.max_exposure_s = 0.0;
-    o->motion_blur_exposure_s = given_blur_exposure;
-  }
+// The request the flags make (the ones CLI11 does not write into it directly).
+void CompleteRequest(SimulateArgs& a, const CLI::App& cmd) {
+  sim::SimulationRequest& r = a.request;
+  r.options.output_dir = a.out;
+  r.options.trajectory = a.trajectory;
+  if (!a.blackout.empty()) r.blackout = std::make_pair(a.blackout.at(0), a.blackout.at(1));
+  r.gyro_bias = ToVector(a.gyro_bias, "--gyro-bias");
+  r.accel_bias = ToVector(a.accel_bias, "--accel-bias");
+  r.imu_noise = !a.no_imu_noise;
+  r.cloud = !a.no_cloud;
+  r.images = !a.no_images;
+  r.auto_exposure = !a.no_auto_exposure;
+  r.given.read_noise = cmd.count("--noise") > 0;
+  r.given.blur = cmd.count("--blur") > 0;
+  r.given.vignetting = cmd.count("--vignetting") > 0;
+  r.given.gain_drift = cmd.count("--gain-drift") > 0;
+  r.given.motion_blur = cmd.count("--motion-blur") > 0;
 }
 
 void Run(SimulateArgs& a, const CLI::App& cmd) {
@@ -79,46 +62,16 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
     for (const auto& name : sim::BuiltinSceneNames()) std::cout << name << '\n';
     return;
   }
-  sim::SimulationOptions& o = a.options;
-  o.realism = ResolveRealism(a);
+  CompleteRequest(a, cmd);
   if (a.realism_report) {
-    std::cout << sim::FormatRealismReport(o.realism);
+    sim::RealismRequest realism = a.request.realism;
+    realism.replay = !a.trajectory.empty();
+    realism.rgbd = a.request.options.rgbd;
+    std::cout << sim::FormatRealismReport(sim::ResolveRealism(realism));
     return;
   }
-  if (cmd.count("--scene") == 0) o.scene = sim::DefaultScene(o.realism, a.trajectory);
-  o.output_dir = a.out;
-  o.trajectory = a.trajectory;
-  o.motion.level = sim::ParseMotionLevel(a.motion);
-  if (a.trajectory.empty() && o.duration_s > 0 && o.duration_s <= o.motion.rest_s) {
-    throw OptionError(
-        fmt::format("--duration {}: random motion starts with {} s at rest (as "
-                    "EuRoC's flights before take-off); give more than that",
-                    o.duration_s, o.motion.rest_s));
-  }
-  o.quality = sim::ParseQuality(a.quality);
-  if (!a.blackout.empty()) {
-    o.blackout_begin_s = a.blackout.at(0);
-    o.blackout_end_s = a.blackout.at(1);
-  }
-  o.imu.initial_gyro_bias = ToVector(a.gyro_bias, "--gyro-bias");
-  o.imu.initial_accel_bias = ToVector(a.accel_bias, "--accel-bias");
-  o.imu.noise = !a.no_imu_noise;
-  o.write_cloud = !a.no_cloud && !a.no_images;
-  o.write_images = !a.no_images;
-  if (o.camera == "kitti") o.camera_rate_hz = 10.0;  // KITTI odometry's frame rate
-  if (o.camera == "tumvi") {
-    // TUM-VI's Bosch BMI160 as its calibration states it (the values of ORB-SLAM3's TUM-VI
-    // settings), cameras at 20 Hz.
-    o.camera_rate_hz = 20.0;
-    o.imu.gyro_noise_density = 0.00016;
-    o.imu.accel_noise_density = 0.0028;
-    o.imu.gyro_random_walk = 0.000022;
-    o.imu.accel_random_walk = 0.00086;
-    o.imu.rate_hz = 200.0;
-  }
-  if (o.realism.On(sim::RealismSource::kAppearance)) ApplyAppearanceUnderFlags(cmd, &o);
-  o.sensor.auto_exposure = !a.no_auto_exposure;
-  const sim::SimulationSummary s = sim::RunSimulation(o);
+  sim::SimulationOptions o;
+  const sim::SimulationSummary s = sim::Simulate(a.request, &o);
   const double duration = 1e-9 * static_cast<double>(s.end_ns - s.begin_ns);
   if (s.layout == "bench") {
     std::cout << fmt::format(
@@ -136,9 +89,9 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
       "mean speed {:.2f} m/s, angular rate mean {:.1f} / max {:.1f} deg/s\n"
       "  scene: {} objects ({} removed near the path), cloud {} points, observed cloud {} "
       "points\n",
-      o.trajectory.empty() ? "random " + a.motion : o.trajectory.string(), o.output_dir.string(),
-      s.layout, s.frames, s.imu_samples, duration, s.path_length_m, s.mean_speed_mps,
-      s.mean_angular_rate_dps, s.max_angular_rate_dps,
+      o.trajectory.empty() ? "random " + a.request.motion : o.trajectory.string(),
+      o.output_dir.string(), s.layout, s.frames, s.imu_samples, duration, s.path_length_m,
+      s.mean_speed_mps, s.mean_angular_rate_dps, s.max_angular_rate_dps,
       s.scene.objects_placed - s.scene.objects_removed, s.scene.objects_removed, s.cloud_points,
       s.observed_points);
   std::cout << fmt::format("  realism {}: ", sim::RealismPresetName(o.realism.preset));
@@ -154,17 +107,13 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
         s.frames / s.total_seconds);
   }
   if (o.camera == "tumvi" && !o.rgbd && o.write_images) {
-    WriteTumViFiles(o.output_dir);
     std::cout << fmt::format(
         "  TUM-VI files: {}/dso/camchain.yaml, imu_config.yaml, "
         "mav0/mocap0/data.csv\n",
         o.output_dir.string());
   }
-  // KITTI's rig: the same sequence in KITTI odometry's layout beside the EuRoC one (images
-  // hard-linked), so `run --dataset OUT/kitti/sequences/00` and `eval --kitti` have exact poses.
   if (o.camera == "kitti" && !o.rgbd && o.write_images) {
     const std::filesystem::path kitti = o.output_dir / "kitti";
-    WriteKittiLayoutFromEuroc(o.output_dir, kitti, "00");
     std::cout << fmt::format("  KITTI layout: {}/sequences/00 (poses: {}/poses/00.txt)\n",
                              kitti.string(), kitti.string());
   }
@@ -174,17 +123,18 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
 
 void RegisterSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
-  sim::SimulationOptions& o = args->options;
+  sim::SimulationRequest& request = args->request;
+  sim::SimulationOptions& o = request.options;
   auto* cmd = app.add_subcommand(
       "simulate",
       "Render a EuRoC-format stereo+IMU (or TUM RGB-D) sequence with exact ground truth");
   cmd->add_option("--out", args->out, "Output directory (created)");
-  // The default scene is chosen from --realism (see Run): no default here.
+  // The default scene is chosen from --realism (sim::ResolveSimulation): no default here.
   o.scene.clear();
   auto* traj = cmd->add_option("--trajectory", args->trajectory,
                                "Replay this ground truth (TUM txt or EuRoC csv)")
                    ->check(CLI::ExistingFile);
-  cmd->add_option("--motion", args->motion, "Random motion level: easy|medium|difficult")
+  cmd->add_option("--motion", request.motion, "Random motion level: easy|medium|difficult")
       ->capture_default_str()
       ->excludes(traj);
   cmd->add_option("--duration", o.duration_s,
@@ -197,17 +147,17 @@ void RegisterSimulateCommand(CLI::App& app) {
                   "Built-in scene (see --list-scenes) or YAML file (default: by --realism: "
                   "euroc_vicon_room / euroc_machine_hall for MH_* replays; vicon_room / "
                   "machine_hall with --realism ideal)");
-  cmd->add_option("--realism", args->realism,
+  cmd->add_option("--realism", request.realism.preset,
                   "ideal|euroc: error sources of real EuRoC recordings (appearance, calibration, "
                   "timing, imu, motion, ground-truth); default euroc for replays of ground truth "
                   "(--trajectory), ideal otherwise (docs/realism.md)");
-  cmd->add_option("--realism-off", args->realism_off,
+  cmd->add_option("--realism-off", request.realism.off,
                   "Switch these sources of the euroc preset off (ablation), e.g. "
                   "calibration,timing")
       ->delimiter(',');
-  cmd->add_option("--realism-param", args->realism_params,
+  cmd->add_option("--realism-param", request.realism.params,
                   "Override a size: NAME=VALUE (names in --realism-report), repeatable");
-  cmd->add_option("--device-seed", args->device_seed,
+  cmd->add_option("--device-seed", request.realism.device_seed,
                   "Seed of the device errors (calibration, IMU axes): one rig for all sequences")
       ->capture_default_str();
   cmd->add_flag("--realism-report", args->realism_report,
@@ -255,7 +205,7 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("--clearance", o.scene_build.clearance_m,
                   "Objects closer than this to the camera path are removed (m)")
       ->capture_default_str();
-  cmd->add_option("--quality", args->quality, "fast|default|high")->capture_default_str();
+  cmd->add_option("--quality", request.quality, "fast|default|high")->capture_default_str();
   cmd->add_flag("--no-cloud", args->no_cloud, "Do not write reference_cloud.ply");
   cmd->add_option("--tracks", o.landmark_tracks,
                   "Also write the exact 2-D tracks of this many surface landmarks in cam0 "

@@ -291,4 +291,42 @@ PYBIND11_MODULE(_pkslam, m) {
       "EuRoC's body ground truth); camera poses (Slam.camera_trajectory()) with "
       "body_from_camera=Slam.body_from_camera, which moves the truth into the camera. A camera "
       "trajectory against body truth without it raises RuntimeError with that hint.");
+  m.def(
+      "_simulate",
+      [](const std::string& out, const std::string& trajectory, double duration, double start,
+         std::uint64_t seed, const std::string& motion, const std::string& quality,
+         const std::string& realism, const std::vector<std::string>& realism_off,
+         const std::vector<std::string>& realism_params, std::uint64_t device_seed,
+         const std::string& scene, const std::string& camera, bool rgbd, bool cloud,
+         bool imu_noise) {
+        api::SimulateOptions o;
+        o.out = out;
+        o.trajectory = trajectory;
+        o.duration_s = duration;
+        o.start_s = start;
+        o.seed = seed;
+        o.motion = motion;
+        o.quality = quality;
+        o.realism = realism;
+        o.realism_off = realism_off;
+        o.realism_params = realism_params;
+        o.device_seed = device_seed;
+        o.scene = scene;
+        o.camera = camera;
+        o.rgbd = rgbd;
+        o.cloud = cloud;
+        o.imu_noise = imu_noise;
+        const api::SimulateSummary s = [&] {
+          py::gil_scoped_release release;  // rendering takes seconds to minutes
+          return api::Simulate(o);
+        }();
+        py::dict d;
+        d["layout"] = s.layout;
+        d["frames"] = s.frames;
+        d["imu_samples"] = s.imu_samples;
+        d["duration_s"] = s.duration_s;
+        d["path_length_m"] = s.path_length_m;
+        return d;
+      },
+      "api::Simulate; pkslam.simulate() is its Python face");
 }

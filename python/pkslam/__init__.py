@@ -10,13 +10,13 @@
     # camera poses: pkslam.evaluate("gt.csv", slam.camera_trajectory(),
     #                               body_from_camera=slam.body_from_camera)
 
-`simulate()` renders an EuRoC-format sequence with exact ground truth (`pkslam simulate`).
+`simulate()` renders an EuRoC-format sequence with exact ground truth (the library behind
+`pkslam simulate`).
 """
 import os
 import shutil
-import subprocess
 
-from ._pkslam import Slam, evaluate, __version__  # noqa: F401
+from ._pkslam import Slam, evaluate, _simulate, __version__  # noqa: F401
 from . import _paths
 
 VOCABULARY = os.environ.get("PKSLAM_VOCABULARY", _paths.VOCABULARY)
@@ -31,24 +31,18 @@ def _executable():
 
 
 def simulate(out, trajectory=None, duration=10.0, seed=1, start=None, motion=None,
-             quality=None, realism=None, extra=()):
-    """Renders a sequence into `out` (EuRoC layout, settings.yaml, ground truth) and returns
-    `out`. trajectory: a TUM/EuRoC ground-truth file to replay (else random motion of the
-    `motion` level); the other arguments are `pkslam simulate` options (see its --help)."""
-    args = [_executable(), "--log-level", "warn", "simulate", "--out", str(out),
-            "--duration", str(duration), "--seed", str(seed), "--quiet"]
-    if trajectory is not None:
-        args += ["--trajectory", str(trajectory)]
-    if start is not None:
-        args += ["--start", str(start)]
-    if motion is not None:
-        args += ["--motion", motion]
-    if quality is not None:
-        args += ["--quality", quality]
-    if realism is not None:
-        args += ["--realism", realism]
-    args += list(extra)
-    result = subprocess.run(args, capture_output=True, text=True)
-    if result.returncode != 0:
-        raise RuntimeError(f"pkslam simulate failed: {result.stderr.strip() or result.stdout.strip()}")
+             quality=None, realism=None, realism_off=(), realism_params=(), device_seed=1,
+             scene=None, camera="euroc", rgbd=False, cloud=True, imu_noise=True):
+    """Renders a sequence into `out` (EuRoC layout, settings.yaml, ground truth; TUM RGB-D with
+    rgbd=True) and returns `out`, in this process (the library behind `pkslam simulate`: the same
+    bytes for the same arguments). trajectory: a TUM/EuRoC ground-truth file to replay (else
+    random motion of the `motion` level: easy|medium|difficult). The other arguments are the
+    `pkslam simulate` options of the same names (see its --help): quality fast|default|high,
+    realism ideal|euroc (None: euroc for replays), realism_off a list of sources,
+    realism_params a list of "NAME=VALUE", camera euroc|kitti|vga|tumvi. A bad value raises
+    ValueError naming it."""
+    _simulate(str(out), "" if trajectory is None else str(trajectory), float(duration),
+              0.0 if start is None else float(start), int(seed), motion or "medium",
+              quality or "default", realism or "", list(realism_off), list(realism_params),
+              int(device_seed), scene or "", camera, bool(rgbd), bool(cloud), bool(imu_noise))
     return str(out)

@@ -18,7 +18,7 @@ def sequence(tmp_path_factory):
     out = tmp_path_factory.mktemp("seq") / "seq"
     # Difficult motion: a path that is not a straight line, so orientations tell frames apart.
     return pkslam.simulate(out, duration=5.0, seed=2, motion="difficult", quality="fast",
-                           extra=["--no-cloud"])
+                           cloud=False)
 
 
 def frames(seq):
@@ -172,3 +172,34 @@ def test_bad_imu_and_poses_raise(sequence):
     poses[3, 0, 3] = np.nan
     with pytest.raises(ValueError, match="estimate pose 3: not finite"):
         pkslam.evaluate(gt, (np.array(stamps, np.int64), poses))
+
+
+def test_simulate_in_process_renders_the_bytes_of_the_command_line(tmp_path):
+    # The library and `pkslam simulate` resolve the same request the same way (one policy in
+    # sim/simulation_request.h): a short replay-free render, byte for byte.
+    python_out = tmp_path / "python"
+    cli_out = tmp_path / "cli"
+    pkslam.simulate(python_out, duration=2.5, seed=5, motion="easy", quality="fast", cloud=False,
+                    realism="euroc", realism_off=["appearance"])
+    cli = subprocess.run([pkslam._executable(), "--log-level", "warn", "simulate", "--out",
+                          str(cli_out), "--duration", "2.5", "--seed", "5", "--motion", "easy",
+                          "--quality", "fast", "--no-cloud", "--realism", "euroc",
+                          "--realism-off", "appearance", "--quiet"],
+                         capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    files = sorted(os.path.relpath(f, cli_out)
+                   for f in glob.glob(str(cli_out / "**" / "*"), recursive=True)
+                   if os.path.isfile(f))
+    assert "mav0/imu0/data.csv" in files and len(files) > 100
+    for name in files:
+        with open(cli_out / name, "rb") as a, open(python_out / name, "rb") as b:
+            assert a.read() == b.read(), name
+
+
+def test_simulate_refuses_bad_values_naming_them(tmp_path):
+    with pytest.raises(ValueError, match="wild"):
+        pkslam.simulate(tmp_path / "a", duration=3, motion="wild")
+    with pytest.raises(ValueError, match="trajectory"):
+        pkslam.simulate(tmp_path / "b", trajectory=tmp_path / "missing.txt")
+    with pytest.raises(ValueError, match="sunshine"):
+        pkslam.simulate(tmp_path / "c", duration=3, realism="euroc", realism_off=["sunshine"])

@@ -13,6 +13,8 @@
 //   slam.Shutdown();
 //   for (const pkslam::api::StampedBodyPose& p : slam.BodyTrajectory()) ...
 // While it runs: MapPoints(), KeyFrames(), TrackedKeypoints(), SetLocalisationMode(), Reset().
+// Evaluate() measures a trajectory against ground truth; Simulate() renders a sequence to try it
+// on.
 //
 // Frames: camera trajectories hold world_from_camera (the left camera), body trajectories
 // world_from_body (the IMU: what EuRoC ground truth describes). Every name says which.
@@ -176,5 +178,36 @@ Evaluation Evaluate(const std::string& ground_truth_file, const std::vector<Stam
                     const std::optional<Eigen::Matrix4d>& body_from_camera = std::nullopt);
 Evaluation Evaluate(const std::string& ground_truth_file,
                     const std::vector<StampedBodyPose>& estimate, const std::string& align = "se3");
+
+// Renders an EuRoC-format stereo+IMU sequence (or a TUM RGB-D one) with exact ground truth into
+// `out`, as `pkslam simulate` does with the same choices (the same bytes for the same seed; its
+// --help and docs/realism.md explain each). A bad value raises std::invalid_argument naming it.
+struct SimulateOptions {
+  std::string out;                  // created if missing
+  std::string trajectory;           // replay this ground truth (TUM/EuRoC); empty: random motion
+  double duration_s = 10.0;         // 0: a replay to the file's end / 60 s of random motion
+  double start_s = 0.0;             // replay: start this far into the file
+  std::uint64_t seed = 1;           // same seed, same bytes
+  std::string motion = "medium";    // random motion: easy | medium | difficult
+  std::string quality = "default";  // fast | default | high
+  std::string realism;              // ideal | euroc; empty: euroc for replays, ideal otherwise
+  std::vector<std::string> realism_off;     // sources of the euroc preset switched off
+  std::vector<std::string> realism_params;  // "NAME=VALUE" size overrides
+  std::uint64_t device_seed = 1;            // the rig's errors (one rig for all sequences)
+  std::string scene;                        // built-in name or YAML file; empty: by the realism
+  std::string camera = "euroc";             // euroc | kitti | vga | tumvi
+  bool rgbd = false;                        // TUM RGB-D output instead of EuRoC stereo
+  bool cloud = true;                        // reference clouds
+  bool imu_noise = true;
+  bool quiet = true;  // no progress bar
+};
+struct SimulateSummary {
+  std::string layout;  // "euroc" | "tum_rgbd"
+  int frames = 0;
+  int imu_samples = 0;
+  double duration_s = 0;
+  double path_length_m = 0;
+};
+SimulateSummary Simulate(const SimulateOptions& options);
 
 }  // namespace pkslam::api
