@@ -47,8 +47,9 @@ class InertialLoopTest : public testing::RevisitTest {
       map->mutable_imu_status().inertial_ba2_done = true;
       KeyFrame* previous = nullptr;
       for (const auto& kf : map->keyframes()) {
-        kf.second->imu.previous = previous;
-        if (previous != nullptr) previous->imu.next = kf.second.get();
+        if (previous != nullptr) {
+          map->inertial_chain().Append(lock, previous, kf.second.get(), std::nullopt);
+        }
         kf.second->imu.state.valid = true;
         kf.second->imu.state.velocity_world = Eigen::Vector3d(0.4, 0.1, -0.05);
         previous = kf.second.get();

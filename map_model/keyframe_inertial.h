@@ -3,8 +3,8 @@
 //
 // Ownership and locking: Frame::imu belongs to the tracking thread like the rest of a Frame.
 // KeyFrame::imu is guarded by the Atlas mutex (shared to read, exclusive to write) like the
-// keyframe's pose; `previous` / `next` point at live keyframes of the same map (the temporal
-// chain of an inertial map, kept by tracking when it creates keyframes).
+// keyframe's pose; `previous()` / `next()` are the map's temporal chain, which only
+// InertialChain (map_model/inertial_chain.h) links, splices and cuts.
 #pragma once
 
 #include <Eigen/Core>
@@ -26,16 +26,23 @@ struct FrameImu {
 };
 
 // A keyframe's IMU data: the preintegration from the previous keyframe of the chain and the
-// estimated state.
+// estimated state. The chain's links are set only by InertialChain (map_model/inertial_chain.h).
 struct KeyFrameImu {
+  // Neighbours in the map's temporal chain, or nullptr.
+  KeyFrame* previous() const { return previous_; }
+  KeyFrame* next() const { return next_; }
+
   std::optional<PreintegratedImu> from_previous;  // spans previous->t_ns() .. this->t_ns()
-  KeyFrame* previous = nullptr;
-  KeyFrame* next = nullptr;
   InertialState state;
   std::optional<InertialStatePrior> prior;  // see InertialStatePrior
   // The camera-IMU time offset (s) the keyframe's stamp was shifted by when it was tracked
   // (online calibration: its state sits at image stamp + this offset on the IMU clock).
   double time_offset_s = 0.0;
+
+ private:
+  friend class InertialChain;
+  KeyFrame* previous_ = nullptr;
+  KeyFrame* next_ = nullptr;
 };
 
 }  // namespace pkslam

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/geometry/so3.h"
+#include "map_model/inertial_chain.h"
 #include "map_model/map_ids.h"
 #include "map_model/world_change.h"
 
@@ -91,6 +92,9 @@ class Map {
   // How many transforms the map underwent (marginalisation priors expire with each).
   int NumWorldTransforms() const { return world_transforms_; }
 
+  // The temporal keyframe chain of an inertial map: the one way to link, splice or cut it.
+  const InertialChain& inertial_chain() const { return inertial_chain_; }
+
   // Drops everything (used on reset). Breaks every keyframe<->point link first.
   void Clear();
 
@@ -108,6 +112,7 @@ class Map {
   KeyFrameId max_kf_id_ = kInvalidId;
   int change_index_ = 0;
   KeyFrameDatabase* database_ = nullptr;
+  InertialChain inertial_chain_{this};
   MapImuStatus imu_status_;
   std::vector<WorldChange> world_changes_;
   double applied_scale_ = 1.0;

@@ -4,6 +4,7 @@
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 
 namespace pkslam {
 namespace {
@@ -31,7 +32,7 @@ InertialCullingContext MakeInertialCullingContext(const KeyFrame& current,
   InertialCullingContext c;
   c.current_id = current.id();
   const KeyFrame* k = &current;
-  for (int n = 1; n < options.window && k->imu.previous != nullptr; ++n) k = k->imu.previous;
+  for (int n = 1; n < options.window && k->imu.previous() != nullptr; ++n) k = k->imu.previous();
   c.window_start_id = k->id();
   if (const Map* map = current.map()) {
     c.map_keyframes = map->NumKeyFrames();
@@ -45,11 +46,11 @@ bool InertialCullingAllowed(const KeyFrame& candidate, const InertialCullingCont
                             const InertialCullingOptions& options) {
   if (!options.enabled || context.map_keyframes <= options.window) return false;
   if (candidate.id() + 2 > context.current_id) return false;  // the two newest stay
-  const KeyFrame* previous = candidate.imu.previous;
-  const KeyFrame* next = candidate.imu.next;
+  const KeyFrame* previous = candidate.imu.previous();
+  const KeyFrame* next = candidate.imu.next();
   if (previous == nullptr || next == nullptr || previous->IsBad() || next->IsBad() ||
       !candidate.imu.from_previous || !next->imu.from_previous ||
-      next->imu.previous != &candidate) {
+      next->imu.previous() != &candidate) {
     return false;
   }
   const double gap = SecondsBetween(*previous, *next);
@@ -60,40 +61,15 @@ bool InertialCullingAllowed(const KeyFrame& candidate, const InertialCullingCont
          (BodyPosition(candidate) - BodyPosition(*previous)).norm() < options.still_distance;
 }
 
-void SpliceOutOfInertialChain(KeyFrame* keyframe) {
-  KeyFrame* previous = keyframe->imu.previous;
-  KeyFrame* next = keyframe->imu.next;
-  if (next != nullptr && next->imu.previous == keyframe) {
-    if (previous != nullptr && keyframe->imu.from_previous && next->imu.from_previous) {
-      // The merged interval starts at `previous`: linearise it at that keyframe's bias.
-      PreintegratedImu& merged = *next->imu.from_previous;
-      merged.bias = previous->imu.state.bias;
-      MergePrevious(*keyframe->imu.from_previous, &merged);
-      next->imu.previous = previous;
-      previous->imu.next = next;
-    } else {
-      next->imu.previous = nullptr;
-      next->imu.from_previous.reset();
-      if (previous != nullptr && previous->imu.next == keyframe) previous->imu.next = nullptr;
-    }
-  } else if (previous != nullptr && previous->imu.next == keyframe) {
-    previous->imu.next = nullptr;
-  }
-  keyframe->imu.previous = nullptr;
-  keyframe->imu.next = nullptr;
-  keyframe->imu.from_previous.reset();
-  keyframe->imu.prior.reset();  // its marginalisation prior goes with it
-}
-
-int RepairInertialChain(KeyFrame* newest, int length) {
+int RepairInertialChain(const MapWriteLock& lock, KeyFrame* newest, int length) {
   int spliced = 0;
   KeyFrame* k = newest;
   for (int n = 0; n < length && k != nullptr; ++n) {
-    KeyFrame* previous = k->imu.previous;
+    KeyFrame* previous = k->imu.previous();
     while (previous != nullptr && previous->IsBad()) {
-      SpliceOutOfInertialChain(previous);
+      previous->map()->inertial_chain().SpliceOut(lock, previous);
       ++spliced;
-      previous = k->imu.previous;
+      previous = k->imu.previous();
     }
     k = previous;
   }

@@ -7,14 +7,19 @@
 // `max_gap_old_s`. Before the last visual-inertial refinement (VIBA2) a keyframe that has not
 // moved (`still_distance` from its predecessor) may also go within `max_gap_old_s`. Never the
 // two newest keyframes, and nothing while the map holds no more than `window` keyframes.
-// Retiring splices the keyframe out of the chain: the next keyframe's preintegration absorbs
-// its interval (re-integrated from the raw steps at the previous keyframe's bias).
+// Retiring splices the keyframe out of the chain (InertialChain::SpliceOut): the next keyframe's
+// preintegration absorbs its interval (re-integrated from the raw steps at the previous
+// keyframe's bias).
 //
 // All functions run in the local mapping thread; they need the Atlas mutex (shared for the
 // queries, exclusive for the splicing).
 #pragma once
 
 #include "map_model/map_ids.h"
+
+namespace pkslam {
+class MapWriteLock;
+}  // namespace pkslam
 
 namespace pkslam {
 
@@ -52,13 +57,9 @@ InertialCullingContext MakeInertialCullingContext(const KeyFrame& current,
 bool InertialCullingAllowed(const KeyFrame& candidate, const InertialCullingContext& context,
                             const InertialCullingOptions& options);
 
-// Takes a retired keyframe out of its map's temporal chain (no-op when it is not linked).
-// Requires the Atlas mutex (exclusive).
-void SpliceOutOfInertialChain(KeyFrame* keyframe);
-
 // Splices out retired keyframes still linked into the newest `length` keyframes of the chain
 // ending at `newest` (a keyframe loop closing protected when it was culled is retired later).
-// Returns how many. Requires the Atlas mutex (exclusive).
-int RepairInertialChain(KeyFrame* newest, int length);
+// Returns how many (each through InertialChain::SpliceOut).
+int RepairInertialChain(const MapWriteLock& lock, KeyFrame* newest, int length);
 
 }  // namespace pkslam

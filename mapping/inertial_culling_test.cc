@@ -33,9 +33,8 @@ class InertialCullingTest : public ::testing::Test {
       kf->imu.state.bias = bias_;
       if (k == 0) continue;
       KeyFrame* previous = map_.keyframes[k - 1].get();
-      kf->imu.previous = previous;
-      previous->imu.next = kf;
-      kf->imu.from_previous = Integrate(previous->t_ns(), kf->t_ns());
+      map_.keyframes[0]->map()->inertial_chain().Append(lock, previous, kf,
+                                                        Integrate(previous->t_ns(), kf->t_ns()));
     }
   }
 
@@ -45,10 +44,10 @@ class InertialCullingTest : public ::testing::Test {
     return pim;
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
-  void Retire(int k) {
+  void Retire(const MapWriteLock& lock, int k) {
     kf(k)->SetBad();
     ASSERT_TRUE(kf(k)->IsBad());
-    SpliceOutOfInertialChain(kf(k));
+    map_.keyframes[0]->map()->inertial_chain().SpliceOut(lock, kf(k));
   }
 
   Atlas atlas_;
@@ -62,11 +61,11 @@ class InertialCullingTest : public ::testing::Test {
 TEST_F(InertialCullingTest, SplicingMergesThePreintegrationIntoTheSuccessor) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   kf(4)->imu.state.bias = ImuBias(Eigen::Vector3d(0.001, 0, 0), Eigen::Vector3d(0.01, 0, 0));
-  Retire(5);
-  EXPECT_EQ(kf(6)->imu.previous, kf(4));
-  EXPECT_EQ(kf(4)->imu.next, kf(6));
-  EXPECT_EQ(kf(5)->imu.previous, nullptr);
-  EXPECT_EQ(kf(5)->imu.next, nullptr);
+  Retire(lock, 5);
+  EXPECT_EQ(kf(6)->imu.previous(), kf(4));
+  EXPECT_EQ(kf(4)->imu.next(), kf(6));
+  EXPECT_EQ(kf(5)->imu.previous(), nullptr);
+  EXPECT_EQ(kf(5)->imu.next(), nullptr);
   EXPECT_FALSE(kf(5)->imu.from_previous.has_value());
   // The same as integrating 4 -> 6 directly, linearised at keyframe 4's bias.
   PreintegratedImu direct = StartPreintegration(kf(4)->imu.state.bias, noise_);
@@ -108,8 +107,8 @@ TEST_F(InertialCullingTest, TimeSpacingDecidesWhichRedundantKeyFramesMayGo) {
   small.map_keyframes = options.window;
   EXPECT_FALSE(InertialCullingAllowed(*kf(25), small, options));
   // Retire 1..11: keyframe 12 then sits between 0 and 13, 0.65 s apart.
-  for (int k = 1; k <= 11; ++k) Retire(k);
-  ASSERT_EQ(kf(12)->imu.previous, kf(0));
+  for (int k = 1; k <= 11; ++k) Retire(lock, k);
+  ASSERT_EQ(kf(12)->imu.previous(), kf(0));
   EXPECT_TRUE(InertialCullingAllowed(*kf(12), c, options));  // older than the window
   InertialCullingContext recent = c;
   recent.window_start_id = kf(10)->id();
@@ -131,12 +130,12 @@ TEST_F(InertialCullingTest, RepairSplicesKeyFramesRetiredWithoutSplicing) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   kf(15)->SetBad();
   kf(16)->SetBad();
-  ASSERT_EQ(kf(17)->imu.previous, kf(16));
-  EXPECT_EQ(RepairInertialChain(kf(29), 42), 2);
-  EXPECT_EQ(kf(17)->imu.previous, kf(14));
-  EXPECT_EQ(kf(14)->imu.next, kf(17));
+  ASSERT_EQ(kf(17)->imu.previous(), kf(16));
+  EXPECT_EQ(RepairInertialChain(lock, kf(29), 42), 2);
+  EXPECT_EQ(kf(17)->imu.previous(), kf(14));
+  EXPECT_EQ(kf(14)->imu.next(), kf(17));
   EXPECT_NEAR(kf(17)->imu.from_previous->dt, 0.15, 1e-12);
-  EXPECT_EQ(RepairInertialChain(kf(29), 42), 0);
+  EXPECT_EQ(RepairInertialChain(lock, kf(29), 42), 0);
 }
 
 }  // namespace

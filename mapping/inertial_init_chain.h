@@ -18,8 +18,9 @@ namespace pkslam {
 
 class KeyFrame;
 
-// InertialChain(kf) (oldest first, ending at kf) continued forward over the keyframes linked
-// after kf (`imu.next`, same map, not retired, with a preintegration from their predecessor).
+// InertialChain::EndingAt(kf) (oldest first, ending at kf) continued forward over the keyframes
+// linked after kf (`imu.next()`, same map, not retired, with a preintegration from their
+// predecessor).
 std::vector<KeyFrame*> InertialChainThrough(KeyFrame* kf);
 
 // The keyframes linked after `last` that have no estimated state yet (stopping at the first

@@ -35,7 +35,7 @@ class InertialInitChainTest : public ::testing::Test {
     const auto samples =
         SampleImu(motion_, 0, (kNum - 1) * 50'000'000LL, 5'000'000, bias_, *rig_->imu, nullptr);
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    testing::LinkWithImu(map_.keyframes, samples, bias_, *rig_->imu);
+    testing::LinkWithImu(lock, map_.keyframes, samples, bias_, *rig_->imu);
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
 

@@ -44,7 +44,7 @@ class MarginalizationMapTest : public ::testing::Test {
       kf->imu.state.bias = bias_;
       kf->imu.state.valid = true;
     }
-    testing::LinkWithImu(map_.keyframes, samples, bias_, noise_);
+    testing::LinkWithImu(lock, map_.keyframes, samples, bias_, noise_);
     map()->mutable_imu_status().imu_initialized = true;
     options_.window = 5;
   }
@@ -123,7 +123,7 @@ TEST_F(MarginalizationMapTest, CulledKeyFrameDropsItsPrior) {
   GiveAnchorPrior(1e4);
   KeyFrame* k = anchor();
   k->SetBad();
-  SpliceOutOfInertialChain(k);
+  map()->inertial_chain().SpliceOut(lock, k);
   EXPECT_FALSE(k->imu.prior.has_value());
 }
 

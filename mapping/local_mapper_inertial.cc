@@ -80,14 +80,14 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
       moving_s_ = 0;
       two_step_motion_s_ = 0;
     }
-    if (const KeyFrame* previous = kf->imu.previous; previous != nullptr && !previous->IsBad()) {
+    if (const KeyFrame* previous = kf->imu.previous(); previous != nullptr && !previous->IsBad()) {
       const SE3d previous_from_kf = previous->world_from_body().Inverse() * kf->world_from_body();
       if (previous_from_kf.translation().norm() > o.moving_distance ||
           previous_from_kf.so3().Log().norm() > o.moving_angle_rad) {
         step_s = std::min(o.moving_max_interval_s,
                           static_cast<double>(kf->t_ns() - previous->t_ns()) * 1e-9);
       }
-      const KeyFrame* before = previous->imu.previous;
+      const KeyFrame* before = previous->imu.previous();
       if (initialized && !ba2 && before != nullptr && !before->IsBad()) {
         const double two_steps = (kf->CameraCenter() - previous->CameraCenter()).norm() +
                                  (previous->CameraCenter() - before->CameraCenter()).norm();
@@ -151,7 +151,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
     auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return;
     const Map* map = kf->map();
-    const std::vector<KeyFrame*> chain = InertialChain(kf.get(), 0);
+    const std::vector<KeyFrame*> chain = InertialChain::EndingAt(kf.get(), 0);
     if (chain.size() < 2 || static_cast<int>(chain.size()) > o.gravity_refinement_max_keyframes) {
       return;
     }
@@ -317,7 +317,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
   {
     auto lock = MapReader(*atlas_).Lock();
     snapshot.bias = kf->imu.state.bias;
-    for (KeyFrame* k : InertialChain(newest.get(), 0)) {
+    for (KeyFrame* k : InertialChain::EndingAt(newest.get(), 0)) {
       snapshot.world_from_body.emplace_back(k->t_ns(), k->world_from_body());
     }
   }
@@ -369,13 +369,13 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
     // Keyframes created from frames tracked before the initialisation reached tracking have
     // no estimated state yet: start them at their predecessor's.
     std::vector<KeyFrame*> missing;
-    for (KeyFrame* k = kf.get(); k != nullptr && !k->imu.state.valid; k = k->imu.previous) {
+    for (KeyFrame* k = kf.get(); k != nullptr && !k->imu.state.valid; k = k->imu.previous()) {
       missing.push_back(k);
     }
     for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
       KeyFrame* k = *it;
-      if (k->imu.previous == nullptr || !k->imu.previous->imu.state.valid) break;
-      k->imu.state = k->imu.previous->imu.state;
+      if (k->imu.previous() == nullptr || !k->imu.previous()->imu.state.valid) break;
+      k->imu.state = k->imu.previous()->imu.state;
     }
   }
   {

@@ -64,7 +64,7 @@ InitialisedStates RunInitialisationWithQueuedKeyFrames(int num_keyframes,
       motion, 0, (num_keyframes - 1) * kKeyFramePeriodNs, kImuPeriodNs, bias, *rig->imu, nullptr);
   {
     auto lock = MapEditor(&atlas).Write(MapEdit::kFixture);
-    testing::LinkWithImu(map.keyframes, samples, ImuBias(), *rig->imu);
+    testing::LinkWithImu(lock, map.keyframes, samples, ImuBias(), *rig->imu);
   }
 
   LocalMappingOptions options;

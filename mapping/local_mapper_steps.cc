@@ -258,7 +258,7 @@ void LocalMapper::CullKeyFrames(const KeyFramePtr& kf) {
                                       : inertial_culling.redundancy_stereo;
   InertialCullingContext context;
   if (inertial) {
-    RepairInertialChain(kf.get(), 2 * inertial_culling.window);
+    RepairInertialChain(lock, kf.get(), 2 * inertial_culling.window);
     context = MakeInertialCullingContext(*kf, inertial_culling);
   }
   int culled = 0;
@@ -294,7 +294,7 @@ void LocalMapper::CullKeyFrames(const KeyFramePtr& kf) {
     if (points > 0 && redundant > redundancy * points) {
       candidate->SetBad();
       if (!candidate->IsBad()) continue;  // protected by loop closing for now
-      if (inertial) SpliceOutOfInertialChain(candidate);
+      if (inertial) candidate->map()->inertial_chain().SpliceOut(lock, candidate);
       ++culled;
     }
   }

@@ -351,7 +351,7 @@ void Tracker::StereoInitialization() {
     current_.ComputeBoW(*vocabulary_);
     kf = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
     map->AddKeyFrame(kf);
-    AttachImu(kf.get(), nullptr, current_);
+    AttachImu(lock, kf.get(), nullptr, current_);
     for (int i = 0; i < current_.size(); ++i) {
       const auto p = current_.UnprojectStereo(i);
       if (!p) continue;

@@ -10,10 +10,11 @@
 #include <optional>
 #include <vector>
 
+#include "core/sensor/rig_calibration.h"
 #include "keyframe/keyframe_selector.h"
 #include "map_model/atlas.h"
-#include "core/sensor/rig_calibration.h"
 #include "map_model/frame.h"
+#include "map_model/map_editor.h"
 #include "map_model/mapping_backend.h"
 #include "tracking/frame_builder.h"
 #include "tracking/tracker_inertial.h"
@@ -183,7 +184,8 @@ class Tracker {
   bool TrackWithImu();
   // Visual pose optimisation, or visual-inertial once the map's IMU is initialised.
   void OptimizeCurrentPose();
-  void AttachImu(KeyFrame* kf, KeyFrame* previous, const Frame& frame);
+  // Tracking's keyframe joins the map's inertial chain after `previous` (map write lock held).
+  void AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previous, const Frame& frame);
   void FillImuSelectorInput(SelectorInput* in) const;
   std::optional<PreintegratedImu> PreintegrateBetween(std::int64_t t0_ns, std::int64_t t1_ns,
                                                       const ImuBias& bias) const;

@@ -247,7 +247,8 @@ void Tracker::OptimizeCurrentPose() {
   imu_->from_keyframe = false;
 }
 
-void Tracker::AttachImu(KeyFrame* kf, KeyFrame* previous, const Frame& frame) {
+void Tracker::AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previous,
+                        const Frame& frame) {
   if (!imu_) return;
   // A world change between tracking and keyframe creation: the keyframe takes the corrected
   // pose (current_ is `frame` except at monocular initialisation, which precedes any change).
@@ -257,10 +258,9 @@ void Tracker::AttachImu(KeyFrame* kf, KeyFrame* previous, const Frame& frame) {
   }
   kf->imu.state = frame.imu.state;
   if (previous == nullptr || previous->IsBad() || previous->map() != kf->map()) return;
-  kf->imu.previous = previous;
-  previous->imu.next = kf;
-  kf->imu.from_previous =
-      PreintegrateBetween(previous->t_ns(), kf->t_ns(), previous->imu.state.bias);
+  kf->map()->inertial_chain().Append(
+      lock, previous, kf,
+      PreintegrateBetween(previous->t_ns(), kf->t_ns(), previous->imu.state.bias));
   if (!kf->imu.state.valid) kf->imu.state.bias = previous->imu.state.bias;
 }
 

@@ -92,7 +92,7 @@ void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
     current_.ComputeBoW(*vocabulary_);
     kf = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
     map->AddKeyFrame(kf);
-    AttachImu(kf.get(), last_kf_.get(), current_);
+    AttachImu(lock, kf.get(), last_kf_.get(), current_);
     if (!IsMonocular(rig_->sensor)) {
       // New points from the closest keypoints with depth that have none (all closer than
       // th_depth and at least the nearest `new_keyframe_min_close_points`).
@@ -184,8 +184,8 @@ void Tracker::CreateInitialMapMonocular(const TwoViewResult& reconstruction) {
     kf_current = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
     map->AddKeyFrame(kf_init);
     map->AddKeyFrame(kf_current);
-    AttachImu(kf_init.get(), nullptr, *init_frame_);
-    AttachImu(kf_current.get(), kf_init.get(), current_);
+    AttachImu(lock, kf_init.get(), nullptr, *init_frame_);
+    AttachImu(lock, kf_current.get(), kf_init.get(), current_);
     for (std::size_t i = 0; i < init_matches_.size(); ++i) {
       const int j = init_matches_[i];
       if (j < 0) continue;

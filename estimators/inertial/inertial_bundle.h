@@ -7,7 +7,7 @@
 // States are body poses world_from_body (BodyPoseManifold), velocities and biases; the visual
 // part (points, observations, outlier handling) is a BundleProblem whose keyframe poses are
 // converted through the rig's body_from_camera. Inertial edges (imu/imu_factors.h) join
-// consecutive keyframes of the map's temporal chain (KeyFrame::imu.previous).
+// consecutive keyframes of the map's temporal chain (KeyFrame::imu.previous()).
 //
 // Local window: the newest `window` keyframes of the chain ending at the new keyframe are free
 // (pose, velocity, biases with random walks); the keyframe just before the window, the anchor,

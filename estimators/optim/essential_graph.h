@@ -4,7 +4,7 @@
 // (4-DoF, inertial maps with the IMU initialised: ORB-SLAM3's OptimizeEssentialGraph4DoF)
 // vertices; edges of the spanning tree, the existing loop edges, strong covisibility
 // (weight >= 100), the new loop connections and, for inertial maps, each keyframe's link to
-// the previous keyframe of the temporal chain (KeyFrame::imu.previous), each holding the
+// the previous keyframe of the temporal chain (KeyFrame::imu.previous()), each holding the
 // relative pose before the correction (for the corrected neighbourhood: its non-corrected
 // pose). The map's first keyframe is fixed. Map points follow the correction of their
 // reference keyframe; keyframe velocities (inertial state) turn with their keyframe.

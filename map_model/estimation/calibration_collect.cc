@@ -110,7 +110,7 @@ CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertia
     for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend() && tried < 10;
          ++it, ++tried) {
       if (it->second->IsBad() || it->second->id() > newest->id()) continue;
-      const std::size_t length = InertialChain(it->second.get(), 0).size();
+      const std::size_t length = InertialChain::EndingAt(it->second.get(), 0).size();
       if (length > longest) {
         longest = length;
         end = it->second.get();

@@ -123,7 +123,7 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
       if (l >= 0) add_edge(i, l, before(l) * world_from_i, EssentialGraphProblem::EdgeKind::kLoop);
     }
     // Inertial maps: the previous keyframe of the temporal chain (ORB-SLAM3's 4-DoF graph).
-    const KeyFrame* previous = kf->imu.previous;
+    const KeyFrame* previous = kf->imu.previous();
     if (options.dof == PoseGraphDof::kYawTranslation && previous != nullptr && !previous->IsBad() &&
         previous != parent && previous->parent() != kf &&
         inserted.count(Ordered(id, previous->id())) == 0) {

@@ -99,7 +99,7 @@ struct InertialLoop {
 };
 
 // The loop scenario in a gravity-aligned world (circle axis = z, drift in yaw + translation),
-// an inertial chain (imu.previous = the keyframe before, a spanning tree that skips one) and
+// an inertial chain (each keyframe after the one before, a spanning tree that skips one) and
 // valid velocities. `loop_tilt` rad of roll error is put into the loop measurement.
 void BuildInertialLoop(double loop_tilt, const testing::SyntheticScene& scene, InertialLoop* l) {
   LoopScenarioOptions o;
@@ -110,8 +110,7 @@ void BuildInertialLoop(double loop_tilt, const testing::SyntheticScene& scene, I
   auto& kfs = l->s.synthetic.keyframes;
   for (std::size_t k = 0; k < kfs.size(); ++k) {
     KeyFrame* kf = kfs[k].get();
-    kf->imu.previous = k > 0 ? kfs[k - 1].get() : nullptr;
-    kf->imu.next = k + 1 < kfs.size() ? kfs[k + 1].get() : nullptr;
+    if (k > 0) kf->map()->inertial_chain().Append(lock, kfs[k - 1].get(), kf, std::nullopt);
     kf->imu.state.valid = true;
     kf->imu.state.velocity_world = Eigen::Vector3d(0.5, -0.2, 0.1 * static_cast<double>(k % 3));
     if (k >= 2) {

@@ -76,26 +76,11 @@ std::vector<MapPointPtr> PointsOf(const std::vector<KeyFrame*>& keyframes, const
 
 }  // namespace
 
-std::vector<KeyFrame*> InertialChain(KeyFrame* newest, int max_length) {
-  std::vector<KeyFrame*> chain;
-  if (newest == nullptr || newest->IsBad()) return chain;
-  chain.push_back(newest);
-  KeyFrame* k = newest;
-  while ((max_length <= 0 || static_cast<int>(chain.size()) < max_length) &&
-         k->imu.previous != nullptr && k->imu.from_previous && !k->imu.previous->IsBad() &&
-         k->imu.previous->map() == newest->map()) {
-    k = k->imu.previous;
-    chain.push_back(k);
-  }
-  std::reverse(chain.begin(), chain.end());
-  return chain;
-}
-
 InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
                                                  const InertialBundleOptions& options) {
   options.Check();
   InertialBundleProblem problem;
-  std::vector<KeyFrame*> chain = InertialChain(keyframe, options.window + 1);
+  std::vector<KeyFrame*> chain = InertialChain::EndingAt(keyframe, options.window + 1);
   // Only keyframes with an estimated inertial state take part (they all have one once the
   // map's IMU is initialised, except possibly the newest few).
   while (!chain.empty() && !chain.front()->imu.state.valid) chain.erase(chain.begin());
@@ -156,7 +141,7 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
                                                 bool free_tilt, double gauge_information) {
   options.Check();
   InertialBundleProblem problem;
-  const std::vector<KeyFrame*> chain = InertialChain(newest, 0);
+  const std::vector<KeyFrame*> chain = InertialChain::EndingAt(newest, 0);
   if (chain.size() < 2) return problem;
   const Map* map = newest->map();
   SetCommon(*newest, options, &problem);
@@ -218,7 +203,7 @@ void ApplyInertialBundle(Map* map, const InertialBundleProblem& problem,
     KeyFrame* from = keyframe(edge.from);
     KeyFrame* to = keyframe(edge.to);
     if (from == nullptr || to == nullptr || from->IsBad() || to->IsBad() ||
-        !to->imu.from_previous || to->imu.previous != from)
+        !to->imu.from_previous || to->imu.previous() != from)
       continue;
     UpdateBias(from->imu.state.bias, reintegration, &*to->imu.from_previous);
   }

@@ -1,6 +1,6 @@
 // The map side of visual-inertial bundle adjustment (estimators/inertial/inertial_bundle.h):
 // Collect (shared Atlas lock) builds the problem from the map's temporal keyframe chain
-// (KeyFrame::imu.previous), Apply (exclusive lock, through the map editor) writes the result
+// (KeyFrame::imu.previous()), Apply (exclusive lock, through the map editor) writes the result
 // back; the solve in between holds no lock.
 #pragma once
 
@@ -8,6 +8,7 @@
 
 #include "estimators/inertial/inertial_bundle.h"
 #include "map_model/estimation/bundle_collect.h"
+#include "map_model/inertial_chain.h"
 #include "map_model/keyframe_inertial.h"
 
 namespace pkslam {
@@ -27,9 +28,5 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
 // `map` is the map the problem was collected from.
 void ApplyInertialBundle(Map* map, const InertialBundleProblem& problem,
                          const InertialBundleResult& result);
-
-// The temporal chain ending at `newest` (oldest first), at most `max_length` keyframes (0: all),
-// stopping at a retired keyframe or one without a preintegration to its predecessor.
-std::vector<KeyFrame*> InertialChain(KeyFrame* newest, int max_length);
 
 }  // namespace pkslam

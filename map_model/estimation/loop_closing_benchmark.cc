@@ -208,7 +208,8 @@ void BM_EssentialGraphYawTranslation(benchmark::State& state) {
   {
     auto lock = MapEditor(&s.atlas).Write(MapEdit::kFixture);
     for (std::size_t k = 1; k < s.synthetic.keyframes.size(); ++k) {
-      s.synthetic.keyframes[k]->imu.previous = s.synthetic.keyframes[k - 1].get();
+      s.synthetic.keyframes[0]->map()->inertial_chain().Append(
+          lock, s.synthetic.keyframes[k - 1].get(), s.synthetic.keyframes[k].get(), std::nullopt);
     }
   }
   EssentialGraphOptions options;

@@ -110,8 +110,8 @@ AtlasRecord AtlasStorage::Snapshot(const Atlas& atlas, const CameraRig& rig,
       k.not_erase = kf->not_erase_;
       k.camera_from_parent = kf->camera_from_parent_;
       k.imu_from_previous = kf->imu.from_previous;
-      k.imu_previous = Saved(kf->imu.previous, map.get()) ? kf->imu.previous->id() : kInvalidId;
-      k.imu_next = Saved(kf->imu.next, map.get()) ? kf->imu.next->id() : kInvalidId;
+      k.imu_previous = Saved(kf->imu.previous(), map.get()) ? kf->imu.previous()->id() : kInvalidId;
+      k.imu_next = Saved(kf->imu.next(), map.get()) ? kf->imu.next()->id() : kInvalidId;
       k.imu_state = kf->imu.state;
       k.imu_prior = kf->imu.prior;
       if (kf->imu.time_offset_s != 0.0 && out.calibration) {
@@ -235,8 +235,8 @@ void AtlasStorage::Restore(const AtlasRecord& record, std::shared_ptr<const Came
       for (KeyFrameId other : k.loop_edges) {
         kf->loop_edges_[other] = keyframe(other, "a loop edge");
       }
-      kf->imu.previous = keyframe(k.imu_previous, "the inertial chain");
-      kf->imu.next = keyframe(k.imu_next, "the inertial chain");
+      InertialChain::Restore(kf, keyframe(k.imu_previous, "the inertial chain"),
+                             keyframe(k.imu_next, "the inertial chain"));
       if (database != nullptr) database->Add(kf);
     }
     map->origin_ = keyframe(m.origin, "the origin");

@@ -47,15 +47,13 @@ class MapFileTest : public ::testing::Test {
       kf->imu.state.valid = true;
       if (k == 0) continue;
       KeyFrame* previous = map_.keyframes[k - 1].get();
-      kf->imu.previous = previous;
-      previous->imu.next = kf;
       PreintegratedImu pim;
       pim.dt = 0.05;
       pim.delta_R = SO3d::Exp(Eigen::Vector3d(0.01 * n01(rng), 0.02, -0.01));
       pim.delta_v = Eigen::Vector3d(n01(rng), 0.1, 0.2);
       pim.covariance = Eigen::Matrix<double, 15, 15>::Identity() * 1e-4;
       pim.steps.push_back({Eigen::Vector3d(0.1, 9.8, 0.2), Eigen::Vector3d(0.01, 0, 0), 0.005});
-      kf->imu.from_previous = pim;
+      map_.keyframes[0]->map()->inertial_chain().Append(lock, previous, kf, pim);
     }
     InertialStatePrior prior;
     prior.information = Eigen::Matrix<double, 15, 15>::Identity() * 42;
@@ -122,8 +120,8 @@ TEST_F(MapFileTest, RoundTripGivesTheSameMapAndTheSameBytes) {
     EXPECT_EQ(kb->parent() ? kb->parent()->id() : -1, ka->parent() ? ka->parent()->id() : -1);
     EXPECT_EQ(kb->children().size(), ka->children().size());
     EXPECT_EQ(kb->loop_edges().size(), ka->loop_edges().size());
-    EXPECT_EQ(kb->imu.previous ? kb->imu.previous->id() : -1,
-              ka->imu.previous ? ka->imu.previous->id() : -1);
+    EXPECT_EQ(kb->imu.previous() ? kb->imu.previous()->id() : -1,
+              ka->imu.previous() ? ka->imu.previous()->id() : -1);
     EXPECT_EQ(kb->imu.state.velocity_world, ka->imu.state.velocity_world);
     ASSERT_EQ(kb->imu.from_previous.has_value(), ka->imu.from_previous.has_value());
     if (ka->imu.from_previous) {
