@@ -74,7 +74,8 @@ Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<con
       selector_(std::move(selector)),
       mapping_(mapping),
       options_(options),
-      builder_(rig_, orb_options) {
+      builder_(rig_, orb_options),
+      local_map_(options_.max_local_keyframes) {
   options_.Check();
   PKSLAM_CHECK(
       atlas_ != nullptr && vocabulary_ != nullptr && selector_ != nullptr && mapping_ != nullptr,
@@ -364,8 +365,7 @@ void Tracker::StereoInitialization() {
       current_.map_points[i] = mp;
       ++points;
     }
-    local_keyframes_ = {kf.get()};
-    local_points_ = kf->GoodMapPoints();
+    local_map_.Reset({kf.get()}, kf->GoodMapPoints());
   }
   PKSLAM_LOG_INFO("new map {} initialised from stereo/depth with {} points",
                   atlas_->current_map()->id(), points);
@@ -423,8 +423,7 @@ void Tracker::Reset() {
     }
     last_.map_points.assign(last_.map_points.size(), nullptr);
     current_.map_points.assign(current_.map_points.size(), nullptr);
-    local_points_.clear();
-    local_keyframes_.clear();
+    local_map_.Clear();
     reference_kf_.reset();
     last_kf_.reset();
     current_.reference_kf.reset();
@@ -440,8 +439,7 @@ void Tracker::StartOver() {
   init_frame_.reset();
   reference_kf_.reset();
   last_kf_.reset();
-  local_points_.clear();
-  local_keyframes_.clear();
+  local_map_.Clear();
   selector_->Reset();
 }
 

@@ -17,6 +17,7 @@
 #include "map_model/map_editor.h"
 #include "map_model/mapping_backend.h"
 #include "tracking/frame_builder.h"
+#include "tracking/local_map.h"
 #include "tracking/tracker_inertial.h"
 #include "tracking/tracking_options.h"
 
@@ -157,9 +158,8 @@ class Tracker {
   // Localisation only (stereo/RGB-D): temporary points from the last frame's depth for the
   // keypoints without a map point, so the motion model can track where the map has none.
   void AddVisualOdometryPoints();
-  void UpdateLocalKeyFrames();
-  void UpdateLocalPoints();
-  int SearchLocalPoints();
+  // The local map's search radius for this frame (pixels at level 0).
+  double LocalSearchRadius() const;
   // `mapping_idle`: whether local mapping takes keyframes at this frame's time.
   // The selector's view of the current frame (caller holds the Atlas lock, shared).
   SelectorInput BuildSelectorInput(bool mapping_idle) const;
@@ -216,9 +216,7 @@ class Tracker {
   int relocalisations_ = 0;
   int failed_relocalisations_ = 0;  // in a row; reset by a success (Relocalize)
 
-  // Local map (rebuilt every frame).
-  std::vector<KeyFrame*> local_keyframes_;
-  std::vector<MapPointPtr> local_points_;
+  LocalMap local_map_;  // rebuilt every frame
   // Temporal stereo points created for the last frame (not in the map).
   // Localisation only: the last frame was tracked by visual odometry (too few map points in
   // view); tracking goes on from it while relocalisation is tried on every frame.

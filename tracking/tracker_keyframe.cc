@@ -240,8 +240,7 @@ void Tracker::CreateInitialMapMonocular(const TwoViewResult& reconstruction) {
       }
     }
     current_.SetPose(tcw);
-    local_keyframes_ = {kf_current.get(), kf_init.get()};
-    local_points_ = kf_init->GoodMapPoints();
+    local_map_.Reset({kf_current.get(), kf_init.get()}, kf_init->GoodMapPoints());
     PKSLAM_LOG_INFO("new map {} initialised from two views with {} points",
                     atlas_->current_map()->id(), atlas_->current_map()->NumMapPoints());
   }

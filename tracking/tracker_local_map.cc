@@ -1,11 +1,12 @@
 // Frame-to-map tracking: motion model, reference keyframe, local map (ORB-SLAM3's
-// TrackWithMotionModel, TrackReferenceKeyFrame, TrackLocalMap). Runs under the Atlas shared
+// TrackWithMotionModel, TrackReferenceKeyFrame, TrackLocalMap; the local map itself is
+// tracking/local_map.h). Runs under the Atlas shared
 // lock taken in Tracker::Track.
 #include <algorithm>
-#include <unordered_set>
 
 #include "core/bow/vocabulary.h"
 #include "map_model/keyframe.h"
+#include "map_model/map.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
 #include "tracking/pose_optimizer.h"
@@ -113,9 +114,12 @@ bool Tracker::TrackWithMotionModel() {
 }
 
 bool Tracker::TrackLocalMap() {
-  UpdateLocalKeyFrames();
-  UpdateLocalPoints();
-  SearchLocalPoints();
+  if (KeyFrame* best = local_map_.Update(&current_)) {
+    reference_kf_ = atlas_->current_map()->Share(best);
+    if (!reference_kf_) reference_kf_ = best->map() != nullptr ? best->map()->Share(best) : nullptr;
+    current_.reference_kf = reference_kf_;
+  }
+  local_map_.Search(&current_, *rig_, LocalSearchRadius());
   current_.outliers.assign(current_.size(), 0);
   OptimizeCurrentPose();
   inliers_ = 0;
@@ -138,124 +142,11 @@ bool Tracker::TrackLocalMap() {
   return inliers_ >= options_.min_inliers;
 }
 
-void Tracker::UpdateLocalKeyFrames() {
-  // Keyframes observing the frame's points, by how many they share.
-  std::map<KeyFrameId, std::pair<KeyFrame*, int>> counter;
-  for (int i = 0; i < current_.size(); ++i) {
-    const auto& mp = current_.map_points[i];
-    if (!mp) continue;
-    if (mp->IsBad()) {
-      current_.map_points[i].reset();
-      continue;
-    }
-    for (const auto& [id, obs] : mp->observations()) {
-      auto& entry = counter[id];
-      entry.first = obs.keyframe;
-      ++entry.second;
-    }
-  }
-  if (counter.empty()) return;
-
-  local_keyframes_.clear();
-  std::unordered_set<KeyFrameId> in_local;
-  KeyFrame* best = nullptr;
-  int best_count = 0;
-  for (const auto& [id, entry] : counter) {
-    KeyFrame* kf = entry.first;
-    if (kf->IsBad()) continue;
-    if (entry.second > best_count) {
-      best_count = entry.second;
-      best = kf;
-    }
-    local_keyframes_.push_back(kf);
-    in_local.insert(id);
-  }
-  // Grow by one neighbour, one child and the parent of each (ORB-SLAM), up to the cap.
-  auto try_add = [&](KeyFrame* kf) {
-    if (kf == nullptr || kf->IsBad() || in_local.count(kf->id()) > 0) return false;
-    local_keyframes_.push_back(kf);
-    in_local.insert(kf->id());
-    return true;
-  };
-  const std::size_t initial = local_keyframes_.size();
-  for (std::size_t k = 0; k < initial; ++k) {
-    if (static_cast<int>(local_keyframes_.size()) > options_.max_local_keyframes) break;
-    KeyFrame* kf = local_keyframes_[k];
-    for (KeyFrame* neighbour : kf->BestCovisibles(10)) {
-      if (try_add(neighbour)) break;
-    }
-    for (const auto& [id, child] : kf->children()) {
-      if (try_add(child)) break;
-    }
-    try_add(kf->parent());
-  }
-  if (best != nullptr) {
-    reference_kf_ = atlas_->current_map()->Share(best);
-    if (!reference_kf_) reference_kf_ = best->map() != nullptr ? best->map()->Share(best) : nullptr;
-    current_.reference_kf = reference_kf_;
-  }
-}
-
-void Tracker::UpdateLocalPoints() {
-  local_points_.clear();
-  std::unordered_set<MapPointId> seen;
-  for (KeyFrame* kf : local_keyframes_) {
-    for (const auto& mp : kf->map_points()) {
-      if (!mp || mp->IsBad()) continue;
-      if (seen.insert(mp->id()).second) local_points_.push_back(mp);
-    }
-  }
-}
-
-int Tracker::SearchLocalPoints() {
-  std::unordered_set<MapPointId> already;
-  for (int i = 0; i < current_.size(); ++i) {
-    auto& mp = current_.map_points[i];
-    if (!mp) continue;
-    if (mp->IsBad()) {
-      mp.reset();
-      continue;
-    }
-    mp->IncreaseVisible();
-    already.insert(mp->id());
-  }
-  const SE3d& tcw = current_.camera_from_world();
-  const Eigen::Vector3d center = current_.CameraCenter();
-  const CameraRig& rig = *rig_;
-  std::vector<ProjectedPoint> projected;
-  projected.reserve(local_points_.size());
-  for (const auto& mp : local_points_) {
-    if (already.count(mp->id()) > 0 || mp->IsBad()) continue;
-    // Frustum test (ORB-SLAM's Frame::isInFrustum with a 60 degree viewing-angle limit).
-    const Eigen::Vector3d p = mp->position();
-    const Eigen::Vector3d pc = tcw * p;
-    if (pc.z() <= 0) continue;
-    const double inv_z = 1.0 / pc.z();
-    const double u = rig.fx * pc.x() * inv_z + rig.cx;
-    const double v = rig.fy * pc.y() * inv_z + rig.cy;
-    if (!rig.bounds.Contains(u, v)) continue;
-    const Eigen::Vector3d ray = p - center;
-    const double distance = ray.norm();
-    if (distance < mp->min_distance() || distance > mp->max_distance()) continue;
-    const double view_cos = ray.dot(mp->normal()) / distance;
-    if (view_cos < 0.5) continue;
-    mp->IncreaseVisible();
-    ProjectedPoint pp;
-    pp.point = mp;
-    pp.u = u;
-    pp.v = v;
-    pp.u_right = IsMonocular(rig.sensor) ? -1.0 : u - rig.bf * inv_z;
-    pp.predicted_level = mp->PredictScale(distance, rig.pyramid);
-    pp.view_cos = view_cos;
-    pp.depth = pc.z();
-    projected.push_back(std::move(pp));
-  }
-  if (projected.empty()) return 0;
-  double th = IsRgbd(rig.sensor) ? 3.0 : options_.local_map_radius;
-  if (current_.id() < last_reloc_frame_id_ + 2) th = options_.local_map_radius_after_reloc;
-  if (state_ == TrackingState::kRecentlyLost || state_ == TrackingState::kLost) th = 15.0;
-  const OrbMatcher matcher(0.8, true);
-  return matcher.SearchByProjection(&current_, projected, th);
+double Tracker::LocalSearchRadius() const {
+  double radius = IsRgbd(rig_->sensor) ? 3.0 : options_.local_map_radius;
+  if (current_.id() < last_reloc_frame_id_ + 2) radius = options_.local_map_radius_after_reloc;
+  if (state_ == TrackingState::kRecentlyLost || state_ == TrackingState::kLost) radius = 15.0;
+  return radius;
 }
 
 }  // namespace pkslam
