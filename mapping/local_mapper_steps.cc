@@ -15,6 +15,7 @@
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
 #include "mapping/inertial_culling.h"
+#include "mapping/keyframe_culling.h"
 #include "mapping/local_mapper.h"
 #include "mapping/triangulation.h"
 
@@ -246,58 +247,20 @@ void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
 void LocalMapper::CullKeyFrames(const KeyFramePtr& kf) {
   auto lock = MapEditor(atlas_).Write(MapEdit::kCullKeyFrames);
   if (kf->IsBad() || kf->map() == nullptr) return;
-  const bool mono = IsMonocular(rig_->sensor);
-  const int observers = options_.culling_observers;
-  const KeyFrame* origin = kf->map()->origin();
   // Inertial maps: the temporal chain's spacing rules (mapping/inertial_culling.h).
   const bool inertial = IsInertial(rig_->sensor);
   const InertialCullingOptions& inertial_culling = options_.inertial.culling;
   if (inertial && !inertial_culling.enabled) return;
-  const double redundancy = !inertial ? options_.culling_redundancy
-                            : mono    ? inertial_culling.redundancy_mono
-                                      : inertial_culling.redundancy_stereo;
-  InertialCullingContext context;
-  if (inertial) {
-    RepairInertialChain(lock, kf.get(), 2 * inertial_culling.window);
-    context = MakeInertialCullingContext(*kf, inertial_culling);
-  }
-  int culled = 0;
-  int examined = 0;
-  for (KeyFrame* candidate : std::vector<KeyFrame*>(kf->CovisiblesByWeight())) {
-    if (candidate == origin || candidate->IsBad()) continue;
-    if (++examined > 100 || (inertial && examined > 20 && abort_ba_.load())) break;
-    if (inertial && !InertialCullingAllowed(*candidate, context, inertial_culling)) continue;
-    const auto& kps = candidate->keypoints_undistorted();
-    int points = 0;
-    int redundant = 0;
-    const auto& slots = candidate->map_points();
-    for (int i = 0; i < static_cast<int>(slots.size()); ++i) {
-      const auto& mp = slots[i];
-      if (!mp || mp->IsBad()) continue;
-      if (!mono) {
-        // Only close points count for stereo: far ones are weakly constrained anyway.
-        const float depth = candidate->depth()[i];
-        if (depth < 0 || depth > rig_->th_depth) continue;
-      }
-      ++points;
-      if (mp->NumObservations() <= observers) continue;
-      const int level = kps[i].octave;
-      int seen_by = 0;
-      for (const auto& [id, obs] : mp->observations()) {
-        if (obs.keyframe == candidate) continue;
-        if (obs.keyframe->keypoints_undistorted()[obs.index].octave <= level + 1) {
-          if (++seen_by >= observers) break;
-        }
-      }
-      if (seen_by >= observers) ++redundant;
-    }
-    if (points > 0 && redundant > redundancy * points) {
-      candidate->SetBad();
-      if (!candidate->IsBad()) continue;  // protected by loop closing for now
-      if (inertial) candidate->map()->inertial_chain().SpliceOut(lock, candidate);
-      ++culled;
-    }
-  }
+  const bool mono = IsMonocular(rig_->sensor);
+  KeyFrameCullingInput input;
+  input.redundancy.share = !inertial ? options_.culling_redundancy
+                           : mono    ? inertial_culling.redundancy_mono
+                                     : inertial_culling.redundancy_stereo;
+  input.redundancy.observers = options_.culling_observers;
+  input.redundancy.max_depth = mono ? -1.0 : rig_->th_depth;
+  input.inertial = inertial ? &inertial_culling : nullptr;
+  input.abort = &abort_ba_;
+  const int culled = CullRedundantKeyFrames(lock, kf.get(), input);
   lock.unlock();
   MutexLock stats_lock(mutex_);
   stats_.keyframes_culled += culled;
