@@ -90,13 +90,113 @@ std::map<std::string, double> ParseParams(const std::vector<std::string>& params
   return out;
 }
 
-}  // namespace
+// Exactly one input, and the options that go with it.
+void CheckOneInput(const RunArgs& args, const RunOptions& o) {
+  const int inputs = (o.dataset.empty() ? 0 : 1) + (args.video.empty() ? 0 : 1) +
+                     (args.camera ? 1 : 0) + (args.images.empty() ? 0 : 1) +
+                     (args.bag.empty() ? 0 : 1);
+  if (inputs != 1) {
+    throw OptionError("give exactly one input: --dataset, --bag, --video, --camera or --images");
+  }
+  if (!args.topics.empty() && args.bag.empty()) throw OptionError("--topics goes with --bag");
+  if (args.fps && args.video.empty()) throw OptionError("--fps goes with --video");
+  if (args.images.empty() != args.timestamps.empty()) {
+    throw OptionError("--images and --timestamps go together");
+  }
+}
 
-void RegisterRunCommand(CLI::App& app) {
-  auto args = std::make_shared<RunArgs>();
-  auto* cmd = app.add_subcommand("run",
-                                 "Run SLAM over a EuRoC, TUM RGB-D or KITTI odometry dataset, a "
-                                 "video, a camera or an image folder");
+// The run in two lines, where its outputs are, and what to look at.
+void PrintSummary(const RunSummary& s, const RunOptions& o) {
+  fmt::print("frames {} tracked {} lost {} keyframes {} map points {} maps {}\n", s.frames,
+             s.tracked, s.lost, s.keyframes, s.map_points, s.maps);
+  fmt::print("wall {:.2f} s for {:.2f} s of data ({:.2f}x real time), median tracking {:.2f} ms\n",
+             s.wall_s, s.sequence_s, s.wall_s > 0 ? s.sequence_s / s.wall_s : 0.0,
+             s.median_tracking_ms);
+  // trajectory_body.txt (body = IMU frame, what EuRoC ground truth describes) is written for
+  // every metric run (system/run_outputs.cc); a visual monocular map has no metric lever arm.
+  fmt::print(
+      "outputs: {}/{{trajectory.txt, {}keyframes.txt, map_points.ply, stats.json, "
+      "run.log}} (docs/run.md lists all)\n",
+      o.out.string(), o.system.sensor == Sensor::kMonocular ? "" : "trajectory_body.txt, ");
+  if (s.input.degraded()) {
+    fmt::print("degraded input: {} warning(s), see {}/stats.json \"input\"\n",
+               s.input.warnings.size(), o.out.string());
+  }
+  if (!s.estimate.warnings.empty()) {
+    fmt::print("suspect estimate: {}; see {}/stats.json \"estimate\"\n",
+               s.estimate.warnings.front(), o.out.string());
+  }
+}
+
+// A run that did not end well exits non-zero (docs/run.md lists the codes).
+void ThrowExitStatus(const RunSummary& s, const RunArgs& args) {
+  if (s.interrupted) {
+    const int signal = interrupt_signal.load();
+    throw CommandExit{128 + signal,
+                      fmt::format("interrupted by {} after {} frames (outputs "
+                                  "written for them)",
+                                  signal == SIGTERM ? "SIGTERM" : "SIGINT", s.frames)};
+  }
+  if (!s.estimate.no_estimate.empty()) {
+    throw CommandExit{kExitNoEstimate,
+                      fmt::format("error: no estimate: {}; see {}/stats.json \"estimate\"",
+                                  s.estimate.no_estimate, args.options.out.string())};
+  }
+  if (args.strict && s.input.degraded()) {
+    throw CommandExit{kExitDegraded, "--strict: the run finished on degraded input"};
+  }
+  if (args.strict && s.estimate.suspect()) {
+    throw CommandExit{kExitSuspect, "--strict: the run's estimate is suspect"};
+  }
+}
+
+// `pkslam run` once its flags are read.
+void Run(RunArgs& args) {
+  RunOptions& o = args.options;
+  // --sensor was checked against SensorNames(), which ParseSensor reads back.
+  o.system.sensor =
+      *ParseSensor(args.sensor.value_or(o.dataset.empty() && args.bag.empty() ? "mono" : "stereo"));
+  if (!args.settings.empty()) o.settings = args.settings;
+  if (!args.vocabulary.empty()) o.vocabulary = args.vocabulary;
+  o.out = args.out;
+  o.system.selector_parameters = ParseParams(args.params);
+  RunControl control;
+  control.interrupt = &interrupted;
+  // Until the first frame a signal takes its default action: reading a dataset polls no flag
+  // (and OpenCV's parser has been seen to loop on a bad file).
+  control.frames_starting = [] {
+    std::signal(SIGINT, OnSignal);
+    std::signal(SIGTERM, OnSignal);
+  };
+  control.trajectory_written = OnTrajectoryWritten;
+  CheckOneInput(args, o);
+  std::unique_ptr<LiveView> live;
+  if (args.live_view_port) {
+    LiveViewOptions live_options;
+    live_options.port = *args.live_view_port;
+    live_options.host = args.live_view_host;
+    live = std::make_unique<LiveView>(live_options);
+    fmt::print("live view: {}\n", live->url());
+    std::fflush(stdout);
+    control.frame_tracked = [&live](const SlamSystem& system, const TrackResult& r,
+                                    const cv::Mat& image,
+                                    std::int64_t t_ns) { live->OnFrame(system, r, image, t_ns); };
+    control.tracking_finished = [&live] { live->Finish(nullptr); };
+  }
+  std::unique_ptr<FrameSource> source;
+  if (!args.video.empty()) source = OpenVideoFile(args.video, args.fps);
+  if (args.camera) source = OpenCamera(*args.camera);
+  if (!args.images.empty()) source = OpenImageFolder(args.images, args.timestamps);
+  const RunSummary s = source ? RunFrameSource(o, *source, control)
+                       : !args.bag.empty()
+                           ? RunBag(o, args.bag, ParseBagTopics(args.topics), control)
+                           : RunDataset(o, control);
+  PrintSummary(s, o);
+  ThrowExitStatus(s, args);
+}
+
+// What to run on: a dataset, bag, video, camera or image folder, and its settings.
+void AddInputOptions(CLI::App* cmd, const std::shared_ptr<RunArgs>& args) {
   cmd->add_option("--dataset", args->options.dataset,
                   "Dataset directory (EuRoC ASL, TUM RGB-D, or a KITTI sequences/NN folder)");
   cmd->add_option("--video", args->video,
@@ -126,6 +226,10 @@ void RegisterRunCommand(CLI::App& app) {
   cmd->add_option("--settings", args->settings,
                   "ORB-SLAM3 v1.0 settings file (EuRoC: default from the sensor.yaml files)");
   cmd->add_option("--vocabulary", args->vocabulary, "ORB vocabulary (DBoW2 .txt or pkslam .bin)");
+}
+
+// The system: outputs folder, selector, seeds, loop closing, online calibration.
+void AddSystemOptions(CLI::App* cmd, const std::shared_ptr<RunArgs>& args) {
   cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
   cmd->add_option("--selector", args->options.system.selector, "Keyframe selector")
       ->capture_default_str();
@@ -171,6 +275,10 @@ void RegisterRunCommand(CLI::App& app) {
                   "they repeat; step in lock-step runs such as --deterministic)")
       ->check(OneOf({"auto", "thread", "step"}))
       ->default_str("auto");
+}
+
+// How tracking meets local mapping in time.
+void AddPacingOptions(CLI::App* cmd, const std::shared_ptr<RunArgs>& args) {
   cmd->add_flag("--realtime", args->options.realtime, "Pace frames to their timestamps");
   cmd->add_flag(
       "--kitti-colour", args->options.kitti_colour,
@@ -192,6 +300,10 @@ void RegisterRunCommand(CLI::App& app) {
                   "(wall: this machine under its present load)")
       ->check(OneOf({"work", "cpu", "wall"}))
       ->capture_default_str();
+}
+
+// Slices, map files, localisation, extra outputs, the live view and input checks.
+void AddSessionOptions(CLI::App* cmd, const std::shared_ptr<RunArgs>& args) {
   cmd->add_option("--max-frames", args->options.max_frames, "Stop after N frames (0: all)");
   cmd->add_option("--first-frame", args->options.first_frame,
                   "Skip the dataset's first N frames (run on a slice)")
@@ -232,94 +344,20 @@ void RegisterRunCommand(CLI::App& app) {
                 "jumps, frames without IMU or depth; see stats.json \"input\"), 4 when its "
                 "estimate is suspect (tracking lost for good, maps stitched or left apart; "
                 "see stats.json \"estimate\")");
-  cmd->callback([args] {
-    RunOptions& o = args->options;
-    // --sensor was checked against SensorNames(), which ParseSensor reads back.
-    o.system.sensor = *ParseSensor(
-        args->sensor.value_or(o.dataset.empty() && args->bag.empty() ? "mono" : "stereo"));
-    if (!args->settings.empty()) o.settings = args->settings;
-    if (!args->vocabulary.empty()) o.vocabulary = args->vocabulary;
-    o.out = args->out;
-    o.system.selector_parameters = ParseParams(args->params);
-    RunControl control;
-    control.interrupt = &interrupted;
-    // Until the first frame a signal takes its default action: reading a dataset polls no flag
-    // (and OpenCV's parser has been seen to loop on a bad file).
-    control.frames_starting = [] {
-      std::signal(SIGINT, OnSignal);
-      std::signal(SIGTERM, OnSignal);
-    };
-    control.trajectory_written = OnTrajectoryWritten;
-    const int inputs = (o.dataset.empty() ? 0 : 1) + (args->video.empty() ? 0 : 1) +
-                       (args->camera ? 1 : 0) + (args->images.empty() ? 0 : 1) +
-                       (args->bag.empty() ? 0 : 1);
-    if (inputs != 1) {
-      throw OptionError("give exactly one input: --dataset, --bag, --video, --camera or --images");
-    }
-    if (!args->topics.empty() && args->bag.empty()) throw OptionError("--topics goes with --bag");
-    if (args->fps && args->video.empty()) throw OptionError("--fps goes with --video");
-    if (args->images.empty() != args->timestamps.empty()) {
-      throw OptionError("--images and --timestamps go together");
-    }
-    std::unique_ptr<LiveView> live;
-    if (args->live_view_port) {
-      LiveViewOptions live_options;
-      live_options.port = *args->live_view_port;
-      live_options.host = args->live_view_host;
-      live = std::make_unique<LiveView>(live_options);
-      fmt::print("live view: {}\n", live->url());
-      std::fflush(stdout);
-      control.frame_tracked = [&live](const SlamSystem& system, const TrackResult& r,
-                                      const cv::Mat& image,
-                                      std::int64_t t_ns) { live->OnFrame(system, r, image, t_ns); };
-      control.tracking_finished = [&live] { live->Finish(nullptr); };
-    }
-    std::unique_ptr<FrameSource> source;
-    if (!args->video.empty()) source = OpenVideoFile(args->video, args->fps);
-    if (args->camera) source = OpenCamera(*args->camera);
-    if (!args->images.empty()) source = OpenImageFolder(args->images, args->timestamps);
-    const RunSummary s = source ? RunFrameSource(o, *source, control)
-                         : !args->bag.empty()
-                             ? RunBag(o, args->bag, ParseBagTopics(args->topics), control)
-                             : RunDataset(o, control);
-    fmt::print("frames {} tracked {} lost {} keyframes {} map points {} maps {}\n", s.frames,
-               s.tracked, s.lost, s.keyframes, s.map_points, s.maps);
-    fmt::print(
-        "wall {:.2f} s for {:.2f} s of data ({:.2f}x real time), median tracking {:.2f} ms\n",
-        s.wall_s, s.sequence_s, s.wall_s > 0 ? s.sequence_s / s.wall_s : 0.0, s.median_tracking_ms);
-    // trajectory_body.txt (body = IMU frame, what EuRoC ground truth describes) is written for
-    // every metric run (system/run_outputs.cc); a visual monocular map has no metric lever arm.
-    fmt::print(
-        "outputs: {}/{{trajectory.txt, {}keyframes.txt, map_points.ply, stats.json, "
-        "run.log}} (docs/run.md lists all)\n",
-        o.out.string(), o.system.sensor == Sensor::kMonocular ? "" : "trajectory_body.txt, ");
-    if (s.input.degraded()) {
-      fmt::print("degraded input: {} warning(s), see {}/stats.json \"input\"\n",
-                 s.input.warnings.size(), o.out.string());
-    }
-    if (!s.estimate.warnings.empty()) {
-      fmt::print("suspect estimate: {}; see {}/stats.json \"estimate\"\n",
-                 s.estimate.warnings.front(), o.out.string());
-    }
-    if (s.interrupted) {
-      const int signal = interrupt_signal.load();
-      throw CommandExit{128 + signal,
-                        fmt::format("interrupted by {} after {} frames (outputs "
-                                    "written for them)",
-                                    signal == SIGTERM ? "SIGTERM" : "SIGINT", s.frames)};
-    }
-    if (!s.estimate.no_estimate.empty()) {
-      throw CommandExit{kExitNoEstimate,
-                        fmt::format("error: no estimate: {}; see {}/stats.json \"estimate\"",
-                                    s.estimate.no_estimate, o.out.string())};
-    }
-    if (args->strict && s.input.degraded()) {
-      throw CommandExit{kExitDegraded, "--strict: the run finished on degraded input"};
-    }
-    if (args->strict && s.estimate.suspect()) {
-      throw CommandExit{kExitSuspect, "--strict: the run's estimate is suspect"};
-    }
-  });
+}
+
+}  // namespace
+
+void RegisterRunCommand(CLI::App& app) {
+  auto args = std::make_shared<RunArgs>();
+  auto* cmd = app.add_subcommand("run",
+                                 "Run SLAM over a EuRoC, TUM RGB-D or KITTI odometry dataset, a "
+                                 "video, a camera or an image folder");
+  AddInputOptions(cmd, args);
+  AddSystemOptions(cmd, args);
+  AddPacingOptions(cmd, args);
+  AddSessionOptions(cmd, args);
+  cmd->callback([args] { Run(*args); });
 }
 
 }  // namespace pkslam::apps
