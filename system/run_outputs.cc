@@ -278,11 +278,34 @@ int WriteTrajectoryOutputs(const SlamSystem& system, const RunOptions& options) 
   return static_cast<int>(frames.poses.size());
 }
 
-void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSummary* summary) {
+namespace {
+
+// What the frame records say, gathered once for the summary and stats.json.
+struct FrameTimes {
+  std::vector<double> tracking_ms;
+  std::vector<double> tracking_cpu_ms;
+  std::vector<double> build_cpu_ms;
+  std::map<std::string, int> states;  // frames per tracking state
+  bool initialised = false;
+  int lost = 0;  // frames not tracked after the first initialisation
+};
+
+FrameTimes SummariseFrames(const std::vector<FrameRecord>& records) {
+  FrameTimes frames;
+  for (const FrameRecord& r : records) {
+    frames.tracking_ms.push_back(r.tracking_ms);
+    frames.tracking_cpu_ms.push_back(r.tracking_cpu_ms);
+    frames.build_cpu_ms.push_back(r.build_cpu_ms);
+    ++frames.states[TrackingStateName(r.state)];
+    if (r.state != TrackingState::kNotInitialized) frames.initialised = true;
+    if (frames.initialised && r.state != TrackingState::kOk) ++frames.lost;
+  }
+  return frames;
+}
+
+// The files beside the trajectory: keyframes, map, traces, inertial outputs.
+void WriteMapOutputs(const SlamSystem& system, const RunOptions& options) {
   const auto& out = options.out;
-  // The trajectory first: when a later file fails (full disk) or a second signal ends the
-  // process, the most valuable output is already complete.
-  const int frames_in_trajectory = WriteTrajectoryOutputs(system, options);
   // A EuRoC recording's ground truth is the body (IMU); settings without IMU.T_b_c1 (ORB-SLAM2
   // stereo files, visual-only ones) give no way there, so the "body" is the camera.
   if (options.system.sensor != Sensor::kMonocular && !system.settings().body_from_cam0 &&
@@ -301,29 +324,19 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   WriteFramesCsv(system.tracker(), out / "frames.csv");
   if (options.system.frame_tracks) WriteFrameTracks(system, out / "frame_tracks.txt");
   WriteInertialOutputs(system, out);
+}
 
+// The summary's counts and the estimate's health (warnings and errors logged).
+void AssessRun(const SlamSystem& system, const RunOptions& options, const FrameTimes& frames,
+               const LoopClosingStats& loop_stats, int frames_in_trajectory, RunSummary* summary) {
   const auto& records = system.tracker().records();
-  std::vector<double> tracking_ms;
-  std::vector<double> tracking_cpu_ms;
-  std::vector<double> build_cpu_ms;
-  std::map<std::string, int> states;
-  bool initialised = false;
-  int lost = 0;
-  for (const FrameRecord& r : records) {
-    tracking_ms.push_back(r.tracking_ms);
-    tracking_cpu_ms.push_back(r.tracking_cpu_ms);
-    build_cpu_ms.push_back(r.build_cpu_ms);
-    ++states[TrackingStateName(r.state)];
-    if (r.state != TrackingState::kNotInitialized) initialised = true;
-    if (initialised && r.state != TrackingState::kOk) ++lost;
-  }
-  const LocalMappingStats mapping = system.mapping_stats();
+  const int lost = frames.lost;
+  const bool initialised = frames.initialised;
   summary->keyframes = system.NumKeyFrames();
   summary->map_points = system.NumMapPoints();
   summary->maps = system.NumMaps();
   summary->lost = lost;
-  summary->median_tracking_ms = Median(tracking_ms);
-  const LoopClosingStats loop_stats = system.loop_stats();
+  summary->median_tracking_ms = Median(frames.tracking_ms);
   // Localisation never starts or resets a map: its losses are gaps in one map's trajectory,
   // reported as such (WriteLocalisation), not stitched maps.
   const bool localise_only = options.system.tracking.localise_only;
@@ -338,7 +351,11 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   if (!summary->estimate.no_estimate.empty()) {
     PKSLAM_LOG_ERROR("no estimate: {}", summary->estimate.no_estimate);
   }
+}
 
+// The calibration estimate against the files it came from: warnings, OUT/calibration/.
+void ReportCalibration(const SlamSystem& system, const RunOptions& options, RunSummary* summary) {
+  const auto& out = options.out;
   const CalibrationReport calibration = system.calibration_report();
   const CalibrationSources sources =
       options.settings ? SourcesFromSettingsFile(*options.settings)
@@ -350,133 +367,184 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
   WriteCalibrationFiles(calibration, system.settings(), out);
   summary->calibration = calibration;
   summary->calibration_warnings = calibration_warnings;
+}
 
-  JsonWriter json;
-  json.BeginObject();
-  json.Member("dataset", options.dataset.string());
-  json.Member("dataset_fingerprint", summary->dataset_fingerprint);
-  json.Member("sensor", SensorName(options.system.sensor));
-  json.Member("selector", options.system.selector);
-  json.Member("deterministic", options.system.deterministic);
-  json.Member("interrupted", summary->interrupted);
-  json.Member("localise_only", options.system.tracking.localise_only);
-  const auto map_file = [&json](const char* key, const std::optional<std::filesystem::path>& file,
-                                const std::optional<SlamSystem::MapFileInfo>& info) {
-    if (!file || !info) return;
-    json.Key(key).BeginObject();
-    json.Member("file", file->string());
-    json.Member("maps", info->maps);
-    json.Member("keyframes", info->keyframes);
-    json.Member("map_points", info->map_points);
-    json.Member("bytes", static_cast<std::int64_t>(info->bytes));
-    json.Member("seconds", info->seconds);
-    json.EndObject();
-  };
-  map_file("map_loaded", options.load_map, summary->map_loaded);
-  map_file("map_saved", options.save_map, summary->map_saved);
-  json.Member("degraded", summary->input.degraded());
-  WriteInputReport(summary->input, &json);
-  WriteEstimateHealth(summary->estimate, &json);
-  if (localise_only) WriteLocalisation(records, &json);
-  json.Member("frames", summary->frames);
-  json.Member("frames_in_trajectory", frames_in_trajectory);
-  json.Member("lost_frames", lost);
-  json.Member("keyframes", summary->keyframes);
-  json.Member("keyframes_created",
-              static_cast<int>(std::count_if(records.begin(), records.end(),
-                                             [](const FrameRecord& r) { return r.keyframe; })));
-  json.Member("keyframes_culled", mapping.keyframes_culled);
+void WriteMapFileJson(JsonWriter* json, const char* key,
+                      const std::optional<std::filesystem::path>& file,
+                      const std::optional<SlamSystem::MapFileInfo>& info) {
+  if (!file || !info) return;
+  json->Key(key).BeginObject();
+  json->Member("file", file->string());
+  json->Member("maps", info->maps);
+  json->Member("keyframes", info->keyframes);
+  json->Member("map_points", info->map_points);
+  json->Member("bytes", static_cast<std::int64_t>(info->bytes));
+  json->Member("seconds", info->seconds);
+  json->EndObject();
+}
+
+// stats.json: what ran on what, map files, input and estimate health.
+void WriteRunJson(const RunOptions& options, const RunSummary& summary,
+                  const std::vector<FrameRecord>& records, JsonWriter* json) {
+  json->Member("dataset", options.dataset.string());
+  json->Member("dataset_fingerprint", summary.dataset_fingerprint);
+  json->Member("sensor", SensorName(options.system.sensor));
+  json->Member("selector", options.system.selector);
+  json->Member("deterministic", options.system.deterministic);
+  json->Member("interrupted", summary.interrupted);
+  json->Member("localise_only", options.system.tracking.localise_only);
+  WriteMapFileJson(json, "map_loaded", options.load_map, summary.map_loaded);
+  WriteMapFileJson(json, "map_saved", options.save_map, summary.map_saved);
+  json->Member("degraded", summary.input.degraded());
+  WriteInputReport(summary.input, json);
+  WriteEstimateHealth(summary.estimate, json);
+  if (options.system.tracking.localise_only) WriteLocalisation(records, json);
+}
+
+// stats.json: frames, keyframes (created, culled, declined, by reason), points, maps, states.
+void WriteCountsJson(const RunSummary& s, const FrameTimes& frames, int frames_in_trajectory,
+                     const LocalMappingStats& mapping, const std::vector<FrameRecord>& records,
+                     JsonWriter* json) {
+  const RunSummary* summary = &s;
+  const int lost = frames.lost;
+  const auto& states = frames.states;
+  json->Member("frames", summary->frames);
+  json->Member("frames_in_trajectory", frames_in_trajectory);
+  json->Member("lost_frames", lost);
+  json->Member("keyframes", summary->keyframes);
+  json->Member("keyframes_created",
+               static_cast<int>(std::count_if(records.begin(), records.end(),
+                                              [](const FrameRecord& r) { return r.keyframe; })));
+  json->Member("keyframes_culled", mapping.keyframes_culled);
   // The keyframe queue's bound (LocalMappingOptions::max_queued_keyframes): its longest length
   // and the keyframes tracking declined because it was full.
-  json.Member("max_queued_keyframes", mapping.max_queued_keyframes);
-  json.Member("keyframes_declined_queue_full", summary->keyframes_declined_queue_full);
+  json->Member("max_queued_keyframes", mapping.max_queued_keyframes);
+  json->Member("keyframes_declined_queue_full", summary->keyframes_declined_queue_full);
   // Which rule of the selector created how many keyframes ("initialisation": a map's first
   // keyframe(s), not a selector decision).
-  json.Key("keyframe_reasons").BeginObject();
-  for (const auto& [reason, count] : summary->keyframe_reasons) json.Member(reason, count);
-  json.EndObject();
+  json->Key("keyframe_reasons").BeginObject();
+  for (const auto& [reason, count] : summary->keyframe_reasons) json->Member(reason, count);
+  json->EndObject();
   // On how many of the frames the selector decided on each of its criteria held (pks and
   // pks-released: criterion1 = D_c > Th_adaptive, criterion2 = ECOG > |COG|).
-  json.Key("selector_criteria").BeginObject();
-  json.Member("decisions", summary->selector_decisions);
-  for (const auto& [criterion, count] : summary->criteria_held) json.Member(criterion, count);
-  json.EndObject();
-  json.Member("map_points", summary->map_points);
-  json.Member("maps", summary->maps);
-  json.Key("tracking_states").BeginObject();
-  for (const auto& [name, count] : states) json.Member(name, count);
-  json.EndObject();
-  json.Member("wall_time_s", summary->wall_s);
-  json.Member("sequence_duration_s", summary->sequence_s);
-  json.Member("realtime_factor", summary->wall_s > 0 ? summary->sequence_s / summary->wall_s : 0.0);
-  json.Member("median_tracking_ms", summary->median_tracking_ms);
-  json.Member("p95_tracking_ms", Quantile(tracking_ms, 0.95).value_or(0.0));
+  json->Key("selector_criteria").BeginObject();
+  json->Member("decisions", summary->selector_decisions);
+  for (const auto& [criterion, count] : summary->criteria_held) json->Member(criterion, count);
+  json->EndObject();
+  json->Member("map_points", summary->map_points);
+  json->Member("maps", summary->maps);
+  json->Key("tracking_states").BeginObject();
+  for (const auto& [name, count] : states) json->Member(name, count);
+  json->EndObject();
+}
+
+// stats.json: wall and CPU time per thread, local mapping's statistics, memory.
+void WriteTimingJson(const RunOptions& options, const RunSummary& s, const FrameTimes& frames,
+                     const LocalMappingStats& mapping, JsonWriter* json) {
+  const RunSummary* summary = &s;
+  json->Member("wall_time_s", summary->wall_s);
+  json->Member("sequence_duration_s", summary->sequence_s);
+  json->Member("realtime_factor",
+               summary->wall_s > 0 ? summary->sequence_s / summary->wall_s : 0.0);
+  json->Member("median_tracking_ms", summary->median_tracking_ms);
+  json->Member("p95_tracking_ms", Quantile(frames.tracking_ms, 0.95).value_or(0.0));
   // Offline runs (live emulation): wall time tracking waited for local mapping's state; it
   // is not part of tracking_ms.
-  json.Member("mapping_wait_s", 1e-3 * mapping.live_wait_ms);
-  json.Member("median_local_mapping_ms", Median(mapping.keyframe_ms));
-  json.Member("local_ba_aborted", mapping.ba_aborted);
-  json.Member("inertial_ba_with_prior", mapping.inertial_ba_with_prior);
-  json.Member("inertial_ba_fixed_anchor", mapping.inertial_ba_fixed_anchor);
-  json.Member("gravity_refinement_enabled", options.system.mapping.inertial.gravity_refinement);
-  json.Key("gravity_refinements").BeginArray();
+  json->Member("mapping_wait_s", 1e-3 * mapping.live_wait_ms);
+  json->Member("median_local_mapping_ms", Median(mapping.keyframe_ms));
+  json->Member("local_ba_aborted", mapping.ba_aborted);
+  json->Member("inertial_ba_with_prior", mapping.inertial_ba_with_prior);
+  json->Member("inertial_ba_fixed_anchor", mapping.inertial_ba_fixed_anchor);
+  json->Member("gravity_refinement_enabled", options.system.mapping.inertial.gravity_refinement);
+  json->Key("gravity_refinements").BeginArray();
   for (const GravityRefinementStat& g : mapping.gravity_refinements) {
-    json.BeginObject();
-    json.Member("t_s", static_cast<double>(g.t_ns) * 1e-9);
-    json.Member("keyframes", g.keyframes);
-    json.Member("tilt_observability", g.observability);
-    json.Member("tilt_change_mrad", 1e3 * g.tilt_change_rad);
-    json.Member("ms", g.ms);
-    json.EndObject();
+    json->BeginObject();
+    json->Member("t_s", static_cast<double>(g.t_ns) * 1e-9);
+    json->Member("keyframes", g.keyframes);
+    json->Member("tilt_observability", g.observability);
+    json->Member("tilt_change_mrad", 1e3 * g.tilt_change_rad);
+    json->Member("ms", g.ms);
+    json->EndObject();
   }
-  json.EndArray();
-  json.Member("gravity_refinements_dropped", mapping.gravity_refinements_dropped);
+  json->EndArray();
+  json->Member("gravity_refinements_dropped", mapping.gravity_refinements_dropped);
   // CPU time (independent of the machine's load): per-thread sums and medians.
   const auto sum = [](const std::vector<double>& v) {
     return std::accumulate(v.begin(), v.end(), 0.0);
   };
-  json.Member("process_cpu_s", ProcessCpuSeconds());
-  json.Member("tracking_cpu_s", 1e-3 * (sum(tracking_cpu_ms) + sum(build_cpu_ms)));
-  json.Member("median_tracking_cpu_ms", Median(tracking_cpu_ms));
-  json.Member("median_build_cpu_ms", Median(build_cpu_ms));
-  json.Member("local_mapping_cpu_s", 1e-3 * sum(mapping.keyframe_cpu_ms));
-  json.Member("median_local_mapping_cpu_ms", Median(mapping.keyframe_cpu_ms));
-  json.Member("median_local_ba_cpu_ms", Median(mapping.ba_cpu_ms));
-  json.Member("peak_memory_mib", PeakMemoryMiB());
+  json->Member("process_cpu_s", ProcessCpuSeconds());
+  json->Member("tracking_cpu_s", 1e-3 * (sum(frames.tracking_cpu_ms) + sum(frames.build_cpu_ms)));
+  json->Member("median_tracking_cpu_ms", Median(frames.tracking_cpu_ms));
+  json->Member("median_build_cpu_ms", Median(frames.build_cpu_ms));
+  json->Member("local_mapping_cpu_s", 1e-3 * sum(mapping.keyframe_cpu_ms));
+  json->Member("median_local_mapping_cpu_ms", Median(mapping.keyframe_cpu_ms));
+  json->Member("median_local_ba_cpu_ms", Median(mapping.ba_cpu_ms));
+  json->Member("peak_memory_mib", PeakMemoryMiB());
+}
+
+// stats.json: exclusive holds of the map lock per kind of change.
+void WriteMapEditsJson(const SlamSystem& system, JsonWriter* json) {
   // Exclusive holds of the map lock per kind of change (map_model/map_editor.h): how often and
   // how long (wall) each kind kept the other threads out of the map.
-  json.Key("map_edits").BeginObject();
+  json->Key("map_edits").BeginObject();
   const MapEditTable edits = system.atlas().EditStats();
   for (int k = 0; k < kNumMapEdits; ++k) {
     const MapEditStats& e = edits[static_cast<std::size_t>(k)];
     if (e.holds == 0) continue;
-    json.Key(std::string(MapEditName(static_cast<MapEdit>(k)))).BeginObject();
-    json.Member("holds", e.holds);
-    json.Member("total_ms", 1e3 * e.total_s);
-    json.Member("max_ms", 1e3 * e.max_s);
-    json.EndObject();
+    json->Key(std::string(MapEditName(static_cast<MapEdit>(k)))).BeginObject();
+    json->Member("holds", e.holds);
+    json->Member("total_ms", 1e3 * e.total_s);
+    json->Member("max_ms", 1e3 * e.max_s);
+    json->EndObject();
   }
-  json.EndObject();
-  WriteLoopClosing(system, options, loop_stats, summary->estimate.lost_for_good_s, &json);
-  WriteCalibrationJson(calibration, calibration_warnings, &json);
-  WriteArray(&json, "tracking_ms", tracking_ms);
-  WriteArray(&json, "local_mapping_ms", mapping.keyframe_ms);
-  WriteArray(&json, "local_ba_ms", mapping.ba_ms);
-  WriteArray(&json, "tracking_cpu_ms", tracking_cpu_ms);
-  WriteArray(&json, "build_cpu_ms", build_cpu_ms);
-  WriteArray(&json, "local_mapping_cpu_ms", mapping.keyframe_cpu_ms);
-  WriteArray(&json, "local_ba_cpu_ms", mapping.ba_cpu_ms);
+  json->EndObject();
+}
+
+// stats.json: the per-frame and per-keyframe series.
+void WriteSeriesJson(const FrameTimes& frames, const LocalMappingStats& mapping, JsonWriter* json) {
+  WriteArray(json, "tracking_ms", frames.tracking_ms);
+  WriteArray(json, "local_mapping_ms", mapping.keyframe_ms);
+  WriteArray(json, "local_ba_ms", mapping.ba_ms);
+  WriteArray(json, "tracking_cpu_ms", frames.tracking_cpu_ms);
+  WriteArray(json, "build_cpu_ms", frames.build_cpu_ms);
+  WriteArray(json, "local_mapping_cpu_ms", mapping.keyframe_cpu_ms);
+  WriteArray(json, "local_ba_cpu_ms", mapping.ba_cpu_ms);
   // Per keyframe: [keyframes, triangulation keypoints, fused projections, solver residuals]
   // (core/util/work_meter.h), what live emulation's work clock prices.
-  json.Key("local_mapping_work").BeginArray();
+  json->Key("local_mapping_work").BeginArray();
   for (const WorkCounts& w : mapping.keyframe_work) {
-    json.BeginArray();
-    for (std::int64_t units : w) json.Value(units);
-    json.EndArray();
+    json->BeginArray();
+    for (std::int64_t units : w) json->Value(units);
+    json->EndArray();
   }
-  json.EndArray();
+  json->EndArray();
+}
+
+}  // namespace
+
+void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSummary* summary) {
+  // The trajectory first: when a later file fails (full disk) or a second signal ends the
+  // process, the most valuable output is already complete.
+  const int frames_in_trajectory = WriteTrajectoryOutputs(system, options);
+  WriteMapOutputs(system, options);
+  const auto& records = system.tracker().records();
+  const FrameTimes frames = SummariseFrames(records);
+  const LocalMappingStats mapping = system.mapping_stats();
+  const LoopClosingStats loop_stats = system.loop_stats();
+  AssessRun(system, options, frames, loop_stats, frames_in_trajectory, summary);
+  ReportCalibration(system, options, summary);
+
+  JsonWriter json;
+  json.BeginObject();
+  WriteRunJson(options, *summary, records, &json);
+  WriteCountsJson(*summary, frames, frames_in_trajectory, mapping, records, &json);
+  WriteTimingJson(options, *summary, frames, mapping, &json);
+  WriteMapEditsJson(system, &json);
+  WriteLoopClosing(system, options, loop_stats, summary->estimate.lost_for_good_s, &json);
+  WriteCalibrationJson(summary->calibration, summary->calibration_warnings, &json);
+  WriteSeriesJson(frames, mapping, &json);
   json.EndObject();
-  WriteFileAtomically(out / "stats.json", json.str() + '\n');
+  WriteFileAtomically(options.out / "stats.json", json.str() + '\n');
 }
 
 }  // namespace pkslam
