@@ -10,6 +10,7 @@
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
+#include "tracking/keyframe_points.h"
 #include "tracking/tracker.h"
 #include "tracking/two_view_initializer.h"
 
@@ -94,31 +95,8 @@ void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
     map->AddKeyFrame(kf);
     AttachImu(lock, kf.get(), last_kf_.get(), current_);
     if (!IsMonocular(rig_->sensor)) {
-      // New points from the closest keypoints with depth that have none (all closer than
-      // th_depth and at least the nearest `new_keyframe_min_close_points`).
-      std::vector<std::pair<float, int>> by_depth;
-      for (int i = 0; i < current_.size(); ++i) {
-        if (current_.depth()[i] > 0) by_depth.emplace_back(current_.depth()[i], i);
-      }
-      std::sort(by_depth.begin(), by_depth.end());
-      int count = 0;
-      for (const auto& [z, i] : by_depth) {
-        auto& slot = current_.map_points[i];
-        const bool create = !slot || slot->NumObservations() < 1;
-        if (create) {
-          slot.reset();
-          const auto p = current_.UnprojectStereo(i);
-          auto mp = std::make_shared<MapPoint>(atlas_->NextMapPointId(), *p, kf.get(), map);
-          mp->AddObservation(kf.get(), i);
-          kf->AddMapPoint(mp, i);
-          mp->ComputeDistinctiveDescriptor();
-          mp->UpdateNormalAndDepth();
-          map->AddMapPoint(mp);
-          slot = mp;
-        }
-        ++count;
-        if (z > rig_->th_depth && count > options_.new_keyframe_min_close_points) break;
-      }
+      const ClosePointRule rule{rig_->th_depth, options_.new_keyframe_min_close_points};
+      AddClosePoints(lock, atlas_, map, kf.get(), rule, &current_);
     }
   }
   reference_kf_ = kf;

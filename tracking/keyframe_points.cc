@@ -1,0 +1,46 @@
+#include "tracking/keyframe_points.h"
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include "core/util/error.h"
+#include "map_model/atlas.h"
+#include "map_model/keyframe.h"
+#include "map_model/map.h"
+#include "map_model/map_editor.h"
+#include "map_model/map_point.h"
+
+namespace pkslam {
+
+int AddClosePoints(const MapWriteLock& lock, Atlas* atlas, Map* map, KeyFrame* keyframe,
+                   const ClosePointRule& rule, Frame* frame) {
+  PKSLAM_CHECK(lock.owns_lock(), "AddClosePoints without the Atlas's write lock");
+  std::vector<std::pair<float, int>> by_depth;
+  for (int i = 0; i < frame->size(); ++i) {
+    if (frame->depth()[i] > 0) by_depth.emplace_back(frame->depth()[i], i);
+  }
+  std::sort(by_depth.begin(), by_depth.end());
+  int count = 0;
+  int created = 0;
+  for (const auto& [z, i] : by_depth) {
+    auto& slot = frame->map_points[i];
+    if (!slot || slot->NumObservations() < 1) {
+      slot.reset();
+      const auto p = frame->UnprojectStereo(i);
+      auto mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), *p, keyframe, map);
+      mp->AddObservation(keyframe, i);
+      keyframe->AddMapPoint(mp, i);
+      mp->ComputeDistinctiveDescriptor();
+      mp->UpdateNormalAndDepth();
+      map->AddMapPoint(mp);
+      slot = mp;
+      ++created;
+    }
+    ++count;
+    if (z > rule.th_depth && count > rule.min_close) break;
+  }
+  return created;
+}
+
+}  // namespace pkslam
