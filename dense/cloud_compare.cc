@@ -4,28 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <nanoflann.hpp>
 
+#include "core/geometry/point_cloud_index.h"
 #include "core/util/error.h"
 
 namespace pkslam::dense {
-namespace {
-
-struct PointsAdaptor {
-  const std::vector<Eigen::Vector3f>& points;
-  std::size_t kdtree_get_point_count() const { return points.size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t dim) const { return points[i][dim]; }
-  template <class BoundingBox>
-  bool kdtree_get_bbox(BoundingBox& /*bb*/) const {
-    return false;
-  }
-};
-
-using KdTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointsAdaptor>,
-                                        PointsAdaptor, 3, std::size_t>;
-
-}  // namespace
 
 DistanceStats SummariseDistances(const std::vector<float>& distances,
                                  const std::vector<double>& thresholds_m) {
@@ -65,22 +48,17 @@ std::vector<float> NearestDistances(const std::vector<Eigen::Vector3f>& query,
                                     const std::vector<Eigen::Vector3f>& target,
                                     std::vector<std::uint32_t>* nearest) {
   PKSLAM_CHECK(!target.empty(), "nearest-neighbour search in an empty cloud");
-  PKSLAM_CHECK(target.size() < UINT32_MAX, "too many points");
+  PKSLAM_CHECK(target.size() < INT32_MAX, "too many points");
   if (nearest != nullptr) nearest->assign(query.size(), 0);
-  const PointsAdaptor adaptor{target};
-  KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  const PointCloudIndex index(target, 10);
   std::vector<float> distances(query.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, query.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        std::size_t index = 0;
-                        float d2 = 0;
-                        nanoflann::KNNResultSet<float, std::size_t> result(1);
-                        result.init(&index, &d2);
-                        tree.findNeighbors(result, query[i].data(), nanoflann::SearchParams());
+                        const auto [nearest_index, d2] = index.Nearest(query[i]);
                         distances[i] = std::sqrt(d2);
                         if (nearest != nullptr) {
-                          (*nearest)[i] = static_cast<std::uint32_t>(index);
+                          (*nearest)[i] = static_cast<std::uint32_t>(nearest_index);
                         }
                       }
                     });

@@ -1,5 +1,5 @@
 // Comparing a reconstructed cloud with a reference cloud by nearest-neighbour distances
-// (k-d tree, nanoflann):
+// (k-d tree: core/geometry/point_cloud_index.h):
 //   accuracy      distances cloud -> reference: mean, median, RMS, max, share within
 //                 1 / 2 / 5 cm; with reference normals also the distance to the reference
 //                 surface (|n . (p - q)| at the nearest reference point q: a point sampled

@@ -1,7 +1,7 @@
 // Point-to-point ICP (Besl & McKay 1992), the registration of seed 001 (section 2, Eqs. 3-4):
 // each iteration pairs every source point (moved by the current estimate) with its nearest
-// target point (nanoflann k-d tree), optionally drops pairs farther apart than a rejection
-// distance, and solves the closed-form rigid alignment of the pairs (rigid_alignment.h).
+// target point (core/geometry/point_cloud_index.h), optionally drops pairs farther apart than a
+// rejection distance, and solves the closed-form rigid alignment of the pairs (rigid_alignment.h).
 // It stops when an update moves the estimate by less than the tolerances, or when the mean
 // squared error stops decreasing by more than a relative tolerance.
 //
@@ -17,28 +17,12 @@
 #include <memory>
 #include <vector>
 
+#include "core/geometry/point_cloud_index.h"
 #include "core/geometry/se3.h"
 
 namespace pkslam::rgbd {
 
-// A k-d tree over a fixed point set (float coordinates). Immutable after construction;
-// concurrent queries are safe.
-class PointCloudIndex {
- public:
-  explicit PointCloudIndex(std::vector<Eigen::Vector3f> points);
-  ~PointCloudIndex();
-  PointCloudIndex(PointCloudIndex&&) noexcept;
-  PointCloudIndex& operator=(PointCloudIndex&&) noexcept;
-
-  const std::vector<Eigen::Vector3f>& points() const;
-  std::size_t size() const { return points().size(); }
-  // Index of the nearest point and its squared distance; index -1 for an empty cloud.
-  std::pair<int, float> Nearest(const Eigen::Vector3f& query) const;
-
- private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
-};
+using pkslam::PointCloudIndex;
 
 struct IcpOptions {
   int max_iterations = 50;

@@ -18,25 +18,6 @@ std::vector<Eigen::Vector3f> RoomCloud(const SE3d& world_from_camera, int stride
   return LiftDepthImage(view.depth_m, cv::Mat(), DepthLifter(camera), stride).points;
 }
 
-TEST(PointCloudIndex, FindsTheNearestPoint) {
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<float> u(-1, 1);
-  std::vector<Eigen::Vector3f> points;
-  for (int i = 0; i < 500; ++i) points.emplace_back(u(rng), u(rng), u(rng));
-  const PointCloudIndex index(points);
-  for (int q = 0; q < 50; ++q) {
-    const Eigen::Vector3f query(u(rng), u(rng), u(rng));
-    int best = 0;
-    for (int i = 1; i < 500; ++i) {
-      if ((points[i] - query).squaredNorm() < (points[best] - query).squaredNorm()) best = i;
-    }
-    const auto [found, d2] = index.Nearest(query);
-    EXPECT_EQ(found, best);
-    EXPECT_NEAR(d2, (points[best] - query).squaredNorm(), 1e-6);
-  }
-  EXPECT_EQ(PointCloudIndex({}).Nearest(Eigen::Vector3f::Zero()).first, -1);
-}
-
 // Uniform random points on a room corner (floor, two walls) with a box: no grid to alias.
 std::vector<Eigen::Vector3f> RandomCorner(int n, unsigned seed) {
   std::mt19937 rng(seed);
