@@ -64,10 +64,7 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
   }
   CompleteRequest(a, cmd);
   if (a.realism_report) {
-    sim::RealismRequest realism = a.request.realism;
-    realism.replay = !a.trajectory.empty();
-    realism.rgbd = a.request.options.rgbd;
-    std::cout << sim::FormatRealismReport(sim::ResolveRealism(realism));
+    std::cout << sim::FormatRealismReport(sim::ResolveRealism(sim::RealismOf(a.request)));
     return;
   }
   sim::SimulationOptions o;
@@ -106,13 +103,13 @@ void Run(SimulateArgs& a, const CLI::App& cmd) {
         "  {:.1f} frames/s end to end (rendering, image formation and PNG files)\n",
         s.frames / s.total_seconds);
   }
-  if (o.camera == "tumvi" && !o.rgbd && o.write_images) {
+  if (o.camera == "tumvi" && sim::WritesStereoSequence(o)) {
     std::cout << fmt::format(
         "  TUM-VI files: {}/dso/camchain.yaml, imu_config.yaml, "
         "mav0/mocap0/data.csv\n",
         o.output_dir.string());
   }
-  if (o.camera == "kitti" && !o.rgbd && o.write_images) {
+  if (o.camera == "kitti" && sim::WritesStereoSequence(o)) {
     const std::filesystem::path kitti = o.output_dir / "kitti";
     std::cout << fmt::format("  KITTI layout: {}/sequences/00 (poses: {}/poses/00.txt)\n",
                              kitti.string(), kitti.string());

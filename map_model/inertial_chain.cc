@@ -58,15 +58,6 @@ void InertialChain::SpliceOut(const MapWriteLock& lock, KeyFrame* keyframe) cons
   keyframe->imu.prior.reset();
 }
 
-void InertialChain::CutBefore(const MapWriteLock& lock, KeyFrame* keyframe) const {
-  RequireWriteLock(lock, "CutBefore");
-  if (KeyFrame* previous = keyframe->imu.previous_; previous && previous->imu.next_ == keyframe) {
-    previous->imu.next_ = nullptr;
-  }
-  keyframe->imu.previous_ = nullptr;
-  keyframe->imu.from_previous.reset();
-}
-
 std::vector<KeyFrame*> InertialChain::EndingAt(KeyFrame* newest, int max_length) {
   std::vector<KeyFrame*> chain;
   if (newest == nullptr || newest->IsBad()) return chain;

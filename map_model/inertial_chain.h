@@ -45,9 +45,6 @@ class InertialChain {
   // chain is cut there instead. The keyframe's marginalisation prior goes with it.
   void SpliceOut(const MapWriteLock& lock, KeyFrame* keyframe) const;
 
-  // Drops the interval before `keyframe` (an IMU gap): the chain is cut there.
-  void CutBefore(const MapWriteLock& lock, KeyFrame* keyframe) const;
-
   // The chain ending at `newest` (oldest first), at most `max_length` keyframes (0: all),
   // stopping at a retired keyframe, one of another map or one without a preintegration to its
   // predecessor. Empty for a retired `newest`. Atlas mutex held (shared).

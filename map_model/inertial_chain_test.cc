@@ -91,17 +91,6 @@ TEST_F(InertialChainTest, SpliceOutWithoutBothIntervalsCutsTheChain) {
   EXPECT_EQ(chain().Check(), std::nullopt);
 }
 
-TEST_F(InertialChainTest, CutBeforeEndsTheChainThere) {
-  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  Link(lock, 4);
-  chain().CutBefore(lock, kf(2));
-  EXPECT_EQ(kf(1)->imu.next(), nullptr);
-  EXPECT_EQ(kf(2)->imu.previous(), nullptr);
-  EXPECT_EQ(kf(2)->imu.next(), kf(3));
-  EXPECT_EQ(InertialChain::EndingAt(kf(3), 0), (std::vector<KeyFrame*>{kf(2), kf(3)}));
-  EXPECT_EQ(chain().Check(), std::nullopt);
-}
-
 TEST_F(InertialChainTest, RefusesKeyframesOfAnotherMapAndChangesWithoutTheWriteLock) {
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);

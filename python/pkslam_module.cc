@@ -291,42 +291,27 @@ PYBIND11_MODULE(_pkslam, m) {
       "EuRoC's body ground truth); camera poses (Slam.camera_trajectory()) with "
       "body_from_camera=Slam.body_from_camera, which moves the truth into the camera. A camera "
       "trajectory against body truth without it raises RuntimeError with that hint.");
+  // api::SimulateOptions field by field; pkslam.simulate() (pkslam/__init__.py) fills it.
+  py::class_<api::SimulateOptions>(m, "_SimulateOptions")
+      .def(py::init<>())
+      .def_readwrite("out", &api::SimulateOptions::out)
+      .def_readwrite("trajectory", &api::SimulateOptions::trajectory)
+      .def_readwrite("duration_s", &api::SimulateOptions::duration_s)
+      .def_readwrite("start_s", &api::SimulateOptions::start_s)
+      .def_readwrite("seed", &api::SimulateOptions::seed)
+      .def_readwrite("motion", &api::SimulateOptions::motion)
+      .def_readwrite("quality", &api::SimulateOptions::quality)
+      .def_readwrite("realism", &api::SimulateOptions::realism)
+      .def_readwrite("realism_off", &api::SimulateOptions::realism_off)
+      .def_readwrite("realism_params", &api::SimulateOptions::realism_params)
+      .def_readwrite("device_seed", &api::SimulateOptions::device_seed)
+      .def_readwrite("scene", &api::SimulateOptions::scene)
+      .def_readwrite("camera", &api::SimulateOptions::camera)
+      .def_readwrite("rgbd", &api::SimulateOptions::rgbd)
+      .def_readwrite("cloud", &api::SimulateOptions::cloud)
+      .def_readwrite("imu_noise", &api::SimulateOptions::imu_noise);
+  // Rendering takes seconds to minutes: other Python threads run meanwhile.
   m.def(
-      "_simulate",
-      [](const std::string& out, const std::string& trajectory, double duration, double start,
-         std::uint64_t seed, const std::string& motion, const std::string& quality,
-         const std::string& realism, const std::vector<std::string>& realism_off,
-         const std::vector<std::string>& realism_params, std::uint64_t device_seed,
-         const std::string& scene, const std::string& camera, bool rgbd, bool cloud,
-         bool imu_noise) {
-        api::SimulateOptions o;
-        o.out = out;
-        o.trajectory = trajectory;
-        o.duration_s = duration;
-        o.start_s = start;
-        o.seed = seed;
-        o.motion = motion;
-        o.quality = quality;
-        o.realism = realism;
-        o.realism_off = realism_off;
-        o.realism_params = realism_params;
-        o.device_seed = device_seed;
-        o.scene = scene;
-        o.camera = camera;
-        o.rgbd = rgbd;
-        o.cloud = cloud;
-        o.imu_noise = imu_noise;
-        const api::SimulateSummary s = [&] {
-          py::gil_scoped_release release;  // rendering takes seconds to minutes
-          return api::Simulate(o);
-        }();
-        py::dict d;
-        d["layout"] = s.layout;
-        d["frames"] = s.frames;
-        d["imu_samples"] = s.imu_samples;
-        d["duration_s"] = s.duration_s;
-        d["path_length_m"] = s.path_length_m;
-        return d;
-      },
-      "api::Simulate; pkslam.simulate() is its Python face");
+      "_simulate", [](const api::SimulateOptions& o) { api::Simulate(o); },
+      py::call_guard<py::gil_scoped_release>(), "api::Simulate");
 }

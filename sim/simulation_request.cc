@@ -43,12 +43,20 @@ void ApplyCamera(SimulationOptions* o) {
 
 }  // namespace
 
+RealismRequest RealismOf(const SimulationRequest& request) {
+  RealismRequest realism = request.realism;
+  realism.replay = !request.options.trajectory.empty();
+  realism.rgbd = request.options.rgbd;
+  return realism;
+}
+
+bool WritesStereoSequence(const SimulationOptions& o) {
+  return !o.rgbd && o.write_images && !o.bench && !o.reference_only;
+}
+
 SimulationOptions ResolveSimulation(const SimulationRequest& request) {
   SimulationOptions o = request.options;
-  RealismRequest realism = request.realism;
-  realism.replay = !o.trajectory.empty();
-  realism.rgbd = o.rgbd;
-  o.realism = ResolveRealism(realism);
+  o.realism = ResolveRealism(RealismOf(request));
   if (o.scene.empty()) o.scene = DefaultScene(o.realism, o.trajectory);
   o.motion.level = ParseMotionLevel(request.motion);
   if (o.trajectory.empty() && o.duration_s > 0 && o.duration_s <= o.motion.rest_s) {
@@ -77,7 +85,7 @@ SimulationSummary Simulate(const SimulationRequest& request, SimulationOptions* 
   const SimulationOptions o = ResolveSimulation(request);
   if (resolved != nullptr) *resolved = o;
   const SimulationSummary summary = RunSimulation(o);
-  const bool stereo_sequence = !o.rgbd && o.write_images && !o.bench && !o.reference_only;
+  const bool stereo_sequence = WritesStereoSequence(o);
   if (o.camera == "tumvi" && stereo_sequence) WriteTumViFiles(o.output_dir);
   // The same sequence in KITTI odometry's layout beside the EuRoC one, so `run --dataset
   // OUT/kitti/sequences/00` and `eval --kitti` have exact poses.

@@ -39,8 +39,15 @@ struct SimulationRequest {
   } given;
 };
 
+// The request's realism with what the options imply filled in (replay, rgbd).
+RealismRequest RealismOf(const SimulationRequest& request);
+
 // The options a request renders with. OptionError naming the option for a bad value.
 SimulationOptions ResolveSimulation(const SimulationRequest& request);
+
+// Whether a render with these options is a stereo sequence on disk, the one its camera's other
+// layouts (TUM-VI files, KITTI's) are written beside.
+bool WritesStereoSequence(const SimulationOptions& options);
 
 // Renders the request: RunSimulation on its options, then the other layouts its camera asks for
 // (tumvi: TUM-VI's dso/camchain.yaml, imu_config.yaml and mocap0; kitti: KITTI's odometry layout

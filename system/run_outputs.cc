@@ -330,12 +330,10 @@ void WriteMapOutputs(const SlamSystem& system, const RunOptions& options) {
 void AssessRun(const SlamSystem& system, const RunOptions& options, const FrameTimes& frames,
                const LoopClosingStats& loop_stats, int frames_in_trajectory, RunSummary* summary) {
   const auto& records = system.tracker().records();
-  const int lost = frames.lost;
-  const bool initialised = frames.initialised;
   summary->keyframes = system.NumKeyFrames();
   summary->map_points = system.NumMapPoints();
   summary->maps = system.NumMaps();
-  summary->lost = lost;
+  summary->lost = frames.lost;
   summary->median_tracking_ms = Median(frames.tracking_ms);
   // Localisation never starts or resets a map: its losses are gaps in one map's trajectory,
   // reported as such (WriteLocalisation), not stitched maps.
@@ -346,7 +344,7 @@ void AssessRun(const SlamSystem& system, const RunOptions& options, const FrameT
   for (const std::string& w : summary->estimate.warnings)
     PKSLAM_LOG_WARN("suspect estimate: {}", w);
   summary->estimate.no_estimate =
-      NoEstimateReason(static_cast<int>(records.size()), frames_in_trajectory, !initialised,
+      NoEstimateReason(static_cast<int>(records.size()), frames_in_trajectory, !frames.initialised,
                        IsMonocular(options.system.sensor));
   if (!summary->estimate.no_estimate.empty()) {
     PKSLAM_LOG_ERROR("no estimate: {}", summary->estimate.no_estimate);
@@ -355,18 +353,15 @@ void AssessRun(const SlamSystem& system, const RunOptions& options, const FrameT
 
 // The calibration estimate against the files it came from: warnings, OUT/calibration/.
 void ReportCalibration(const SlamSystem& system, const RunOptions& options, RunSummary* summary) {
-  const auto& out = options.out;
-  const CalibrationReport calibration = system.calibration_report();
   const CalibrationSources sources =
       options.settings ? SourcesFromSettingsFile(*options.settings)
       : std::filesystem::exists(options.dataset / "mav0")
           ? SourcesFromEurocDataset(options.dataset)
           : SourcesFromSettingsFile(options.dataset / "settings.yaml");
-  const std::vector<std::string> calibration_warnings = CalibrationWarnings(calibration, sources);
-  for (const std::string& w : calibration_warnings) PKSLAM_LOG_WARN("{}", w);
-  WriteCalibrationFiles(calibration, system.settings(), out);
-  summary->calibration = calibration;
-  summary->calibration_warnings = calibration_warnings;
+  summary->calibration = system.calibration_report();
+  summary->calibration_warnings = CalibrationWarnings(summary->calibration, sources);
+  for (const std::string& w : summary->calibration_warnings) PKSLAM_LOG_WARN("{}", w);
+  WriteCalibrationFiles(summary->calibration, system.settings(), options.out);
 }
 
 void WriteMapFileJson(JsonWriter* json, const char* key,
@@ -402,16 +397,13 @@ void WriteRunJson(const RunOptions& options, const RunSummary& summary,
 }
 
 // stats.json: frames, keyframes (created, culled, declined, by reason), points, maps, states.
-void WriteCountsJson(const RunSummary& s, const FrameTimes& frames, int frames_in_trajectory,
+void WriteCountsJson(const RunSummary& summary, const FrameTimes& frames, int frames_in_trajectory,
                      const LocalMappingStats& mapping, const std::vector<FrameRecord>& records,
                      JsonWriter* json) {
-  const RunSummary* summary = &s;
-  const int lost = frames.lost;
-  const auto& states = frames.states;
-  json->Member("frames", summary->frames);
+  json->Member("frames", summary.frames);
   json->Member("frames_in_trajectory", frames_in_trajectory);
-  json->Member("lost_frames", lost);
-  json->Member("keyframes", summary->keyframes);
+  json->Member("lost_frames", frames.lost);
+  json->Member("keyframes", summary.keyframes);
   json->Member("keyframes_created",
                static_cast<int>(std::count_if(records.begin(), records.end(),
                                               [](const FrameRecord& r) { return r.keyframe; })));
@@ -419,34 +411,32 @@ void WriteCountsJson(const RunSummary& s, const FrameTimes& frames, int frames_i
   // The keyframe queue's bound (LocalMappingOptions::max_queued_keyframes): its longest length
   // and the keyframes tracking declined because it was full.
   json->Member("max_queued_keyframes", mapping.max_queued_keyframes);
-  json->Member("keyframes_declined_queue_full", summary->keyframes_declined_queue_full);
+  json->Member("keyframes_declined_queue_full", summary.keyframes_declined_queue_full);
   // Which rule of the selector created how many keyframes ("initialisation": a map's first
   // keyframe(s), not a selector decision).
   json->Key("keyframe_reasons").BeginObject();
-  for (const auto& [reason, count] : summary->keyframe_reasons) json->Member(reason, count);
+  for (const auto& [reason, count] : summary.keyframe_reasons) json->Member(reason, count);
   json->EndObject();
   // On how many of the frames the selector decided on each of its criteria held (pks and
   // pks-released: criterion1 = D_c > Th_adaptive, criterion2 = ECOG > |COG|).
   json->Key("selector_criteria").BeginObject();
-  json->Member("decisions", summary->selector_decisions);
-  for (const auto& [criterion, count] : summary->criteria_held) json->Member(criterion, count);
+  json->Member("decisions", summary.selector_decisions);
+  for (const auto& [criterion, count] : summary.criteria_held) json->Member(criterion, count);
   json->EndObject();
-  json->Member("map_points", summary->map_points);
-  json->Member("maps", summary->maps);
+  json->Member("map_points", summary.map_points);
+  json->Member("maps", summary.maps);
   json->Key("tracking_states").BeginObject();
-  for (const auto& [name, count] : states) json->Member(name, count);
+  for (const auto& [name, count] : frames.states) json->Member(name, count);
   json->EndObject();
 }
 
 // stats.json: wall and CPU time per thread, local mapping's statistics, memory.
-void WriteTimingJson(const RunOptions& options, const RunSummary& s, const FrameTimes& frames,
+void WriteTimingJson(const RunOptions& options, const RunSummary& summary, const FrameTimes& frames,
                      const LocalMappingStats& mapping, JsonWriter* json) {
-  const RunSummary* summary = &s;
-  json->Member("wall_time_s", summary->wall_s);
-  json->Member("sequence_duration_s", summary->sequence_s);
-  json->Member("realtime_factor",
-               summary->wall_s > 0 ? summary->sequence_s / summary->wall_s : 0.0);
-  json->Member("median_tracking_ms", summary->median_tracking_ms);
+  json->Member("wall_time_s", summary.wall_s);
+  json->Member("sequence_duration_s", summary.sequence_s);
+  json->Member("realtime_factor", summary.wall_s > 0 ? summary.sequence_s / summary.wall_s : 0.0);
+  json->Member("median_tracking_ms", summary.median_tracking_ms);
   json->Member("p95_tracking_ms", Quantile(frames.tracking_ms, 0.95).value_or(0.0));
   // Offline runs (live emulation): wall time tracking waited for local mapping's state; it
   // is not part of tracking_ms.
@@ -482,10 +472,9 @@ void WriteTimingJson(const RunOptions& options, const RunSummary& s, const Frame
   json->Member("peak_memory_mib", PeakMemoryMiB());
 }
 
-// stats.json: exclusive holds of the map lock per kind of change.
+// stats.json: exclusive holds of the map lock per kind of change (map_model/map_editor.h): how
+// often and how long (wall) each kind kept the other threads out of the map.
 void WriteMapEditsJson(const SlamSystem& system, JsonWriter* json) {
-  // Exclusive holds of the map lock per kind of change (map_model/map_editor.h): how often and
-  // how long (wall) each kind kept the other threads out of the map.
   json->Key("map_edits").BeginObject();
   const MapEditTable edits = system.atlas().EditStats();
   for (int k = 0; k < kNumMapEdits; ++k) {

@@ -13,9 +13,10 @@
 
 namespace pkslam {
 
-int AddClosePoints(const MapWriteLock& lock, Atlas* atlas, Map* map, KeyFrame* keyframe,
+int AddClosePoints(const MapWriteLock& lock, Atlas* atlas, KeyFrame* keyframe,
                    const ClosePointRule& rule, Frame* frame) {
   PKSLAM_CHECK(lock.owns_lock(), "AddClosePoints without the Atlas's write lock");
+  Map* map = keyframe->map();
   std::vector<std::pair<float, int>> by_depth;
   for (int i = 0; i < frame->size(); ++i) {
     if (frame->depth()[i] > 0) by_depth.emplace_back(frame->depth()[i], i);

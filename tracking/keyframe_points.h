@@ -19,9 +19,10 @@ struct ClosePointRule {
 };
 
 // Creates the points for `frame`'s keypoints as above, observed by `keyframe` (made from
-// `frame`, in `map`), and puts them into the frame's slots. A slot whose point has observations
-// keeps it; a temporary one (visual odometry) is replaced. Returns the points created.
-int AddClosePoints(const MapWriteLock& lock, Atlas* atlas, Map* map, KeyFrame* keyframe,
+// `frame`) and added to the keyframe's map, and puts them into the frame's slots. A slot whose
+// point has observations keeps it; a temporary one (visual odometry) is replaced. Returns the
+// points created.
+int AddClosePoints(const MapWriteLock& lock, Atlas* atlas, KeyFrame* keyframe,
                    const ClosePointRule& rule, Frame* frame);
 
 }  // namespace pkslam

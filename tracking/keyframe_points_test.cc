@@ -60,7 +60,7 @@ TEST_F(KeyFramePointsTest, AllCloseKeypointsBecomeObservedPointsAtTheirStereoPos
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   KeyFramePtr kf = MakeKeyFrame();
   const ClosePointRule rule{rig_->th_depth, 5};
-  const int created = AddClosePoints(lock, &atlas_, atlas_.current_map(), kf.get(), rule, &frame_);
+  const int created = AddClosePoints(lock, &atlas_, kf.get(), rule, &frame_);
   // The close ones and the first far one, where the walk stops.
   EXPECT_EQ(created, close + 1);
   EXPECT_EQ(atlas_.current_map()->NumMapPoints(), created);
@@ -80,7 +80,7 @@ TEST_F(KeyFramePointsTest, AtLeastTheNearestMinCloseEvenWhenNoneIsClose) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   KeyFramePtr kf = MakeKeyFrame();
   const ClosePointRule rule{0.01, 10};  // nothing is closer than 1 cm
-  EXPECT_EQ(AddClosePoints(lock, &atlas_, atlas_.current_map(), kf.get(), rule, &frame_), 11);
+  EXPECT_EQ(AddClosePoints(lock, &atlas_, kf.get(), rule, &frame_), 11);
 }
 
 TEST_F(KeyFramePointsTest, MatchedPointsStayAndTemporaryOnesAreReplaced) {
@@ -96,7 +96,7 @@ TEST_F(KeyFramePointsTest, MatchedPointsStayAndTemporaryOnesAreReplaced) {
   frame_.map_points[order[1]] = temporary;
   KeyFramePtr kf = MakeKeyFrame();
   const ClosePointRule rule{0.01, 3};  // the nearest 4
-  EXPECT_EQ(AddClosePoints(lock, &atlas_, atlas_.current_map(), kf.get(), rule, &frame_), 3);
+  EXPECT_EQ(AddClosePoints(lock, &atlas_, kf.get(), rule, &frame_), 3);
   EXPECT_EQ(frame_.map_points[order[0]], matched);
   EXPECT_NE(frame_.map_points[order[1]], temporary);
   EXPECT_EQ(frame_.map_points[order[1]]->observations().count(kf->id()), 1u);
@@ -109,9 +109,7 @@ TEST_F(KeyFramePointsTest, RefusesToChangeTheMapWithoutTheWriteLock) {
     kf = MakeKeyFrame();
   }
   auto unlocked = MapEditor(&atlas_).WriteLater(MapEdit::kFixture);
-  EXPECT_THROW(
-      AddClosePoints(unlocked, &atlas_, atlas_.current_map(), kf.get(), ClosePointRule{}, &frame_),
-      Error);
+  EXPECT_THROW(AddClosePoints(unlocked, &atlas_, kf.get(), ClosePointRule{}, &frame_), Error);
   EXPECT_EQ(atlas_.current_map()->NumMapPoints(), 0);
 }
 

@@ -96,7 +96,7 @@ void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
     AttachImu(lock, kf.get(), last_kf_.get(), current_);
     if (!IsMonocular(rig_->sensor)) {
       const ClosePointRule rule{rig_->th_depth, options_.new_keyframe_min_close_points};
-      AddClosePoints(lock, atlas_, map, kf.get(), rule, &current_);
+      AddClosePoints(lock, atlas_, kf.get(), rule, &current_);
     }
   }
   reference_kf_ = kf;

@@ -16,7 +16,7 @@
 import os
 import shutil
 
-from ._pkslam import Slam, evaluate, _simulate, __version__  # noqa: F401
+from ._pkslam import Slam, evaluate, _simulate, _SimulateOptions, __version__  # noqa: F401
 from . import _paths
 
 VOCABULARY = os.environ.get("PKSLAM_VOCABULARY", _paths.VOCABULARY)
@@ -41,8 +41,24 @@ def simulate(out, trajectory=None, duration=10.0, seed=1, start=None, motion=Non
     realism ideal|euroc (None: euroc for replays), realism_off a list of sources,
     realism_params a list of "NAME=VALUE", camera euroc|kitti|vga|tumvi. A bad value raises
     ValueError naming it."""
-    _simulate(str(out), "" if trajectory is None else str(trajectory), float(duration),
-              0.0 if start is None else float(start), int(seed), motion or "medium",
-              quality or "default", realism or "", list(realism_off), list(realism_params),
-              int(device_seed), scene or "", camera, bool(rgbd), bool(cloud), bool(imu_noise))
+    options = _SimulateOptions()
+    options.out = str(out)
+    if trajectory is not None:
+        options.trajectory = str(trajectory)
+    options.duration_s = float(duration)
+    if start is not None:
+        options.start_s = float(start)
+    options.seed = int(seed)
+    options.motion = motion or options.motion
+    options.quality = quality or options.quality
+    options.realism = realism or ""
+    options.realism_off = list(realism_off)
+    options.realism_params = list(realism_params)
+    options.device_seed = int(device_seed)
+    options.scene = scene or ""
+    options.camera = camera
+    options.rgbd = bool(rgbd)
+    options.cloud = bool(cloud)
+    options.imu_noise = bool(imu_noise)
+    _simulate(options)
     return str(out)
