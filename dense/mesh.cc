@@ -7,7 +7,6 @@
 #include <open3d/geometry/TriangleMesh.h>
 #include <open3d/io/TriangleMeshIO.h>
 #include <open3d/pipelines/integration/ScalableTSDFVolume.h>
-#include <sys/resource.h>
 #include <tbb/parallel_for.h>
 
 #include <chrono>
@@ -17,6 +16,7 @@
 #include <optional>
 #include <string>
 
+#include "core/util/cpu_time.h"
 #include "core/util/error.h"
 #include "core/util/progress.h"
 
@@ -44,16 +44,6 @@ open3d::geometry::Image ToOpen3d(const cv::Mat& mat) {
   }
   return image;
 }
-
-double PeakMemoryMiB() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
-
-}  // namespace
-
-namespace {
 
 // The TSDF volume and what it fuses: depth maps of `camera`'s pixels (ideal pinhole).
 class TsdfFusion {

@@ -50,8 +50,8 @@ class InertialLoopTest : public testing::RevisitTest {
         if (previous != nullptr) {
           map->inertial_chain().Append(lock, previous, kf.second.get(), std::nullopt);
         }
-        kf.second->imu.state.valid = true;
-        kf.second->imu.state.velocity_world = Eigen::Vector3d(0.4, 0.1, -0.05);
+        kf.second->mutable_imu(lock).state.valid = true;
+        kf.second->mutable_imu(lock).state.velocity_world = Eigen::Vector3d(0.4, 0.1, -0.05);
         previous = kf.second.get();
       }
     }
@@ -63,7 +63,7 @@ class InertialLoopTest : public testing::RevisitTest {
     for (const Map* map : atlas_.maps()) {
       for (const auto& [id, kf] : map->keyframes()) {
         s.camera_from_world[id] = kf->camera_from_world();
-        s.velocity[id] = kf->imu.state.velocity_world;
+        s.velocity[id] = kf->imu().state.velocity_world;
       }
       s.gravity_in_camera.merge(GravityInCameras(*map));
     }
@@ -105,7 +105,7 @@ TEST_F(InertialLoopTest, CorrectsYawAndTranslationKeepingGravity) {
     EXPECT_LT(CentreError(kf, poses_[static_cast<std::size_t>(k)]), 0.02) << "keyframe " << k;
     const SO3d turn = kf.world_from_camera().so3() * before.camera_from_world.at(kf.id()).so3();
     EXPECT_NEAR(ClosestYawAngle(turn), -0.03, 2e-3);
-    EXPECT_LT((kf.imu.state.velocity_world - turn * before.velocity.at(kf.id())).norm(), 1e-9);
+    EXPECT_LT((kf.imu().state.velocity_world - turn * before.velocity.at(kf.id())).norm(), 1e-9);
   }
   EXPECT_GT(atlas_.current_map()->NumWorldChanges(), 0);  // tracking re-anchors on its keyframe
 }
@@ -122,7 +122,7 @@ TEST_F(InertialLoopTest, TwoInertialMapsMergeByYawAndTranslation) {
     const KeyFrame& kf = *second_[static_cast<std::size_t>(k)];
     EXPECT_LT(CentreError(kf, poses_[static_cast<std::size_t>(k)]), 0.02) << "keyframe " << k;
     const SO3d turn = kf.world_from_camera().so3() * before.camera_from_world.at(kf.id()).so3();
-    EXPECT_LT((kf.imu.state.velocity_world - turn * before.velocity.at(kf.id())).norm(), 1e-9);
+    EXPECT_LT((kf.imu().state.velocity_world - turn * before.velocity.at(kf.id())).norm(), 1e-9);
   }
 }
 

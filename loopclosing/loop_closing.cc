@@ -334,10 +334,10 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
         const auto gravity_before = GravityInCameras(*map);
         if (use_inertial) {
           MergeGlobalBundle(
-              map, inertial.visual, [&] { ApplyInertialBundle(map, inertial, inertial_result); },
-              true);
+              lock, map, inertial.visual,
+              [&] { ApplyInertialBundle(lock, map, inertial, inertial_result); }, true);
         } else {
-          MergeGlobalBundle(map, problem, result);
+          MergeGlobalBundle(lock, map, problem, result);
         }
         applied = true;
         if (IsInertial(sensor_) && map->imu_status().imu_initialized) {

@@ -212,7 +212,7 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
     graph.dof = GraphDof(*map);
     graph.num_threads = options_.num_threads;
     const EssentialGraphProblem problem = CollectEssentialGraph(map, correction, graph);
-    ApplyEssentialGraph(map, problem, SolveEssentialGraph(problem, graph));
+    ApplyEssentialGraph(lock, map, problem, SolveEssentialGraph(problem, graph));
     query->AddLoopEdge(region.matched.get());
     region.matched->AddLoopEdge(query);
     // Tracking predicts from its last keyframe (corrected pose and velocity) next time.
@@ -254,8 +254,9 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     const Sim3d current_from_merged = merged_from_current.Inverse();
     for (const auto& [id, kf] : current->keyframes()) {
       kf->SetPose((Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
-      kf->imu.state.velocity_world =
-          merged_from_current.scale() * (merged_from_current.so3() * kf->imu.state.velocity_world);
+      kf->mutable_imu(lock).state.velocity_world =
+          merged_from_current.scale() *
+          (merged_from_current.so3() * kf->imu().state.velocity_world);
     }
     for (const auto& [id, kf] : current->retired_keyframes()) {
       kf->SetPose((Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
@@ -317,7 +318,7 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
                          : (options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3);
     graph.num_threads = options_.num_threads;
     const EssentialGraphProblem problem = CollectEssentialGraph(merged, correction, graph);
-    ApplyEssentialGraph(merged, problem, SolveEssentialGraph(problem, graph));
+    ApplyEssentialGraph(lock, merged, problem, SolveEssentialGraph(problem, graph));
     query->AddLoopEdge(region.matched.get());
     region.matched->AddLoopEdge(query);
 

@@ -27,35 +27,35 @@ void InertialChain::Append(const MapWriteLock& lock, KeyFrame* previous, KeyFram
   PKSLAM_CHECK(previous->map() == map_ && keyframe->map() == map_,
                "InertialChain::Append: keyframes {} and {} are not both of map {}", previous->id(),
                keyframe->id(), map_->id());
-  keyframe->imu.previous_ = previous;
-  previous->imu.next_ = keyframe;
-  keyframe->imu.from_previous = std::move(from_previous);
+  keyframe->imu_.previous_ = previous;
+  previous->imu_.next_ = keyframe;
+  keyframe->imu_.from_previous = std::move(from_previous);
 }
 
 void InertialChain::SpliceOut(const MapWriteLock& lock, KeyFrame* keyframe) const {
   RequireWriteLock(lock, "SpliceOut");
-  KeyFrame* previous = keyframe->imu.previous_;
-  KeyFrame* next = keyframe->imu.next_;
-  if (next != nullptr && next->imu.previous_ == keyframe) {
-    if (previous != nullptr && keyframe->imu.from_previous && next->imu.from_previous) {
+  KeyFrame* previous = keyframe->imu_.previous_;
+  KeyFrame* next = keyframe->imu_.next_;
+  if (next != nullptr && next->imu_.previous_ == keyframe) {
+    if (previous != nullptr && keyframe->imu_.from_previous && next->imu_.from_previous) {
       // The merged interval starts at `previous`: linearise it at that keyframe's bias.
-      PreintegratedImu& merged = *next->imu.from_previous;
-      merged.bias = previous->imu.state.bias;
-      MergePrevious(*keyframe->imu.from_previous, &merged);
-      next->imu.previous_ = previous;
-      previous->imu.next_ = next;
+      PreintegratedImu& merged = *next->imu_.from_previous;
+      merged.bias = previous->imu_.state.bias;
+      MergePrevious(*keyframe->imu_.from_previous, &merged);
+      next->imu_.previous_ = previous;
+      previous->imu_.next_ = next;
     } else {
-      next->imu.previous_ = nullptr;
-      next->imu.from_previous.reset();
-      if (previous != nullptr && previous->imu.next_ == keyframe) previous->imu.next_ = nullptr;
+      next->imu_.previous_ = nullptr;
+      next->imu_.from_previous.reset();
+      if (previous != nullptr && previous->imu_.next_ == keyframe) previous->imu_.next_ = nullptr;
     }
-  } else if (previous != nullptr && previous->imu.next_ == keyframe) {
-    previous->imu.next_ = nullptr;
+  } else if (previous != nullptr && previous->imu_.next_ == keyframe) {
+    previous->imu_.next_ = nullptr;
   }
-  keyframe->imu.previous_ = nullptr;
-  keyframe->imu.next_ = nullptr;
-  keyframe->imu.from_previous.reset();
-  keyframe->imu.prior.reset();
+  keyframe->imu_.previous_ = nullptr;
+  keyframe->imu_.next_ = nullptr;
+  keyframe->imu_.from_previous.reset();
+  keyframe->imu_.prior.reset();
 }
 
 std::vector<KeyFrame*> InertialChain::EndingAt(KeyFrame* newest, int max_length) {
@@ -64,9 +64,9 @@ std::vector<KeyFrame*> InertialChain::EndingAt(KeyFrame* newest, int max_length)
   chain.push_back(newest);
   KeyFrame* k = newest;
   while ((max_length <= 0 || static_cast<int>(chain.size()) < max_length) &&
-         k->imu.previous_ != nullptr && k->imu.from_previous && !k->imu.previous_->IsBad() &&
-         k->imu.previous_->map() == newest->map()) {
-    k = k->imu.previous_;
+         k->imu_.previous_ != nullptr && k->imu_.from_previous && !k->imu_.previous_->IsBad() &&
+         k->imu_.previous_->map() == newest->map()) {
+    k = k->imu_.previous_;
     chain.push_back(k);
   }
   std::reverse(chain.begin(), chain.end());
@@ -74,16 +74,16 @@ std::vector<KeyFrame*> InertialChain::EndingAt(KeyFrame* newest, int max_length)
 }
 
 void InertialChain::Restore(KeyFrame* keyframe, KeyFrame* previous, KeyFrame* next) {
-  keyframe->imu.previous_ = previous;
-  keyframe->imu.next_ = next;
+  keyframe->imu_.previous_ = previous;
+  keyframe->imu_.next_ = next;
 }
 
 std::optional<std::string> InertialChain::Check() const {
   auto check = [&](const KeyFrame& k) -> std::optional<std::string> {
-    const KeyFrame* previous = k.imu.previous_;
-    const KeyFrame* next = k.imu.next_;
+    const KeyFrame* previous = k.imu_.previous_;
+    const KeyFrame* next = k.imu_.next_;
     if (previous != nullptr) {
-      if (previous->imu.next_ != &k) {
+      if (previous->imu_.next_ != &k) {
         return fmt::format("keyframe {}: its previous {} does not link back", k.id(),
                            previous->id());
       }
@@ -92,7 +92,7 @@ std::optional<std::string> InertialChain::Check() const {
                            previous->id());
       }
     }
-    if (next != nullptr && next->imu.previous_ != &k) {
+    if (next != nullptr && next->imu_.previous_ != &k) {
       return fmt::format("keyframe {}: its next {} does not link back", k.id(), next->id());
     }
     return std::nullopt;

@@ -1,9 +1,9 @@
 // The temporal keyframe chain of an inertial map, and the only code that changes it.
 //
 // Invariant (kept by every operation here; the first two checked by InertialChain::Check):
-//   - k->imu.next()->imu.previous() == k and k->imu.previous()->imu.next() == k where set;
+//   - k->imu().next()->imu().previous() == k and k->imu().previous()->imu().next() == k where set;
 //   - linked keyframes belong to the same map;
-//   - k->imu.from_previous, when set on a linked keyframe, spans previous->t_ns() .. k->t_ns()
+//   - k->imu().from_previous, when set on a linked keyframe, spans previous->t_ns() .. k->t_ns()
 //     (on the IMU clock: each stamp shifted by its keyframe's time offset);
 //   - a keyframe spliced out has neither links, preintegration nor marginalisation prior.
 // Keyframes appended by tracking (kInsertKeyFrame, kInitialise) are linked to the newest

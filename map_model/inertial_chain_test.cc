@@ -42,13 +42,13 @@ class InertialChainTest : public ::testing::Test {
 TEST_F(InertialChainTest, AppendLinksBothWaysAndKeepsTheInterval) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Link(lock, 3);
-  EXPECT_EQ(kf(0)->imu.previous(), nullptr);
-  EXPECT_EQ(kf(0)->imu.next(), kf(1));
-  EXPECT_EQ(kf(1)->imu.previous(), kf(0));
-  EXPECT_EQ(kf(1)->imu.next(), kf(2));
-  EXPECT_EQ(kf(2)->imu.next(), nullptr);
-  ASSERT_TRUE(kf(2)->imu.from_previous.has_value());
-  EXPECT_EQ(kf(2)->imu.from_previous->dt, 0.05);
+  EXPECT_EQ(kf(0)->imu().previous(), nullptr);
+  EXPECT_EQ(kf(0)->imu().next(), kf(1));
+  EXPECT_EQ(kf(1)->imu().previous(), kf(0));
+  EXPECT_EQ(kf(1)->imu().next(), kf(2));
+  EXPECT_EQ(kf(2)->imu().next(), nullptr);
+  ASSERT_TRUE(kf(2)->imu().from_previous.has_value());
+  EXPECT_EQ(kf(2)->imu().from_previous->dt, 0.05);
   EXPECT_EQ(chain().Check(), std::nullopt);
   EXPECT_EQ(InertialChain::EndingAt(kf(2), 0), (std::vector<KeyFrame*>{kf(0), kf(1), kf(2)}));
   EXPECT_EQ(InertialChain::EndingAt(kf(2), 2), (std::vector<KeyFrame*>{kf(1), kf(2)}));
@@ -58,23 +58,23 @@ TEST_F(InertialChainTest, AnIntervalMissingAtAnImuGapLinksButEndsTheChainForEsti
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Link(lock, 2);
   chain().Append(lock, kf(1), kf(2), std::nullopt);
-  EXPECT_EQ(kf(2)->imu.previous(), kf(1));
+  EXPECT_EQ(kf(2)->imu().previous(), kf(1));
   EXPECT_EQ(InertialChain::EndingAt(kf(2), 0), (std::vector<KeyFrame*>{kf(2)}));
 }
 
 TEST_F(InertialChainTest, SpliceOutMergesTheIntervalAndDropsThePrior) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Link(lock, 4);
-  kf(2)->imu.prior = InertialStatePrior();
+  kf(2)->mutable_imu(lock).prior = InertialStatePrior();
   kf(2)->SetBad();
   chain().SpliceOut(lock, kf(2));
-  EXPECT_EQ(kf(1)->imu.next(), kf(3));
-  EXPECT_EQ(kf(3)->imu.previous(), kf(1));
-  EXPECT_NEAR(kf(3)->imu.from_previous->dt, 0.10, 1e-12);  // both intervals
-  EXPECT_EQ(kf(2)->imu.previous(), nullptr);
-  EXPECT_EQ(kf(2)->imu.next(), nullptr);
-  EXPECT_FALSE(kf(2)->imu.from_previous.has_value());
-  EXPECT_FALSE(kf(2)->imu.prior.has_value());
+  EXPECT_EQ(kf(1)->imu().next(), kf(3));
+  EXPECT_EQ(kf(3)->imu().previous(), kf(1));
+  EXPECT_NEAR(kf(3)->imu().from_previous->dt, 0.10, 1e-12);  // both intervals
+  EXPECT_EQ(kf(2)->imu().previous(), nullptr);
+  EXPECT_EQ(kf(2)->imu().next(), nullptr);
+  EXPECT_FALSE(kf(2)->imu().from_previous.has_value());
+  EXPECT_FALSE(kf(2)->imu().prior.has_value());
   EXPECT_EQ(chain().Check(), std::nullopt);
   EXPECT_EQ(InertialChain::EndingAt(kf(3), 0), (std::vector<KeyFrame*>{kf(0), kf(1), kf(3)}));
 }
@@ -85,9 +85,9 @@ TEST_F(InertialChainTest, SpliceOutWithoutBothIntervalsCutsTheChain) {
   chain().Append(lock, kf(1), kf(2), std::nullopt);
   chain().Append(lock, kf(2), kf(3), Interval(0.05));
   chain().SpliceOut(lock, kf(2));  // no interval 1 -> 2 to merge
-  EXPECT_EQ(kf(1)->imu.next(), nullptr);
-  EXPECT_EQ(kf(3)->imu.previous(), nullptr);
-  EXPECT_FALSE(kf(3)->imu.from_previous.has_value());
+  EXPECT_EQ(kf(1)->imu().next(), nullptr);
+  EXPECT_EQ(kf(3)->imu().previous(), nullptr);
+  EXPECT_FALSE(kf(3)->imu().from_previous.has_value());
   EXPECT_EQ(chain().Check(), std::nullopt);
 }
 
@@ -97,12 +97,12 @@ TEST_F(InertialChainTest, RefusesKeyframesOfAnotherMapAndChangesWithoutTheWriteL
     Map* other = atlas_.CreateNewMap();
     kf(5)->set_map(other);  // as if merged away
     EXPECT_THROW(chain().Append(lock, kf(4), kf(5), Interval(0.05)), Error);
-    EXPECT_EQ(kf(4)->imu.next(), nullptr);
+    EXPECT_EQ(kf(4)->imu().next(), nullptr);
     kf(5)->set_map(kf(0)->map());
   }
   auto unlocked = MapEditor(&atlas_).WriteLater(MapEdit::kFixture);
   EXPECT_THROW(chain().Append(unlocked, kf(0), kf(1), Interval(0.05)), Error);
-  EXPECT_EQ(kf(0)->imu.next(), nullptr);
+  EXPECT_EQ(kf(0)->imu().next(), nullptr);
 }
 
 }  // namespace

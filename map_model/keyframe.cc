@@ -3,8 +3,10 @@
 #include <algorithm>
 
 #include "core/sensor/depth_uncertainty.h"
+#include "core/util/error.h"
 #include "map_model/frame.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/recalibrate_features.h"
 
@@ -39,7 +41,7 @@ KeyFrame::KeyFrame(KeyFrameId id, const Frame& frame, Map* map)
       feature_vector_(frame.feature_vector()),
       map_points_(frame.map_points) {
   if (frame.HasPose()) SetPose(frame.camera_from_world());
-  imu.time_offset_s = frame.imu.time_offset_s;
+  imu_.time_offset_s = frame.imu.time_offset_s;
 }
 
 KeyFrame::KeyFrame(KeyFrameId id, FrameId frame_id, std::int64_t t_ns,
@@ -238,6 +240,12 @@ bool KeyFrame::SetErase() {
     return true;
   }
   return false;
+}
+
+KeyFrameImu& KeyFrame::mutable_imu(const MapWriteLock& lock) {
+  PKSLAM_CHECK(lock.owns_lock(),
+               "keyframe {}: inertial data changed without the Atlas's write lock", id_);
+  return imu_;
 }
 
 void KeyFrame::SetBad() {

@@ -26,6 +26,8 @@
 
 namespace pkslam {
 
+class MapWriteLock;
+
 class KeyFrame {
  public:
   // Copies the frame's features and pose; map-point slots start as in the frame.
@@ -131,11 +133,17 @@ class KeyFrame {
   void Recalibrate(std::shared_ptr<const CameraRig> rig, const RigWarp& warp,
                    const SE3d& new_from_old);
 
-  // --- inertial sensors (guarded by the Atlas mutex; map_model/keyframe_inertial.h) ---
-  KeyFrameImu imu;
+  // --- inertial sensors (map_model/keyframe_inertial.h) ---
+  // Read under the Atlas lock (shared).
+  const KeyFrameImu& imu() const { return imu_; }
+  // The one door to change the keyframe's inertial state, prior, preintegration and time
+  // offset: the Atlas's write lock is a parameter (refused at run time if not held). The chain
+  // links change only through the map's InertialChain.
+  KeyFrameImu& mutable_imu(const MapWriteLock& lock);
 
  private:
-  friend class AtlasStorage;  // map files: map_model/storage/atlas_storage.h
+  friend class AtlasStorage;   // map files: map_model/storage/atlas_storage.h
+  friend class InertialChain;  // the temporal links (map_model/inertial_chain.h)
   // An empty keyframe that AtlasStorage fills from a map file.
   KeyFrame(KeyFrameId id, FrameId frame_id, std::int64_t t_ns, std::shared_ptr<const CameraRig> rig,
            Map* map);
@@ -176,6 +184,7 @@ class KeyFrame {
   bool not_erase_ = false;
   bool to_be_erased_ = false;
   SE3d camera_from_parent_;
+  KeyFrameImu imu_;  // guarded by the Atlas mutex
 };
 
 }  // namespace pkslam

@@ -2,9 +2,10 @@
 // algorithms are in imu/, tracking/tracker_inertial.cc and mapping/).
 //
 // Ownership and locking: Frame::imu belongs to the tracking thread like the rest of a Frame.
-// KeyFrame::imu is guarded by the Atlas mutex (shared to read, exclusive to write) like the
-// keyframe's pose; `previous()` / `next()` are the map's temporal chain, which only
-// InertialChain (map_model/inertial_chain.h) links, splices and cuts.
+// A keyframe's KeyFrameImu is guarded by the Atlas mutex like the keyframe's pose: KeyFrame::imu()
+// reads it under the shared lock, KeyFrame::mutable_imu(lock) is the one door to change it and
+// takes the write lock as a parameter; `previous()` / `next()` are the map's temporal chain,
+// which only InertialChain (map_model/inertial_chain.h) links, splices and cuts.
 #pragma once
 
 #include <Eigen/Core>

@@ -32,7 +32,8 @@ InertialCullingContext MakeInertialCullingContext(const KeyFrame& current,
   InertialCullingContext c;
   c.current_id = current.id();
   const KeyFrame* k = &current;
-  for (int n = 1; n < options.window && k->imu.previous() != nullptr; ++n) k = k->imu.previous();
+  for (int n = 1; n < options.window && k->imu().previous() != nullptr; ++n)
+    k = k->imu().previous();
   c.window_start_id = k->id();
   if (const Map* map = current.map()) {
     c.map_keyframes = map->NumKeyFrames();
@@ -46,11 +47,11 @@ bool InertialCullingAllowed(const KeyFrame& candidate, const InertialCullingCont
                             const InertialCullingOptions& options) {
   if (!options.enabled || context.map_keyframes <= options.window) return false;
   if (candidate.id() + 2 > context.current_id) return false;  // the two newest stay
-  const KeyFrame* previous = candidate.imu.previous();
-  const KeyFrame* next = candidate.imu.next();
+  const KeyFrame* previous = candidate.imu().previous();
+  const KeyFrame* next = candidate.imu().next();
   if (previous == nullptr || next == nullptr || previous->IsBad() || next->IsBad() ||
-      !candidate.imu.from_previous || !next->imu.from_previous ||
-      next->imu.previous() != &candidate) {
+      !candidate.imu().from_previous || !next->imu().from_previous ||
+      next->imu().previous() != &candidate) {
     return false;
   }
   const double gap = SecondsBetween(*previous, *next);
@@ -65,11 +66,11 @@ int RepairInertialChain(const MapWriteLock& lock, KeyFrame* newest, int length) 
   int spliced = 0;
   KeyFrame* k = newest;
   for (int n = 0; n < length && k != nullptr; ++n) {
-    KeyFrame* previous = k->imu.previous();
+    KeyFrame* previous = k->imu().previous();
     while (previous != nullptr && previous->IsBad()) {
       previous->map()->inertial_chain().SpliceOut(lock, previous);
       ++spliced;
-      previous = k->imu.previous();
+      previous = k->imu().previous();
     }
     k = previous;
   }

@@ -30,7 +30,7 @@ class InertialCullingTest : public ::testing::Test {
     for (int k = 0; k < kNumKeyFrames; ++k) {
       KeyFrame* kf = map_.keyframes[k].get();
       ASSERT_EQ(kf->t_ns(), k * kCullingPeriodNs);
-      kf->imu.state.bias = bias_;
+      kf->mutable_imu(lock).state.bias = bias_;
       if (k == 0) continue;
       KeyFrame* previous = map_.keyframes[k - 1].get();
       map_.keyframes[0]->map()->inertial_chain().Append(lock, previous, kf,
@@ -60,19 +60,20 @@ class InertialCullingTest : public ::testing::Test {
 
 TEST_F(InertialCullingTest, SplicingMergesThePreintegrationIntoTheSuccessor) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  kf(4)->imu.state.bias = ImuBias(Eigen::Vector3d(0.001, 0, 0), Eigen::Vector3d(0.01, 0, 0));
+  kf(4)->mutable_imu(lock).state.bias =
+      ImuBias(Eigen::Vector3d(0.001, 0, 0), Eigen::Vector3d(0.01, 0, 0));
   Retire(lock, 5);
-  EXPECT_EQ(kf(6)->imu.previous(), kf(4));
-  EXPECT_EQ(kf(4)->imu.next(), kf(6));
-  EXPECT_EQ(kf(5)->imu.previous(), nullptr);
-  EXPECT_EQ(kf(5)->imu.next(), nullptr);
-  EXPECT_FALSE(kf(5)->imu.from_previous.has_value());
+  EXPECT_EQ(kf(6)->imu().previous(), kf(4));
+  EXPECT_EQ(kf(4)->imu().next(), kf(6));
+  EXPECT_EQ(kf(5)->imu().previous(), nullptr);
+  EXPECT_EQ(kf(5)->imu().next(), nullptr);
+  EXPECT_FALSE(kf(5)->imu().from_previous.has_value());
   // The same as integrating 4 -> 6 directly, linearised at keyframe 4's bias.
-  PreintegratedImu direct = StartPreintegration(kf(4)->imu.state.bias, noise_);
+  PreintegratedImu direct = StartPreintegration(kf(4)->imu().state.bias, noise_);
   IntegrateSamples(samples_, kf(4)->t_ns(), kf(6)->t_ns(), &direct);
-  const PreintegratedImu& merged = *kf(6)->imu.from_previous;
+  const PreintegratedImu& merged = *kf(6)->imu().from_previous;
   EXPECT_NEAR(merged.dt, 0.1, 1e-12);
-  EXPECT_LT((merged.bias.accel - kf(4)->imu.state.bias.accel).norm(), 1e-15);
+  EXPECT_LT((merged.bias.accel - kf(4)->imu().state.bias.accel).norm(), 1e-15);
   EXPECT_LT((merged.delta_R.Log() - direct.delta_R.Log()).norm(), 1e-9);
   EXPECT_LT((merged.delta_v - direct.delta_v).norm(), 1e-9);
   EXPECT_LT((merged.delta_p - direct.delta_p).norm(), 1e-9);
@@ -108,7 +109,7 @@ TEST_F(InertialCullingTest, TimeSpacingDecidesWhichRedundantKeyFramesMayGo) {
   EXPECT_FALSE(InertialCullingAllowed(*kf(25), small, options));
   // Retire 1..11: keyframe 12 then sits between 0 and 13, 0.65 s apart.
   for (int k = 1; k <= 11; ++k) Retire(lock, k);
-  ASSERT_EQ(kf(12)->imu.previous(), kf(0));
+  ASSERT_EQ(kf(12)->imu().previous(), kf(0));
   EXPECT_TRUE(InertialCullingAllowed(*kf(12), c, options));  // older than the window
   InertialCullingContext recent = c;
   recent.window_start_id = kf(10)->id();
@@ -130,11 +131,11 @@ TEST_F(InertialCullingTest, RepairSplicesKeyFramesRetiredWithoutSplicing) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   kf(15)->SetBad();
   kf(16)->SetBad();
-  ASSERT_EQ(kf(17)->imu.previous(), kf(16));
+  ASSERT_EQ(kf(17)->imu().previous(), kf(16));
   EXPECT_EQ(RepairInertialChain(lock, kf(29), 42), 2);
-  EXPECT_EQ(kf(17)->imu.previous(), kf(14));
-  EXPECT_EQ(kf(14)->imu.next(), kf(17));
-  EXPECT_NEAR(kf(17)->imu.from_previous->dt, 0.15, 1e-12);
+  EXPECT_EQ(kf(17)->imu().previous(), kf(14));
+  EXPECT_EQ(kf(14)->imu().next(), kf(17));
+  EXPECT_NEAR(kf(17)->imu().from_previous->dt, 0.15, 1e-12);
   EXPECT_EQ(RepairInertialChain(lock, kf(29), 42), 0);
 }
 

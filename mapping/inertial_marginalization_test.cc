@@ -41,8 +41,8 @@ class MarginalizationMapTest : public ::testing::Test {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (int k = 0; k < kChainKeyFrames; ++k) {
       KeyFrame* kf = map_.keyframes[k].get();
-      kf->imu.state.bias = bias_;
-      kf->imu.state.valid = true;
+      kf->mutable_imu(lock).state.bias = bias_;
+      kf->mutable_imu(lock).state.valid = true;
     }
     testing::LinkWithImu(lock, map_.keyframes, samples, bias_, noise_);
     map()->mutable_imu_status().imu_initialized = true;
@@ -53,15 +53,15 @@ class MarginalizationMapTest : public ::testing::Test {
   KeyFrame* newest() { return kf(kChainKeyFrames - 1); }
   KeyFrame* anchor() { return kf(kChainKeyFrames - 1 - options_.window); }
   // A prior at the anchor's current state, stamped with the map.
-  void GiveAnchorPrior(double information) {
+  void GiveAnchorPrior(const MapWriteLock& lock, double information) {
     InertialStatePrior prior;
     prior.mean.world_from_body =
         anchor()->world_from_camera() * anchor()->rig().body_from_camera.Inverse();
-    prior.mean.velocity_world = anchor()->imu.state.velocity_world;
-    prior.bias_mean = anchor()->imu.state.bias;
+    prior.mean.velocity_world = anchor()->imu().state.velocity_world;
+    prior.bias_mean = anchor()->imu().state.bias;
     prior.information = information * Eigen::Matrix<double, 15, 15>::Identity();
     StampPrior(*map(), &prior);
-    anchor()->imu.prior = prior;
+    anchor()->mutable_imu(lock).prior = prior;
   }
 
   Atlas atlas_;
@@ -83,7 +83,7 @@ TEST_F(MarginalizationMapTest, ValidPriorFreesTheAnchorStalePriorIsIgnored) {
     EXPECT_EQ(p.marginalize_from, 0);
     EXPECT_EQ(p.marginalize_to, 1);
   }
-  GiveAnchorPrior(1e4);
+  GiveAnchorPrior(lock, 1e4);
   {
     const InertialBundleProblem p = CollectLocalInertialBundle(newest(), options_);
     EXPECT_FALSE(p.visual.keyframes[0].fixed);
@@ -100,31 +100,31 @@ TEST_F(MarginalizationMapTest, ValidPriorFreesTheAnchorStalePriorIsIgnored) {
   }
   // A loop correction / merge / global or full inertial BA moved the map: stale.
   map()->IncreaseChangeIndex();
-  EXPECT_FALSE(PriorIsValid(*anchor()->imu.prior, *map()));
+  EXPECT_FALSE(PriorIsValid(*anchor()->imu().prior, *map()));
   {
     const InertialBundleProblem p = CollectLocalInertialBundle(newest(), options_);
     EXPECT_TRUE(p.visual.keyframes[0].fixed);
     EXPECT_FALSE(p.anchor_prior.has_value());
   }
   // An IMU initialisation / refinement rotated the map: stale too.
-  GiveAnchorPrior(1e4);
-  EXPECT_TRUE(PriorIsValid(*anchor()->imu.prior, *map()));
+  GiveAnchorPrior(lock, 1e4);
+  EXPECT_TRUE(PriorIsValid(*anchor()->imu().prior, *map()));
   map()->RecordWorldChange({WorldChange::Kind::kTransform, SO3d(), 1.0});
-  EXPECT_FALSE(PriorIsValid(*anchor()->imu.prior, *map()));
+  EXPECT_FALSE(PriorIsValid(*anchor()->imu().prior, *map()));
   // Another map.
-  GiveAnchorPrior(1e4);
-  InertialStatePrior other = *anchor()->imu.prior;
+  GiveAnchorPrior(lock, 1e4);
+  InertialStatePrior other = *anchor()->imu().prior;
   other.map_id = map()->id() + 1;
   EXPECT_FALSE(PriorIsValid(other, *map()));
 }
 
 TEST_F(MarginalizationMapTest, CulledKeyFrameDropsItsPrior) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  GiveAnchorPrior(1e4);
+  GiveAnchorPrior(lock, 1e4);
   KeyFrame* k = anchor();
   k->SetBad();
   map()->inertial_chain().SpliceOut(lock, k);
-  EXPECT_FALSE(k->imu.prior.has_value());
+  EXPECT_FALSE(k->imu().prior.has_value());
 }
 
 TEST_F(MarginalizationMapTest, SolveMarginalisesTheAnchorOntoTheNextKeyFrame) {
@@ -142,16 +142,16 @@ TEST_F(MarginalizationMapTest, SolveMarginalisesTheAnchorOntoTheNextKeyFrame) {
   KeyFrame* next = kf(kChainKeyFrames - options_.window);
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    ApplyInertialBundle(map(), p, r);
-    ASSERT_TRUE(next->imu.prior.has_value());
-    EXPECT_TRUE(PriorIsValid(*next->imu.prior, *map()));
-    EXPECT_EQ(next->imu.prior->bias_mean.gyro, r.next_prior->bias_mean.gyro);
-    EXPECT_TRUE(next->imu.prior->mean.velocity_world.allFinite());
+    ApplyInertialBundle(lock, map(), p, r);
+    ASSERT_TRUE(next->imu().prior.has_value());
+    EXPECT_TRUE(PriorIsValid(*next->imu().prior, *map()));
+    EXPECT_EQ(next->imu().prior->bias_mean.gyro, r.next_prior->bias_mean.gyro);
+    EXPECT_TRUE(next->imu().prior->mean.velocity_world.allFinite());
     // Applying a result collected before a map-wide change stores nothing.
-    next->imu.prior.reset();
+    next->mutable_imu(lock).prior.reset();
     map()->IncreaseChangeIndex();
-    ApplyInertialBundle(map(), p, r);
-    EXPECT_FALSE(next->imu.prior.has_value());
+    ApplyInertialBundle(lock, map(), p, r);
+    EXPECT_FALSE(next->imu().prior.has_value());
   }
 }
 

@@ -223,7 +223,7 @@ void LocalMapper::ResetQueue() {
   if (!thread_.joinable()) {
     MutexLock lock(mutex_);
     queue_.clear();
-    recent_points_.clear();
+    recent_points_.Clear();
     return;
   }
   MutexLock lock(mutex_);
@@ -278,7 +278,7 @@ void LocalMapper::Run() {
       lock.lock();
       live_free_ns_ = std::numeric_limits<std::int64_t>::min();
       queue_.clear();
-      recent_points_.clear();
+      recent_points_.Clear();
       reset_requested_ = false;
       idle_.notify_all();
       continue;

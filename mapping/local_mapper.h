@@ -36,6 +36,8 @@
 #include "map_model/mapping_backend.h"
 #include "mapping/calibration_refinement.h"
 #include "mapping/inertial_mapping.h"
+#include "mapping/inertial_motion_clock.h"
+#include "mapping/recent_points.h"
 
 namespace pkslam {
 
@@ -307,14 +309,10 @@ class LocalMapper : public MappingBackend {
   std::atomic<bool> slow_motion_{false};
 
   // Owned by the mapping thread: points created recently, checked by CullRecentPoints.
-  std::vector<MapPointPtr> recent_points_;
-  // Owned by the mapping thread: seconds of motion since the IMU initialisation of moving_map_
-  // (the clock of the VIBA refinements, mapping/inertial_mapping.h).
-  const Map* moving_map_ = nullptr;
-  double moving_s_ = 0;
-  // Owned by the mapping thread: ORB-SLAM3 v0.3's mTinit, the keyframe intervals since the IMU
-  // initialisation of moving_map_ over which the body travelled more than 5 cm in two steps.
-  double two_step_motion_s_ = 0;
+  RecentPoints recent_points_;
+  // Owned by the mapping thread: the motion time and ORB-SLAM3 v0.3's mTinit of the current
+  // inertial map (mapping/inertial_motion_clock.h).
+  InertialMotionClock motion_clock_;
 
   // Online calibration: set before Start(), read-only afterwards.
   RigCalibration calibration_prior_;

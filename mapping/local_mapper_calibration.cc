@@ -236,10 +236,10 @@ void LocalMapper::ApplySolvedCalibration(SolvedCalibration solved) {
       // map lies, so the map moves to it with the bodies where they are now, as after the
       // final adjustment (a solve thrown away here was redone from the next keyframe on: 2-3
       // of 9 adjustments of a V1_02 replay with loops, 2026-11-29).
-      MoveToCalibration(atlas_, result.estimate, next);
+      MoveToCalibration(lock, atlas_, result.estimate, next);
       note = "calibration only: the map moved meanwhile";
     } else {
-      ApplyCalibration(atlas_, map, problem, result, next);
+      ApplyCalibration(lock, atlas_, map, problem, result, next);
     }
   }
   RefinePointsToCalibration(atlas_, problem.bundle.visual.map_id);

@@ -12,34 +12,14 @@
 #include "estimators/inertial/inertial_initializer.h"
 #include "imu/preintegration.h"
 #include "map_model/estimation/global_bundle_merge.h"
+#include "map_model/estimation/inertial_init_collect.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
-#include "mapping/inertial_init_chain.h"
 #include "mapping/local_mapper.h"
 
 namespace pkslam {
-namespace {
-
-// Rotates (world' = R * world) and scales (x' = s x) every keyframe and point of the map, as
-// ORB-SLAM3's Map::ApplyScaledRotation. Requires the Atlas mutex (exclusive).
-void ApplyScaledRotation(Map* map, const SO3d& new_from_old, double scale) {
-  for (const auto& [id, kf] : map->keyframes()) {
-    const SE3d& tcw = kf->camera_from_world();
-    SE3d updated(tcw.so3() * new_from_old.Inverse(), scale * tcw.translation());
-    kf->SetPose(updated);
-    kf->imu.state.velocity_world = scale * (new_from_old * kf->imu.state.velocity_world);
-  }
-  for (const auto& [id, point] : map->map_points()) {
-    if (point->IsBad()) continue;
-    point->SetPosition(scale * (new_from_old * point->position()));
-    point->UpdateNormalAndDepth();
-  }
-}
-
-}  // namespace
-
 void InertialMappingOptions::Check() const {
   PKSLAM_CHECK_OPTION(min_keyframes >= 3, "inertial.min_keyframes", "{}", min_keyframes);
   PKSLAM_CHECK_OPTION(min_time_stereo_s >= 0 && min_time_mono_s >= 0, "inertial.min_time",
@@ -75,43 +55,25 @@ void LocalMapper::InertialStep(const KeyFramePtr& kf) {
     ba1 = map->imu_status().inertial_ba1_done;
     ba2 = map->imu_status().inertial_ba2_done;
     init_t_ns = map->imu_status().imu_init_t_ns;
-    if (map != moving_map_) {
-      moving_map_ = map;
-      moving_s_ = 0;
-      two_step_motion_s_ = 0;
-    }
-    if (const KeyFrame* previous = kf->imu.previous(); previous != nullptr && !previous->IsBad()) {
-      const SE3d previous_from_kf = previous->world_from_body().Inverse() * kf->world_from_body();
-      if (previous_from_kf.translation().norm() > o.moving_distance ||
-          previous_from_kf.so3().Log().norm() > o.moving_angle_rad) {
-        step_s = std::min(o.moving_max_interval_s,
-                          static_cast<double>(kf->t_ns() - previous->t_ns()) * 1e-9);
-      }
-      const KeyFrame* before = previous->imu.previous();
-      if (initialized && !ba2 && before != nullptr && !before->IsBad()) {
-        const double two_steps = (kf->CameraCenter() - previous->CameraCenter()).norm() +
-                                 (previous->CameraCenter() - before->CameraCenter()).norm();
-        if (two_steps > 0.05) two_step_motion_s_ += (kf->t_ns() - previous->t_ns()) * 1e-9;
-        if (two_step_motion_s_ < 10.0 && two_steps < 0.1) slow_motion_.store(true);
-      }
-    }
+    const KeyFrameMotion motion = motion_clock_.Observe(*kf, initialized && !ba2, o);
+    step_s = motion.step_s;
+    if (motion.slow_motion) slow_motion_.store(true);
   }
   const bool mono = IsMonocular(rig_->sensor);
   if (!initialized) {
     initializing_imu_.store(true);
     if (InitializeImu(kf, o.init_gyro_prior,
                       mono ? o.init_accel_prior_mono : o.init_accel_prior_stereo, 0)) {
-      moving_s_ = 0;
-      two_step_motion_s_ = 0;
+      motion_clock_.Restart();
     }
     initializing_imu_.store(false);
     return;
   }
   // The refinements wait for motion time since the initialisation, not clock time: a platform
   // standing still adds nothing that separates the accelerometer bias from gravity.
-  moving_s_ += step_s;
+  const double moving_s = motion_clock_.Advance(step_s);
   const double since =
-      o.viba_motion_time ? moving_s_ : static_cast<double>(kf->t_ns() - init_t_ns) * 1e-9;
+      o.viba_motion_time ? moving_s : static_cast<double>(kf->t_ns() - init_t_ns) * 1e-9;
   // The steps below move every state of the map (MergeGlobalBundle), which would make a
   // calibration adjustment solving in its own thread find its map moved and be discarded; they
   // wait for it to end (a later keyframe runs them).
@@ -200,17 +162,19 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
     const KeyFrame& first = *first_kf;
     const Eigen::Vector3d up_before = first.camera_from_world().so3() * Eigen::Vector3d::UnitZ();
     MergeGlobalBundle(
-        map, problem.visual, [&] { ApplyInertialBundle(map, problem, result); },
+        lock, map, problem.visual, [&] { ApplyInertialBundle(lock, map, problem, result); },
         /*apply_sets_velocities=*/true);
     const Eigen::Vector3d up_after = first.camera_from_world().so3() * Eigen::Vector3d::UnitZ();
     stat.tilt_change_rad = std::atan2(up_after.cross(up_before).norm(), up_after.dot(up_before));
     // Keyframes tracked while the BA ran continue from the newest estimate.
     for (const auto& [id, other] : map->keyframes()) {
-      if (other->id() > kf->id() && !other->IsBad()) other->imu.state.bias = kf->imu.state.bias;
+      if (other->id() > kf->id() && !other->IsBad()) {
+        other->mutable_imu(lock).state.bias = kf->imu().state.bias;
+      }
     }
     map->mutable_imu_status().gravity_refinement_observability = stat.observability;
     map->RecordWorldChange({});
-    accel_bias = kf->imu.state.bias.accel;
+    accel_bias = kf->imu().state.bias.accel;
   }
   stat.ms = WallMsSince(start);
   PKSLAM_LOG_INFO(
@@ -231,44 +195,26 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
   const bool refinement = stage > 0;
   const InertialMappingOptions& o = options_.inertial;
   const bool mono = IsMonocular(rig_->sensor);
-  std::vector<InertialInitKeyFrame> keyframes;
-  std::vector<PreintegratedImu> preintegrations;
-  std::vector<KeyFrame*> chain;
-  KeyFramePtr newest;  // the chain's newest keyframe (kf, or one tracking created after it)
-  ImuBias initial_bias;
+  std::optional<InertialInitProblem> problem;
   {
     auto lock = MapReader(*atlas_).Lock();
-    if (kf->IsBad() || kf->map() == nullptr) return false;
-    chain = InertialChainThrough(kf.get());
-    newest = kf->map()->Share(chain.back());
-    if (newest == nullptr) newest = kf;
-    PKSLAM_LOG_DEBUG("IMU initialisation check at kf {}: chain {}", kf->id(), chain.size());
-    if (static_cast<int>(chain.size()) < o.min_keyframes) return false;
-    const double span = static_cast<double>(chain.back()->t_ns() - chain.front()->t_ns()) * 1e-9;
-    if (span < (mono ? o.min_time_mono_s : o.min_time_stereo_s)) return false;
-    if (mono && !refinement) {
-      double travel = 0;
-      for (std::size_t i = 1; i < chain.size(); ++i) {
-        travel += (chain[i]->CameraCenter() - chain[i - 1]->CameraCenter()).norm();
-      }
-      // Scale is unobservable without motion: wait (documented in inertial_mapping.h).
-      PKSLAM_LOG_DEBUG("IMU initialisation check: travel {:.3f}", travel);
-      if (travel < o.mono_min_travel) return false;
-    }
-    for (std::size_t i = 0; i < chain.size(); ++i) {
-      keyframes.push_back({chain[i]->t_ns(), chain[i]->world_from_body()});
-      if (i > 0) preintegrations.push_back(*chain[i]->imu.from_previous);
-    }
-    initial_bias = kf->imu.state.bias;
+    InertialInitRule rule;
+    rule.min_keyframes = o.min_keyframes;
+    rule.min_time_s = mono ? o.min_time_mono_s : o.min_time_stereo_s;
+    if (mono && !refinement) rule.min_travel = o.mono_min_travel;
+    problem = CollectInertialInit(kf.get(), rule);
   }
+  if (!problem) return false;
+  // The chain's newest keyframe: kf, or one tracking created after it.
+  const KeyFramePtr newest = problem->newest != nullptr ? problem->newest : kf;
   InertialInitializerOptions init_options;
   init_options.estimate_scale = mono;
   init_options.gyro_bias_prior_information = gyro_prior;
   init_options.accel_bias_prior_information = accel_prior;
   init_options.gravity_magnitude = o.local_ba.gravity_magnitude;
   const auto start = std::chrono::steady_clock::now();
-  const InertialInitResult r =
-      InitializeInertial(keyframes, preintegrations, initial_bias, init_options);
+  const InertialInitResult r = InitializeInertial(problem->keyframes, problem->preintegrations,
+                                                  problem->initial_bias, init_options);
   if (!r.success) {
     PKSLAM_LOG_WARN("IMU initialisation at t = {:.2f} s failed: {}", kf->t_s(), r.message);
     return false;
@@ -277,36 +223,13 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
     auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
     Map* map = kf->map();
     if (map == nullptr || kf->IsBad()) return false;
-    const SO3d new_from_old = r.world_from_gravity.Inverse();
-    // Chain keyframes get the estimated velocities, keyframes tracking added after them since
-    // the collection predicted ones (inertial_init_chain.h); any other without a state (cut
-    // off by an IMU gap) the newest one's. Everything is rotated (and scaled) below.
-    for (std::size_t i = 0; i < chain.size(); ++i) {
-      if (chain[i]->IsBad()) continue;
-      chain[i]->imu.state.velocity_world = r.velocities_world[i];
-      chain[i]->imu.state.valid = true;
-    }
-    for (const auto& [id, other] : map->keyframes()) {
-      other->imu.state.bias = r.bias;
-      if (other->imu.from_previous) Reintegrate(r.bias, &*other->imu.from_previous);
-    }
-    PropagateVelocities(chain.back(), r.bias, r.gravity_world, r.scale);
-    for (const auto& [id, other] : map->keyframes()) {
-      if (!other->imu.state.valid) {
-        other->imu.state.velocity_world = r.velocities_world.back();
-        other->imu.state.valid = true;
-      }
-    }
-    ApplyScaledRotation(map, new_from_old, r.scale);
-    map->mutable_imu_status().imu_initialized = true;
-    if (!refinement) map->mutable_imu_status().imu_init_t_ns = kf->t_ns();
-    map->RecordWorldChange({WorldChange::Kind::kTransform, new_from_old, r.scale});
+    ApplyInertialInit(lock, map, *problem, r, refinement, kf->t_ns());
   }
   const double ms = WallMsSince(start);
   PKSLAM_LOG_INFO(
       "IMU {} at t = {:.2f} s over {} keyframes: scale {:.4f}, gyro bias ({:.5f} "
       "{:.5f} {:.5f}), accel bias ({:.4f} {:.4f} {:.4f}), {:.0f} ms",
-      refinement ? "refinement" : "initialisation", kf->t_s(), chain.size(), r.scale,
+      refinement ? "refinement" : "initialisation", kf->t_s(), problem->chain.size(), r.scale,
       r.bias.gyro.x(), r.bias.gyro.y(), r.bias.gyro.z(), r.bias.accel.x(), r.bias.accel.y(),
       r.bias.accel.z(), ms);
   FullInertialBundleAdjustment(newest, gyro_prior, accel_prior);
@@ -316,7 +239,7 @@ bool LocalMapper::InitializeImu(const KeyFramePtr& kf, double gyro_prior, double
   snapshot.scale = r.scale;
   {
     auto lock = MapReader(*atlas_).Lock();
-    snapshot.bias = kf->imu.state.bias;
+    snapshot.bias = kf->imu().state.bias;
     for (KeyFrame* k : InertialChain::EndingAt(newest.get(), 0)) {
       snapshot.world_from_body.emplace_back(k->t_ns(), k->world_from_body());
     }
@@ -346,11 +269,11 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
   auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
   Map* map = atlas_->FindMap(problem.visual.map_id);
   if (kf->map() == nullptr || map == nullptr) return;
-  ApplyInertialBundle(map, problem, result);
+  ApplyInertialBundle(lock, map, problem, result);
   // Keyframes newer than the problem take the estimated biases too.
   if (!result.biases.empty()) {
     for (const auto& [id, other] : kf->map()->keyframes()) {
-      if (other->id() > kf->id()) other->imu.state.bias = result.biases.front();
+      if (other->id() > kf->id()) other->mutable_imu(lock).state.bias = result.biases.front();
     }
   }
   kf->map()->RecordWorldChange({});
@@ -369,13 +292,13 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
     // Keyframes created from frames tracked before the initialisation reached tracking have
     // no estimated state yet: start them at their predecessor's.
     std::vector<KeyFrame*> missing;
-    for (KeyFrame* k = kf.get(); k != nullptr && !k->imu.state.valid; k = k->imu.previous()) {
+    for (KeyFrame* k = kf.get(); k != nullptr && !k->imu().state.valid; k = k->imu().previous()) {
       missing.push_back(k);
     }
     for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
       KeyFrame* k = *it;
-      if (k->imu.previous() == nullptr || !k->imu.previous()->imu.state.valid) break;
-      k->imu.state = k->imu.previous()->imu.state;
+      if (k->imu().previous() == nullptr || !k->imu().previous()->imu().state.valid) break;
+      k->mutable_imu(lock).state = k->imu().previous()->imu().state;
     }
   }
   {
@@ -388,7 +311,7 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
   auto lock = MapEditor(atlas_).Write(MapEdit::kApplyInertialBundle);
   Map* map = atlas_->FindMap(problem.visual.map_id);
   if (kf->map() == nullptr || map == nullptr) return true;
-  ApplyInertialBundle(map, problem, result);
+  ApplyInertialBundle(lock, map, problem, result);
   kf->map()->RecordWorldChange({});
   lock.unlock();
   PKSLAM_LOG_DEBUG(

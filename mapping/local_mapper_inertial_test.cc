@@ -79,13 +79,13 @@ InitialisedStates RunInitialisationWithQueuedKeyFrames(int num_keyframes,
     out.initialized = true;
     out.trigger = kf->id();
     for (const KeyFramePtr& k : map.keyframes) {
-      if (!k->imu.state.valid) {
+      if (!k->imu().state.valid) {
         out.body_velocity.emplace_back();
         continue;
       }
       const SO3d world_from_body =
           k->world_from_camera().so3() * rig->body_from_camera.so3().Inverse();
-      out.body_velocity.emplace_back(world_from_body.Inverse() * k->imu.state.velocity_world);
+      out.body_velocity.emplace_back(world_from_body.Inverse() * k->imu().state.velocity_world);
     }
   });
   for (const KeyFramePtr& kf : map.keyframes) mapper.InsertKeyFrame(kf);

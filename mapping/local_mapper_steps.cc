@@ -1,23 +1,20 @@
 // LocalMapper: the per-keyframe steps (ORB-SLAM3's LocalMapping::Run body).
-#include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <mutex>
 #include <shared_mutex>
-#include <unordered_set>
 
 #include "core/util/cpu_time.h"
 #include "core/util/log.h"
 #include "core/util/wall_time.h"
 #include "map_model/keyframe.h"
-#include "map_model/keyframe_database.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
-#include "map_model/matching/orb_matcher.h"
 #include "mapping/inertial_culling.h"
+#include "mapping/keyframe_admission.h"
 #include "mapping/keyframe_culling.h"
 #include "mapping/local_mapper.h"
-#include "mapping/triangulation.h"
+#include "mapping/neighbour_fusion.h"
+#include "mapping/neighbour_triangulation.h"
 
 namespace pkslam {
 
@@ -84,45 +81,16 @@ void LocalMapper::ProcessNext() {
 
 void LocalMapper::ProcessNewKeyFrame(const KeyFramePtr& kf) {
   auto lock = MapEditor(atlas_).Write(MapEdit::kProcessKeyFrame);
-  if (kf->IsBad() || kf->map() == nullptr) return;
-  const auto& points = kf->map_points();
-  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
-    const MapPointPtr mp = points[i];
-    if (!mp || mp->IsBad()) continue;
-    if (!mp->IsInKeyFrame(kf.get())) {
-      // A point tracked by the frame: the keyframe becomes one of its observers.
-      mp->AddObservation(kf.get(), i);
-      mp->UpdateNormalAndDepth();
-      mp->ComputeDistinctiveDescriptor();
-    } else {
-      // Created by tracking for this keyframe (stereo/RGB-D): watch it for a while.
-      recent_points_.push_back(mp);
-    }
-  }
-  kf->UpdateConnections();
-  // Findable by relocalisation and place recognition from now on.
-  if (KeyFrameDatabase* database = atlas_->database()) database->Add(kf.get());
+  // Created by tracking for this keyframe (stereo/RGB-D): watched for a while.
+  for (const MapPointPtr& mp : AdmitKeyFrame(lock, atlas_, kf.get())) recent_points_.Watch(mp);
 }
 
 void LocalMapper::CullRecentPoints(const KeyFramePtr& kf) {
   auto lock = MapEditor(atlas_).Write(MapEdit::kCullPoints);
-  const int min_observations = IsMonocular(rig_->sensor) ? 2 : 3;
-  int culled = 0;
-  std::erase_if(recent_points_, [&](const MapPointPtr& mp) {
-    if (mp->IsBad()) return true;
-    const KeyFrameId age = kf->id() - mp->first_keyframe_id();
-    if (mp->FoundRatio() < options_.min_found_ratio) {
-      mp->SetBad();
-      ++culled;
-      return true;
-    }
-    if (age >= 2 && mp->NumObservations() <= min_observations) {
-      mp->SetBad();
-      ++culled;
-      return true;
-    }
-    return age >= 3;  // survived its probation
-  });
+  RecentPointRule rule;
+  rule.min_found_ratio = options_.min_found_ratio;
+  rule.min_observations = IsMonocular(rig_->sensor) ? 2 : 3;
+  const int culled = recent_points_.Cull(lock, kf->id(), rule);
   lock.unlock();
   MutexLock stats_lock(mutex_);
   stats_.points_culled += culled;
@@ -130,98 +98,34 @@ void LocalMapper::CullRecentPoints(const KeyFramePtr& kf) {
 
 void LocalMapper::CreateNewMapPoints(const KeyFramePtr& kf) {
   const bool mono = IsMonocular(rig_->sensor);
-  const int n_neighbours =
+  NeighbourTriangulationOptions search;
+  search.neighbours =
       mono ? options_.triangulation_neighbours_mono : options_.triangulation_neighbours_stereo;
-  std::vector<TriangulatedPoint> created;
-  std::vector<KeyFrame*> neighbours;
+  search.monocular = mono;
+  search.stop = [this] { return HasQueued(); };
+  search.work = &work_;
+  std::vector<TriangulatedPoint> found;
   {
     auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return;
-    neighbours = kf->BestCovisibles(n_neighbours);
-    const OrbMatcher matcher(0.6, false);
-    std::unordered_set<int> claimed;  // keypoints of kf already given a point this round
-    for (std::size_t n = 0; n < neighbours.size(); ++n) {
-      if (n > 0 && HasQueued()) break;
-      KeyFrame* other = neighbours[n];
-      if (!HasTriangulationBaseline(*kf, *other, mono)) continue;
-      work_.Add(WorkKind::kTriangulationPair,
-                static_cast<std::int64_t>(kf->keypoints_undistorted().size() +
-                                          other->keypoints_undistorted().size()));
-      const auto pairs = matcher.SearchForTriangulation(*kf, *other);
-      for (const auto& [i1, i2] : pairs) {
-        if (claimed.count(i1) > 0) continue;
-        if (auto p = TriangulatePair(*kf, i1, *other, i2, mono)) {
-          claimed.insert(i1);
-          created.push_back({*p, other, i1, i2});
-        }
-      }
-    }
+    found = TriangulateWithNeighbours(*kf, search);
   }
-  if (created.empty()) return;
+  if (found.empty()) return;
   PaceToTracker();  // not StepBoundary: the points were triangulated with the present rig
   auto lock = MapEditor(atlas_).Write(MapEdit::kCreatePoints);
-  Map* map = kf->map();
-  if (kf->IsBad() || map == nullptr) return;
-  int added = 0;
-  for (const auto& c : created) {
-    // Tracking never fills existing keyframes' slots and we are the only other writer, but a
-    // neighbour may have been retired by loop closing's fusion meanwhile.
-    if (c.other->IsBad() || kf->map_point(c.index1) || c.other->map_point(c.index2)) continue;
-    auto mp = std::make_shared<MapPoint>(atlas_->NextMapPointId(), c.position, kf.get(), map);
-    mp->AddObservation(kf.get(), c.index1);
-    mp->AddObservation(c.other, c.index2);
-    kf->AddMapPoint(mp, c.index1);
-    c.other->AddMapPoint(mp, c.index2);
-    mp->ComputeDistinctiveDescriptor();
-    mp->UpdateNormalAndDepth();
-    map->AddMapPoint(mp);
-    recent_points_.push_back(mp);
-    ++added;
-  }
+  const std::vector<MapPointPtr> added = AddTriangulatedPoints(lock, atlas_, kf.get(), found);
+  for (const MapPointPtr& mp : added) recent_points_.Watch(mp);
   lock.unlock();
   MutexLock stats_lock(mutex_);
-  stats_.points_created += added;
+  stats_.points_created += static_cast<int>(added.size());
 }
 
 void LocalMapper::SearchInNeighbours(const KeyFramePtr& kf) {
   auto lock = MapEditor(atlas_).Write(MapEdit::kFuse);
-  if (kf->IsBad() || kf->map() == nullptr) return;
-  const int n = IsMonocular(rig_->sensor) ? 30 : 10;
-  std::vector<KeyFrame*> targets;
-  std::unordered_set<KeyFrameId> in_targets{kf->id()};
-  for (KeyFrame* neighbour : kf->BestCovisibles(n)) {
-    if (neighbour->IsBad() || !in_targets.insert(neighbour->id()).second) continue;
-    targets.push_back(neighbour);
-  }
-  const std::size_t first_ring = targets.size();
-  for (std::size_t i = 0; i < first_ring; ++i) {
-    for (KeyFrame* second : targets[i]->BestCovisibles(20)) {
-      if (second->IsBad() || !in_targets.insert(second->id()).second) continue;
-      targets.push_back(second);
-    }
-  }
-  const OrbMatcher matcher;
-  // Our points into the neighbours...
-  const std::vector<MapPointPtr> ours = kf->GoodMapPoints();
-  for (KeyFrame* target : targets) matcher.Fuse(target, ours);
-  // ...and the neighbours' points into us.
-  std::vector<MapPointPtr> candidates;
-  std::unordered_set<MapPointId> seen;
-  for (const auto& mp : kf->GoodMapPoints()) seen.insert(mp->id());
-  for (KeyFrame* target : targets) {
-    for (const auto& mp : target->map_points()) {
-      if (!mp || mp->IsBad() || !seen.insert(mp->id()).second) continue;
-      candidates.push_back(mp);
-    }
-  }
-  matcher.Fuse(kf.get(), candidates);
-  work_.Add(WorkKind::kFuseProjection,
-            static_cast<std::int64_t>(ours.size() * targets.size() + candidates.size()));
-  for (const auto& mp : kf->GoodMapPoints()) {
-    mp->ComputeDistinctiveDescriptor();
-    mp->UpdateNormalAndDepth();
-  }
-  kf->UpdateConnections();
+  NeighbourFusionOptions fusion;
+  fusion.first_ring = IsMonocular(rig_->sensor) ? 30 : 10;
+  fusion.work = &work_;
+  FuseWithNeighbours(lock, kf.get(), fusion);
 }
 
 void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {

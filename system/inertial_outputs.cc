@@ -47,7 +47,7 @@ void WriteInertialOutputs(const SlamSystem& system, const std::filesystem::path&
   }
   if (best != nullptr) {
     for (const auto& [id, kf] : best->keyframes()) {
-      const InertialState& s = kf->imu.state;
+      const InertialState& s = kf->imu().state;
       out << fmt::format(
           "{:.9f},{:.6f},{:.6f},{:.6f},{:.7f},{:.7f},{:.7f},{:.6f},{:.6f},{:.6f},{},{}\n",
           kf->t_s(), s.velocity_world.x(), s.velocity_world.y(), s.velocity_world.z(),

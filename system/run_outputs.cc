@@ -1,11 +1,9 @@
 #include "system/run_outputs.h"
 
-#include <sys/resource.h>
-
 #include <algorithm>
-#include <optional>
 #include <fstream>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -251,12 +249,6 @@ void RemoveRunOutputs(const std::filesystem::path& out) {
           fmt::format("cannot remove the earlier run's {}: {}", file.string(), ec.message()));
     }
   }
-}
-
-double PeakMemoryMiB() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
 int WriteTrajectoryOutputs(const SlamSystem& system, const RunOptions& options) {

@@ -22,7 +22,4 @@ void WriteRunOutputs(const SlamSystem& system, const RunOptions& options, RunSum
 // earlier --trace run). Throws Error naming the file when one cannot be removed.
 void RemoveRunOutputs(const std::filesystem::path& out);
 
-// Peak resident memory of this process in MiB (getrusage).
-double PeakMemoryMiB();
-
 }  // namespace pkslam

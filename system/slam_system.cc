@@ -178,7 +178,7 @@ void SlamSystem::FinishCalibration() {
     // the keyframes of a stationary stretch by 1-3 cm (ATE 6.8 -> 77.5 mm), while elsewhere
     // they changed the ATE by under 2 mm either way (docs/calibration.md, "A quick look").
     auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
-    MoveToCalibration(&atlas_, result.estimate, next);
+    MoveToCalibration(lock, &atlas_, result.estimate, next);
   }
   RefinePointsToCalibration(&atlas_, problem.bundle.visual.map_id);
   // Tracking has ended: its records follow the keyframes here.

@@ -82,7 +82,7 @@ Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<con
       "tracker needs an atlas, a vocabulary, a selector and local mapping");
   if (IsInertial(rig_->sensor)) {
     PKSLAM_CHECK(rig_->imu.has_value(), "inertial sensor without IMU noise model");
-    imu_ = std::make_unique<InertialTrackingState>();
+    imu_ = std::make_unique<InertialTrackingState>(*rig_->imu);
   }
 }
 
@@ -119,8 +119,9 @@ void Tracker::SetRig(const RigSetup& setup, const RigSetup& old_setup) {
   const RigWarp warp(old_setup, setup);
   rig_ = setup.rig;
   builder_.SetRig(rig_);
+  if (imu_) imu_->samples.SetNoise(*rig_->imu);
   if (last_.size() > 0 || last_.HasPose()) last_.Recalibrate(rig_, warp, new_from_old);
-  if (init_frame_) init_frame_->Recalibrate(rig_, warp, new_from_old);
+  if (two_view_.started()) two_view_.first().Recalibrate(rig_, warp, new_from_old);
   if (velocity_) velocity_ = new_from_old * *velocity_ * old_from_new;
   for (FrameRecord& r : records_) {
     r.camera_from_reference = new_from_old * r.camera_from_reference * old_from_new;
@@ -167,38 +168,7 @@ TrackResult Tracker::Track(Frame frame) {
       for (auto& mp : last_.map_points) {
         while (mp && mp->replaced_by()) mp = mp->replaced_by();
       }
-      if (options_.localise_only) {
-        ok = TrackLocalisationOnly();
-      } else {
-        if (state_ == TrackingState::kOk && ImuReady()) {
-          ok = TrackWithImu();
-          if (!ok) ok = TrackReferenceKeyFrame();
-        } else if (state_ == TrackingState::kRecentlyLost && ImuReady()) {
-          ok = PredictWithImu();  // IMU-only prediction; the local map search decides
-        } else if (state_ == TrackingState::kOk) {
-          if (!velocity_ || current_.id() < last_reloc_frame_id_ + 2) {
-            ok = TrackReferenceKeyFrame();
-          } else {
-            ok = TrackWithMotionModel();
-            if (!ok) ok = TrackReferenceKeyFrame();
-          }
-        } else if (state_ == TrackingState::kRecentlyLost) {
-          ok = Relocalize();
-        }
-        if (ok) ok = TrackLocalMap();
-
-        if (ok) {
-          state_ = TrackingState::kOk;
-        } else if (state_ == TrackingState::kOk) {
-          const bool keep = atlas_->current_map()->NumKeyFrames() > MinKeyFramesToKeepMap();
-          state_ = keep ? TrackingState::kRecentlyLost : TrackingState::kLost;
-          lost_since_t_ns_ = current_.t_ns();
-        } else if (state_ == TrackingState::kRecentlyLost &&
-                   (current_.t_ns() - lost_since_t_ns_) * 1e-9 > options_.recently_lost_timeout_s) {
-          state_ = TrackingState::kLost;
-        }
-      }
-
+      ok = options_.localise_only ? TrackLocalisationOnly() : TrackInMap();
       if (ok) {
         velocity_ = current_.camera_from_world() * last_.world_from_camera();
         // Matches to points that are not in the map (no observations) are dropped.
@@ -212,43 +182,11 @@ TrackResult Tracker::Track(Frame frame) {
       }
       if (ok && !options_.localise_only) {
         selector_input =
-            BuildSelectorInput(emulated ? idle_at_frame : mapping_->AcceptsKeyFrames());
-        // Taken once per decision (a keyframe's second input, SnapshotAfterCreation, has none).
-        selector_input.slow_motion_before_refinement = mapping_->TakeSlowMotionFlag();
-        last_decision_ = selector_->Decide(selector_input);
-        if (MapStarving(selector_input)) {
-          last_decision_.insert = true;
-          last_decision_.interrupt_local_ba = true;
-          last_decision_.reason += ";starving";
-        }
-        if (last_decision_.insert && mapping_->QueueFull()) {
-          // Backpressure (LocalMappingOptions::max_queued_keyframes): whatever the selector
-          // says, no keyframe while local mapping has a full queue.
-          last_decision_.insert = false;
-          result.keyframe_declined_queue_full = true;
-        }
-        if (trace_enabled_) {
-          trace_.push_back({current_.t_ns(), current_.id(), last_decision_,
-                            selector_input.FramesSinceLastKeyFrame()});
-        }
+            DecideKeyFrame(emulated ? idle_at_frame : mapping_->AcceptsKeyFrames(), &result);
       }
     }
     if (ok) {
-      if (last_decision_.interrupt_local_ba) mapping_->InterruptBundleAdjustment();
-      if (last_decision_.insert && !options_.localise_only) {
-        CreateNewKeyFrame(selector_input);
-        new_keyframe = true;
-      }
-      // Outliers went into the keyframe (BA decides on them); the next frame must not use
-      // them for its pose.
-      for (int i = 0; i < current_.size(); ++i) {
-        if (current_.map_points[i] && current_.outliers[i]) current_.map_points[i].reset();
-      }
-      result.keyframe_reason = last_decision_.reason;
-      result.selector_decided = !options_.localise_only;
-      for (const auto& [key, value] : last_decision_.trace) {
-        if (key.starts_with("criterion") && value != 0) result.criteria_held.push_back(key);
-      }
+      new_keyframe = ActOnDecision(selector_input, &result);
     } else {
       velocity_.reset();
     }
@@ -274,6 +212,81 @@ TrackResult Tracker::Track(Frame frame) {
     last_ = std::move(current_);
   }
   return result;
+}
+
+bool Tracker::TrackInMap() {
+  bool ok = false;
+  if (state_ == TrackingState::kOk && ImuReady()) {
+    ok = TrackWithImu();
+    if (!ok) ok = TrackReferenceKeyFrame();
+  } else if (state_ == TrackingState::kRecentlyLost && ImuReady()) {
+    ok = PredictWithImu();  // IMU-only prediction; the local map search decides
+  } else if (state_ == TrackingState::kOk) {
+    if (!velocity_ || current_.id() < last_reloc_frame_id_ + 2) {
+      ok = TrackReferenceKeyFrame();
+    } else {
+      ok = TrackWithMotionModel();
+      if (!ok) ok = TrackReferenceKeyFrame();
+    }
+  } else if (state_ == TrackingState::kRecentlyLost) {
+    ok = Relocalize();
+  }
+  if (ok) ok = TrackLocalMap();
+
+  if (ok) {
+    state_ = TrackingState::kOk;
+  } else if (state_ == TrackingState::kOk) {
+    const bool keep = atlas_->current_map()->NumKeyFrames() > MinKeyFramesToKeepMap();
+    state_ = keep ? TrackingState::kRecentlyLost : TrackingState::kLost;
+    lost_since_t_ns_ = current_.t_ns();
+  } else if (state_ == TrackingState::kRecentlyLost &&
+             (current_.t_ns() - lost_since_t_ns_) * 1e-9 > options_.recently_lost_timeout_s) {
+    state_ = TrackingState::kLost;
+  }
+  return ok;
+}
+
+SelectorInput Tracker::DecideKeyFrame(bool mapping_idle, TrackResult* result) {
+  SelectorInput selector_input = BuildSelectorInput(mapping_idle);
+  // Taken once per decision (a keyframe's second input, SnapshotAfterCreation, has none).
+  selector_input.slow_motion_before_refinement = mapping_->TakeSlowMotionFlag();
+  last_decision_ = selector_->Decide(selector_input);
+  if (MapStarving(selector_input)) {
+    last_decision_.insert = true;
+    last_decision_.interrupt_local_ba = true;
+    last_decision_.reason += ";starving";
+  }
+  if (last_decision_.insert && mapping_->QueueFull()) {
+    // Backpressure (LocalMappingOptions::max_queued_keyframes): whatever the selector
+    // says, no keyframe while local mapping has a full queue.
+    last_decision_.insert = false;
+    result->keyframe_declined_queue_full = true;
+  }
+  if (trace_enabled_) {
+    trace_.push_back(
+        {current_.t_ns(), current_.id(), last_decision_, selector_input.FramesSinceLastKeyFrame()});
+  }
+  return selector_input;
+}
+
+bool Tracker::ActOnDecision(const SelectorInput& selector_input, TrackResult* result) {
+  bool new_keyframe = false;
+  if (last_decision_.interrupt_local_ba) mapping_->InterruptBundleAdjustment();
+  if (last_decision_.insert && !options_.localise_only) {
+    CreateNewKeyFrame(selector_input);
+    new_keyframe = true;
+  }
+  // Outliers went into the keyframe (BA decides on them); the next frame must not use
+  // them for its pose.
+  for (int i = 0; i < current_.size(); ++i) {
+    if (current_.map_points[i] && current_.outliers[i]) current_.map_points[i].reset();
+  }
+  result->keyframe_reason = last_decision_.reason;
+  result->selector_decided = !options_.localise_only;
+  for (const auto& [key, value] : last_decision_.trace) {
+    if (key.starts_with("criterion") && value != 0) result->criteria_held.push_back(key);
+  }
+  return new_keyframe;
 }
 
 std::vector<FrameRecord::Observation> Tracker::LastFrameInliers() const {
@@ -339,48 +352,22 @@ bool Tracker::MapStarving(const SelectorInput& in) const {
 }
 
 void Tracker::StereoInitialization() {
-  if (current_.size() <= options_.min_features_stereo_init) return;
-  int with_depth = 0;
-  for (int i = 0; i < current_.size(); ++i) with_depth += current_.HasDepth(i) ? 1 : 0;
-  if (with_depth < options_.min_depth_points_stereo_init) return;
-  KeyFramePtr kf;
-  int points = 0;
+  if (!CanStartDepthMap(current_, options_)) return;
+  DepthMapStart start;
   {
     auto lock = MapEditor(atlas_).Write(MapEdit::kInitialise);
-    Map* map = atlas_->current_map();
-    current_.SetPose(SE3d());
-    current_.ComputeBoW(*vocabulary_);
-    kf = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
-    map->AddKeyFrame(kf);
-    AttachImu(lock, kf.get(), nullptr, current_);
-    for (int i = 0; i < current_.size(); ++i) {
-      const auto p = current_.UnprojectStereo(i);
-      if (!p) continue;
-      auto mp = std::make_shared<MapPoint>(atlas_->NextMapPointId(), *p, kf.get(), map);
-      mp->AddObservation(kf.get(), i);
-      kf->AddMapPoint(mp, i);
-      mp->ComputeDistinctiveDescriptor();
-      mp->UpdateNormalAndDepth();
-      map->AddMapPoint(mp);
-      current_.map_points[i] = mp;
-      ++points;
-    }
-    local_map_.Reset({kf.get()}, kf->GoodMapPoints());
+    start = StartDepthMap(lock, atlas_, *vocabulary_, AttachKeyFrameFunction(), &current_);
+    local_map_.Reset({start.keyframe.get()}, start.keyframe->GoodMapPoints());
   }
   PKSLAM_LOG_INFO("new map {} initialised from stereo/depth with {} points",
-                  atlas_->current_map()->id(), points);
-  mapping_->InsertKeyFrame(kf);
+                  atlas_->current_map()->id(), start.points);
+  mapping_->InsertKeyFrame(start.keyframe);
   if (options_.lockstep) mapping_->WaitUntilIdle();
-  last_kf_ = kf;
-  reference_kf_ = kf;
-  current_.reference_kf = kf;
-  inliers_ = points;
-  selector_->Reset();
-  SelectorInput input;
-  input.frame_id = current_.id();
-  input.t_ns = current_.t_ns();
-  selector_->OnKeyFrameInserted(input);
-  state_ = TrackingState::kOk;
+  last_kf_ = start.keyframe;
+  reference_kf_ = start.keyframe;
+  current_.reference_kf = start.keyframe;
+  inliers_ = start.points;
+  StartSelectorAtNewMap();
 }
 
 int Tracker::MinKeyFramesToKeepMap() const {
@@ -436,7 +423,7 @@ void Tracker::Reset() {
 void Tracker::StartOver() {
   state_ = TrackingState::kNotInitialized;
   velocity_.reset();
-  init_frame_.reset();
+  two_view_.Reset();
   reference_kf_.reset();
   last_kf_.reset();
   local_map_.Clear();

@@ -18,13 +18,13 @@
 #include "map_model/mapping_backend.h"
 #include "tracking/frame_builder.h"
 #include "tracking/local_map.h"
+#include "tracking/map_initializer.h"
 #include "tracking/tracker_inertial.h"
 #include "tracking/tracking_options.h"
 
 namespace pkslam {
 
 class Vocabulary;
-struct TwoViewResult;
 
 enum class TrackingState { kNotInitialized, kOk, kRecentlyLost, kLost };
 const char* TrackingStateName(TrackingState s);
@@ -131,7 +131,7 @@ class Tracker {
   void SetTimeOffset(double seconds) { time_offset_s_ = seconds; }
   // The gyroscope's per-axis scale-factor error (RigCalibration::gyro_scale): samples are
   // divided by 1 + k as they are integrated.
-  void SetGyroScale(const Eigen::Vector3d& k) { gyro_scale_ = k; }
+  void SetGyroScale(const Eigen::Vector3d& k);
   // A new calibration estimate (online calibration) moved the map's keyframes to `setup`'s rig:
   // frames are built with it from now on, and what tracking keeps of earlier frames (the last
   // frame, the monocular initialisation frame, the motion model, the records' poses relative to
@@ -140,11 +140,26 @@ class Tracker {
 
  private:
   TrackResult Track(Frame frame);
+  // An initialised map, not localisation only: tracks the frame by the IMU, the motion model,
+  // the reference keyframe or relocalisation, then against the local map, and moves the state
+  // machine (OK / RECENTLY_LOST / LOST). Atlas lock held (shared).
+  bool TrackInMap();
+  // The tracked frame's keyframe decision (selector, a starving monocular map, backpressure),
+  // traced when asked. Returns the selector's input. Atlas lock held (shared).
+  SelectorInput DecideKeyFrame(bool mapping_idle, TrackResult* result);
+  // Carries out last_decision_ (interrupting local BA, creating the keyframe) after the lock is
+  // released. Returns whether a keyframe was created.
+  bool ActOnDecision(const SelectorInput& selector_input, TrackResult* result);
   // Monocular: the map is about to starve of keyframes (TrackingOptions::starving_*).
   bool MapStarving(const SelectorInput& in) const;
+  // Map initialisation (its parts in tracking/map_initializer.h).
   void StereoInitialization();
   void MonocularInitialization();
   void CreateInitialMapMonocular(const TwoViewResult& reconstruction);
+  // AttachImu as the map initialiser's callback.
+  AttachKeyFrame AttachKeyFrameFunction();
+  // A new map's first keyframe was made: the selector starts over from it, tracking is OK.
+  void StartSelectorAtNewMap();
   bool TrackReferenceKeyFrame();
   bool TrackWithMotionModel();
   bool TrackLocalMap();
@@ -187,8 +202,6 @@ class Tracker {
   // Tracking's keyframe joins the map's inertial chain after `previous` (map write lock held).
   void AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previous, const Frame& frame);
   void FillImuSelectorInput(SelectorInput* in) const;
-  std::optional<PreintegratedImu> PreintegrateBetween(std::int64_t t0_ns, std::int64_t t1_ns,
-                                                      const ImuBias& bias) const;
 
   Atlas* atlas_;
   const Vocabulary* vocabulary_;
@@ -197,13 +210,11 @@ class Tracker {
   MappingBackend* mapping_;
   TrackingOptions options_;
   FrameBuilder builder_;
-  std::vector<cv::Point2f> init_prev_matched_;  // monocular: where init keypoints were seen
-  std::vector<int> init_matches_;
+  TwoViewStart two_view_;  // monocular: the first frame of the initial pair
 
   TrackingState state_ = TrackingState::kNotInitialized;
   Frame current_;
   Frame last_;
-  std::optional<Frame> init_frame_;  // monocular: first frame of the initial pair
   std::optional<SE3d> velocity_;     // camera_from_world(current) * world_from_camera(last)
   KeyFramePtr reference_kf_;
   KeyFramePtr last_kf_;
@@ -225,7 +236,6 @@ class Tracker {
   std::vector<FrameRecord> records_;
   bool trace_enabled_ = false;
   double time_offset_s_ = 0.0;
-  Eigen::Vector3d gyro_scale_ = Eigen::Vector3d::Zero();
   bool frame_tracks_enabled_ = false;
   std::vector<TraceRow> trace_;
   SelectorDecision last_decision_;

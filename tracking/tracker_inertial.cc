@@ -14,7 +14,7 @@
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
-#include "map_model/matching/orb_matcher.h"
+#include "tracking/frame_tracking.h"
 #include "tracking/tracker.h"
 
 namespace pkslam {
@@ -36,13 +36,11 @@ SE3d CameraFromWorld(const SE3d& world_from_body, const CameraRig& rig) {
 
 void Tracker::AddImu(const std::vector<ImuMeasurement>& samples) {
   PKSLAM_CHECK(imu_ != nullptr, "IMU samples given to a {} tracker", SensorName(rig_->sensor));
-  for (const ImuMeasurement& m : samples) {
-    if (!imu_->queue.empty() && m.t_ns <= imu_->queue.back().t_ns) {
-      throw Error(fmt::format("IMU sample at {} ns is not after the previous one ({} ns)", m.t_ns,
-                              imu_->queue.back().t_ns));
-    }
-    imu_->queue.push_back(m);
-  }
+  imu_->samples.Add(samples);
+}
+
+void Tracker::SetGyroScale(const Eigen::Vector3d& k) {
+  if (imu_) imu_->samples.SetGyroScale(k);
 }
 
 bool Tracker::ImuReady() const {
@@ -50,29 +48,6 @@ bool Tracker::ImuReady() const {
   // (no keyframes to anchor them), so an inertial prior would pull the pose off.
   return imu_ != nullptr && !options_.localise_only &&
          atlas_->current_map()->imu_status().imu_initialized;
-}
-
-std::optional<PreintegratedImu> Tracker::PreintegrateBetween(std::int64_t t0_ns, std::int64_t t1_ns,
-                                                             const ImuBias& bias) const {
-  const auto& q = imu_->queue;
-  if (q.empty() || t1_ns <= t0_ns || q.front().t_ns > t0_ns || q.back().t_ns < t1_ns) {
-    return std::nullopt;
-  }
-  // The last sample at or before t0 through the first at or after t1.
-  auto first = std::upper_bound(q.begin(), q.end(), t0_ns,
-                                [](std::int64_t t, const ImuMeasurement& m) { return t < m.t_ns; });
-  if (first != q.begin()) --first;
-  auto last = std::lower_bound(q.begin(), q.end(), t1_ns,
-                               [](const ImuMeasurement& m, std::int64_t t) { return m.t_ns < t; });
-  std::vector<ImuMeasurement> samples(first, last + 1);
-  if (!gyro_scale_.isZero()) {
-    const Eigen::Vector3d inverse = Eigen::Vector3d::Ones().cwiseQuotient(
-        Eigen::Vector3d::Ones() + gyro_scale_);
-    for (ImuMeasurement& m : samples) m.gyro = m.gyro.cwiseProduct(inverse);
-  }
-  PreintegratedImu pim = StartPreintegration(bias, *rig_->imu);
-  IntegrateSamples(samples, t0_ns, t1_ns, &pim);
-  return pim;
 }
 
 void Tracker::PreintegrateImu() {
@@ -84,21 +59,20 @@ void Tracker::PreintegrateImu() {
     if (last_.imu.state.valid) {
       bias = last_.imu.state.bias;
     } else if (last_kf_) {
-      bias = last_kf_->imu.state.bias;
+      bias = last_kf_->imu().state.bias;
     }
   }
   current_.imu.state.bias = bias;
   if (imu_->last_frame_t_ns >= 0) {
     current_.imu.from_last_frame =
-        PreintegrateBetween(imu_->last_frame_t_ns, current_.t_ns(), bias);
+        imu_->samples.Between(imu_->last_frame_t_ns, current_.t_ns(), bias);
   }
   imu_->last_frame_t_ns = current_.t_ns();
   // Keep what the oldest anchor still needs.
   std::int64_t anchor = current_.t_ns();
   if (last_kf_) anchor = std::min(anchor, last_kf_->t_ns());
-  if (init_frame_) anchor = std::min(anchor, init_frame_->t_ns());
-  auto& q = imu_->queue;
-  while (q.size() >= 2 && q[1].t_ns <= anchor) q.pop_front();
+  if (two_view_.started()) anchor = std::min(anchor, two_view_.first().t_ns());
+  imu_->samples.KeepFrom(anchor);
 }
 
 void Tracker::SyncWithInertialMap() {
@@ -108,42 +82,26 @@ void Tracker::SyncWithInertialMap() {
 
 void Tracker::SyncWithInertialMapLocked(bool correct_current) {
   const Map* map = atlas_->current_map();
-  const int changes = map->NumWorldChanges();
-  if (map != imu_->map) {
-    imu_->map = map;
-    imu_->seen_world_changes = changes;
-    imu_->seen_scale = map->applied_scale();
-    imu_->from_keyframe = true;
-    imu_->last_frame_information.reset();
-    return;
-  }
-  if (changes == imu_->seen_world_changes) return;
-  // Every change re-estimated the keyframes' states: predict from the last keyframe.
+  const WorldChangesSeen seen = imu_->world.Follow(*map);
+  if (!seen.ForgetsLastFrame()) return;
+  // A new map, or every change re-estimated the keyframes' states: predict from the last
+  // keyframe.
   imu_->from_keyframe = true;
   imu_->last_frame_information.reset();
-  int transforms = 0;
-  const WorldChange* transform = nullptr;
-  for (int i = imu_->seen_world_changes; i < changes; ++i) {
-    if (map->world_change(i).kind == WorldChange::Kind::kTransform) {
-      ++transforms;
-      transform = &map->world_change(i);
-    }
-  }
-  imu_->seen_world_changes = changes;
   // Local mapping rotated / rescaled the map after the current frame was tracked: its pose is
-  // in the old world. One transform is carried across exactly; more cannot be (not observed).
-  if (correct_current && current_.HasPose() && transforms == 1) {
+  // in the old world (WorldChangesSeen::single_transform).
+  if (correct_current && current_.HasPose() && seen.single_transform) {
+    const WorldChange& transform = *seen.single_transform;
     const SE3d& tcw = current_.camera_from_world();
     current_.SetPose(
-        SE3d(tcw.so3() * transform->rotation.Inverse(), transform->scale * tcw.translation()));
+        SE3d(tcw.so3() * transform.rotation.Inverse(), transform.scale * tcw.translation()));
     current_.imu.state.velocity_world =
-        transform->scale * (transform->rotation * current_.imu.state.velocity_world);
+        transform.scale * (transform.rotation * current_.imu.state.velocity_world);
   }
-  if (map->applied_scale() != imu_->seen_scale) {
+  if (seen.scale_ratio) {
     // Monocular-inertial initialisation rescaled the map: what tracking keeps relative to its
     // keyframes scales with it.
-    const double ratio = map->applied_scale() / imu_->seen_scale;
-    imu_->seen_scale = map->applied_scale();
+    const double ratio = *seen.scale_ratio;
     for (FrameRecord& r : records_) {
       if (r.reference && r.reference->map() == map) r.camera_from_reference.translation() *= ratio;
     }
@@ -159,11 +117,11 @@ bool Tracker::PredictWithImu() {
   const PreintegratedImu* pim = nullptr;
   if (imu_->from_keyframe || !last_.imu.state.valid || !current_.imu.from_last_frame ||
       !last_.HasPose()) {
-    if (!last_kf_ || last_kf_->IsBad() || !last_kf_->imu.state.valid) return false;
+    if (!last_kf_ || last_kf_->IsBad() || !last_kf_->imu().state.valid) return false;
     start = {WorldFromBody(last_kf_->camera_from_world(), *rig_),
-             last_kf_->imu.state.velocity_world};
-    bias = last_kf_->imu.state.bias;
-    kf_pim = PreintegrateBetween(last_kf_->t_ns(), current_.t_ns(), bias);
+             last_kf_->imu().state.velocity_world};
+    bias = last_kf_->imu().state.bias;
+    kf_pim = imu_->samples.Between(last_kf_->t_ns(), current_.t_ns(), bias);
     if (!kf_pim) return false;
     pim = &*kf_pim;
   } else {
@@ -186,15 +144,9 @@ bool Tracker::PredictWithImu() {
 bool Tracker::TrackWithImu() {
   UpdateLastFrame();
   if (!PredictWithImu()) return false;
-  std::fill(current_.map_points.begin(), current_.map_points.end(), nullptr);
   const bool mono = IsMonocular(rig_->sensor);
   const double th = mono ? options_.motion_model_radius_mono : options_.motion_model_radius_stereo;
-  const OrbMatcher matcher(0.9, true);
-  int n = matcher.SearchByProjection(&current_, last_, th, mono);
-  if (n < options_.min_matches_motion_model) {
-    std::fill(current_.map_points.begin(), current_.map_points.end(), nullptr);
-    n = matcher.SearchByProjection(&current_, last_, 2 * th, mono);
-  }
+  MatchLastFrame(last_, th, mono, options_.min_matches_motion_model, &current_);
   current_.outliers.assign(current_.size(), 0);
   // The IMU prediction stands: the matches are classified by the visual-inertial optimisation
   // after the local map search (ORB-SLAM3 runs a visual-only optimisation here first; with the
@@ -220,14 +172,14 @@ void Tracker::OptimizeCurrentPose() {
     in.previous_information = *imu_->last_frame_information;
     in.preintegration = &*current_.imu.from_last_frame;
   } else {
-    if (!last_kf_ || last_kf_->IsBad() || !last_kf_->imu.state.valid) {
+    if (!last_kf_ || last_kf_->IsBad() || !last_kf_->imu().state.valid) {
       OptimizePose(&current_, options_.pose);
       return;
     }
     in.previous_state = {WorldFromBody(last_kf_->camera_from_world(), *rig_),
-                         last_kf_->imu.state.velocity_world};
-    in.previous_bias = last_kf_->imu.state.bias;
-    kf_pim = PreintegrateBetween(last_kf_->t_ns(), current_.t_ns(), in.previous_bias);
+                         last_kf_->imu().state.velocity_world};
+    in.previous_bias = last_kf_->imu().state.bias;
+    kf_pim = imu_->samples.Between(last_kf_->t_ns(), current_.t_ns(), in.previous_bias);
     if (!kf_pim) {
       OptimizePose(&current_, options_.pose);
       return;
@@ -256,12 +208,12 @@ void Tracker::AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previo
     SyncWithInertialMapLocked(true);
     kf->SetPose(current_.camera_from_world());
   }
-  kf->imu.state = frame.imu.state;
+  kf->mutable_imu(lock).state = frame.imu.state;
   if (previous == nullptr || previous->IsBad() || previous->map() != kf->map()) return;
   kf->map()->inertial_chain().Append(
       lock, previous, kf,
-      PreintegrateBetween(previous->t_ns(), kf->t_ns(), previous->imu.state.bias));
-  if (!kf->imu.state.valid) kf->imu.state.bias = previous->imu.state.bias;
+      imu_->samples.Between(previous->t_ns(), kf->t_ns(), previous->imu().state.bias));
+  if (!kf->imu().state.valid) kf->mutable_imu(lock).state.bias = previous->imu().state.bias;
 }
 
 void Tracker::FillImuSelectorInput(SelectorInput* in) const {

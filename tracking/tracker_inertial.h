@@ -3,24 +3,25 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <optional>
 
 #include "core/imu/imu_types.h"
 #include "map_model/map_ids.h"
+#include "tracking/imu_buffer.h"
 #include "tracking/inertial_pose_optimizer.h"
+#include "tracking/world_change_cursor.h"
 
 namespace pkslam {
 
 struct InertialTrackingState {
-  // IMU samples not yet consumed, time-ordered; trimmed to what the oldest anchor (last
-  // keyframe, last frame, monocular initial frame) still needs.
-  std::deque<ImuMeasurement> queue;
+  explicit InertialTrackingState(const ImuNoise& noise) : samples(noise) {}
+
+  // IMU samples not yet consumed, trimmed to what the oldest anchor (last keyframe, last
+  // frame, monocular initial frame) still needs.
+  ImuBuffer samples;
   std::int64_t last_frame_t_ns = -1;
-  // The map the fields below refer to and what was last seen of its inertial changes.
-  const Map* map = nullptr;
-  int seen_world_changes = 0;  // cursor into the map's world-change log
-  double seen_scale = 1.0;
+  // What was last seen of the current map's world changes; the fields below refer to it.
+  WorldChangeCursor world;
   // Predict and optimise against the last keyframe (true after the map changed under us)
   // instead of the last frame.
   bool from_keyframe = true;

@@ -8,42 +8,17 @@
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_point.h"
-#include "map_model/matching/orb_matcher.h"
+#include "tracking/frame_tracking.h"
 #include "tracking/pose_optimizer.h"
 #include "tracking/tracker.h"
 
 namespace pkslam {
-namespace {
-
-// Drops matches rejected by the pose optimisation; returns matches to points in the map.
-int DiscardOutliers(Frame* frame) {
-  int in_map = 0;
-  for (int i = 0; i < frame->size(); ++i) {
-    if (!frame->map_points[i]) continue;
-    if (frame->outliers[i]) {
-      frame->map_points[i].reset();
-      frame->outliers[i] = 0;
-    } else if (frame->map_points[i]->NumObservations() > 0) {
-      ++in_map;
-    }
-  }
-  return in_map;
-}
-
-}  // namespace
-
 bool Tracker::TrackReferenceKeyFrame() {
   if (!reference_kf_ || reference_kf_->IsBad()) return false;
-  current_.ComputeBoW(*vocabulary_);
-  const OrbMatcher matcher(options_.reference_kf_ratio, true);
-  std::vector<MapPointPtr> matches;
-  const int n = matcher.SearchByBoW(*reference_kf_, current_, &matches);
-  if (n < options_.min_matches_reference_kf) return false;
-  current_.map_points = std::move(matches);
-  current_.outliers.assign(current_.size(), 0);
-  current_.SetPose(last_.camera_from_world());
-  OptimizePose(&current_, options_.pose);
-  return DiscardOutliers(&current_) >= 10;
+  const ReferenceMatching matching{options_.reference_kf_ratio, options_.min_matches_reference_kf};
+  const std::optional<int> in_map = TrackToKeyFrame(
+      *reference_kf_, *vocabulary_, last_.camera_from_world(), matching, options_.pose, &current_);
+  return in_map && *in_map >= 10;
 }
 
 int Tracker::InlierMatches(const Frame& frame, bool map_only) {
@@ -91,20 +66,11 @@ void Tracker::AddVisualOdometryPoints() {
 bool Tracker::TrackWithMotionModel() {
   UpdateLastFrame();
   current_.SetPose(*velocity_ * last_.camera_from_world());
-  std::fill(current_.map_points.begin(), current_.map_points.end(), nullptr);
   const bool mono = IsMonocular(rig_->sensor);
   const double th = mono ? options_.motion_model_radius_mono : options_.motion_model_radius_stereo;
-  const OrbMatcher matcher(0.9, true);
-  int n = matcher.SearchByProjection(&current_, last_, th, mono);
-  if (n < options_.min_matches_motion_model) {
-    // Wider window before giving up (ORB-SLAM doubles it).
-    std::fill(current_.map_points.begin(), current_.map_points.end(), nullptr);
-    n = matcher.SearchByProjection(&current_, last_, 2 * th, mono);
-  }
+  const int n = MatchLastFrame(last_, th, mono, options_.min_matches_motion_model, &current_);
   if (n < options_.min_matches_motion_model) return false;
-  current_.outliers.assign(current_.size(), 0);
-  OptimizePose(&current_, options_.pose);
-  const int in_map = DiscardOutliers(&current_);
+  const int in_map = OptimizeAndDiscard(options_.pose, &current_);
   if (options_.localise_only && !mono) {
     // Localisation: temporary visual-odometry points count too (TrackLocalisationOnly decides
     // whether the map or odometry placed the frame); ORB-SLAM asks for 20 matches in all.

@@ -1,9 +1,10 @@
 // CPU time of the calling thread and of the process, for speed statistics that do not depend
 // on how busy a shared machine is (wall-clock milliseconds include time spent preempted or
-// waiting on locks; CPU milliseconds do not).
+// waiting on locks; CPU milliseconds do not); and the process's peak memory.
 #pragma once
 
 #include <pthread.h>
+#include <sys/resource.h>
 #include <time.h>
 
 #include <optional>
@@ -43,6 +44,13 @@ inline double ClockSeconds(clockid_t clock) {
   timespec ts{};
   if (clock_gettime(clock, &ts) != 0) return 0.0;
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Peak resident memory of this process in MiB (getrusage; ru_maxrss is in KiB on Linux).
+inline double PeakMemoryMiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
 }  // namespace pkslam

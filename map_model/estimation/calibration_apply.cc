@@ -22,23 +22,28 @@ Eigen::Vector3d GyroRescale(const RigCalibration& from, const RigCalibration& to
 }
 
 // A keyframe's preintegration and gyro bias moved to a new gyro scale correction.
-void RescaleKeyFrameGyro(const Eigen::Vector3d& factor, KeyFrame* kf) {
-  if (kf->imu.from_previous) RescaleGyro(factor, &*kf->imu.from_previous);
-  kf->imu.state.bias.gyro = kf->imu.state.bias.gyro.cwiseProduct(factor);
+void RescaleKeyFrameGyro(const MapWriteLock& lock, const Eigen::Vector3d& factor, KeyFrame* kf) {
+  KeyFrameImu& imu = kf->mutable_imu(lock);
+  if (imu.from_previous) RescaleGyro(factor, &*imu.from_previous);
+  imu.state.bias.gyro = imu.state.bias.gyro.cwiseProduct(factor);
 }
 
 }  // namespace
 
-void MoveToCalibration(Atlas* atlas, const RigCalibration& calibration, const RigSetup& setup) {
+void MoveToCalibration(const MapWriteLock& lock, Atlas* atlas, const RigCalibration& calibration,
+                       const RigSetup& setup) {
+  PKSLAM_CHECK(lock.owns_lock(), "MoveToCalibration without the Atlas's write lock");
   const RigSetup old = atlas->rig_setup();
   const Eigen::Vector3d gyro_factor = GyroRescale(atlas->calibration(), calibration);
   if (gyro_factor != Eigen::Vector3d::Ones()) {
     // The chain's preintegrations were integrated with the old correction (tracking corrects
     // each sample as it integrates it: Tracker::SetGyroScale).
     for (Map* map : atlas->maps()) {
-      for (const auto& [id, kf] : map->keyframes()) RescaleKeyFrameGyro(gyro_factor, kf.get());
+      for (const auto& [id, kf] : map->keyframes()) {
+        RescaleKeyFrameGyro(lock, gyro_factor, kf.get());
+      }
       for (const auto& [id, kf] : map->retired_keyframes()) {
-        RescaleKeyFrameGyro(gyro_factor, kf.get());
+        RescaleKeyFrameGyro(lock, gyro_factor, kf.get());
       }
     }
   }
@@ -85,11 +90,12 @@ int RefinePointsToCalibration(Atlas* atlas, MapId map_id) {
   return moved;
 }
 
-void ApplyCalibration(Atlas* atlas, Map* map, const CalibrationBundleProblem& problem,
+void ApplyCalibration(const MapWriteLock& lock, Atlas* atlas, Map* map,
+                      const CalibrationBundleProblem& problem,
                       const CalibrationBundleResult& result, const RigSetup& setup) {
   // The adjustment's gyro biases are those of rates corrected with the problem's scale.
   const Eigen::Vector3d gyro_factor = GyroRescale(problem.initial, result.estimate);
-  MoveToCalibration(atlas, result.estimate, setup);
+  MoveToCalibration(lock, atlas, result.estimate, setup);
   if (map == nullptr) return;
   const InertialBundleProblem& bundle = problem.bundle;
   PKSLAM_CHECK(result.world_from_body.size() == bundle.visual.keyframes.size(),
@@ -107,10 +113,10 @@ void ApplyCalibration(Atlas* atlas, Map* map, const CalibrationBundleProblem& pr
   written.biases = result.bundle.biases;
   for (ImuBias& b : written.biases) b.gyro = b.gyro.cwiseProduct(gyro_factor);
   MergeGlobalBundle(
-      map, bundle.visual,
+      lock, map, bundle.visual,
       [&] {
         if (problem.inertial) {
-          ApplyInertialBundle(map, bundle, written);
+          ApplyInertialBundle(lock, map, bundle, written);
         } else {
           ApplyBundle(map, bundle.visual, written.visual);
         }

@@ -8,8 +8,10 @@
 
 namespace pkslam {
 
-// Requires the Atlas mutex (exclusive). Every keyframe of every map (live and retired) moves to
-// `setup`, the rig of `result.estimate` (KeyFrame::Recalibrate: keypoints re-rectified or
+class MapWriteLock;
+
+// With the Atlas's write lock (a parameter). Every keyframe of every map (live and retired) moves
+// to `setup`, the rig of `result.estimate` (KeyFrame::Recalibrate: keypoints re-rectified or
 // re-undistorted, stereo depths recomputed, poses expressed in the new tracking camera with the
 // body kept), the Atlas takes the estimate as its calibration, and then the problem's keyframes,
 // points, velocities and biases of `map` get the adjustment's values; keyframes and points the
@@ -17,7 +19,8 @@ namespace pkslam {
 // a world change in `map` so tracking predicts from its keyframes again. The adjustment's
 // outliers are not erased (local BA decides about observations). `map` may be null (the map
 // went away meanwhile): then only the calibration moves.
-void ApplyCalibration(Atlas* atlas, Map* map, const CalibrationBundleProblem& problem,
+void ApplyCalibration(const MapWriteLock& lock, Atlas* atlas, Map* map,
+                      const CalibrationBundleProblem& problem,
                       const CalibrationBundleResult& result, const RigSetup& setup);
 
 // Every point of map `map_id` refined with the keyframe poses held (structure-only,
@@ -27,7 +30,9 @@ void ApplyCalibration(Atlas* atlas, Map* map, const CalibrationBundleProblem& pr
 int RefinePointsToCalibration(Atlas* atlas, MapId map_id);
 
 // Only the calibration: every keyframe moves to `setup` as above, poses and points stay (a
-// calibration read from a file or a map, before or between adjustments). Exclusive lock.
-void MoveToCalibration(Atlas* atlas, const RigCalibration& calibration, const RigSetup& setup);
+// calibration read from a file or a map, before or between adjustments). With the Atlas's
+// write lock (a parameter).
+void MoveToCalibration(const MapWriteLock& lock, Atlas* atlas, const RigCalibration& calibration,
+                       const RigSetup& setup);
 
 }  // namespace pkslam

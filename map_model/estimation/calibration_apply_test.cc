@@ -72,7 +72,7 @@ TEST_F(CalibrationApplyTest, MovingToAnEstimateKeepsPhysicalPixelsAndBodies) {
   const int version = atlas_.calibration_version();
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
-    MoveToCalibration(&atlas_, estimate, next);
+    MoveToCalibration(lock, &atlas_, estimate, next);
   }
   auto lock = MapReader(atlas_).Lock();
   EXPECT_EQ(atlas_.calibration_version(), version + 1);
@@ -109,28 +109,28 @@ TEST_F(CalibrationApplyTest, AGyroScaleEstimateMovesTheChainsPreintegrationsAndB
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (std::size_t k = 1; k < map_.keyframes.size(); ++k) {
-      map_.keyframes[k]->imu.from_previous = pim;
-      map_.keyframes[k]->imu.state.bias.gyro = Eigen::Vector3d(0.01, -0.02, 0.0);
+      map_.keyframes[k]->mutable_imu(lock).from_previous = pim;
+      map_.keyframes[k]->mutable_imu(lock).state.bias.gyro = Eigen::Vector3d(0.01, -0.02, 0.0);
     }
   }
   RigCalibration estimate = file_;
   estimate.gyro_scale = Eigen::Vector3d(0.0, 0.005, 0.0);
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
-    MoveToCalibration(&atlas_, estimate, setup_);
+    MoveToCalibration(lock, &atlas_, estimate, setup_);
   }
   auto lock = MapReader(atlas_).Lock();
   EXPECT_EQ(atlas_.calibration().gyro_scale, estimate.gyro_scale);
   PreintegratedImu expected = pim;
   RescaleGyro(Eigen::Vector3d(1.0, 1.0 / 1.005, 1.0), &expected);
   const KeyFrame& kf = *map_.keyframes[4];
-  ASSERT_TRUE(kf.imu.from_previous.has_value());
-  EXPECT_NEAR(kf.imu.from_previous->steps[0].gyro.y(), 0.8 / 1.005, 1e-15);
-  EXPECT_EQ(kf.imu.from_previous->delta_R.quaternion().coeffs(),
+  ASSERT_TRUE(kf.imu().from_previous.has_value());
+  EXPECT_NEAR(kf.imu().from_previous->steps[0].gyro.y(), 0.8 / 1.005, 1e-15);
+  EXPECT_EQ(kf.imu().from_previous->delta_R.quaternion().coeffs(),
             expected.delta_R.quaternion().coeffs());
-  EXPECT_NEAR(kf.imu.state.bias.gyro.y(), -0.02 / 1.005, 1e-15);
+  EXPECT_NEAR(kf.imu().state.bias.gyro.y(), -0.02 / 1.005, 1e-15);
   // The rotation integrated about y is 0.5% smaller: 40 steps of (0.8 + 0.02) rad/s * 5 ms.
-  EXPECT_NEAR((pim.delta_R.Inverse() * kf.imu.from_previous->delta_R).Angle(),
+  EXPECT_NEAR((pim.delta_R.Inverse() * kf.imu().from_previous->delta_R).Angle(),
               0.164 * 0.005 / 1.005, 1e-5);
 }
 
@@ -155,7 +155,7 @@ TEST_F(CalibrationApplyTest, AnAdjustmentOfAnExactMapMovesLittleAndAppliesCleanl
   const SE3d body_before = map_.keyframes[7]->world_from_body();
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
-    ApplyCalibration(&atlas_, atlas_.current_map(), problem, result, next);
+    ApplyCalibration(lock, &atlas_, atlas_.current_map(), problem, result, next);
   }
   EXPECT_GT(RefinePointsToCalibration(&atlas_, atlas_.current_map()->id()), -1);
   auto lock = MapReader(atlas_).Lock();

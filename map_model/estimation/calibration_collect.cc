@@ -77,8 +77,9 @@ void CalibrationCollectOptions::Check() const {
 }
 
 Eigen::Vector3d AngularVelocityAt(const KeyFrame& kf, double window_s) {
-  if (!kf.imu.from_previous || kf.imu.from_previous->steps.empty()) return Eigen::Vector3d::Zero();
-  const auto& steps = kf.imu.from_previous->steps;
+  if (!kf.imu().from_previous || kf.imu().from_previous->steps.empty())
+    return Eigen::Vector3d::Zero();
+  const auto& steps = kf.imu().from_previous->steps;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double span = 0;
   for (auto it = steps.rbegin(); it != steps.rend() && span < window_s; ++it) {
@@ -86,7 +87,7 @@ Eigen::Vector3d AngularVelocityAt(const KeyFrame& kf, double window_s) {
     span += it->dt;
   }
   if (span <= 0) return Eigen::Vector3d::Zero();
-  return sum / span - kf.imu.state.bias.gyro;
+  return sum / span - kf.imu().state.bias.gyro;
 }
 
 CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertial,
@@ -139,14 +140,14 @@ CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertia
     keyframes.push_back(kf.get());
     problem.angular_velocity.push_back(problem.inertial ? AngularVelocityAt(*kf)
                                                         : Eigen::Vector3d::Zero());
-    problem.time_offset_applied.push_back(kf->imu.time_offset_s);
+    problem.time_offset_applied.push_back(kf->imu().time_offset_s);
   }
   // The edges' copies carry no steps: the gyro scale's Jacobians come from the keyframes'.
   if (options.gyro_scale_jacobians) {
     for (const auto& e : problem.bundle.edges) {
       const KeyFrame& to = *keyframes[static_cast<std::size_t>(e.to)];
-      problem.gyro_scale_jacobians.push_back(to.imu.from_previous
-                                                 ? GyroScaleJacobiansOf(*to.imu.from_previous)
+      problem.gyro_scale_jacobians.push_back(to.imu().from_previous
+                                                 ? GyroScaleJacobiansOf(*to.imu().from_previous)
                                                  : GyroScaleJacobians{});
     }
   }

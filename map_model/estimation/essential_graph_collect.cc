@@ -11,6 +11,7 @@
 #include "estimators/optim/yaw_manifold.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 
 namespace pkslam {
@@ -123,7 +124,7 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
       if (l >= 0) add_edge(i, l, before(l) * world_from_i, EssentialGraphProblem::EdgeKind::kLoop);
     }
     // Inertial maps: the previous keyframe of the temporal chain (ORB-SLAM3's 4-DoF graph).
-    const KeyFrame* previous = kf->imu.previous();
+    const KeyFrame* previous = kf->imu().previous();
     if (options.dof == PoseGraphDof::kYawTranslation && previous != nullptr && !previous->IsBad() &&
         previous != parent && previous->parent() != kf &&
         inserted.count(Ordered(id, previous->id())) == 0) {
@@ -162,8 +163,9 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
   return problem;
 }
 
-void ApplyEssentialGraph(Map* map, const EssentialGraphProblem& problem,
+void ApplyEssentialGraph(const MapWriteLock& lock, Map* map, const EssentialGraphProblem& problem,
                          const EssentialGraphResult& result) {
+  PKSLAM_CHECK(lock.owns_lock(), "ApplyEssentialGraph without the Atlas's write lock");
   PKSLAM_CHECK(map != nullptr, "ApplyEssentialGraph without a map");
   PKSLAM_CHECK(problem.map_id == kInvalidId || problem.map_id == map->id(),
                "essential graph of map {} applied to map {}", problem.map_id, map->id());
@@ -182,10 +184,11 @@ void ApplyEssentialGraph(Map* map, const EssentialGraphProblem& problem,
   // Keyframes created after Collect move with their nearest ancestor in the graph.
   const int max_steps = map->NumKeyFrames() + static_cast<int>(map->retired_keyframes().size());
   // Velocities live in the world frame: they turn (and scale) with the keyframe's world.
-  auto move_velocity = [](KeyFrame* kf, const Sim3d& world_new_from_world_old) {
-    if (!kf->imu.state.valid) return;
-    kf->imu.state.velocity_world = world_new_from_world_old.scale() *
-                                   (world_new_from_world_old.so3() * kf->imu.state.velocity_world);
+  auto move_velocity = [&lock](KeyFrame* kf, const Sim3d& world_new_from_world_old) {
+    if (!kf->imu().state.valid) return;
+    kf->mutable_imu(lock).state.velocity_world =
+        world_new_from_world_old.scale() *
+        (world_new_from_world_old.so3() * kf->imu().state.velocity_world);
   };
   auto ancestor_vertex = [&](const KeyFrame* kf) {
     for (int step = 0; kf != nullptr && step <= max_steps; ++step, kf = kf->parent()) {

@@ -8,6 +8,8 @@
 
 namespace pkslam {
 
+class MapWriteLock;
+
 // Builds the graph over the live keyframes of `map`. Requires the Atlas mutex (shared).
 EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& correction,
                                             const EssentialGraphOptions& options);
@@ -19,7 +21,7 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
 // keyframe it follows (or, for points and keyframes created after Collect, of the nearest
 // spanning-tree ancestor in the graph), updates normals and depth ranges, and bumps the map's
 // change index.
-void ApplyEssentialGraph(Map* map, const EssentialGraphProblem& problem,
+void ApplyEssentialGraph(const MapWriteLock& lock, Map* map, const EssentialGraphProblem& problem,
                          const EssentialGraphResult& result);
 
 }  // namespace pkslam

@@ -39,7 +39,7 @@ Outcome CloseLoop(LoopScenario* s, const testing::SyntheticScene& scene, PoseGra
   out.result = SolveEssentialGraph(out.problem, options);
   {
     auto lock = MapEditor(&s->atlas).Write(MapEdit::kFixture);
-    ApplyEssentialGraph(s->map, out.problem, out.result);
+    ApplyEssentialGraph(lock, s->map, out.problem, out.result);
   }
   out.kf_rmse_after = KeyFramePositionRmse(*s);
   out.point_rmse_after = PointRmse(*s, scene);
@@ -123,7 +123,7 @@ TEST(EssentialGraphTest, KeyFramesAndPointsAddedAfterCollectFollowTheirAncestor)
   }
   const auto result = SolveEssentialGraph(problem, eg);
   auto lock = MapEditor(&s.atlas).Write(MapEdit::kFixture);
-  ApplyEssentialGraph(s.map, problem, result);
+  ApplyEssentialGraph(lock, s.map, problem, result);
   const SE3d rel = late->camera_from_world() * anchor->world_from_camera();
   EXPECT_LT((rel.translation() - late_from_anchor.translation()).norm(), 1e-9);
   EXPECT_LT((rel.so3().Inverse() * late_from_anchor.so3()).Log().norm(), 1e-9);

@@ -111,8 +111,9 @@ void BuildInertialLoop(double loop_tilt, const testing::SyntheticScene& scene, I
   for (std::size_t k = 0; k < kfs.size(); ++k) {
     KeyFrame* kf = kfs[k].get();
     if (k > 0) kf->map()->inertial_chain().Append(lock, kfs[k - 1].get(), kf, std::nullopt);
-    kf->imu.state.valid = true;
-    kf->imu.state.velocity_world = Eigen::Vector3d(0.5, -0.2, 0.1 * static_cast<double>(k % 3));
+    kf->mutable_imu(lock).state.valid = true;
+    kf->mutable_imu(lock).state.velocity_world =
+        Eigen::Vector3d(0.5, -0.2, 0.1 * static_cast<double>(k % 3));
     if (k >= 2) {
       kf->parent()->EraseChild(kf);
       kf->ChangeParent(kfs[k - 2].get());
@@ -130,7 +131,7 @@ void BuildInertialLoop(double loop_tilt, const testing::SyntheticScene& scene, I
     l->pose_before.push_back(it != c.non_corrected_camera_from_world.end()
                                  ? it->second.ToSE3ScaledTranslation()
                                  : kf->camera_from_world());
-    l->velocity_before.push_back(kf->imu.state.velocity_world);
+    l->velocity_before.push_back(kf->imu().state.velocity_world);
   }
   lock.unlock();
   l->kf_rmse_before = KeyFramePositionRmse(l->s);
@@ -151,7 +152,7 @@ Solved Close(LoopScenario* s, PoseGraphDof dof) {
   }
   out.result = SolveEssentialGraph(out.problem, options);
   auto lock = MapEditor(&s->atlas).Write(MapEdit::kFixture);
-  ApplyEssentialGraph(s->map, out.problem, out.result);
+  ApplyEssentialGraph(lock, s->map, out.problem, out.result);
   return out;
 }
 
@@ -198,9 +199,10 @@ TEST(EssentialGraphYawTest, InertialLoopIsCorrectedInYawAndTranslationOnly) {
     const SO3d turn =
         kf->world_from_camera().so3() * l.pose_before[static_cast<std::size_t>(k)].so3();
     max_yaw = std::max(max_yaw, std::abs(ClosestYawAngle(turn)));
-    EXPECT_LT((kf->imu.state.velocity_world - turn * l.velocity_before[static_cast<std::size_t>(k)])
-                  .norm(),
-              1e-9);
+    EXPECT_LT(
+        (kf->imu().state.velocity_world - turn * l.velocity_before[static_cast<std::size_t>(k)])
+            .norm(),
+        1e-9);
   }
   EXPECT_GT(max_yaw, 0.05);  // the correction did turn the keyframes
 }

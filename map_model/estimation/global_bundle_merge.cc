@@ -6,19 +6,23 @@
 #include <map>
 #include <set>
 
+#include "core/util/error.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 
 namespace pkslam {
 
-void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResult& result) {
+void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& problem,
+                       const BundleResult& result) {
   MergeGlobalBundle(
-      map, problem, [&] { ApplyBundle(map, problem, result); }, false);
+      lock, map, problem, [&] { ApplyBundle(map, problem, result); }, false);
 }
 
-void MergeGlobalBundle(Map* map, const BundleProblem& problem, const std::function<void()>& apply,
-                       bool apply_sets_velocities) {
+void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& problem,
+                       const std::function<void()>& apply, bool apply_sets_velocities) {
+  PKSLAM_CHECK(lock.owns_lock(), "MergeGlobalBundle without the Atlas's write lock");
   if (map == nullptr || map->origin() == nullptr) return;
   // Poses before the write-back: what everything outside the problem is relative to.
   std::map<KeyFrameId, SE3d> before;
@@ -53,10 +57,10 @@ void MergeGlobalBundle(Map* map, const BundleProblem& problem, const std::functi
   // Velocities (inertial maps) turn with their keyframe's orientation.
   for (const auto& [id, kf] : map->keyframes()) {
     const auto it = before.find(id);
-    if (kf->IsBad() || !kf->imu.state.valid || it == before.end()) continue;
+    if (kf->IsBad() || !kf->imu().state.valid || it == before.end()) continue;
     if (apply_sets_velocities && in_problem.count(id) > 0) continue;
-    kf->imu.state.velocity_world =
-        kf->world_from_camera().so3() * (it->second.so3() * kf->imu.state.velocity_world);
+    kf->mutable_imu(lock).state.velocity_world =
+        kf->world_from_camera().so3() * (it->second.so3() * kf->imu().state.velocity_world);
   }
 
   // Points created meanwhile move rigidly with their reference keyframe.

@@ -14,14 +14,17 @@
 
 namespace pkslam {
 
-// Requires the Atlas mutex (exclusive). Keyframes and points no longer in `map` are left
+class MapWriteLock;
+
+// With the Atlas's write lock (a parameter). Keyframes and points no longer in `map` are left
 // alone. Bumps the map's change index.
-void MergeGlobalBundle(Map* map, const BundleProblem& problem, const BundleResult& result);
+void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& problem,
+                       const BundleResult& result);
 // The same with the write-back of the problem's keyframes and points done by `apply` (e.g.
 // ApplyInertialBundle); `apply_sets_velocities`: the problem's keyframes got their velocities
 // from `apply` (only the others are turned with their keyframe).
-void MergeGlobalBundle(Map* map, const BundleProblem& problem, const std::function<void()>& apply,
-                       bool apply_sets_velocities);
+void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& problem,
+                       const std::function<void()>& apply, bool apply_sets_velocities);
 
 // Gravity-preservation diagnostics (inertial maps, world z = gravity axis): the world's z axis
 // seen from each live keyframe's camera (R_cw * e_z), and the largest angle (rad) by which a

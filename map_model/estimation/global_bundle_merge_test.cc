@@ -69,7 +69,7 @@ TEST_F(MergeGlobalBundleTest, ProblemKeyframesAndPointsTakeTheOptimisedValues) {
   const BundleResult result = MoveWorld(problem_, change);
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   const int change_index = atlas_.current_map()->change_index();
-  MergeGlobalBundle(atlas_.current_map(), problem_, result);
+  MergeGlobalBundle(lock, atlas_.current_map(), problem_, result);
   for (std::size_t k = 0; k < problem_.keyframes.size(); ++k) {
     const SE3d& got =
         atlas_.current_map()->KeyFrameById(problem_.keyframes[k].keyframe_id)->camera_from_world();
@@ -108,7 +108,7 @@ TEST_F(MergeGlobalBundleTest, NewKeyframesFollowTheirParentAndNewPointsTheirRefe
   const SE3d change(SO3d::Exp(Eigen::Vector3d(0.02, -0.04, 0.01)), Eigen::Vector3d(-0.2, 0.1, 0));
   const BundleResult result = MoveWorld(problem_, change);
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  MergeGlobalBundle(atlas_.current_map(), problem_, result);
+  MergeGlobalBundle(lock, atlas_.current_map(), problem_, result);
   // The whole world moved by `change`: so must the keyframes and the point the BA never saw.
   const SE3d a_expected = a_before * change.Inverse();
   const SE3d b_expected = b_before * change.Inverse();
@@ -132,7 +132,7 @@ TEST_F(MergeGlobalBundleTest, KeyframesOfAnotherMapAreLeftAlone) {
   }
   const SE3d change(SO3d(), Eigen::Vector3d(1.0, 0, 0));
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  MergeGlobalBundle(map_.keyframes.front()->map(), problem_, MoveWorld(problem_, change));
+  MergeGlobalBundle(lock, map_.keyframes.front()->map(), problem_, MoveWorld(problem_, change));
   EXPECT_LT((moved->camera_from_world().translation() - before.translation()).norm(), 1e-12);
 }
 

@@ -12,6 +12,7 @@
 #include "map_model/estimation/inertial_prior_stamp.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 
 namespace pkslam {
@@ -36,8 +37,8 @@ void AddKeyFrame(KeyFrame* kf, bool fixed, std::uint8_t inertial, InertialBundle
   (*index)[kf] = static_cast<int>(problem->visual.keyframes.size());
   problem->visual.keyframes.push_back({kf->id(), kf->camera_from_world(), fixed});
   problem->inertial.push_back(inertial);
-  problem->velocities.push_back(kf->imu.state.velocity_world);
-  problem->biases.push_back(kf->imu.state.bias);
+  problem->velocities.push_back(kf->imu().state.velocity_world);
+  problem->biases.push_back(kf->imu().state.bias);
 }
 
 void SetCommon(const KeyFrame& kf, const InertialBundleOptions& options,
@@ -57,7 +58,7 @@ void AddEdges(const std::vector<KeyFrame*>& chain, const BundleKeyFrameIndex& in
               InertialBundleProblem* problem) {
   for (std::size_t i = 1; i < chain.size(); ++i) {
     problem->edges.push_back(
-        {index.at(chain[i - 1]), index.at(chain[i]), WithoutSteps(*chain[i]->imu.from_previous)});
+        {index.at(chain[i - 1]), index.at(chain[i]), WithoutSteps(*chain[i]->imu().from_previous)});
   }
 }
 
@@ -83,10 +84,10 @@ InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
   std::vector<KeyFrame*> chain = InertialChain::EndingAt(keyframe, options.window + 1);
   // Only keyframes with an estimated inertial state take part (they all have one once the
   // map's IMU is initialised, except possibly the newest few).
-  while (!chain.empty() && !chain.front()->imu.state.valid) chain.erase(chain.begin());
+  while (!chain.empty() && !chain.front()->imu().state.valid) chain.erase(chain.begin());
   if (chain.size() < 2) return problem;
   for (std::size_t i = 1; i < chain.size(); ++i) {
-    if (!chain[i]->imu.state.valid) {
+    if (!chain[i]->imu().state.valid) {
       chain.resize(i);
       break;
     }
@@ -98,15 +99,15 @@ InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
   // The oldest is the anchor, joined by its inertial edge: free with its marginalisation prior
   // when it has a valid one, otherwise fixed.
   const KeyFrame* anchor = chain.front();
-  const bool with_prior =
-      options.marginalization_prior && anchor->imu.prior && PriorIsValid(*anchor->imu.prior, *map);
+  const bool with_prior = options.marginalization_prior && anchor->imu().prior &&
+                          PriorIsValid(*anchor->imu().prior, *map);
   for (std::size_t i = 0; i < chain.size(); ++i) {
     const bool fixed = i == 0 && !with_prior;
     AddKeyFrame(chain[i], fixed, fixed ? kFixedInertial : kFreeInertial, &problem, &index);
   }
   AddEdges(chain, index, &problem);
   if (options.marginalization_prior) {
-    if (with_prior) problem.anchor_prior = *anchor->imu.prior;
+    if (with_prior) problem.anchor_prior = *anchor->imu().prior;
     problem.marginalize_from = 0;
     problem.marginalize_to = 1;
     StampPrior(*map, &problem.stamps);
@@ -155,8 +156,8 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
   if (free_tilt) {
     const KeyFrame& first = *chain.front();
     problem.anchor_prior =
-        PositionYawPrior({first.world_from_body(), first.imu.state.velocity_world},
-                         first.imu.state.bias, gauge_information);
+        PositionYawPrior({first.world_from_body(), first.imu().state.velocity_world},
+                         first.imu().state.bias, gauge_information);
     problem.marginalize_from = 0;
     problem.marginalize_to = -1;
   }
@@ -171,8 +172,9 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
   return problem;
 }
 
-void ApplyInertialBundle(Map* map, const InertialBundleProblem& problem,
+void ApplyInertialBundle(const MapWriteLock& lock, Map* map, const InertialBundleProblem& problem,
                          const InertialBundleResult& result) {
+  PKSLAM_CHECK(lock.owns_lock(), "ApplyInertialBundle without the Atlas's write lock");
   PKSLAM_CHECK(result.velocities.size() == problem.visual.keyframes.size() &&
                    result.biases.size() == problem.visual.keyframes.size(),
                "inertial result does not match the problem");
@@ -185,16 +187,18 @@ void ApplyInertialBundle(Map* map, const InertialBundleProblem& problem,
   for (std::size_t i = 0; i < problem.visual.keyframes.size(); ++i) {
     KeyFrame* kf = keyframe(static_cast<int>(i));
     if (problem.inertial[i] != kFreeInertial || kf == nullptr || kf->IsBad()) continue;
-    kf->imu.state.velocity_world = result.velocities[i];
-    kf->imu.state.bias = result.biases[i];
-    kf->imu.state.valid = true;
+    InertialState& state = kf->mutable_imu(lock).state;
+    state.velocity_world = result.velocities[i];
+    state.bias = result.biases[i];
+    state.valid = true;
   }
   if (result.next_prior && problem.marginalize_to >= 0) {
     KeyFrame* next = keyframe(problem.marginalize_to);
     if (next != nullptr && !next->IsBad() && next->map() != nullptr &&
         PriorIsValid(problem.stamps, *next->map())) {
-      next->imu.prior = *result.next_prior;
-      StampPrior(*next->map(), &*next->imu.prior);
+      std::optional<InertialStatePrior>& prior = next->mutable_imu(lock).prior;
+      prior = *result.next_prior;
+      StampPrior(*next->map(), &*prior);
     }
   }
   // Preintegrations follow their start keyframe's bias (re-integrated when it moved far).
@@ -203,9 +207,9 @@ void ApplyInertialBundle(Map* map, const InertialBundleProblem& problem,
     KeyFrame* from = keyframe(edge.from);
     KeyFrame* to = keyframe(edge.to);
     if (from == nullptr || to == nullptr || from->IsBad() || to->IsBad() ||
-        !to->imu.from_previous || to->imu.previous() != from)
+        !to->imu().from_previous || to->imu().previous() != from)
       continue;
-    UpdateBias(from->imu.state.bias, reintegration, &*to->imu.from_previous);
+    UpdateBias(from->imu().state.bias, reintegration, &*to->mutable_imu(lock).from_previous);
   }
 }
 

@@ -13,6 +13,8 @@
 
 namespace pkslam {
 
+class MapWriteLock;
+
 // Requires the Atlas mutex (shared). Keyframes without a valid inertial state end the chain.
 InertialBundleProblem CollectLocalInertialBundle(KeyFrame* keyframe,
                                                  const InertialBundleOptions& options);
@@ -22,11 +24,11 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
                                                 const InertialBundleOptions& options,
                                                 bool free_tilt = false,
                                                 double gauge_information = 1e8);
-// Requires the Atlas mutex (exclusive): ApplyBundle for the visual part, then velocities and
+// With the Atlas's write lock (a parameter): ApplyBundle for the visual part, then velocities and
 // biases of free inertial keyframes, and re-linearises the preintegrations whose bias moved;
 // stores result.next_prior on its keyframe if the map did not move map-wide since Collect.
 // `map` is the map the problem was collected from.
-void ApplyInertialBundle(Map* map, const InertialBundleProblem& problem,
+void ApplyInertialBundle(const MapWriteLock& lock, Map* map, const InertialBundleProblem& problem,
                          const InertialBundleResult& result);
 
 }  // namespace pkslam

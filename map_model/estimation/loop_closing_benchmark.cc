@@ -164,7 +164,7 @@ void TimeEssentialGraph(benchmark::State& state, testing::LoopScenario* s,
   state.counters["kf_rmse_before"] = testing::KeyFramePositionRmse(*s);
   {
     auto lock = MapEditor(&s->atlas).Write(MapEdit::kFixture);
-    ApplyEssentialGraph(s->map, problem, result);
+    ApplyEssentialGraph(lock, s->map, problem, result);
   }
   state.counters["kf_rmse_after"] = testing::KeyFramePositionRmse(*s);
   state.counters["edges"] = static_cast<double>(problem.edges.size());

@@ -187,4 +187,22 @@ inline Sim3d CameraFromCopiedWorld(const SE3d& camera_from_world, double s,
                camera_from_world.translation() - (camera_from_world.so3() * offset) / s);
 }
 
+// A stereo map with BoW and points (MakeBowMap) over a scene of `points` points, keyframes along
+// MakeForwardPath(keyframes, 0.15 m): the fixture of the tracking parts' tests.
+struct StereoBowMap {
+  StereoBowMap(int points, std::uint64_t scene_seed, int keyframes, std::uint64_t path_seed)
+      : scene(MakeScene(points, scene_seed)),
+        vocabulary(TrainSceneVocabulary(scene)),
+        rig(MakeStereoRig()),
+        poses(MakeForwardPath(keyframes, 0.15, path_seed)),
+        map(MakeBowMap(&atlas, scene, rig, poses, {}, vocabulary, true)) {}
+
+  SyntheticScene scene;
+  Vocabulary vocabulary;
+  std::shared_ptr<CameraRig> rig;
+  std::vector<SE3d> poses;
+  Atlas atlas;
+  SyntheticMap map;
+};
+
 }  // namespace pkslam::testing

@@ -109,13 +109,14 @@ AtlasRecord AtlasStorage::Snapshot(const Atlas& atlas, const CameraRig& rig,
       }
       k.not_erase = kf->not_erase_;
       k.camera_from_parent = kf->camera_from_parent_;
-      k.imu_from_previous = kf->imu.from_previous;
-      k.imu_previous = Saved(kf->imu.previous(), map.get()) ? kf->imu.previous()->id() : kInvalidId;
-      k.imu_next = Saved(kf->imu.next(), map.get()) ? kf->imu.next()->id() : kInvalidId;
-      k.imu_state = kf->imu.state;
-      k.imu_prior = kf->imu.prior;
-      if (kf->imu.time_offset_s != 0.0 && out.calibration) {
-        out.calibration->keyframe_time_offsets.emplace_back(kf->id(), kf->imu.time_offset_s);
+      k.imu_from_previous = kf->imu().from_previous;
+      k.imu_previous =
+          Saved(kf->imu().previous(), map.get()) ? kf->imu().previous()->id() : kInvalidId;
+      k.imu_next = Saved(kf->imu().next(), map.get()) ? kf->imu().next()->id() : kInvalidId;
+      k.imu_state = kf->imu().state;
+      k.imu_prior = kf->imu().prior;
+      if (kf->imu().time_offset_s != 0.0 && out.calibration) {
+        out.calibration->keyframe_time_offsets.emplace_back(kf->id(), kf->imu().time_offset_s);
       }
     }
     for (const auto& [id, point] : map->map_points_) {
@@ -181,10 +182,10 @@ void AtlasStorage::Restore(const AtlasRecord& record, std::shared_ptr<const Came
       kf->map_points_.assign(k.map_points.size(), nullptr);
       kf->not_erase_ = k.not_erase;
       kf->camera_from_parent_ = k.camera_from_parent;
-      kf->imu.from_previous = k.imu_from_previous;
-      kf->imu.state = k.imu_state;
-      kf->imu.prior = k.imu_prior;
-      kf->imu.time_offset_s = time_offsets.count(k.id) > 0 ? time_offsets.at(k.id) : 0.0;
+      kf->imu_.from_previous = k.imu_from_previous;
+      kf->imu_.state = k.imu_state;
+      kf->imu_.prior = k.imu_prior;
+      kf->imu_.time_offset_s = time_offsets.count(k.id) > 0 ? time_offsets.at(k.id) : 0.0;
       keyframes[k.id] = kf.get();
       map->keyframes_[k.id] = kf;
     }

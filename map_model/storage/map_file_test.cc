@@ -42,9 +42,9 @@ class MapFileTest : public ::testing::Test {
     std::normal_distribution<double> n01;
     for (std::size_t k = 0; k < map_.keyframes.size(); ++k) {
       KeyFrame* kf = map_.keyframes[k].get();
-      kf->imu.state.velocity_world = Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
-      kf->imu.state.bias.gyro = 1e-3 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
-      kf->imu.state.valid = true;
+      kf->mutable_imu(lock).state.velocity_world = Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+      kf->mutable_imu(lock).state.bias.gyro = 1e-3 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+      kf->mutable_imu(lock).state.valid = true;
       if (k == 0) continue;
       KeyFrame* previous = map_.keyframes[k - 1].get();
       PreintegratedImu pim;
@@ -59,7 +59,7 @@ class MapFileTest : public ::testing::Test {
     prior.information = Eigen::Matrix<double, 15, 15>::Identity() * 42;
     prior.sqrt_information = Eigen::Matrix<double, 15, 15>::Identity() * std::sqrt(42.0);
     prior.map_id = map()->id();
-    map_.keyframes[3]->imu.prior = prior;
+    map_.keyframes[3]->mutable_imu(lock).prior = prior;
     map()->mutable_imu_status().imu_initialized = true;
     map()->RecordWorldChange(
         {WorldChange::Kind::kTransform, SO3d::Exp(Eigen::Vector3d(0, 0, 1)), 1.5});
@@ -120,16 +120,16 @@ TEST_F(MapFileTest, RoundTripGivesTheSameMapAndTheSameBytes) {
     EXPECT_EQ(kb->parent() ? kb->parent()->id() : -1, ka->parent() ? ka->parent()->id() : -1);
     EXPECT_EQ(kb->children().size(), ka->children().size());
     EXPECT_EQ(kb->loop_edges().size(), ka->loop_edges().size());
-    EXPECT_EQ(kb->imu.previous() ? kb->imu.previous()->id() : -1,
-              ka->imu.previous() ? ka->imu.previous()->id() : -1);
-    EXPECT_EQ(kb->imu.state.velocity_world, ka->imu.state.velocity_world);
-    ASSERT_EQ(kb->imu.from_previous.has_value(), ka->imu.from_previous.has_value());
-    if (ka->imu.from_previous) {
-      EXPECT_EQ(kb->imu.from_previous->delta_R.quaternion().coeffs(),
-                ka->imu.from_previous->delta_R.quaternion().coeffs());
-      EXPECT_EQ(kb->imu.from_previous->steps.size(), ka->imu.from_previous->steps.size());
+    EXPECT_EQ(kb->imu().previous() ? kb->imu().previous()->id() : -1,
+              ka->imu().previous() ? ka->imu().previous()->id() : -1);
+    EXPECT_EQ(kb->imu().state.velocity_world, ka->imu().state.velocity_world);
+    ASSERT_EQ(kb->imu().from_previous.has_value(), ka->imu().from_previous.has_value());
+    if (ka->imu().from_previous) {
+      EXPECT_EQ(kb->imu().from_previous->delta_R.quaternion().coeffs(),
+                ka->imu().from_previous->delta_R.quaternion().coeffs());
+      EXPECT_EQ(kb->imu().from_previous->steps.size(), ka->imu().from_previous->steps.size());
     }
-    EXPECT_EQ(kb->imu.prior.has_value(), ka->imu.prior.has_value());
+    EXPECT_EQ(kb->imu().prior.has_value(), ka->imu().prior.has_value());
   }
   for (const auto& [id, pa] : a->map_points()) {
     const MapPointPtr pb = b->MapPointById(id);

@@ -1,0 +1,49 @@
+// Relocalisation (ORB-SLAM3's Tracking::Relocalization): keyframes that look like the frame
+// (BoW place search in the keyframe database) are matched to it, a PnP RANSAC per candidate
+// proposes poses, and a pose is accepted once pose optimisation and projection searches
+// confirm it with at least kMinRelocalisationInliers inliers.
+//
+// Tracking thread, Atlas lock held (shared): it reads keyframes and points and writes only the
+// frame.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "core/sensor/camera_rig.h"
+#include "map_model/frame.h"
+#include "map_model/map_ids.h"
+#include "tracking/pose_optimizer.h"
+
+namespace pkslam {
+
+class KeyFrameDatabase;
+class Vocabulary;
+
+constexpr int kMinRelocalisationInliers = 50;
+
+struct RelocalisationOptions {
+  // The wider place search (lower word and group ratios, at most `wide_candidates` places),
+  // for after repeated failure: the view is then likely further from every keyframe than the
+  // usual thresholds allow.
+  bool wide = false;
+  int wide_candidates = 20;
+  std::uint64_t seed = 0;  // the PnP RANSAC's
+  PoseOptimizerOptions pose;
+};
+
+struct RelocalisationResult {
+  bool success = false;
+  KeyFrameId keyframe = kInvalidId;  // the candidate that confirmed the pose
+  int inliers = 0;
+  std::size_t places = 0;      // keyframes the place search returned
+  std::size_t candidates = 0;  // of them, with enough BoW matches for a PnP
+};
+
+// Finds `frame`'s pose in `map` (computes its BoW first). On success the frame has the pose
+// and its inlier matches; otherwise it has no matches (its pose is left as the last PnP put it).
+RelocalisationResult RelocaliseFrame(const KeyFrameDatabase& database, const Map* map,
+                                     const Vocabulary& vocabulary, const CameraRig& rig,
+                                     const RelocalisationOptions& options, Frame* frame);
+
+}  // namespace pkslam
