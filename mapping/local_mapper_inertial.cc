@@ -8,10 +8,10 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/wall_time.h"
-#include "estimators/inertial/gravity_gauge.h"
 #include "estimators/inertial/inertial_initializer.h"
 #include "imu/preintegration.h"
 #include "map_model/estimation/global_bundle_merge.h"
+#include "map_model/estimation/gravity_refinement_collect.h"
 #include "map_model/estimation/inertial_init_collect.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
@@ -103,40 +103,29 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
   ba.iterations_first = o.gravity_refinement_iterations;
   ba.iterations_second = 0;
   ba.num_threads = options_.ba.num_threads;
-  InertialBundleProblem problem;
-  GravityRefinementStat stat;
-  int change_index = 0;
   // A queued keyframe comes first (a monocular map gets its points only here); the next
   // keyframe tries again.
   if (HasQueued()) return;
+  std::optional<GravityRefinementProblem> problem;
   {
     auto lock = MapReader(*atlas_).Lock();
-    if (kf->IsBad() || kf->map() == nullptr) return;
-    const Map* map = kf->map();
-    const std::vector<KeyFrame*> chain = InertialChain::EndingAt(kf.get(), 0);
-    if (chain.size() < 2 || static_cast<int>(chain.size()) > o.gravity_refinement_max_keyframes) {
-      return;
-    }
-    std::vector<SO3d> orientations;
-    orientations.reserve(chain.size());
-    for (const KeyFrame* k : chain) orientations.push_back(k->world_from_body().so3());
-    stat.observability = TiltObservability(orientations);
-    const double due =
-        std::max(o.gravity_refinement_min,
-                 map->imu_status().gravity_refinement_observability + o.gravity_refinement_step);
-    if (stat.observability < due) return;
-    problem = CollectFullInertialBundle(kf.get(), ba, /*free_tilt=*/true);
-    change_index = map->change_index();
+    GravityRefinementRule rule;
+    rule.min_observability = o.gravity_refinement_min;
+    rule.step = o.gravity_refinement_step;
+    rule.max_keyframes = o.gravity_refinement_max_keyframes;
+    problem = CollectGravityRefinement(kf.get(), rule, ba);
   }
-  if (problem.edges.empty()) return;
+  if (!problem || problem->bundle.edges.empty()) return;
+  GravityRefinementStat stat;
+  stat.observability = problem->observability;
   stat.t_ns = kf->t_ns();
-  stat.keyframes = static_cast<int>(problem.edges.size()) + 1;
+  stat.keyframes = static_cast<int>(problem->bundle.edges.size()) + 1;
   const auto start = std::chrono::steady_clock::now();
   // A full inertial BA takes hundreds of ms, during which a monocular map gets no new points
   // (mono-inertial V1_02 replay with live timing: mapping busy 350 ms in a fast turn, inliers
   // 215 -> 31, tracking lost). Tracking may interrupt it like a local BA; the best iterate so
   // far is applied (each accepted iteration lowers the cost), or nothing if none was made.
-  const InertialBundleResult result = SolveInertialBundle(problem, ba, &abort_ba_, &work_);
+  const InertialBundleResult result = SolveInertialBundle(problem->bundle, ba, &abort_ba_, &work_);
   if (result.visual.aborted && result.visual.iterations == 0) {
     PKSLAM_LOG_DEBUG("gravity refinement at t = {:.2f} s interrupted before its first step",
                      kf->t_s());
@@ -146,7 +135,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
   {
     auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
     Map* map = kf->map();
-    if (map == nullptr || kf->IsBad() || map->change_index() != change_index) {
+    if (map == nullptr || kf->IsBad() || map->change_index() != problem->change_index) {
       // A loop correction or merge moved the map meanwhile: the result is stale; the next
       // keyframe tries again.
       PKSLAM_LOG_INFO("gravity refinement at t = {:.2f} s dropped: the map moved meanwhile",
@@ -155,25 +144,7 @@ void LocalMapper::RefineGravity(const KeyFramePtr& kf) {
       ++stats_.gravity_refinements_dropped;
       return;
     }
-    // Live or retired: the problem's first keyframe measures the tilt change either way.
-    const KeyFramePtr first_kf = map->FindKeyFrame(problem.visual.keyframes.front().keyframe_id);
-    PKSLAM_CHECK(first_kf != nullptr, "gravity refinement: keyframe {} left map {}",
-                 problem.visual.keyframes.front().keyframe_id, map->id());
-    const KeyFrame& first = *first_kf;
-    const Eigen::Vector3d up_before = first.camera_from_world().so3() * Eigen::Vector3d::UnitZ();
-    MergeGlobalBundle(
-        lock, map, problem.visual, [&] { ApplyInertialBundle(lock, map, problem, result); },
-        /*apply_sets_velocities=*/true);
-    const Eigen::Vector3d up_after = first.camera_from_world().so3() * Eigen::Vector3d::UnitZ();
-    stat.tilt_change_rad = std::atan2(up_after.cross(up_before).norm(), up_after.dot(up_before));
-    // Keyframes tracked while the BA ran continue from the newest estimate.
-    for (const auto& [id, other] : map->keyframes()) {
-      if (other->id() > kf->id() && !other->IsBad()) {
-        other->mutable_imu(lock).state.bias = kf->imu().state.bias;
-      }
-    }
-    map->mutable_imu_status().gravity_refinement_observability = stat.observability;
-    map->RecordWorldChange({});
+    stat.tilt_change_rad = ApplyGravityRefinement(lock, map, *kf, *problem, result);
     accel_bias = kf->imu().state.bias.accel;
   }
   stat.ms = WallMsSince(start);

@@ -82,7 +82,7 @@ Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<con
       "tracker needs an atlas, a vocabulary, a selector and local mapping");
   if (IsInertial(rig_->sensor)) {
     PKSLAM_CHECK(rig_->imu.has_value(), "inertial sensor without IMU noise model");
-    imu_ = std::make_unique<InertialTrackingState>(*rig_->imu);
+    imu_ = std::make_unique<InertialTracking>(*rig_->imu);
   }
 }
 
@@ -119,7 +119,7 @@ void Tracker::SetRig(const RigSetup& setup, const RigSetup& old_setup) {
   const RigWarp warp(old_setup, setup);
   rig_ = setup.rig;
   builder_.SetRig(rig_);
-  if (imu_) imu_->samples.SetNoise(*rig_->imu);
+  if (imu_) imu_->samples().SetNoise(*rig_->imu);
   if (last_.size() > 0 || last_.HasPose()) last_.Recalibrate(rig_, warp, new_from_old);
   if (two_view_.started()) two_view_.first().Recalibrate(rig_, warp, new_from_old);
   if (velocity_) velocity_ = new_from_old * *velocity_ * old_from_new;

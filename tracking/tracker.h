@@ -17,9 +17,9 @@
 #include "map_model/map_editor.h"
 #include "map_model/mapping_backend.h"
 #include "tracking/frame_builder.h"
+#include "tracking/inertial_tracking.h"
 #include "tracking/local_map.h"
 #include "tracking/map_initializer.h"
-#include "tracking/tracker_inertial.h"
 #include "tracking/tracking_options.h"
 
 namespace pkslam {
@@ -239,7 +239,7 @@ class Tracker {
   bool frame_tracks_enabled_ = false;
   std::vector<TraceRow> trace_;
   SelectorDecision last_decision_;
-  std::unique_ptr<InertialTrackingState> imu_;  // inertial sensors only
+  std::unique_ptr<InertialTracking> imu_;  // inertial sensors only
 };
 
 }  // namespace pkslam

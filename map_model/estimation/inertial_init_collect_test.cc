@@ -27,18 +27,7 @@ class InertialInitCollectTest : public ::testing::Test {
  protected:
   void SetUp() override {
     rig_ = testing::MakeStereoRig(Sensor::kStereoInertial);
-    rig_->imu = ImuNoise();
-    std::vector<SE3d> camera_from_world;
-    for (int k = 0; k < kNum; ++k) {
-      truth_.push_back(motion_.State(0.05 * k));
-      camera_from_world.push_back(truth_.back().world_from_body.Inverse());
-    }
-    map_ = testing::MakeMap(&atlas_, testing::MakeScene(300, 5), rig_, camera_from_world,
-                            testing::FrameOptions());
-    const auto samples =
-        SampleImu(motion_, 0, (kNum - 1) * 50'000'000LL, 5'000'000, bias_, *rig_->imu, nullptr);
-    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    testing::LinkWithImu(lock, map_.keyframes, samples, bias_, *rig_->imu);
+    truth_ = testing::MakeHelixChain(&atlas_, rig_, motion_, kNum, bias_, &map_);
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
 
