@@ -240,16 +240,7 @@ void LocalMapper::FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyr
   auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
   Map* map = atlas_->FindMap(problem.visual.map_id);
   if (kf->map() == nullptr || map == nullptr) return;
-  ApplyInertialBundle(lock, map, problem, result);
-  // Keyframes newer than the problem take the estimated biases too.
-  if (!result.biases.empty()) {
-    for (const auto& [id, other] : kf->map()->keyframes()) {
-      if (other->id() > kf->id()) other->mutable_imu(lock).state.bias = result.biases.front();
-    }
-  }
-  kf->map()->RecordWorldChange({});
-  // Every state moved: marginalisation priors of the local inertial BA are stale.
-  kf->map()->IncreaseChangeIndex();
+  ApplyFullInertialBundle(lock, map, *kf, problem, result);
 }
 
 bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
@@ -260,17 +251,7 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
     auto lock = MapEditor(atlas_).Write(MapEdit::kApplyInertialBundle);
     if (kf->IsBad() || kf->map() == nullptr || !kf->map()->imu_status().imu_initialized)
       return false;
-    // Keyframes created from frames tracked before the initialisation reached tracking have
-    // no estimated state yet: start them at their predecessor's.
-    std::vector<KeyFrame*> missing;
-    for (KeyFrame* k = kf.get(); k != nullptr && !k->imu().state.valid; k = k->imu().previous()) {
-      missing.push_back(k);
-    }
-    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
-      KeyFrame* k = *it;
-      if (k->imu().previous() == nullptr || !k->imu().previous()->imu().state.valid) break;
-      k->mutable_imu(lock).state = k->imu().previous()->imu().state;
-    }
+    StartMissingInertialStates(lock, kf.get());
   }
   {
     auto lock = MapReader(*atlas_).Lock();

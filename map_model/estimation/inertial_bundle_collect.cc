@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <unordered_map>
 #include <unordered_set>
+#include <vector>
 
 #include "core/util/error.h"
 #include "estimators/inertial/gravity_gauge.h"
@@ -211,6 +212,37 @@ void ApplyInertialBundle(const MapWriteLock& lock, Map* map, const InertialBundl
       continue;
     UpdateBias(from->imu().state.bias, reintegration, &*to->mutable_imu(lock).from_previous);
   }
+}
+
+int StartMissingInertialStates(const MapWriteLock& lock, KeyFrame* newest) {
+  PKSLAM_CHECK(lock.owns_lock(), "StartMissingInertialStates without the Atlas's write lock");
+  std::vector<KeyFrame*> missing;
+  for (KeyFrame* k = newest; k != nullptr && !k->imu().state.valid; k = k->imu().previous()) {
+    missing.push_back(k);
+  }
+  int started = 0;
+  for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+    KeyFrame* k = *it;
+    if (k->imu().previous() == nullptr || !k->imu().previous()->imu().state.valid) break;
+    k->mutable_imu(lock).state = k->imu().previous()->imu().state;
+    ++started;
+  }
+  return started;
+}
+
+void ApplyFullInertialBundle(const MapWriteLock& lock, Map* map, const KeyFrame& newest,
+                             const InertialBundleProblem& problem,
+                             const InertialBundleResult& result) {
+  ApplyInertialBundle(lock, map, problem, result);
+  Map* own = newest.map();
+  if (own == nullptr) return;
+  if (!result.biases.empty()) {
+    for (const auto& [id, other] : own->keyframes()) {
+      if (other->id() > newest.id()) other->mutable_imu(lock).state.bias = result.biases.front();
+    }
+  }
+  own->RecordWorldChange({});
+  own->IncreaseChangeIndex();
 }
 
 }  // namespace pkslam

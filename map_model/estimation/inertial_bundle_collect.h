@@ -31,4 +31,17 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
 void ApplyInertialBundle(const MapWriteLock& lock, Map* map, const InertialBundleProblem& problem,
                          const InertialBundleResult& result);
 
+// Keyframes created from frames tracked before the IMU initialisation reached tracking have no
+// estimated state yet: walking back from `newest` over those without one, each (oldest first)
+// starts from its predecessor's state. Returns how many got one.
+int StartMissingInertialStates(const MapWriteLock& lock, KeyFrame* newest);
+
+// A full inertial BA of `newest`'s chain written back (an IMU initialisation stage's): the
+// problem's values (ApplyInertialBundle), keyframes newer than `newest` take the estimated
+// (shared) bias, a world change is recorded for tracking, and the map's change index moves,
+// since every state moved (the local BA's marginalisation priors become stale).
+void ApplyFullInertialBundle(const MapWriteLock& lock, Map* map, const KeyFrame& newest,
+                             const InertialBundleProblem& problem,
+                             const InertialBundleResult& result);
+
 }  // namespace pkslam
