@@ -1,7 +1,10 @@
 // The tracking thread's logic (runs in the caller's thread, as in ORB-SLAM3): builds a Frame
 // from the images, initialises a map, tracks the camera against the last frame / reference
 // keyframe and the local map, asks the KeyframeSelector for keyframes and hands them to local
-// mapping. Owns its frames; touches the map model only under the Atlas mutex.
+// mapping. It keeps the state machine; the work is done by its parts (tracking/README.md:
+// map_initializer.h, frame_tracking.h, local_map.h, relocaliser.h, selector_snapshot.h,
+// keyframe_points.h, inertial_tracking.h). Owns its frames; touches the map model only under the
+// Atlas mutex.
 #pragma once
 
 #include <cstdint>
@@ -179,7 +182,8 @@ class Tracker {
   // The selector's view of the current frame (caller holds the Atlas lock, shared).
   SelectorInput BuildSelectorInput(bool mapping_idle) const;
   void CreateNewKeyFrame(const SelectorInput& input);
-  // Finds the frame's pose in the current map from BoW candidates (tracking/relocalization.cc).
+  // Finds the frame's pose in the current map (RelocaliseFrame, tracking/relocaliser.h), with
+  // the failure count that widens the place search (tracking/relocalization.cc).
   bool Relocalize();
   // Keyframes a lost map needs to be kept (else reset): options' for monocular maps, 0 else.
   int MinKeyFramesToKeepMap() const;
@@ -188,7 +192,7 @@ class Tracker {
   void StartOver();
   void RecordFrame(bool keyframe, double ms, double cpu_ms);
 
-  // --- inertial sensors (tracking/tracker_inertial.cc) ---
+  // --- inertial sensors (tracking/tracker_inertial.cc; the work: tracking/inertial_tracking.h) ---
   bool ImuReady() const;  // the current map's IMU is initialised (Atlas lock held)
   void PreintegrateImu();
   void SyncWithInertialMap();
