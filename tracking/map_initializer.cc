@@ -13,14 +13,6 @@
 #include "map_model/matching/orb_matcher.h"
 
 namespace pkslam {
-namespace {
-
-// A new point of `map` at `position` (world), with `reference` as its reference keyframe.
-MapPointPtr NewPoint(Atlas* atlas, Map* map, const Eigen::Vector3d& position, KeyFrame* reference) {
-  return std::make_shared<MapPoint>(atlas->NextMapPointId(), position, reference, map);
-}
-
-}  // namespace
 
 bool CanStartDepthMap(const Frame& frame, const TrackingOptions& options) {
   if (frame.size() <= options.min_features_stereo_init) return false;
@@ -43,7 +35,7 @@ DepthMapStart StartDepthMap(const MapWriteLock& lock, Atlas* atlas, const Vocabu
   for (int i = 0; i < frame->size(); ++i) {
     const auto p = frame->UnprojectStereo(i);
     if (!p) continue;
-    MapPointPtr mp = NewPoint(atlas, map, *p, kf);
+    auto mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), *p, kf, map);
     mp->AddObservation(kf, i);
     kf->AddMapPoint(mp, i);
     mp->ComputeDistinctiveDescriptor();
@@ -107,7 +99,8 @@ TwoViewKeyFrames CreateTwoViewMap(const MapWriteLock& lock, Atlas* atlas,
   for (std::size_t i = 0; i < matches.size(); ++i) {
     const int j = matches[i];
     if (j < 0) continue;
-    MapPointPtr mp = NewPoint(atlas, map, reconstruction.points[i], out.second.get());
+    auto mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), reconstruction.points[i],
+                                         out.second.get(), map);
     out.first->AddMapPoint(mp, static_cast<int>(i));
     out.second->AddMapPoint(mp, j);
     mp->AddObservation(out.first.get(), static_cast<int>(i));

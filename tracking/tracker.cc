@@ -367,7 +367,7 @@ void Tracker::StereoInitialization() {
   reference_kf_ = start.keyframe;
   current_.reference_kf = start.keyframe;
   inliers_ = start.points;
-  StartSelectorAtNewMap();
+  BeginTrackingNewMap();
 }
 
 int Tracker::MinKeyFramesToKeepMap() const {

@@ -162,7 +162,7 @@ class Tracker {
   // AttachImu as the map initialiser's callback.
   AttachKeyFrame AttachKeyFrameFunction();
   // A new map's first keyframe was made: the selector starts over from it, tracking is OK.
-  void StartSelectorAtNewMap();
+  void BeginTrackingNewMap();
   bool TrackReferenceKeyFrame();
   bool TrackWithMotionModel();
   bool TrackLocalMap();

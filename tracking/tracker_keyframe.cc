@@ -107,7 +107,7 @@ void Tracker::CreateInitialMapMonocular(const TwoViewResult& reconstruction) {
   inliers_ = map.second->TrackedMapPoints(1);
   last_ = two_view_.first();  // replaced by the current frame at the end of Track
   two_view_.Reset();
-  StartSelectorAtNewMap();
+  BeginTrackingNewMap();
 }
 
 AttachKeyFrame Tracker::AttachKeyFrameFunction() {
@@ -116,7 +116,7 @@ AttachKeyFrame Tracker::AttachKeyFrameFunction() {
   };
 }
 
-void Tracker::StartSelectorAtNewMap() {
+void Tracker::BeginTrackingNewMap() {
   selector_->Reset();
   SelectorInput input;
   input.frame_id = current_.id();
