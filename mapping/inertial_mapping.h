@@ -1,5 +1,6 @@
-// Options of local mapping's inertial work (mapping/local_mapper_inertial.cc): the staged IMU
-// initialisation of ORB-SLAM3 (../shared/docs/ORBSLAM3_FACTS.md "IMU") and local inertial BA.
+// Options of local mapping's inertial work (mapping/inertial_stages.h, local_mapper_inertial.cc):
+// the staged IMU initialisation of ORB-SLAM3 (../shared/docs/ORBSLAM3_FACTS.md "IMU") and local
+// inertial BA.
 //
 // Stages, per map: (1) once the temporal keyframe chain holds >= min_keyframes spanning
 // >= min_time_*_s: inertial-only MAP (estimators/inertial/inertial_initializer.h) over gravity

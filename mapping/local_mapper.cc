@@ -44,7 +44,14 @@ void LocalMappingOptions::Check() const {
 
 LocalMapper::LocalMapper(Atlas* atlas, std::shared_ptr<const CameraRig> rig,
                          LocalMappingOptions options)
-    : atlas_(atlas), rig_(std::move(rig)), options_(options) {
+    : atlas_(atlas),
+      rig_(std::move(rig)),
+      options_(options),
+      calibrator_(atlas, rig_->sensor, options_.calibration, options_.ba.num_threads),
+      inertial_stages_(
+          atlas, rig_->sensor, options_.inertial, options_.ba.num_threads,
+          InertialStageHooks{[this] { return HasQueued(); },
+                             [this] { return calibrator_.Running(); }, &abort_ba_, &work_}) {
   options_.Check();
 }
 
@@ -55,8 +62,7 @@ void LocalMapper::SetKeyFrameConsumer(std::function<void(const KeyFramePtr&)> co
 }
 
 void LocalMapper::SetCalibrationPrior(RigCalibration file, RigShape shape) {
-  calibration_prior_ = std::move(file);
-  rig_shape_ = std::move(shape);
+  calibrator_.SetPrior(std::move(file), std::move(shape));
 }
 
 void LocalMapper::Start() {
@@ -78,7 +84,7 @@ void LocalMapper::Finish() {
   paced_.notify_all();
   if (thread_.joinable()) {
     thread_.join();
-    StopCalibrationThread();  // the run's final adjustment follows (SlamSystem)
+    calibrator_.Stop();  // the run's final adjustment follows (SlamSystem)
   } else {
     // Never started: drain inline so every keyframe still gets processed.
     while (HasQueued()) ProcessNext();
@@ -145,11 +151,22 @@ void LocalMapper::EmulateLive(bool on, double pace, LiveClock clock) {
   emulate_live_ = on;
   live_pace_ = pace;
   live_clock_ = clock;
+  CalibrationPacing calibration;
+  calibration.paced = Paced();
   if (Paced()) {
     work_.SetPacer([this] { PaceToTracker(); });
+    calibration.position = [this] {
+      MutexLock lock(mutex_);
+      return LiveDataPosition{LiveReachedNs(),
+                              stop_requested_ || finish_requested_ || reset_requested_};
+    };
+    calibration.data_ns = [this](const WorkCounts& work) {
+      return DataNs(kReferenceWork.Seconds(work));
+    };
   } else {
     work_.SetPacer(nullptr);
   }
+  calibrator_.SetPacing(std::move(calibration));
 }
 
 void LocalMapper::NoteFrameTime(std::int64_t t_ns) {
@@ -242,7 +259,7 @@ void LocalMapper::RequestStop() {
   abort_ba_.store(true);
   // A merge would discard the adjustment's result. A paced one runs on: where it stopped would
   // depend on this machine's speed.
-  if (!Paced()) calibration_abort_.store(true);
+  if (!Paced()) calibrator_.Interrupt();
   wake_.notify_all();
   paced_.notify_all();
 }
@@ -261,8 +278,17 @@ void LocalMapper::Release() {
 }
 
 LocalMappingStats LocalMapper::stats() const {
-  MutexLock lock(mutex_);
-  return stats_;
+  LocalMappingStats stats;
+  {
+    MutexLock lock(mutex_);
+    stats = stats_;
+  }
+  stats.calibration_refinements = calibrator_.history();
+  InertialStagesStats inertial = inertial_stages_.stats();
+  stats.imu_stages = std::move(inertial.imu_stages);
+  stats.gravity_refinements = std::move(inertial.gravity_refinements);
+  stats.gravity_refinements_dropped = inertial.gravity_refinements_dropped;
+  return stats;
 }
 
 void LocalMapper::Run() {
@@ -274,7 +300,7 @@ void LocalMapper::Run() {
     }
     if (reset_requested_) {
       lock.unlock();
-      StopCalibrationThread();  // its map is about to go
+      calibrator_.Stop();  // its map is about to go
       lock.lock();
       live_free_ns_ = std::numeric_limits<std::int64_t>::min();
       queue_.clear();

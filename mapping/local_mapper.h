@@ -16,7 +16,6 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
-#include <future>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -36,7 +35,8 @@
 #include "map_model/mapping_backend.h"
 #include "mapping/calibration_refinement.h"
 #include "mapping/inertial_mapping.h"
-#include "mapping/inertial_motion_clock.h"
+#include "mapping/inertial_stages.h"
+#include "mapping/online_calibrator.h"
 #include "mapping/recent_points.h"
 
 namespace pkslam {
@@ -66,25 +66,6 @@ struct LocalMappingOptions {
   OnlineCalibrationOptions calibration;
 
   void Check() const;
-};
-
-// The map's keyframe chain right after one IMU initialisation stage (its full visual-inertial
-// BA included), for evaluation against ground truth (scale, gravity, biases per stage).
-struct ImuStageSnapshot {
-  std::int64_t t_ns = 0;  // the keyframe that triggered the stage
-  int stage = 0;          // 0 initialisation, 1 VIBA1, 2 VIBA2
-  double scale = 1.0;     // the scale the inertial-only step applied
-  ImuBias bias;
-  std::vector<std::pair<std::int64_t, SE3d>> world_from_body;  // chain keyframes, oldest first
-};
-
-// One gravity refinement (estimators/inertial/gravity_gauge.h).
-struct GravityRefinementStat {
-  std::int64_t t_ns = 0;       // the keyframe that triggered it
-  int keyframes = 0;           // chain keyframes in the BA
-  double observability = 0;    // TiltObservability of the chain
-  double tilt_change_rad = 0;  // how far gravity moved, seen from the first keyframe
-  double ms = 0;
 };
 
 struct LocalMappingStats {
@@ -154,8 +135,8 @@ class LocalMapper : public MappingBackend {
   void InsertKeyFrame(const KeyFramePtr& kf) override;
   bool AcceptsKeyFrames() const override { return accept_keyframes_.load(); }
   bool IsStoppedOrStopRequested() const override;
-  bool IsInitializingImu() const override { return initializing_imu_.load(); }
-  bool TakeSlowMotionFlag() override { return slow_motion_.exchange(false); }
+  bool IsInitializingImu() const override { return inertial_stages_.initializing(); }
+  bool TakeSlowMotionFlag() override { return inertial_stages_.TakeSlowMotionFlag(); }
   int QueueSize() const override;
   bool QueueFull() const override;
   void InterruptBundleAdjustment() override { abort_ba_.store(true); }
@@ -195,10 +176,10 @@ class LocalMapper : public MappingBackend {
   // thread with no map lock held: before each step that changes the map and after each solver
   // iteration (the work meter's pacer). No-op otherwise.
   void PaceToTracker();
-  // PaceToTracker, then a calibration adjustment due by then (ApplyDueCalibration).
+  // PaceToTracker, then a calibration adjustment due by then (OnlineCalibrator::ApplyDue).
   void StepBoundary() {
     PaceToTracker();
-    ApplyDueCalibration();
+    calibrator_.ApplyDue();
   }
   // Live emulation: the data time the current keyframe's processing has reached.
   std::int64_t LiveReachedNs() const PKSLAM_REQUIRES(mutex_);
@@ -211,55 +192,9 @@ class LocalMapper : public MappingBackend {
   void LocalBundleAdjustment(const KeyFramePtr& kf);
   void CullKeyFrames(const KeyFramePtr& kf);
 
-  // --- inertial sensors (mapping/local_mapper_inertial.cc) ---
-  // IMU initialisation stages (first, VIBA1, VIBA2) when due.
-  void InertialStep(const KeyFramePtr& kf);
-  bool InitializeImu(const KeyFramePtr& kf, double gyro_prior, double accel_prior, int stage);
-  void FullInertialBundleAdjustment(const KeyFramePtr& kf, double gyro_prior, double accel_prior);
-  // Local inertial BA once the map's IMU is initialised; false if it did not apply (then the
-  // visual local BA runs).
+  // Local inertial BA once the map's IMU is initialised (mapping/local_mapper_inertial.cc);
+  // false if it did not apply (then the visual local BA runs).
   bool LocalInertialBundleAdjustment(const KeyFramePtr& kf);
-  // Gravity refinement when due (InertialMappingOptions::gravity_refinement).
-  void RefineGravity(const KeyFramePtr& kf);
-  // --- online calibration (mapping/local_mapper_calibration.cc) ---
-  // One calibration adjustment: gathered in the keyframe step, then solved and applied.
-  struct CalibrationJob {
-    KeyFramePtr kf;  // the keyframe that triggered it
-    CalibrationBundleProblem problem;
-    CalibrationRefinementStat stat;
-    RigSetup setup;        // the rig it was gathered with
-    int change_index = 0;  // its map's change index then
-  };
-  // A solved adjustment waiting to be applied.
-  struct SolvedCalibration {
-    CalibrationJob job;
-    CalibrationBundleResult result;
-    RigSetup next;  // the rig of the estimate (built outside the map lock)
-    std::chrono::steady_clock::time_point start;
-  };
-  // A calibration bundle adjustment of kf's map when due (OnlineCalibrationOptions): started in
-  // the calibration thread (own_thread) or run inside the step.
-  void RefineCalibration(const KeyFramePtr& kf);
-  // Solves `job`; nullopt when there is nothing to apply (the stats say why). `abort`: the flag
-  // that interrupts the solve; `work`: the meter it counts on (nullptr: none).
-  std::optional<SolvedCalibration> SolveCalibration(CalibrationJob job,
-                                                    const std::atomic<bool>* abort,
-                                                    WorkMeter* work);
-  // Applies a solved adjustment unless the map or the rig was replaced meanwhile.
-  void ApplySolvedCalibration(SolvedCalibration solved);
-  // Live emulation on the work clock with own_thread: applies the adjustment solving in the
-  // calibration thread once local mapping's data time has passed the data time it was started
-  // at plus its solve's work on the reference machine (waiting for the solve if this machine is
-  // slower), so where it lands does not depend on this machine's speed. Mapping thread, at its
-  // step boundaries.
-  void ApplyDueCalibration();
-  // Whether an adjustment started and has not ended (paced: not yet applied or dropped).
-  bool CalibrationOutstanding() const;
-  // Adds an adjustment's record to the stats with its note and its wall time since `start`.
-  void RecordCalibration(CalibrationRefinementStat stat, std::string note,
-                         std::chrono::steady_clock::time_point start);
-  void JoinCalibrationThread();  // waits for the calibration thread, if any
-  void StopCalibrationThread();  // interrupts it, waits, and drops a paced result
 
   Atlas* atlas_;
   std::shared_ptr<const CameraRig> rig_;
@@ -304,45 +239,16 @@ class LocalMapper : public MappingBackend {
 
   std::atomic<bool> accept_keyframes_{true};
   std::atomic<bool> abort_ba_{false};
-  std::atomic<bool> initializing_imu_{false};
-  // Raised by InertialStep, taken by tracking (MappingBackend::TakeSlowMotionFlag).
-  std::atomic<bool> slow_motion_{false};
 
   // Owned by the mapping thread: points created recently, checked by CullRecentPoints.
   RecentPoints recent_points_;
-  // Owned by the mapping thread: the motion time and ORB-SLAM3 v0.3's mTinit of the current
-  // inertial map (mapping/inertial_motion_clock.h).
-  InertialMotionClock motion_clock_;
 
-  // Online calibration: set before Start(), read-only afterwards.
-  RigCalibration calibration_prior_;
-  RigShape rig_shape_;
-  // Owned by the mapping thread: the map the calibration schedule follows and the span (s) at
-  // which its next adjustment is due.
-  const Map* calibration_map_ = nullptr;
-  double calibration_due_s_ = 0;
-  // The calibration thread (OnlineCalibrationOptions::own_thread), one adjustment at a time:
-  // started and joined by the mapping thread; the reset stops it before the queue is cleared,
-  // Finish after the mapping thread has ended. It writes the map under the map's write lock and
-  // the stats and the retry under mutex_; `calibration_running_` is true from its start until
-  // its job has ended, `calibration_abort_` interrupts its solve (reset, Finish; RequestStop
-  // unless paced).
-  std::thread calibration_thread_;
-  std::atomic<bool> calibration_running_{false};
-  std::atomic<bool> calibration_abort_{false};
-  // Paced (live emulation on the work clock): the thread only solves, counting on
-  // calibration_work_, and hands the result over through calibration_solved_; the mapping
-  // thread owns the rest and applies it (ApplyDueCalibration). RequestStop does not interrupt
-  // a paced solve (where it stopped would depend on this machine's speed); a loop correction
-  // meanwhile is met by applying the calibration only.
-  WorkMeter calibration_work_;
-  std::future<std::optional<SolvedCalibration>> calibration_solved_;
-  bool calibration_pending_ = false;  // a paced job started, not yet applied or dropped
-  std::int64_t calibration_start_ns_ = 0;  // the data time it started at
-  WorkCounts calibration_work_start_{};    // calibration_work_ then
-  // Set when an adjustment was not applied because the map moved meanwhile: the span at which
-  // the next keyframe tries again.
-  std::optional<double> calibration_retry_s_ PKSLAM_GUARDED_BY(mutex_);
+  // Online calibration's schedule and thread (mapping/online_calibrator.h), driven by the
+  // mapping thread; Finish and the reset stop it.
+  OnlineCalibrator calibrator_;
+  // The IMU initialisation stages and gravity refinement (mapping/inertial_stages.h), driven
+  // by the mapping thread.
+  InertialStages inertial_stages_;
 
   std::thread thread_;
 };

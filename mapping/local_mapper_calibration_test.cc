@@ -7,10 +7,8 @@
 #include <memory>
 #include <thread>
 
-#include "core/sensor/test_rig_calibration.h"
 #include "map_model/keyframe.h"
-#include "map_model/map_editor.h"
-#include "map_model/testing/synthetic_map.h"
+#include "mapping/calibration_test_map.h"
 #include "mapping/local_mapper.h"
 
 namespace pkslam {
@@ -18,24 +16,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Twelve keyframes of a stereo map built in the rectified camera of the EuRoC calibration,
-// which the Atlas and the mapper's prior hold (12 x 50 ms of data).
-struct CalibrationMapFixture {
-  CalibrationMapFixture() {
-    file = testing::EurocRigCalibration();
-    shape.sensor = Sensor::kStereo;
-    shape.pyramid = ScalePyramid(8, 1.2);
-    setup = BuildRig(file, shape);
-    {
-      auto lock = MapEditor(&atlas).Write(MapEdit::kFixture);
-      atlas.SetCalibration(file, setup);
-    }
-    testing::FrameOptions frames;
-    frames.pixel_noise = 0.5;
-    map = testing::MakeMap(&atlas, testing::MakeScene(600, 11), setup.rig,
-                           testing::MakeForwardPath(12, 0.15, 3), frames);
-  }
-
+// The calibration test map, with a mapper that calibrates it.
+struct CalibrationMapFixture : testing::CalibrationTestMap {
   // A started mapper with online calibration due from the start (0.1 s of data). `paced`: live
   // emulation on the work clock, tracking far ahead (so pacing never waits for it).
   std::unique_ptr<LocalMapper> StartMapper(bool own_thread, bool paced = false) {
@@ -51,12 +33,6 @@ struct CalibrationMapFixture {
     if (paced) mapper->NoteFrameTime(std::numeric_limits<std::int64_t>::max() / 2);
     return mapper;
   }
-
-  Atlas atlas;
-  RigCalibration file;
-  RigShape shape;
-  RigSetup setup;
-  testing::SyntheticMap map;
 };
 
 class LocalMapperCalibrationTest : public ::testing::Test {
@@ -147,7 +123,6 @@ TEST_F(LocalMapperCalibrationTest, AResetOrFinishWhileItSolvesEndsItCleanly) {
   ASSERT_EQ(adjustments.size(), 1u);  // recorded however it ended
   EXPECT_FALSE(adjustments[0].note.empty() && !adjustments[0].applied);
 }
-
 
 TEST_F(LocalMapperCalibrationTest, PacedTheAdjustmentLandsAtTheSameStepOnAnyMachine) {
   // Applied by local mapping once its data time passes the start plus the solve's work priced

@@ -64,9 +64,12 @@ void LocalMapper::ProcessNext() {
     if (options_.cull_keyframes) CullKeyFrames(kf);
   }
   StepBoundary();
-  if (IsInertial(rig_->sensor) && !IsStoppedOrStopRequested()) InertialStep(kf);
+  if (IsInertial(rig_->sensor) && !IsStoppedOrStopRequested()) inertial_stages_.Step(kf);
   StepBoundary();
-  if (options_.calibration.enabled && !IsStoppedOrStopRequested()) RefineCalibration(kf);
+  if (options_.calibration.enabled && !IsStoppedOrStopRequested()) {
+    calibrator_.Step(kf, HasQueued(), !options_.calibration.own_thread || !thread_.joinable(),
+                     &abort_ba_, &work_);
+  }
   StepBoundary();
   {
     MutexLock lock(mutex_);

@@ -200,7 +200,7 @@ TrackResult Tracker::Track(Frame frame) {
       frame_wait_ms;
   RecordFrame(new_keyframe, ms, 1e3 * (ThreadCpuSeconds() - cpu_start));
   records_.back().visual_odometry =
-      options_.localise_only && visual_odometry_ && state_ == TrackingState::kOk;
+      options_.localise_only && localisation_.visual_odometry() && state_ == TrackingState::kOk;
   result.state = state_;
   result.new_keyframe = new_keyframe;
   result.inliers = inliers_;

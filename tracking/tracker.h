@@ -2,9 +2,9 @@
 // from the images, initialises a map, tracks the camera against the last frame / reference
 // keyframe and the local map, asks the KeyframeSelector for keyframes and hands them to local
 // mapping. It keeps the state machine; the work is done by its parts (tracking/README.md:
-// map_initializer.h, frame_tracking.h, local_map.h, relocaliser.h, selector_snapshot.h,
-// keyframe_points.h, inertial_tracking.h). Owns its frames; touches the map model only under the
-// Atlas mutex.
+// map_initializer.h, frame_tracking.h, local_map.h, relocaliser.h, localisation_tracking.h,
+// selector_snapshot.h, keyframe_points.h, inertial_tracking.h). Owns its frames; touches the map
+// model only under the Atlas mutex.
 #pragma once
 
 #include <cstdint>
@@ -22,6 +22,7 @@
 #include "tracking/frame_builder.h"
 #include "tracking/inertial_tracking.h"
 #include "tracking/local_map.h"
+#include "tracking/localisation_tracking.h"
 #include "tracking/map_initializer.h"
 #include "tracking/tracking_options.h"
 
@@ -45,7 +46,7 @@ struct FrameRecord {
   std::optional<SE3d> camera_from_world_online;
   bool keyframe = false;
   // Localisation only: the pose came from visual odometry against the previous frame, not
-  // from the loaded map's points (TrackLocalisationOnly).
+  // from the loaded map's points (tracking/localisation_tracking.h).
   bool visual_odometry = false;
   // Wall time from image to pose: building the frame (ORB extraction, stereo matching) and
   // tracking it, as ORB-SLAM3's examples time Track*(); live-emulation waits excluded.
@@ -120,7 +121,7 @@ class Tracker {
   // frames.
   void SetLocaliseOnly(bool on) {
     options_.localise_only = on;
-    visual_odometry_ = false;
+    localisation_.Restart();
   }
   bool localise_only() const { return options_.localise_only; }
   // The last frame's pose inliers (map point id, undistorted left-image pixel); empty when it
@@ -166,16 +167,12 @@ class Tracker {
   bool TrackReferenceKeyFrame();
   bool TrackWithMotionModel();
   bool TrackLocalMap();
-  // Localisation only: motion model or reference keyframe while tracked, relocalisation
-  // otherwise, then the local map; sets state_ (kOk or kLost). Atlas lock held (shared).
+  // Localisation only (localisation_ chooses between the moves); sets state_ (kOk or kLost).
+  // Atlas lock held (shared).
   bool TrackLocalisationOnly();
-  // Inlier matches of `frame`: to map points only (temporary visual-odometry points have no
-  // observations), or all.
-  static int InlierMatches(const Frame& frame, bool map_only);
+  // The last frame's pose moves with its reference keyframe; localisation only (stereo/RGB-D),
+  // it gets visual-odometry points.
   void UpdateLastFrame();
-  // Localisation only (stereo/RGB-D): temporary points from the last frame's depth for the
-  // keypoints without a map point, so the motion model can track where the map has none.
-  void AddVisualOdometryPoints();
   // The local map's search radius for this frame (pixels at level 0).
   double LocalSearchRadius() const;
   // `mapping_idle`: whether local mapping takes keyframes at this frame's time.
@@ -232,10 +229,8 @@ class Tracker {
   int failed_relocalisations_ = 0;  // in a row; reset by a success (Relocalize)
 
   LocalMap local_map_;  // rebuilt every frame
-  // Temporal stereo points created for the last frame (not in the map).
-  // Localisation only: the last frame was tracked by visual odometry (too few map points in
-  // view); tracking goes on from it while relocalisation is tried on every frame.
-  bool visual_odometry_ = false;
+  // Localisation only: map or visual odometry (tracking/localisation_tracking.h).
+  LocalisationTracking localisation_;
 
   std::vector<FrameRecord> records_;
   bool trace_enabled_ = false;

@@ -9,10 +9,12 @@
 #include "map_model/map.h"
 #include "map_model/map_point.h"
 #include "tracking/frame_tracking.h"
+#include "tracking/localisation_tracking.h"
 #include "tracking/pose_optimizer.h"
 #include "tracking/tracker.h"
 
 namespace pkslam {
+
 bool Tracker::TrackReferenceKeyFrame() {
   if (!reference_kf_ || reference_kf_->IsBad()) return false;
   const ReferenceMatching matching{options_.reference_kf_ratio, options_.min_matches_reference_kf};
@@ -21,45 +23,14 @@ bool Tracker::TrackReferenceKeyFrame() {
   return in_map && *in_map >= 10;
 }
 
-int Tracker::InlierMatches(const Frame& frame, bool map_only) {
-  int n = 0;
-  for (int i = 0; i < frame.size(); ++i) {
-    const auto& mp = frame.map_points[i];
-    const bool outlier = i < static_cast<int>(frame.outliers.size()) && frame.outliers[i];
-    if (mp && !outlier && (!map_only || mp->NumObservations() > 0)) ++n;
-  }
-  return n;
-}
-
 void Tracker::UpdateLastFrame() {
   // The reference keyframe may have moved (local BA) since the last frame was tracked.
   const FrameRecord& record = records_.back();
   if (record.reference && !record.reference->IsBad()) {
     last_.SetPose(record.camera_from_reference * record.reference->camera_from_world());
   }
-  if (options_.localise_only && !IsMonocular(rig_->sensor)) AddVisualOdometryPoints();
-}
-
-void Tracker::AddVisualOdometryPoints() {
-  // The closest keypoints with depth that have no map point: all closer than th_depth, and at
-  // least max_temporal_points of them (ORB-SLAM's UpdateLastFrame does the same in its
-  // localisation mode).
-  std::vector<std::pair<float, int>> by_depth;
-  for (int i = 0; i < last_.size(); ++i) {
-    if (!last_.HasDepth(i)) continue;
-    const auto& mp = last_.map_points[i];
-    if (mp && mp->NumObservations() > 0) continue;
-    by_depth.emplace_back(last_.depth()[i], i);
-  }
-  std::sort(by_depth.begin(), by_depth.end());
-  int added = 0;
-  for (const auto& [depth, i] : by_depth) {
-    if (depth > rig_->th_depth && added >= options_.max_temporal_points) break;
-    const auto world = last_.UnprojectStereo(i);
-    if (!world) continue;
-    last_.map_points[i] = MapPoint::Temporary(*world, last_.descriptors()[i]);
-    if (i < static_cast<int>(last_.outliers.size())) last_.outliers[i] = 0;
-    ++added;
+  if (options_.localise_only && !IsMonocular(rig_->sensor)) {
+    AddVisualOdometryPoints(rig_->th_depth, options_.max_temporal_points, &last_);
   }
 }
 
@@ -72,7 +43,7 @@ bool Tracker::TrackWithMotionModel() {
   if (n < options_.min_matches_motion_model) return false;
   const int in_map = OptimizeAndDiscard(options_.pose, &current_);
   if (options_.localise_only && !mono) {
-    // Localisation: temporary visual-odometry points count too (TrackLocalisationOnly decides
+    // Localisation: temporary visual-odometry points count too (LocalisationTracking decides
     // whether the map or odometry placed the frame); ORB-SLAM asks for 20 matches in all.
     return in_map >= 10 || InlierMatches(current_, /*map_only=*/false) >= 20;
   }

@@ -1,7 +1,7 @@
 // Gravity-preserving (4-DoF) pieces of the inertial loop correction (issue 7).
 //
 // In an inertial map whose IMU is initialised the world frame is gravity-aligned: gravity is
-// (0, 0, -g) (mapping/local_mapper_inertial.cc rotates the map by world_from_gravity^-1 at the
+// (0, 0, -g) (mapping/inertial_stages.cc rotates the map by world_from_gravity^-1 at the
 // initialisation; the inertial BAs keep gravity_world = (0, 0, -g)). Roll and pitch of every
 // keyframe are then observable through the accelerometer and must not be changed by a loop
 // correction: only yaw (a rotation about the world z axis) and translation are free.
