@@ -87,59 +87,51 @@ void PrintStats(const char* name, const dense::DistanceStats& s) {
   fmt::print("\n");
 }
 
-void RunCompare(const CompareArgs& args) {
-  args.compare.Check();
-  if (!args.dataset.empty() && args.align_run.empty()) {
-    throw OptionError("--dataset (restricted completeness) needs --align-run and --gt");
-  }
-  // A mesh (a PLY with faces, e.g. `pkslam dense --mesh`) is measured through points sampled
-  // uniformly on its triangles.
-  PointCloud cloud;
-  if (dense::PlyHasFaces(args.cloud)) {
-    cloud = dense::SampleMesh(args.cloud, args.mesh_spacing_m);
-    fmt::print("mesh: {} points sampled on its triangles ({} m spacing)\n", cloud.size(),
-               args.mesh_spacing_m);
-  } else {
-    cloud = ReadPly(args.cloud);
-  }
-  const PointCloud ref = ReadPly(args.ref);
-  if (cloud.empty()) throw InputError(args.cloud, "the cloud has no points");
-  if (ref.empty()) throw InputError(args.ref, "the reference cloud has no points");
+// The cloud to measure: a PLY's points, or points sampled on a mesh's triangles (a PLY with
+// faces, e.g. `pkslam dense --mesh`).
+PointCloud ReadCloud(const CompareArgs& args) {
+  if (!dense::PlyHasFaces(args.cloud)) return ReadPly(args.cloud);
+  PointCloud cloud = dense::SampleMesh(args.cloud, args.mesh_spacing_m);
+  fmt::print("mesh: {} points sampled on its triangles ({} m spacing)\n", cloud.size(),
+             args.mesh_spacing_m);
+  return cloud;
+}
 
-  std::optional<Alignment> alignment;
-  if (!args.align_run.empty()) {
-    alignment = AlignRun(args);
-    for (auto& p : cloud.points) {
-      p = (alignment->ref_from_slam * p.cast<double>()).cast<float>();
-    }
-    fmt::print("aligned by {} ({} pose pairs of {}): trajectory ATE rmse {:.4f} m, scale {:.4f}\n",
-               args.align, alignment->evaluation.pairs.size(), alignment->estimate.string(),
-               alignment->evaluation.ate_translation_m.rmse, alignment->ref_from_slam.scale());
-    if (!args.write_aligned.empty()) {
-      WritePly(cloud, args.write_aligned, cloud.has_colour() ? PlyColour::kRgb : PlyColour::kNone,
-               "pkslam cloud-compare: cloud aligned to the reference frame");
-    }
+// --align-run: moves the cloud into the reference's frame by the run's trajectory alignment.
+std::optional<Alignment> AlignCloud(const CompareArgs& args, PointCloud* cloud) {
+  if (args.align_run.empty()) return std::nullopt;
+  Alignment alignment = AlignRun(args);
+  for (auto& p : cloud->points) {
+    p = (alignment.ref_from_slam * p.cast<double>()).cast<float>();
   }
-
-  std::vector<std::uint8_t> visible;
-  if (!args.dataset.empty()) {
-    const fs::path keyframes_file = fs::path(args.align_run) / "keyframes.txt";
-    const Trajectory keyframes = ReadTrajectory(keyframes_file, TrajectoryFormat::kTum);
-    const auto source = dense::KeyframeImageSource::Open(
-        args.dataset,
-        args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings));
-    std::vector<SE3d> camera_from_ref;
-    const Sim3d& s = alignment->ref_from_slam;
-    for (const StampedPose& kf : keyframes.poses) {
-      const SE3d ref_from_camera(s.so3() * kf.pose.so3(), s * kf.pose.translation());
-      camera_from_ref.push_back(ref_from_camera.Inverse());
-    }
-    visible =
-        dense::VisibleFromCameras(ref.points, camera_from_ref, source.camera(), args.visibility);
+  fmt::print("aligned by {} ({} pose pairs of {}): trajectory ATE rmse {:.4f} m, scale {:.4f}\n",
+             args.align, alignment.evaluation.pairs.size(), alignment.estimate.string(),
+             alignment.evaluation.ate_translation_m.rmse, alignment.ref_from_slam.scale());
+  if (!args.write_aligned.empty()) {
+    WritePly(*cloud, args.write_aligned, cloud->has_colour() ? PlyColour::kRgb : PlyColour::kNone,
+             "pkslam cloud-compare: cloud aligned to the reference frame");
   }
+  return alignment;
+}
 
-  const dense::CompareResult r =
-      dense::CompareClouds(cloud.points, ref.points, args.compare, visible, ref.normals);
+// --dataset: which reference points the run's keyframes saw (empty without it).
+std::vector<std::uint8_t> VisibleReferencePoints(const CompareArgs& args,
+                                                 const Alignment& alignment,
+                                                 const PointCloud& ref) {
+  const fs::path keyframes_file = fs::path(args.align_run) / "keyframes.txt";
+  const Trajectory keyframes = ReadTrajectory(keyframes_file, TrajectoryFormat::kTum);
+  const auto source = dense::KeyframeImageSource::Open(
+      args.dataset, args.settings.empty() ? std::nullopt : std::optional<fs::path>(args.settings));
+  std::vector<SE3d> camera_from_ref;
+  const Sim3d& s = alignment.ref_from_slam;
+  for (const StampedPose& kf : keyframes.poses) {
+    const SE3d ref_from_camera(s.so3() * kf.pose.so3(), s * kf.pose.translation());
+    camera_from_ref.push_back(ref_from_camera.Inverse());
+  }
+  return dense::VisibleFromCameras(ref.points, camera_from_ref, source.camera(), args.visibility);
+}
+
+void PrintComparison(const CompareArgs& args, const dense::CompareResult& r, bool aligned) {
   fmt::print("cloud {} ({} points), reference {} ({} points)\n", args.cloud, r.cloud_points,
              args.ref, r.ref_points);
   PrintStats("accuracy", r.accuracy);
@@ -150,7 +142,7 @@ void RunCompare(const CompareArgs& args) {
   // A SLAM cloud lives in the run's map frame: compared unaligned with a reference in the
   // ground truth's frame, every number above is meaningless. Say so instead of letting a
   // 0% completeness pass for a result.
-  if (!alignment && r.accuracy.median > 0.25) {
+  if (!aligned && r.accuracy.median > 0.25) {
     fmt::print(
         "warning: the median distance to the reference is {:.2f} m: the cloud is probably not "
         "in the reference's frame; pass --align-run RUN --gt GROUND_TRUTH\n",
@@ -164,12 +156,17 @@ void RunCompare(const CompareArgs& args) {
         100.0 * static_cast<double>(*r.subset_points) / static_cast<double>(r.ref_points),
         args.visibility.min_depth_m, args.visibility.max_depth_m);
   }
+}
 
-  struct ObservedCompleteness {
-    std::string ref;
-    std::size_t points = 0;
-    double completeness = 0;
-  };
+// Completeness against a reference of the observed surfaces only (--observed-ref).
+struct ObservedCompleteness {
+  std::string ref;
+  std::size_t points = 0;
+  double completeness = 0;
+};
+
+std::vector<ObservedCompleteness> MeasureObservedCompleteness(const CompareArgs& args,
+                                                              const PointCloud& cloud) {
   std::vector<ObservedCompleteness> observed;
   for (const std::string& file : args.observed_refs) {
     const PointCloud ref_observed = ReadPly(file);
@@ -180,63 +177,86 @@ void RunCompare(const CompareArgs& args) {
     fmt::print("completeness  {:.1f}% of the {} points of {} (observed surfaces)\n",
                100 * observed.back().completeness, observed.back().points, file);
   }
+  return observed;
+}
 
-  if (!args.json.empty()) {
-    JsonWriter json;
+void WriteComparisonJson(const CompareArgs& args, const dense::CompareResult& r,
+                         const std::optional<Alignment>& alignment,
+                         const std::vector<ObservedCompleteness>& observed) {
+  JsonWriter json;
+  json.BeginObject();
+  json.Member("cloud", args.cloud);
+  json.Member("ref", args.ref);
+  json.Member("cloud_points", static_cast<std::uint64_t>(r.cloud_points));
+  json.Member("ref_points", static_cast<std::uint64_t>(r.ref_points));
+  json.Key("alignment");
+  if (alignment) {
     json.BeginObject();
-    json.Member("cloud", args.cloud);
-    json.Member("ref", args.ref);
-    json.Member("cloud_points", static_cast<std::uint64_t>(r.cloud_points));
-    json.Member("ref_points", static_cast<std::uint64_t>(r.ref_points));
-    json.Key("alignment");
-    if (alignment) {
-      json.BeginObject();
-      json.Member("method", args.align);
-      json.Member("run", args.align_run);
-      json.Member("gt", args.gt);
-      json.Member("pairs", static_cast<std::uint64_t>(alignment->evaluation.pairs.size()));
-      json.Member("trajectory_ate_rmse_m", alignment->evaluation.ate_translation_m.rmse);
-      json.Member("scale", alignment->ref_from_slam.scale());
-      json.EndObject();
-    } else {
-      json.Null();
-    }
-    json.Key("accuracy");
-    dense::WriteDistanceStatsJson(r.accuracy, json);
-    json.Key("surface_accuracy");
-    if (r.surface_accuracy) {
-      dense::WriteDistanceStatsJson(*r.surface_accuracy, json);
-    } else {
-      json.Null();
-    }
-    json.Key("reference_to_cloud");
-    dense::WriteDistanceStatsJson(r.reference_to_cloud, json);
-    json.Member("completeness_threshold_m", args.compare.completeness_m);
-    json.Member("completeness", r.completeness);
-    json.Key("completeness_visible");
-    if (r.subset_completeness) {
-      json.BeginObject();
-      json.Member("visible_ref_points", static_cast<std::uint64_t>(*r.subset_points));
-      json.Member("completeness", *r.subset_completeness);
-      json.Member("min_depth_m", args.visibility.min_depth_m);
-      json.Member("max_depth_m", args.visibility.max_depth_m);
-      json.Member("occlusion_tolerance_m", args.visibility.occlusion_tolerance_m);
-      json.EndObject();
-    } else {
-      json.Null();
-    }
-    json.Key("completeness_observed").BeginArray();
-    for (const ObservedCompleteness& o : observed) {
-      json.BeginObject();
-      json.Member("ref", o.ref);
-      json.Member("ref_points", static_cast<std::uint64_t>(o.points));
-      json.Member("completeness", o.completeness);
-      json.EndObject();
-    }
-    json.EndArray();
+    json.Member("method", args.align);
+    json.Member("run", args.align_run);
+    json.Member("gt", args.gt);
+    json.Member("pairs", static_cast<std::uint64_t>(alignment->evaluation.pairs.size()));
+    json.Member("trajectory_ate_rmse_m", alignment->evaluation.ate_translation_m.rmse);
+    json.Member("scale", alignment->ref_from_slam.scale());
     json.EndObject();
-    WriteFileAtomically(args.json, json.str());
+  } else {
+    json.Null();
   }
+  json.Key("accuracy");
+  dense::WriteDistanceStatsJson(r.accuracy, json);
+  json.Key("surface_accuracy");
+  if (r.surface_accuracy) {
+    dense::WriteDistanceStatsJson(*r.surface_accuracy, json);
+  } else {
+    json.Null();
+  }
+  json.Key("reference_to_cloud");
+  dense::WriteDistanceStatsJson(r.reference_to_cloud, json);
+  json.Member("completeness_threshold_m", args.compare.completeness_m);
+  json.Member("completeness", r.completeness);
+  json.Key("completeness_visible");
+  if (r.subset_completeness) {
+    json.BeginObject();
+    json.Member("visible_ref_points", static_cast<std::uint64_t>(*r.subset_points));
+    json.Member("completeness", *r.subset_completeness);
+    json.Member("min_depth_m", args.visibility.min_depth_m);
+    json.Member("max_depth_m", args.visibility.max_depth_m);
+    json.Member("occlusion_tolerance_m", args.visibility.occlusion_tolerance_m);
+    json.EndObject();
+  } else {
+    json.Null();
+  }
+  json.Key("completeness_observed").BeginArray();
+  for (const ObservedCompleteness& o : observed) {
+    json.BeginObject();
+    json.Member("ref", o.ref);
+    json.Member("ref_points", static_cast<std::uint64_t>(o.points));
+    json.Member("completeness", o.completeness);
+    json.EndObject();
+  }
+  json.EndArray();
+  json.EndObject();
+  WriteFileAtomically(args.json, json.str());
+}
+
+void RunCompare(const CompareArgs& args) {
+  args.compare.Check();
+  if (!args.dataset.empty() && args.align_run.empty()) {
+    throw OptionError("--dataset (restricted completeness) needs --align-run and --gt");
+  }
+  PointCloud cloud = ReadCloud(args);
+  const PointCloud ref = ReadPly(args.ref);
+  if (cloud.empty()) throw InputError(args.cloud, "the cloud has no points");
+  if (ref.empty()) throw InputError(args.ref, "the reference cloud has no points");
+  const std::optional<Alignment> alignment = AlignCloud(args, &cloud);
+  const std::vector<std::uint8_t> visible = args.dataset.empty()
+                                                ? std::vector<std::uint8_t>()
+                                                : VisibleReferencePoints(args, *alignment, ref);
+  const dense::CompareResult r =
+      dense::CompareClouds(cloud.points, ref.points, args.compare, visible, ref.normals);
+  PrintComparison(args, r, alignment.has_value());
+  const std::vector<ObservedCompleteness> observed = MeasureObservedCompleteness(args, cloud);
+  if (!args.json.empty()) WriteComparisonJson(args, r, alignment, observed);
   if (!args.hist.empty()) {
     dense::PlotDistanceHistograms({{"cloud -> reference (accuracy)", r.accuracy_distances},
                                    {"reference -> cloud (completeness)", r.completeness_distances}},

@@ -75,7 +75,9 @@ Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<con
       mapping_(mapping),
       options_(options),
       builder_(rig_, orb_options),
-      local_map_(options_.max_local_keyframes) {
+      local_map_(options_.max_local_keyframes),
+      decision_(IsMonocular(rig_->sensor),
+                StarvingRule{options_.starving_inliers, options_.starving_ratio}) {
   options_.Check();
   PKSLAM_CHECK(
       atlas_ != nullptr && vocabulary_ != nullptr && selector_ != nullptr && mapping_ != nullptr,
@@ -250,29 +252,17 @@ SelectorInput Tracker::DecideKeyFrame(bool mapping_idle, TrackResult* result) {
   SelectorInput selector_input = BuildSelectorInput(mapping_idle);
   // Taken once per decision (a keyframe's second input, SnapshotAfterCreation, has none).
   selector_input.slow_motion_before_refinement = mapping_->TakeSlowMotionFlag();
-  last_decision_ = selector_->Decide(selector_input);
-  if (MapStarving(selector_input)) {
-    last_decision_.insert = true;
-    last_decision_.interrupt_local_ba = true;
-    last_decision_.reason += ";starving";
-  }
-  if (last_decision_.insert && mapping_->QueueFull()) {
-    // Backpressure (LocalMappingOptions::max_queued_keyframes): whatever the selector
-    // says, no keyframe while local mapping has a full queue.
-    last_decision_.insert = false;
-    result->keyframe_declined_queue_full = true;
-  }
-  if (trace_enabled_) {
-    trace_.push_back(
-        {current_.t_ns(), current_.id(), last_decision_, selector_input.FramesSinceLastKeyFrame()});
-  }
+  decision_.Decide(
+      *selector_, selector_input, inliers_, [this] { return mapping_->QueueFull(); },
+      &result->keyframe_declined_queue_full);
   return selector_input;
 }
 
 bool Tracker::ActOnDecision(const SelectorInput& selector_input, TrackResult* result) {
+  const SelectorDecision& decision = decision_.last();
   bool new_keyframe = false;
-  if (last_decision_.interrupt_local_ba) mapping_->InterruptBundleAdjustment();
-  if (last_decision_.insert && !options_.localise_only) {
+  if (decision.interrupt_local_ba) mapping_->InterruptBundleAdjustment();
+  if (decision.insert && !options_.localise_only) {
     CreateNewKeyFrame(selector_input);
     new_keyframe = true;
   }
@@ -281,11 +271,9 @@ bool Tracker::ActOnDecision(const SelectorInput& selector_input, TrackResult* re
   for (int i = 0; i < current_.size(); ++i) {
     if (current_.map_points[i] && current_.outliers[i]) current_.map_points[i].reset();
   }
-  result->keyframe_reason = last_decision_.reason;
+  result->keyframe_reason = decision.reason;
   result->selector_decided = !options_.localise_only;
-  for (const auto& [key, value] : last_decision_.trace) {
-    if (key.starts_with("criterion") && value != 0) result->criteria_held.push_back(key);
-  }
+  result->criteria_held = CriteriaHeld(decision);
   return new_keyframe;
 }
 
@@ -339,16 +327,6 @@ void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
     }
   }
   records_.push_back(std::move(r));
-}
-
-bool Tracker::MapStarving(const SelectorInput& in) const {
-  if (last_decision_.insert || !IsMonocular(rig_->sensor) || in.local_mapping_idle ||
-      in.local_mapping_stopped || in.only_tracking || in.local_mapping_queue >= 3) {
-    return false;
-  }
-  if (last_decision_.deferred_busy && inliers_ < options_.starving_inliers) return true;
-  return in.reference_tracked_points > 0 &&
-         inliers_ < options_.starving_ratio * in.reference_tracked_points;
 }
 
 void Tracker::StereoInitialization() {

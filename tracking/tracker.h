@@ -3,8 +3,8 @@
 // keyframe and the local map, asks the KeyframeSelector for keyframes and hands them to local
 // mapping. It keeps the state machine; the work is done by its parts (tracking/README.md:
 // map_initializer.h, frame_tracking.h, local_map.h, relocaliser.h, localisation_tracking.h,
-// selector_snapshot.h, keyframe_points.h, inertial_tracking.h). Owns its frames; touches the map
-// model only under the Atlas mutex.
+// selector_snapshot.h, keyframe_decision.h, keyframe_points.h, inertial_tracking.h). Owns its
+// frames; touches the map model only under the Atlas mutex.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +21,7 @@
 #include "map_model/mapping_backend.h"
 #include "tracking/frame_builder.h"
 #include "tracking/inertial_tracking.h"
+#include "tracking/keyframe_decision.h"
 #include "tracking/local_map.h"
 #include "tracking/localisation_tracking.h"
 #include "tracking/map_initializer.h"
@@ -101,14 +102,9 @@ class Tracker {
   const std::vector<FrameRecord>& records() const { return records_; }
   const KeyframeSelector& selector() const { return *selector_; }
   // Keyframe-decision traces (one per tracked frame), for --trace.
-  struct TraceRow {
-    std::int64_t t_ns;
-    FrameId frame_id;
-    SelectorDecision decision;
-    int frames_since_keyframe;
-  };
-  const std::vector<TraceRow>& trace() const { return trace_; }
-  void EnableTrace(bool on) { trace_enabled_ = on; }
+  using TraceRow = KeyFrameTraceRow;
+  const std::vector<TraceRow>& trace() const { return decision_.trace(); }
+  void EnableTrace(bool on) { decision_.EnableTrace(on); }
   // Record every frame's matched map points in its FrameRecord (for --frame-tracks).
   void EnableFrameTracks(bool on) { frame_tracks_enabled_ = on; }
   // Localisation only (TrackingOptions::localise_only) on a map loaded into the Atlas: the
@@ -151,11 +147,9 @@ class Tracker {
   // The tracked frame's keyframe decision (selector, a starving monocular map, backpressure),
   // traced when asked. Returns the selector's input. Atlas lock held (shared).
   SelectorInput DecideKeyFrame(bool mapping_idle, TrackResult* result);
-  // Carries out last_decision_ (interrupting local BA, creating the keyframe) after the lock is
+  // Carries out the decision (interrupting local BA, creating the keyframe) after the lock is
   // released. Returns whether a keyframe was created.
   bool ActOnDecision(const SelectorInput& selector_input, TrackResult* result);
-  // Monocular: the map is about to starve of keyframes (TrackingOptions::starving_*).
-  bool MapStarving(const SelectorInput& in) const;
   // Map initialisation (its parts in tracking/map_initializer.h).
   void StereoInitialization();
   void MonocularInitialization();
@@ -233,11 +227,10 @@ class Tracker {
   LocalisationTracking localisation_;
 
   std::vector<FrameRecord> records_;
-  bool trace_enabled_ = false;
   double time_offset_s_ = 0.0;
   bool frame_tracks_enabled_ = false;
-  std::vector<TraceRow> trace_;
-  SelectorDecision last_decision_;
+  // The selector's decision with tracking's overrides, and its trace (keyframe_decision.h).
+  KeyFrameDecision decision_;
   std::unique_ptr<InertialTracking> imu_;  // inertial sensors only
 };
 

@@ -30,7 +30,7 @@ SelectorInput Tracker::BuildSelectorInput(bool mapping_idle) const {
   FillImuSelectorInput(&in);
   in.local_mapping_stopped = mapping_->IsStoppedOrStopRequested();
   in.local_mapping_idle = mapping_idle;
-  in.trace_wanted = trace_enabled_;
+  in.trace_wanted = decision_.tracing();
   in.local_mapping_initializing = mapping_->IsInitializingImu();
   in.local_mapping_queue = mapping_->QueueSize();
   return in;
