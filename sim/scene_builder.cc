@@ -274,16 +274,9 @@ bool Overlaps(const std::vector<Shape>& a, const std::vector<Shape>& b, float ga
   return false;
 }
 
-}  // namespace
-
-Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
-                 const std::vector<Eigen::Vector3d>& path, SceneBuildReport* report) {
-  options.Check();
-  Scene scene;
-  scene.name = d.name;
-  scene.ambient = static_cast<float>(d.ambient);
-
-  // Room: the described box, grown to hold the path with margins.
+// The described room, grown to hold the path with margins.
+RoomFrame FitRoom(const SceneDescription& d, const SceneBuildOptions& options,
+                  const std::vector<Eigen::Vector3d>& path) {
   RoomFrame room;
   room.min = Eigen::Vector3d(d.room_center.x() - 0.5 * d.room_size.x(),
                              d.room_center.y() - 0.5 * d.room_size.y(), d.floor_z);
@@ -303,13 +296,12 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
     room.max = room.max.cwiseMax(hi + high_margin);
   }
   room.scale = (room.max - room.min).head<2>().cwiseQuotient(d.room_size.head<2>());
+  return room;
+}
 
-  // Textures: one per material plus the shared macro-variation texture.
-  const std::filesystem::path photo_dir =
-      options.photo_dir.empty() ? DefaultPhotoDir() : options.photo_dir;
-  SceneBuildReport local_report;
-  SceneBuildReport& rep = report ? *report : local_report;
-  rep = SceneBuildReport();
+// One texture and material per described material, then the shared macro-variation texture.
+void AddMaterials(const SceneDescription& d, const SceneBuildOptions& options,
+                  const std::filesystem::path& photo_dir, Scene* scene, SceneBuildReport* rep) {
   for (std::size_t i = 0; i < d.materials.size(); ++i) {
     const MaterialDesc& m = d.materials[i];
     TextureSpec spec = m.texture;
@@ -327,8 +319,8 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
       spec.kind = TextureKind::kRepetitive;
     }
     bool fallback = false;
-    scene.textures.push_back(BuildTexture(spec, photo_dir, options.colour, &fallback));
-    if (fallback) rep.missing_photos.push_back(spec.photo);
+    scene->textures.push_back(BuildTexture(spec, photo_dir, options.colour, &fallback));
+    if (fallback) rep->missing_photos.push_back(spec.photo);
     Material mat;
     mat.texture = static_cast<int>(i);
     mat.tile_m = static_cast<float>(m.tile_m);
@@ -338,7 +330,7 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
     mat.emission = static_cast<float>(m.emission);
     // Procedural noise is seamless and has no recognisable motif: shuffling would only add seams.
     mat.shuffle_tiles = spec.kind == TextureKind::kPhoto;
-    scene.materials.push_back(mat);
+    scene->materials.push_back(mat);
   }
   TextureSpec macro;
   macro.kind = TextureKind::kNoise;
@@ -347,32 +339,22 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
   macro.max_cells = 32;
   macro.contrast = 0.25;
   macro.seed = DeriveSeed(options.seed, 0x4D4143);
-  scene.textures.push_back(BuildTexture(macro, photo_dir, false));
-  for (Material& m : scene.materials) {
+  scene->textures.push_back(BuildTexture(macro, photo_dir, false));
+  for (Material& m : scene->materials) {
     if (m.macro_strength > 0.0f) {
-      m.macro_texture = static_cast<int>(scene.textures.size()) - 1;
+      m.macro_texture = static_cast<int>(scene->textures.size()) - 1;
       m.macro_tile_m = 9.0f;
     }
   }
+}
 
-  Builder builder(d, options);
-  Shape room_shape = builder.NewShape(ShapeType::kRoom, "room", 0);
-  room_shape.center = (0.5 * (room.min + room.max)).cast<float>();
-  room_shape.half = (0.5 * (room.max - room.min)).cast<float>();
-  for (int f = 0; f < 6; ++f) room_shape.material[f] = d.MaterialIndex(d.room_materials[f]);
-  scene.shapes.push_back(room_shape);
-
-  // Described objects: removed (whole) when too close to the path.
-  std::vector<std::vector<Shape>> groups;
-  int group_id = 1;
-  for (const ObjectDesc& o : d.objects) {
-    std::vector<Shape> parts;
-    builder.AddObject(o, room, group_id++, &parts);
-    groups.push_back(std::move(parts));
-  }
-  // Scatter: random placements that avoid the path and each other from the start. Their own
-  // random stream (not the builder's, which every shape draws texture offsets from), so adding
-  // an object to a scene does not move every scattered one.
+// Scatter: random placements that avoid the path and each other from the start, appended to
+// `groups` (object groups so far) with ids from `group_id` on. Their own random stream (not the
+// builder's, which every shape draws texture offsets from), so adding an object to a scene does
+// not move every scattered one.
+void ScatterObjects(const SceneDescription& d, const SceneBuildOptions& options,
+                    const RoomFrame& room, const std::vector<Eigen::Vector3d>& path,
+                    Builder* builder, int* group_id, std::vector<std::vector<Shape>>* groups) {
   Rng rng(DeriveSeed(options.seed, 0x5343415454));
   for (const ScatterDesc& s : d.scatter) {
     for (int i = 0; i < s.count; ++i) {
@@ -386,7 +368,7 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
         o.size = size;
         o.yaw_deg = placed->yaw_deg;
         o.levels = s.levels;
-        o.name = fmt::format("scatter{}", group_id);
+        o.name = fmt::format("scatter{}", *group_id);
         if (s.type == ObjectType::kShelf) {
           o.materials = s.materials;
         } else {
@@ -403,20 +385,53 @@ Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
             Eigen::Vector3d((pos.x() - c.x()) / room.scale.x(), (pos.y() - c.y()) / room.scale.y(),
                             decal ? 0.003 + 0.0002 * (i % 16) : 0.0);
         std::vector<Shape> parts;
-        builder.AddObject(o, room, group_id, &parts);
+        builder->AddObject(o, room, *group_id, &parts);
         // Decals may cross anything (tape over tape); solids keep apart.
         bool ok = !TooClose(parts, path, options.clearance_m);
-        for (const auto& g : groups) {
+        for (const auto& g : *groups) {
           if (!ok || decal) break;
           ok = !Overlaps(parts, g, 0.15f);
         }
         if (!ok) continue;
-        ++group_id;
-        groups.push_back(std::move(parts));
+        ++*group_id;
+        groups->push_back(std::move(parts));
         break;
       }
     }
   }
+}
+
+}  // namespace
+
+Scene BuildScene(const SceneDescription& d, const SceneBuildOptions& options,
+                 const std::vector<Eigen::Vector3d>& path, SceneBuildReport* report) {
+  options.Check();
+  Scene scene;
+  scene.name = d.name;
+  scene.ambient = static_cast<float>(d.ambient);
+  const RoomFrame room = FitRoom(d, options, path);
+  SceneBuildReport local_report;
+  SceneBuildReport& rep = report ? *report : local_report;
+  rep = SceneBuildReport();
+  AddMaterials(d, options, options.photo_dir.empty() ? DefaultPhotoDir() : options.photo_dir,
+               &scene, &rep);
+
+  Builder builder(d, options);
+  Shape room_shape = builder.NewShape(ShapeType::kRoom, "room", 0);
+  room_shape.center = (0.5 * (room.min + room.max)).cast<float>();
+  room_shape.half = (0.5 * (room.max - room.min)).cast<float>();
+  for (int f = 0; f < 6; ++f) room_shape.material[f] = d.MaterialIndex(d.room_materials[f]);
+  scene.shapes.push_back(room_shape);
+
+  // Described objects, then scattered ones; a group too close to the path is removed whole.
+  std::vector<std::vector<Shape>> groups;
+  int group_id = 1;
+  for (const ObjectDesc& o : d.objects) {
+    std::vector<Shape> parts;
+    builder.AddObject(o, room, group_id++, &parts);
+    groups.push_back(std::move(parts));
+  }
+  ScatterObjects(d, options, room, path, &builder, &group_id, &groups);
   rep.objects_placed = static_cast<int>(groups.size());
   for (auto& g : groups) {
     if (TooClose(g, path, options.clearance_m)) {
