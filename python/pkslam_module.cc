@@ -105,31 +105,28 @@ py::dict EvaluationDict(const api::Evaluation& e) {
   return d;
 }
 
-}  // namespace
-
-PYBIND11_MODULE(_pkslam, m) {
-  m.doc() = "pkslam: keyframe SLAM (the C++ library's public API with NumPy arrays)";
-  m.attr("__version__") = api::kApiVersion;
-  py::class_<api::Slam>(m, "Slam")
-      .def(py::init([](const std::string& settings, const std::string& vocabulary,
-                       const std::string& sensor, const std::string& selector, bool deterministic,
-                       bool localise_only, bool loop_closing,
-                       const std::map<std::string, double>& selector_parameters) {
-             api::SlamOptions o;
-             o.settings = settings;
-             o.vocabulary = vocabulary;
-             o.sensor = sensor;
-             o.selector = selector;
-             o.deterministic = deterministic;
-             o.localise_only = localise_only;
-             o.loop_closing = loop_closing;
-             o.selector_parameters = selector_parameters;
-             return std::make_unique<api::Slam>(o);
-           }),
-           py::arg("settings"), py::arg("vocabulary"), py::arg("sensor") = "stereo",
-           py::arg("selector") = "orbslam3", py::arg("deterministic") = false,
-           py::arg("localise_only") = false, py::arg("loop_closing") = true,
-           py::arg("selector_parameters") = std::map<std::string, double>{})
+// Slam: construction, the images and IMU samples it tracks, its state and pose.
+void BindSlamTracking(py::class_<api::Slam>* slam) {
+  py::class_<api::Slam>& c = *slam;
+  c.def(py::init([](const std::string& settings, const std::string& vocabulary,
+                    const std::string& sensor, const std::string& selector, bool deterministic,
+                    bool localise_only, bool loop_closing,
+                    const std::map<std::string, double>& selector_parameters) {
+          api::SlamOptions o;
+          o.settings = settings;
+          o.vocabulary = vocabulary;
+          o.sensor = sensor;
+          o.selector = selector;
+          o.deterministic = deterministic;
+          o.localise_only = localise_only;
+          o.loop_closing = loop_closing;
+          o.selector_parameters = selector_parameters;
+          return std::make_unique<api::Slam>(o);
+        }),
+        py::arg("settings"), py::arg("vocabulary"), py::arg("sensor") = "stereo",
+        py::arg("selector") = "orbslam3", py::arg("deterministic") = false,
+        py::arg("localise_only") = false, py::arg("loop_closing") = true,
+        py::arg("selector_parameters") = std::map<std::string, double>{})
       .def(
           "track_mono",
           [](api::Slam& s, const py::array& image, std::int64_t t_ns) {
@@ -175,27 +172,32 @@ PYBIND11_MODULE(_pkslam, m) {
       .def_property_readonly("state",
                              [](const api::Slam& s) { return api::SlamStateName(s.state()); })
       .def("pose", &api::Slam::CurrentPose,
-           "world_from_camera (4x4) of the last frame, or None when it was not tracked")
-      .def(
-          "map_points",
-          [](const api::Slam& s) {
-            const auto points = s.MapPoints();
-            const auto n = static_cast<py::ssize_t>(points.size());
-            py::array_t<double> xyz({n, py::ssize_t{3}});
-            py::array_t<std::int64_t> ids(n);
-            py::array_t<std::int32_t> observations(n);
-            auto x = xyz.mutable_unchecked<2>();
-            auto id = ids.mutable_unchecked<1>();
-            auto obs = observations.mutable_unchecked<1>();
-            for (py::ssize_t i = 0; i < n; ++i) {
-              const auto& p = points[static_cast<std::size_t>(i)];
-              for (int c = 0; c < 3; ++c) x(i, c) = p.world_position(c);
-              id(i) = p.id;
-              obs(i) = p.observations;
-            }
-            return py::make_tuple(xyz, ids, observations);
-          },
-          "(world positions[N, 3], ids[N], observing keyframes[N]) of the largest map's points")
+           "world_from_camera (4x4) of the last frame, or None when it was not tracked");
+}
+
+// Slam: the map (points, keyframes, the last frame's inliers), its modes and map files.
+void BindSlamMap(py::class_<api::Slam>* slam) {
+  py::class_<api::Slam>& c = *slam;
+  c.def(
+       "map_points",
+       [](const api::Slam& s) {
+         const auto points = s.MapPoints();
+         const auto n = static_cast<py::ssize_t>(points.size());
+         py::array_t<double> xyz({n, py::ssize_t{3}});
+         py::array_t<std::int64_t> ids(n);
+         py::array_t<std::int32_t> observations(n);
+         auto x = xyz.mutable_unchecked<2>();
+         auto id = ids.mutable_unchecked<1>();
+         auto obs = observations.mutable_unchecked<1>();
+         for (py::ssize_t i = 0; i < n; ++i) {
+           const auto& p = points[static_cast<std::size_t>(i)];
+           for (int c = 0; c < 3; ++c) x(i, c) = p.world_position(c);
+           id(i) = p.id;
+           obs(i) = p.observations;
+         }
+         return py::make_tuple(xyz, ids, observations);
+       },
+       "(world positions[N, 3], ids[N], observing keyframes[N]) of the largest map's points")
       .def(
           "keyframes",
           [](const api::Slam& s) {
@@ -244,11 +246,16 @@ PYBIND11_MODULE(_pkslam, m) {
       .def_property_readonly("num_map_points", &api::Slam::NumMapPoints)
       .def("save_map", &api::Slam::SaveMap, py::arg("file"))
       .def("load_map", &api::Slam::LoadMap, py::arg("file"))
-      .def("shutdown", &api::Slam::Shutdown, py::call_guard<py::gil_scoped_release>())
-      .def(
-          "camera_trajectory",
-          [](const api::Slam& s) { return TrajectoryArrays(s.CameraTrajectory()); },
-          "(t_ns[N], world_from_camera[N, 4, 4]) of every tracked frame (the left camera)")
+      .def("shutdown", &api::Slam::Shutdown, py::call_guard<py::gil_scoped_release>());
+}
+
+// Slam: the trajectories of every tracked frame and of the keyframes.
+void BindSlamTrajectories(py::class_<api::Slam>* slam) {
+  py::class_<api::Slam>& c = *slam;
+  c.def(
+       "camera_trajectory",
+       [](const api::Slam& s) { return TrajectoryArrays(s.CameraTrajectory()); },
+       "(t_ns[N], world_from_camera[N, 4, 4]) of every tracked frame (the left camera)")
       .def(
           "body_trajectory",
           [](const api::Slam& s) { return TrajectoryArrays(s.BodyTrajectory()); },
@@ -264,9 +271,14 @@ PYBIND11_MODULE(_pkslam, m) {
           "Removed: camera_trajectory() or body_trajectory()")
       .def_property_readonly("body_from_camera", &api::Slam::BodyFromCamera,
                              "The rig's camera-to-body transform (4x4)")
-      .def("keyframe_trajectory",
-           [](const api::Slam& s) { return TrajectoryArrays(s.KeyFrameTrajectory()); },
-           "(t_ns[N], world_from_camera[N, 4, 4]) of the keyframes");
+      .def(
+          "keyframe_trajectory",
+          [](const api::Slam& s) { return TrajectoryArrays(s.KeyFrameTrajectory()); },
+          "(t_ns[N], world_from_camera[N, 4, 4]) of the keyframes");
+}
+
+// pkslam.evaluate(): ATE/RPE as `pkslam eval`.
+void BindEvaluate(py::module_& m) {
   m.def(
       "evaluate",
       [](const std::string& gt, const py::object& est, const std::string& align,
@@ -291,6 +303,9 @@ PYBIND11_MODULE(_pkslam, m) {
       "EuRoC's body ground truth); camera poses (Slam.camera_trajectory()) with "
       "body_from_camera=Slam.body_from_camera, which moves the truth into the camera. A camera "
       "trajectory against body truth without it raises RuntimeError with that hint.");
+}
+
+void BindSimulate(py::module_& m) {
   // api::SimulateOptions field by field; pkslam.simulate() (pkslam/__init__.py) fills it.
   py::class_<api::SimulateOptions>(m, "_SimulateOptions")
       .def(py::init<>())
@@ -314,4 +329,17 @@ PYBIND11_MODULE(_pkslam, m) {
   m.def(
       "_simulate", [](const api::SimulateOptions& o) { api::Simulate(o); },
       py::call_guard<py::gil_scoped_release>(), "api::Simulate");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_pkslam, m) {
+  m.doc() = "pkslam: keyframe SLAM (the C++ library's public API with NumPy arrays)";
+  m.attr("__version__") = api::kApiVersion;
+  py::class_<api::Slam> slam(m, "Slam");
+  BindSlamTracking(&slam);
+  BindSlamMap(&slam);
+  BindSlamTrajectories(&slam);
+  BindEvaluate(m);
+  BindSimulate(m);
 }
