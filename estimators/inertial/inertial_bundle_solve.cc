@@ -102,6 +102,293 @@ std::optional<InertialStatePrior> MarginalPrior(
   return MakeInertialStatePrior(next, bias, h_next, b_next);
 }
 
+// One solve: the state copied from the problem, the Ceres problem built over it, the passes,
+// and the result written back from it.
+class InertialSolve {
+ public:
+  InertialSolve(const InertialBundleProblem& problem, const InertialBundleOptions& options)
+      : problem_(problem),
+        options_(options),
+        visual_(problem.visual),
+        num_kf_(static_cast<int>(visual_.keyframes.size())),
+        num_points_(static_cast<int>(visual_.points.size())),
+        camera_(BodyCamera::Of({visual_.fx, visual_.fy, visual_.cx, visual_.cy, visual_.bf},
+                               problem.camera_from_body)),
+        body_from_camera_(problem.camera_from_body.Inverse()),
+        s_(num_kf_, num_points_),
+        losses_(options.chi2_mono, options.chi2_stereo, /*robust=*/true),
+        // Removing outlier blocks between the passes needs Ceres' removal index; a single pass
+        // (ORB-SLAM3's local inertial BA) only classifies them and skips its upkeep.
+        ceres_problem_(ProblemOptions(
+            {.loss_functions = true, .fast_removal = options.iterations_second > 0})),
+        pose_added_(static_cast<std::size_t>(num_kf_), 0),
+        inertial_added_(static_cast<std::size_t>(num_kf_), 0) {
+    for (int i = 0; i < num_kf_; ++i) {
+      BodyPoseToBlock(visual_.keyframes[i].camera_from_world.Inverse() * problem.camera_from_body,
+                      s_.pose(i));
+      Eigen::Map<Eigen::Vector3d>(s_.v(i)) = problem.velocities[i];
+      Eigen::Map<Eigen::Vector3d>(s_.bg(i)) = problem.biases[i].gyro;
+      Eigen::Map<Eigen::Vector3d>(s_.ba(i)) = problem.biases[i].accel;
+    }
+    for (int i = 0; i < num_points_; ++i) {
+      Eigen::Map<Eigen::Vector3d>(s_.point(i)) = visual_.points[i].position_world;
+    }
+    // With shared biases every keyframe uses the blocks of the first inertial keyframe.
+    for (int i = 0; i < num_kf_ && problem.shared_bias; ++i) {
+      if (problem.inertial[i] != 0) {
+        shared_index_ = i;
+        break;
+      }
+    }
+  }
+
+  // The result as the problem stands (`aborted`: before any solve).
+  InertialBundleResult Unsolved(bool aborted) {
+    result_.visual.aborted = aborted;
+    WriteResult();
+    return std::move(result_);
+  }
+
+  InertialBundleResult Run(const std::atomic<bool>* abort, WorkMeter* work) {
+    AddInertialResiduals();
+    AddObservations();
+    ceres::Solver::Options solver_options = Options();
+    AbortCallback abort_callback(abort, work, &ceres_problem_);
+    solver_options.callbacks.push_back(&abort_callback);
+    Solve(options_.iterations_first, abort_callback, &solver_options);
+    ClassifyOutliers();
+    if (!result_.visual.aborted && options_.iterations_second > 0) {
+      losses_.SetRobust(false);
+      Solve(options_.iterations_second, abort_callback, &solver_options);
+    }
+    if (marginalize_ && marg_edge_ && !result_.visual.aborted) Marginalize();
+    WriteResult();
+    return std::move(result_);
+  }
+
+ private:
+  double* bg(int i) { return s_.bg(shared_index_ >= 0 ? shared_index_ : i); }
+  double* ba(int i) { return s_.ba(shared_index_ >= 0 ? shared_index_ : i); }
+
+  void WriteResult() {
+    result_.visual.camera_from_world.clear();
+    result_.visual.points_world.clear();
+    result_.velocities.clear();
+    result_.biases.clear();
+    for (int i = 0; i < num_kf_; ++i) {
+      result_.visual.camera_from_world.push_back(
+          visual_.keyframes[i].fixed
+              ? visual_.keyframes[i].camera_from_world
+              : (BodyPoseFromBlock(s_.pose(i)) * body_from_camera_).Inverse());
+      result_.velocities.emplace_back(Eigen::Map<const Eigen::Vector3d>(s_.v(i)));
+      result_.biases.emplace_back(Eigen::Map<const Eigen::Vector3d>(bg(i)),
+                                  Eigen::Map<const Eigen::Vector3d>(ba(i)));
+    }
+    for (int i = 0; i < num_points_; ++i) {
+      result_.visual.points_world.emplace_back(Eigen::Map<const Eigen::Vector3d>(s_.point(i)));
+    }
+  }
+
+  void AddPose(int i) {
+    if (pose_added_[i]) return;
+    ceres_problem_.AddParameterBlock(s_.pose(i), kBodyPoseBlockSize, &pose_manifold_);
+    if (visual_.keyframes[i].fixed) ceres_problem_.SetParameterBlockConstant(s_.pose(i));
+    pose_added_[i] = 1;
+  }
+
+  // Inertial blocks: constant for anchors (inertial == 2).
+  void AddInertial(int i) {
+    AddPose(i);
+    if (inertial_added_[i]) return;
+    inertial_added_[i] = 1;
+    ceres_problem_.AddParameterBlock(s_.v(i), 3);
+    ceres_problem_.AddParameterBlock(bg(i), 3);
+    ceres_problem_.AddParameterBlock(ba(i), 3);
+    if (problem_.inertial[i] == 2) {
+      ceres_problem_.SetParameterBlockConstant(s_.v(i));
+      if (shared_index_ < 0) {
+        ceres_problem_.SetParameterBlockConstant(bg(i));
+        ceres_problem_.SetParameterBlockConstant(ba(i));
+      }
+    }
+  }
+
+  // The anchor's prior, the preintegration edges with their bias random walks (or the shared
+  // biases' priors), noting the residual blocks of the anchor that the marginalisation folds
+  // into the next prior.
+  void AddInertialResiduals() {
+    const int marg_from = problem_.marginalize_from;
+    const int marg_to = problem_.marginalize_to;
+    marginalize_ = marg_from >= 0 && marg_to >= 0 && shared_index_ < 0;
+    if (problem_.anchor_prior && marg_from >= 0 && shared_index_ < 0) {
+      AddInertial(marg_from);
+      const InertialStatePrior& prior = *problem_.anchor_prior;
+      marginalized_.push_back(ceres_problem_.AddResidualBlock(
+          prior.sqrt_information
+              ? new InertialStatePriorError(prior.mean, prior.bias_mean, *prior.sqrt_information,
+                                            InertialStatePriorError::SqrtInformation{})
+              : new InertialStatePriorError(prior.mean, prior.bias_mean, prior.information),
+          nullptr, {s_.pose(marg_from), s_.v(marg_from), bg(marg_from), ba(marg_from)}));
+    }
+    for (const auto& e : problem_.edges) {
+      AddInertial(e.from);
+      AddInertial(e.to);
+      const bool marg = marginalize_ && e.from == marg_from && e.to == marg_to;
+      marg_edge_ = marg_edge_ || marg;
+      const ceres::ResidualBlockId inertial = ceres_problem_.AddResidualBlock(
+          new InertialError(e.preintegration, problem_.gravity_world), nullptr,
+          {s_.pose(e.from), s_.v(e.from), bg(e.from), ba(e.from), s_.pose(e.to), s_.v(e.to)});
+      if (marg) marginalized_.push_back(inertial);
+      if (shared_index_ < 0) {
+        const ceres::ResidualBlockId gyro = ceres_problem_.AddResidualBlock(
+            BiasRandomWalkError::Gyro(e.preintegration).release(), nullptr, bg(e.from), bg(e.to));
+        const ceres::ResidualBlockId accel = ceres_problem_.AddResidualBlock(
+            BiasRandomWalkError::Accel(e.preintegration).release(), nullptr, ba(e.from), ba(e.to));
+        if (marg) {
+          marginalized_.push_back(gyro);
+          marginalized_.push_back(accel);
+        }
+      }
+    }
+    if (shared_index_ >= 0) {
+      if (problem_.gyro_prior_information > 0) {
+        ceres_problem_.AddResidualBlock(
+            new BiasPriorError(Eigen::Vector3d::Zero(), problem_.gyro_prior_information), nullptr,
+            bg(shared_index_));
+      }
+      if (problem_.accel_prior_information > 0) {
+        ceres_problem_.AddResidualBlock(
+            new BiasPriorError(Eigen::Vector3d::Zero(), problem_.accel_prior_information), nullptr,
+            ba(shared_index_));
+      }
+    }
+  }
+
+  void AddObservations() {
+    const int num_obs = static_cast<int>(visual_.observations.size());
+    blocks_.assign(static_cast<std::size_t>(num_obs), nullptr);
+    point_added_.assign(static_cast<std::size_t>(num_points_), 0);
+    for (int i = 0; i < num_obs; ++i) {
+      const BundleProblem::ObservationState& o = visual_.observations[i];
+      if (!std::isfinite(ObservationChi2(camera_, o, s_))) continue;
+      AddPose(o.keyframe_index);
+      point_added_[o.point_index] = 1;
+      double* pose = s_.pose(o.keyframe_index);
+      double* point = s_.point(o.point_index);
+      if (o.u_right >= 0) {
+        blocks_[i] = ceres_problem_.AddResidualBlock(
+            new BodyStereoReprojectionError(camera_, Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right),
+                                            o.inv_sigma2),
+            losses_.stereo(), pose, point);
+      } else {
+        blocks_[i] = ceres_problem_.AddResidualBlock(
+            new BodyMonoReprojectionError(camera_, o.uv, o.inv_sigma2), losses_.mono(), pose,
+            point);
+      }
+    }
+  }
+
+  // Schur elimination: points first, then poses and inertial blocks.
+  ceres::Solver::Options Options() {
+    int free_poses = 0;
+    for (int i = 0; i < num_kf_; ++i) free_poses += pose_added_[i] && !visual_.keyframes[i].fixed;
+    ceres::Solver::Options solver_options =
+        SolverOptions(SchurSolverFor(free_poses), 0, options_.num_threads);
+    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    for (int i = 0; i < num_points_; ++i) {
+      if (point_added_[i]) ordering->AddElementToGroup(s_.point(i), 0);
+    }
+    for (int i = 0; i < num_kf_; ++i) {
+      if (pose_added_[i]) ordering->AddElementToGroup(s_.pose(i), 1);
+      if (inertial_added_[i]) {
+        ordering->AddElementToGroup(s_.v(i), 1);
+        if (shared_index_ < 0 || i == shared_index_) {
+          ordering->AddElementToGroup(bg(i), 1);
+          ordering->AddElementToGroup(ba(i), 1);
+        }
+      }
+    }
+    solver_options.linear_solver_ordering = ordering;
+    return solver_options;
+  }
+
+  void Solve(int iterations, const AbortCallback& abort_callback,
+             ceres::Solver::Options* solver_options) {
+    if (ceres_problem_.NumResidualBlocks() == 0) return;
+    solver_options->max_num_iterations = iterations;
+    ceres::Solver::Summary summary;
+    ceres::Solve(*solver_options, &ceres_problem_, &summary);
+    if (first_solve_) result_.visual.initial_cost = summary.initial_cost;
+    first_solve_ = false;
+    result_.visual.final_cost = summary.final_cost;
+    result_.visual.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
+    result_.visual.aborted = abort_callback.fired();
+    if (summary.termination_type == ceres::FAILURE) {
+      PKSLAM_LOG_WARN("inertial bundle adjustment: solver failure: {}", summary.message);
+    }
+  }
+
+  // Outliers after the robust pass; removed before a second pass.
+  void ClassifyOutliers() {
+    const int num_obs = static_cast<int>(visual_.observations.size());
+    for (int i = 0; i < num_obs; ++i) {
+      const auto& o = visual_.observations[i];
+      const bool outlier = !(ObservationChi2(camera_, o, s_) <=
+                             (o.u_right >= 0 ? options_.chi2_stereo : options_.chi2_mono));
+      if (!outlier) continue;
+      result_.visual.outlier_observations.push_back(i);
+      if (blocks_[i] != nullptr && options_.iterations_second > 0) {
+        ceres_problem_.RemoveResidualBlock(blocks_[i]);
+        blocks_[i] = nullptr;
+      }
+    }
+  }
+
+  // The next keyframe's prior: the anchor's inertial factors and its inlier reprojections
+  // marginalised onto it.
+  void Marginalize() {
+    const int marg_from = problem_.marginalize_from;
+    const int marg_to = problem_.marginalize_to;
+    const int num_obs = static_cast<int>(visual_.observations.size());
+    std::vector<std::uint8_t> outlier(static_cast<std::size_t>(num_obs), 0);
+    for (int i : result_.visual.outlier_observations) outlier[i] = 1;
+    const std::size_t first_visual = marginalized_.size();
+    for (int i = 0; i < num_obs; ++i) {
+      if (blocks_[i] != nullptr && outlier[i] == 0 &&
+          visual_.observations[i].keyframe_index == marg_from) {
+        marginalized_.push_back(blocks_[i]);
+      }
+    }
+    result_.next_prior =
+        MarginalPrior(ceres_problem_,
+                      {s_.pose(marg_from), s_.v(marg_from), bg(marg_from), ba(marg_from),
+                       s_.pose(marg_to), s_.v(marg_to), bg(marg_to), ba(marg_to)},
+                      marginalized_, first_visual, options_);
+  }
+
+  const InertialBundleProblem& problem_;
+  const InertialBundleOptions& options_;
+  const BundleProblem& visual_;
+  const int num_kf_;
+  const int num_points_;
+  const BodyCamera camera_;
+  const SE3d body_from_camera_;
+  State s_;
+  int shared_index_ = -1;
+  InertialBundleResult result_;
+  ReprojectionLosses losses_;
+  BodyPoseManifold pose_manifold_;
+  ceres::Problem ceres_problem_;
+  std::vector<std::uint8_t> pose_added_;
+  std::vector<std::uint8_t> inertial_added_;
+  bool marginalize_ = false;
+  bool marg_edge_ = false;
+  std::vector<ceres::ResidualBlockId> marginalized_;
+  std::vector<ceres::ResidualBlockId> blocks_;
+  std::vector<std::uint8_t> point_added_;
+  bool first_solve_ = true;
+};
+
 }  // namespace
 
 void InertialBundleOptions::Check() const {
@@ -126,233 +413,11 @@ InertialBundleResult SolveInertialBundle(const InertialBundleProblem& problem,
                                          const InertialBundleOptions& options,
                                          const std::atomic<bool>* abort, WorkMeter* work) {
   options.Check();
-  const BundleProblem& visual = problem.visual;
-  const int num_kf = static_cast<int>(visual.keyframes.size());
-  const int num_points = static_cast<int>(visual.points.size());
-  const BodyCamera camera = BodyCamera::Of({visual.fx, visual.fy, visual.cx, visual.cy, visual.bf},
-                                           problem.camera_from_body);
-  const SE3d body_from_camera = problem.camera_from_body.Inverse();
-
-  State s(num_kf, num_points);
-  for (int i = 0; i < num_kf; ++i) {
-    BodyPoseToBlock(visual.keyframes[i].camera_from_world.Inverse() * problem.camera_from_body,
-                    s.pose(i));
-    Eigen::Map<Eigen::Vector3d>(s.v(i)) = problem.velocities[i];
-    Eigen::Map<Eigen::Vector3d>(s.bg(i)) = problem.biases[i].gyro;
-    Eigen::Map<Eigen::Vector3d>(s.ba(i)) = problem.biases[i].accel;
-  }
-  for (int i = 0; i < num_points; ++i) {
-    Eigen::Map<Eigen::Vector3d>(s.point(i)) = visual.points[i].position_world;
-  }
-  // With shared biases every keyframe uses the blocks of the first inertial keyframe.
-  int shared_index = -1;
-  for (int i = 0; i < num_kf && problem.shared_bias; ++i) {
-    if (problem.inertial[i] != 0) {
-      shared_index = i;
-      break;
-    }
-  }
-  auto bg = [&](int i) { return s.bg(shared_index >= 0 ? shared_index : i); };
-  auto ba = [&](int i) { return s.ba(shared_index >= 0 ? shared_index : i); };
-
-  InertialBundleResult result;
-  auto write_result = [&]() {
-    result.visual.camera_from_world.clear();
-    result.visual.points_world.clear();
-    result.velocities.clear();
-    result.biases.clear();
-    for (int i = 0; i < num_kf; ++i) {
-      result.visual.camera_from_world.push_back(
-          visual.keyframes[i].fixed ? visual.keyframes[i].camera_from_world
-                                    : (BodyPoseFromBlock(s.pose(i)) * body_from_camera).Inverse());
-      result.velocities.emplace_back(Eigen::Map<const Eigen::Vector3d>(s.v(i)));
-      result.biases.emplace_back(Eigen::Map<const Eigen::Vector3d>(bg(i)),
-                                 Eigen::Map<const Eigen::Vector3d>(ba(i)));
-    }
-    for (int i = 0; i < num_points; ++i) {
-      result.visual.points_world.emplace_back(Eigen::Map<const Eigen::Vector3d>(s.point(i)));
-    }
-  };
+  InertialSolve solve(problem, options);
   if (problem.empty() || (abort != nullptr && abort->load())) {
-    result.visual.aborted = !problem.empty();
-    write_result();
-    return result;
+    return solve.Unsolved(/*aborted=*/!problem.empty());
   }
-
-  ReprojectionLosses losses(options.chi2_mono, options.chi2_stereo, /*robust=*/true);
-  BodyPoseManifold pose_manifold;
-  // Removing outlier blocks between the passes needs Ceres' removal index; a single pass
-  // (ORB-SLAM3's local inertial BA) only classifies them and skips its upkeep.
-  ceres::Problem ceres_problem(
-      ProblemOptions({.loss_functions = true, .fast_removal = options.iterations_second > 0}));
-
-  std::vector<std::uint8_t> pose_added(static_cast<std::size_t>(num_kf), 0);
-  auto add_pose = [&](int i) {
-    if (pose_added[i]) return;
-    ceres_problem.AddParameterBlock(s.pose(i), kBodyPoseBlockSize, &pose_manifold);
-    if (visual.keyframes[i].fixed) ceres_problem.SetParameterBlockConstant(s.pose(i));
-    pose_added[i] = 1;
-  };
-  // Inertial blocks: constant for anchors (inertial == 2).
-  std::vector<std::uint8_t> inertial_added(static_cast<std::size_t>(num_kf), 0);
-  auto add_inertial = [&](int i) {
-    add_pose(i);
-    if (inertial_added[i]) return;
-    inertial_added[i] = 1;
-    ceres_problem.AddParameterBlock(s.v(i), 3);
-    ceres_problem.AddParameterBlock(bg(i), 3);
-    ceres_problem.AddParameterBlock(ba(i), 3);
-    if (problem.inertial[i] == 2) {
-      ceres_problem.SetParameterBlockConstant(s.v(i));
-      if (shared_index < 0) {
-        ceres_problem.SetParameterBlockConstant(bg(i));
-        ceres_problem.SetParameterBlockConstant(ba(i));
-      }
-    }
-  };
-
-  // The residual blocks of the anchor that the marginalisation folds into the next prior.
-  const int marg_from = problem.marginalize_from;
-  const int marg_to = problem.marginalize_to;
-  const bool marginalize = marg_from >= 0 && marg_to >= 0 && shared_index < 0;
-  std::vector<ceres::ResidualBlockId> marginalized;
-  bool marg_edge = false;
-  if (problem.anchor_prior && marg_from >= 0 && shared_index < 0) {
-    add_inertial(marg_from);
-    const InertialStatePrior& prior = *problem.anchor_prior;
-    marginalized.push_back(ceres_problem.AddResidualBlock(
-        prior.sqrt_information
-            ? new InertialStatePriorError(prior.mean, prior.bias_mean, *prior.sqrt_information,
-                                          InertialStatePriorError::SqrtInformation{})
-            : new InertialStatePriorError(prior.mean, prior.bias_mean, prior.information),
-        nullptr, {s.pose(marg_from), s.v(marg_from), bg(marg_from), ba(marg_from)}));
-  }
-  for (const auto& e : problem.edges) {
-    add_inertial(e.from);
-    add_inertial(e.to);
-    const bool marg = marginalize && e.from == marg_from && e.to == marg_to;
-    marg_edge = marg_edge || marg;
-    const ceres::ResidualBlockId inertial = ceres_problem.AddResidualBlock(
-        new InertialError(e.preintegration, problem.gravity_world), nullptr,
-        {s.pose(e.from), s.v(e.from), bg(e.from), ba(e.from), s.pose(e.to), s.v(e.to)});
-    if (marg) marginalized.push_back(inertial);
-    if (shared_index < 0) {
-      const ceres::ResidualBlockId gyro = ceres_problem.AddResidualBlock(
-          BiasRandomWalkError::Gyro(e.preintegration).release(), nullptr, bg(e.from), bg(e.to));
-      const ceres::ResidualBlockId accel = ceres_problem.AddResidualBlock(
-          BiasRandomWalkError::Accel(e.preintegration).release(), nullptr, ba(e.from), ba(e.to));
-      if (marg) {
-        marginalized.push_back(gyro);
-        marginalized.push_back(accel);
-      }
-    }
-  }
-  if (shared_index >= 0) {
-    if (problem.gyro_prior_information > 0) {
-      ceres_problem.AddResidualBlock(
-          new BiasPriorError(Eigen::Vector3d::Zero(), problem.gyro_prior_information), nullptr,
-          bg(shared_index));
-    }
-    if (problem.accel_prior_information > 0) {
-      ceres_problem.AddResidualBlock(
-          new BiasPriorError(Eigen::Vector3d::Zero(), problem.accel_prior_information), nullptr,
-          ba(shared_index));
-    }
-  }
-
-  const int num_obs = static_cast<int>(visual.observations.size());
-  std::vector<ceres::ResidualBlockId> blocks(static_cast<std::size_t>(num_obs), nullptr);
-  std::vector<std::uint8_t> point_added(static_cast<std::size_t>(num_points), 0);
-  for (int i = 0; i < num_obs; ++i) {
-    const BundleProblem::ObservationState& o = visual.observations[i];
-    if (!std::isfinite(ObservationChi2(camera, o, s))) continue;
-    add_pose(o.keyframe_index);
-    point_added[o.point_index] = 1;
-    double* pose = s.pose(o.keyframe_index);
-    double* point = s.point(o.point_index);
-    if (o.u_right >= 0) {
-      blocks[i] = ceres_problem.AddResidualBlock(
-          new BodyStereoReprojectionError(camera, Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right),
-                                          o.inv_sigma2),
-          losses.stereo(), pose, point);
-    } else {
-      blocks[i] = ceres_problem.AddResidualBlock(
-          new BodyMonoReprojectionError(camera, o.uv, o.inv_sigma2), losses.mono(), pose, point);
-    }
-  }
-
-  int free_poses = 0;
-  for (int i = 0; i < num_kf; ++i) free_poses += pose_added[i] && !visual.keyframes[i].fixed;
-  ceres::Solver::Options solver_options =
-      SolverOptions(SchurSolverFor(free_poses), 0, options.num_threads);
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  for (int i = 0; i < num_points; ++i) {
-    if (point_added[i]) ordering->AddElementToGroup(s.point(i), 0);
-  }
-  for (int i = 0; i < num_kf; ++i) {
-    if (pose_added[i]) ordering->AddElementToGroup(s.pose(i), 1);
-    if (inertial_added[i]) {
-      ordering->AddElementToGroup(s.v(i), 1);
-      if (shared_index < 0 || i == shared_index) {
-        ordering->AddElementToGroup(bg(i), 1);
-        ordering->AddElementToGroup(ba(i), 1);
-      }
-    }
-  }
-  solver_options.linear_solver_ordering = ordering;
-  AbortCallback abort_callback(abort, work, &ceres_problem);
-  solver_options.callbacks.push_back(&abort_callback);
-
-  bool first = true;
-  auto solve = [&](int iterations) {
-    if (ceres_problem.NumResidualBlocks() == 0) return;
-    solver_options.max_num_iterations = iterations;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options, &ceres_problem, &summary);
-    if (first) result.visual.initial_cost = summary.initial_cost;
-    first = false;
-    result.visual.final_cost = summary.final_cost;
-    result.visual.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
-    result.visual.aborted = abort_callback.fired();
-    if (summary.termination_type == ceres::FAILURE) {
-      PKSLAM_LOG_WARN("inertial bundle adjustment: solver failure: {}", summary.message);
-    }
-  };
-
-  solve(options.iterations_first);
-  for (int i = 0; i < num_obs; ++i) {
-    const auto& o = visual.observations[i];
-    const bool outlier = !(ObservationChi2(camera, o, s) <=
-                           (o.u_right >= 0 ? options.chi2_stereo : options.chi2_mono));
-    if (!outlier) continue;
-    result.visual.outlier_observations.push_back(i);
-    if (blocks[i] != nullptr && options.iterations_second > 0) {
-      ceres_problem.RemoveResidualBlock(blocks[i]);
-      blocks[i] = nullptr;
-    }
-  }
-  if (!result.visual.aborted && options.iterations_second > 0) {
-    losses.SetRobust(false);
-    solve(options.iterations_second);
-  }
-  if (marginalize && marg_edge && !result.visual.aborted) {
-    std::vector<std::uint8_t> outlier(static_cast<std::size_t>(num_obs), 0);
-    for (int i : result.visual.outlier_observations) outlier[i] = 1;
-    const std::size_t first_visual = marginalized.size();
-    for (int i = 0; i < num_obs; ++i) {
-      if (blocks[i] != nullptr && outlier[i] == 0 &&
-          visual.observations[i].keyframe_index == marg_from) {
-        marginalized.push_back(blocks[i]);
-      }
-    }
-    result.next_prior =
-        MarginalPrior(ceres_problem,
-                      {s.pose(marg_from), s.v(marg_from), bg(marg_from), ba(marg_from),
-                       s.pose(marg_to), s.v(marg_to), bg(marg_to), ba(marg_to)},
-                      marginalized, first_visual, options);
-  }
-  write_result();
-  return result;
+  return solve.Run(abort, work);
 }
 
 }  // namespace pkslam
