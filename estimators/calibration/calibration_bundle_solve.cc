@@ -173,12 +173,13 @@ class CalibrationSolve {
     AbortCallback abort_callback(abort, work, &ceres_problem_,
                                  options_.min_iterations_before_abort);
     solver_options.callbacks.push_back(&abort_callback);
-    Solve(options_.iterations_first, abort_callback, &solver_options);
+    BundlePasses passes(&ceres_problem_, &abort_callback, "calibration bundle adjustment");
+    passes.Run(options_.iterations_first, &solver_options, &result_.bundle.visual);
     RejectOutliers();
     if (!result_.bundle.visual.aborted && options_.iterations_second > 0) {
       loss_left_.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
       loss_right_.Reset(nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
-      Solve(options_.iterations_second, abort_callback, &solver_options);
+      passes.Run(options_.iterations_second, &solver_options, &result_.bundle.visual);
     }
     WriteResult();
     if (options_.covariance && !result_.bundle.visual.aborted && problem_.free.Any()) Sigmas();
@@ -389,23 +390,6 @@ class CalibrationSolve {
     return solver_options;
   }
 
-  void Solve(int iterations, const AbortCallback& abort_callback,
-             ceres::Solver::Options* solver_options) {
-    if (ceres_problem_.NumResidualBlocks() == 0) return;
-    solver_options->max_num_iterations = iterations;
-    ceres::Solver::Summary summary;
-    ceres::Solve(*solver_options, &ceres_problem_, &summary);
-    if (first_solve_) result_.bundle.visual.initial_cost = summary.initial_cost;
-    first_solve_ = false;
-    result_.bundle.visual.final_cost = summary.final_cost;
-    result_.bundle.visual.iterations +=
-        std::max(0, static_cast<int>(summary.iterations.size()) - 1);
-    result_.bundle.visual.aborted = abort_callback.fired();
-    if (summary.termination_type == ceres::FAILURE) {
-      PKSLAM_LOG_WARN("calibration bundle adjustment: solver failure: {}", summary.message);
-    }
-  }
-
   // Outliers after the robust pass: whitened chi2 of the left keypoint or the right coordinate.
   void RejectOutliers() {
     const int num_obs = static_cast<int>(visual_.observations.size());
@@ -477,7 +461,6 @@ class CalibrationSolve {
   std::vector<std::uint8_t> inertial_added_;
   std::vector<ObsBlocks> blocks_;
   std::vector<std::uint8_t> point_added_;
-  bool first_solve_ = true;
 };
 
 }  // namespace

@@ -6,13 +6,11 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
-#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
 
 #include "core/util/error.h"
-#include "core/util/log.h"
 #include "estimators/inertial/inertial_bundle.h"
 #include "estimators/inertial/marginalization.h"
 #include "estimators/optim/ceres_setup.h"
@@ -155,11 +153,12 @@ class InertialSolve {
     ceres::Solver::Options solver_options = Options();
     AbortCallback abort_callback(abort, work, &ceres_problem_);
     solver_options.callbacks.push_back(&abort_callback);
-    Solve(options_.iterations_first, abort_callback, &solver_options);
+    BundlePasses passes(&ceres_problem_, &abort_callback, "inertial bundle adjustment");
+    passes.Run(options_.iterations_first, &solver_options, &result_.visual);
     ClassifyOutliers();
     if (!result_.visual.aborted && options_.iterations_second > 0) {
       losses_.SetRobust(false);
-      Solve(options_.iterations_second, abort_callback, &solver_options);
+      passes.Run(options_.iterations_second, &solver_options, &result_.visual);
     }
     if (marginalize_ && marg_edge_ && !result_.visual.aborted) Marginalize();
     WriteResult();
@@ -312,22 +311,6 @@ class InertialSolve {
     return solver_options;
   }
 
-  void Solve(int iterations, const AbortCallback& abort_callback,
-             ceres::Solver::Options* solver_options) {
-    if (ceres_problem_.NumResidualBlocks() == 0) return;
-    solver_options->max_num_iterations = iterations;
-    ceres::Solver::Summary summary;
-    ceres::Solve(*solver_options, &ceres_problem_, &summary);
-    if (first_solve_) result_.visual.initial_cost = summary.initial_cost;
-    first_solve_ = false;
-    result_.visual.final_cost = summary.final_cost;
-    result_.visual.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
-    result_.visual.aborted = abort_callback.fired();
-    if (summary.termination_type == ceres::FAILURE) {
-      PKSLAM_LOG_WARN("inertial bundle adjustment: solver failure: {}", summary.message);
-    }
-  }
-
   // Outliers after the robust pass; removed before a second pass.
   void ClassifyOutliers() {
     const int num_obs = static_cast<int>(visual_.observations.size());
@@ -386,7 +369,6 @@ class InertialSolve {
   std::vector<ceres::ResidualBlockId> marginalized_;
   std::vector<ceres::ResidualBlockId> blocks_;
   std::vector<std::uint8_t> point_added_;
-  bool first_solve_ = true;
 };
 
 }  // namespace

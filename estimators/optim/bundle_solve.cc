@@ -4,13 +4,11 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
-#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
 
 #include "core/util/error.h"
-#include "core/util/log.h"
 #include "estimators/optim/bundle_adjustment.h"
 #include "estimators/optim/bundle_adjustment_internal.h"
 #include "estimators/optim/ceres_setup.h"
@@ -153,27 +151,10 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
   if (overrides.callback != nullptr) solver_options.callbacks.push_back(overrides.callback);
   if (abort_callback.active()) solver_options.callbacks.push_back(&abort_callback);
 
-  bool first_solve = true;
-  auto solve = [&](int iterations) {
-    if (ceres_problem.NumResidualBlocks() == 0) return;
-    solver_options.max_num_iterations = iterations;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options, &ceres_problem, &summary);
-    if (first_solve) result.initial_cost = summary.initial_cost;
-    first_solve = false;
-    result.final_cost = summary.final_cost;
-    // summary.iterations starts with iteration 0 (the initial evaluation).
-    result.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
-    result.aborted = abort_callback.fired();
-    // On a numerical failure Ceres leaves the blocks at their initial values: the map stays
-    // consistent, so it is reported rather than thrown from a mapping thread.
-    if (summary.termination_type == ceres::FAILURE) {
-      PKSLAM_LOG_WARN("bundle adjustment: solver failure: {}", summary.message);
-    }
-  };
+  BundlePasses passes(&ceres_problem, &abort_callback, "bundle adjustment");
 
   // Pass 1: robust. Then drop the outliers and (unless aborted) refine without the loss.
-  solve(options.iterations_first);
+  passes.Run(options.iterations_first, &solver_options, &result);
   std::vector<std::uint8_t> outlier(static_cast<std::size_t>(num_obs), 0);
   for (int i = 0; i < num_obs; ++i) {
     outlier[i] = blocks[i] == nullptr || IsOutlier(k, problem.observations[i], state, options);
@@ -188,7 +169,7 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
       }
     }
     losses.SetRobust(false);
-    solve(options.iterations_second);
+    passes.Run(options.iterations_second, &solver_options, &result);
     for (int i = 0; i < num_obs; ++i) {
       if (!outlier[i]) outlier[i] = IsOutlier(k, problem.observations[i], state, options);
     }

@@ -2,7 +2,11 @@
 
 #include <ceres/problem.h>
 
+#include <algorithm>
 #include <cmath>
+
+#include "core/util/log.h"
+#include "estimators/optim/bundle_adjustment.h"
 
 namespace pkslam {
 
@@ -49,6 +53,22 @@ ReprojectionLosses::ReprojectionLosses(double chi2_mono, double chi2_stereo, boo
 void ReprojectionLosses::SetRobust(bool robust) {
   mono_.Reset(robust ? &huber_mono_ : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
   stereo_.Reset(robust ? &huber_stereo_ : nullptr, ceres::DO_NOT_TAKE_OWNERSHIP);
+}
+
+void BundlePasses::Run(int iterations, ceres::Solver::Options* options, BundleResult* result) {
+  if (problem_->NumResidualBlocks() == 0) return;
+  options->max_num_iterations = iterations;
+  ceres::Solver::Summary summary;
+  ceres::Solve(*options, problem_, &summary);
+  if (first_) result->initial_cost = summary.initial_cost;
+  first_ = false;
+  result->final_cost = summary.final_cost;
+  // summary.iterations starts with iteration 0 (the initial evaluation).
+  result->iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
+  result->aborted = abort_callback_->fired();
+  if (summary.termination_type == ceres::FAILURE) {
+    PKSLAM_LOG_WARN("{}: solver failure: {}", what_, summary.message);
+  }
 }
 
 }  // namespace pkslam

@@ -19,6 +19,8 @@ class Problem;
 
 namespace pkslam {
 
+struct BundleResult;
+
 // Stops the solver once *abort is set (never with a null flag). It returns
 // SOLVER_TERMINATE_SUCCESSFULLY, not SOLVER_ABORT: Ceres then writes the best iterate so far back
 // to the parameter blocks, so an interrupted BA still delivers its progress (as g2o's force-stop
@@ -90,6 +92,25 @@ class ReprojectionLosses {
   ceres::HuberLoss huber_stereo_;
   ceres::LossFunctionWrapper mono_;
   ceres::LossFunctionWrapper stereo_;
+};
+
+// One pass of a bundle adjustment solved in passes (robust, then the refinement without the
+// outliers): solves `problem` for at most `iterations` and adds the pass to `result`. The cost
+// before the first pass and after the last, iterations summed, and whether the abort flag stopped
+// it. An empty problem is not solved. On a numerical failure Ceres leaves the blocks at their
+// initial values, so the map stays consistent: it is logged (naming `what`), not thrown from a
+// mapping thread.
+class BundlePasses {
+ public:
+  BundlePasses(ceres::Problem* problem, const AbortCallback* abort_callback, const char* what)
+      : problem_(problem), abort_callback_(abort_callback), what_(what) {}
+  void Run(int iterations, ceres::Solver::Options* options, BundleResult* result);
+
+ private:
+  ceres::Problem* problem_;
+  const AbortCallback* abort_callback_;
+  const char* what_;
+  bool first_ = true;
 };
 
 }  // namespace pkslam
