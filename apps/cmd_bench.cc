@@ -1,5 +1,5 @@
 // pkslam bench: benchmark suites (datasets x sensors x selectors x sweeps x runs) with
-// reports, resumable runs and scale-out job lists. See evaluation/bench/ and README.md.
+// reports, resumable runs and scale-out job lists. See bench/ and README.md.
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -13,12 +13,12 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "bench/bench.h"
+#include "bench/process.h"
+#include "bench/report.h"
 #include "core/util/build_info.h"
 #include "core/util/error.h"
 #include "core/util/output_guard.h"
-#include "evaluation/bench/bench.h"
-#include "evaluation/bench/process.h"
-#include "evaluation/bench/report.h"
 
 namespace pkslam::apps {
 namespace {
@@ -182,7 +182,7 @@ void RegisterBenchCommand(CLI::App& app) {
       "bench",
       "Benchmark suite: datasets x sensors x keyframe selectors x sweeps x runs -> results.csv, "
       "summary tables, report.md/report.html with plots; resumable; scale-out job lists");
-  cmd->add_option("suite", args->suite, "Suite YAML (see evaluation/suites/)");
+  cmd->add_option("suite", args->suite, "Suite YAML (see bench/suites/)");
   cmd->add_option("--out", args->out, "Output folder (runs/, results.csv, report.html)");
   cmd->add_option("-j,--jobs", args->jobs, "Runs executed at once (child processes)")
       ->capture_default_str();

@@ -12,11 +12,11 @@
 
 #include "apps/cli_errors.h"
 #include "apps/commands.h"
-#include "core/util/output_guard.h"
+#include "bench/process.h"
 #include "core/util/error.h"
 #include "core/util/output_file.h"
+#include "core/util/output_guard.h"
 #include "core/util/project_file.h"
-#include "evaluation/bench/process.h"
 #include "evaluation/evaluate.h"
 #include "io/trajectory.h"
 #include "system/run_dataset.h"

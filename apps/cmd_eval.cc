@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "bench/process.h"
 #include "core/util/error.h"
 #include "core/util/json_writer.h"
 #include "core/util/output_file.h"
 #include "core/util/project_file.h"
-#include "evaluation/bench/process.h"
 #include "evaluation/evaluate.h"
 #include "evaluation/evaluation_output.h"
 #include "io/kitti_dataset.h"

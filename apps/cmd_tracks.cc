@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "bench/process.h"
 #include "core/util/error.h"
 #include "core/util/output_file.h"
 #include "core/util/progress.h"
 #include "core/util/project_file.h"
-#include "evaluation/bench/process.h"
 #include "io/rigid_transform_file.h"
 #include "io/track_file.h"
 #include "io/trajectory.h"

@@ -142,7 +142,7 @@ RealismOptions MakeRealism(RealismPreset preset) {
   if (preset == RealismPreset::kIdeal) return r;  // every source off, every size zero
   r.enabled.fill(true);
   // Sizes: docs/realism.md has each with its documented range and reference; the values sit
-  // inside those ranges (chosen with the ORB-SLAM3 peer on evaluation/suites/realism.yaml).
+  // inside those ranges (chosen with the ORB-SLAM3 peer on bench/suites/realism.yaml).
   CalibrationErrorOptions& c = r.calibration;
   c.focal_px = 0.5;
   c.principal_point_px = 0.75;

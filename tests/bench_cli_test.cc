@@ -1,4 +1,4 @@
-// End-to-end: `pkslam bench` runs the smoke suite (evaluation/suites/smoke.yaml: a rendered
+// End-to-end: `pkslam bench` runs the smoke suite (bench/suites/smoke.yaml: a rendered
 // 5 s flight, stereo, orbslam3 vs pks vs pks with delta 40, 2 deterministic runs each), resumes
 // without re-running, and the scale-out path (--emit-jobs, the jobs run by GNU parallel or sh,
 // --collect) reproduces the same summary. Bad suites give one error line naming file:line.
@@ -103,7 +103,7 @@ void ExpectOneSignAndOneTest(const std::string& report, const std::string& confi
   EXPECT_THAT(report, Not(HasSubstr("improvement")));
 }
 
-const fs::path kSmoke = fs::path(PKSLAM_SOURCE_DIR) / "evaluation/suites/smoke.yaml";
+const fs::path kSmoke = fs::path(PKSLAM_SOURCE_DIR) / "bench/suites/smoke.yaml";
 
 TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
   const fs::path dir = testing::MakeTempDir("bench_smoke");

@@ -7,7 +7,7 @@
 
 namespace pkslam {
 
-// `relative` (e.g. "evaluation/plots.py") under the first ancestor folder of the executable
+// `relative` (e.g. "bench/plots.py") under the first ancestor folder of the executable
 // that has it; otherwise PKSLAM_SOURCE_DIR / relative, which may not exist (callers check).
 std::filesystem::path FindProjectFile(const std::filesystem::path& relative);
 

@@ -22,7 +22,7 @@ CMAKE = {
     "evaluation/CMakeLists.txt": "pkslam_library(pkslam_evaluation\n  SOURCES c.cc\n"
                                  "  DEPS pkslam_io pkslam_core\n  TESTS c_test.cc\n"
                                  "  TEST_DEPS pkslam_map_model\n)\n",
-    "evaluation/bench/CMakeLists.txt": "pkslam_library(pkslam_bench\n  SOURCES d.cc\n"
+    "bench/CMakeLists.txt": "pkslam_library(pkslam_bench\n  SOURCES d.cc\n"
                                        "  DEPS pkslam_evaluation\n)\n",
     "map_model/CMakeLists.txt": "pkslam_library(pkslam_map_model\n  SOURCES e.cc\n"
                                 "  DEPS pkslam_core\n)\n"
@@ -41,7 +41,7 @@ PICTURE = [
     "  io[io: datasets, settings] --> core",
     "  evaluation[evaluation: ATE/RPE] --> io",
     "  %% a comment",
-    "  bench[evaluation/bench] --> evaluation",
+    "  bench[bench] --> evaluation",
     "  map_model --> core",
     "  apps[apps: pkslam] --> bench & map_model",
 ]

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The tables of docs/calibration.md's "Measurements" from a bench of
-evaluation/suites/calibration.yaml (render.sh's renders):
+bench/suites/calibration.yaml (render.sh's renders):
 
 1. ATE (SE(3), m; median over the runs; a failed run counts as the worst) per trajectory and
    sensor: --calibrate off and online on the render with every error source (all), off and online

@@ -1,11 +1,11 @@
 #!/bin/bash
-# Renders the ten sequences of evaluation/suites/calibration.yaml: five full-length EuRoC
+# Renders the ten sequences of bench/suites/calibration.yaml: five full-length EuRoC
 # replays under the euroc realism preset, each with every error source on (NAME_all) and with the
 # calibration source off (NAME_calibration_off: the files hold the true calibration; the
 # images, IMU and timing are the same draw). Resumes: a rendered sequence is kept.
 #
 #   evaluation/studies/calibration/render.sh OUT [PKSLAM]
-#   PKSLAM_CALIBRATION_RENDERS=OUT build/bin/pkslam bench evaluation/suites/calibration.yaml \
+#   PKSLAM_CALIBRATION_RENDERS=OUT build/bin/pkslam bench bench/suites/calibration.yaml \
 #       --out bench-calibration --jobs 2
 #   python3 evaluation/studies/calibration/calibration_table.py bench-calibration
 #
@@ -16,7 +16,7 @@ out=$1
 root=$(cd "$(dirname "$0")/../../.." && pwd)
 pkslam=${2:-$root/build/bin/pkslam}
 shared=${PKSLAM_SHARED_DATA:-$root/../shared/data}
-# name trajectory seed (the seeds of evaluation/suites/realism.yaml's replays)
+# name trajectory seed (the seeds of bench/suites/realism.yaml's replays)
 while read -r name trajectory seed; do
   for variant in all calibration_off; do
     dir=$out/${name}_$variant

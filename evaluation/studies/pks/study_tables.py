@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Tables of the PKS study (docs/pks_study.md) from a collected bench report.
 
-Reads REPORT/results.csv (one row per run) and the analysis of evaluation/bench_statistics.py
+Reads REPORT/results.csv (one row per run) and the analysis of bench/bench_statistics.py
 (run here, on the same rows), and prints markdown:
   1. per sequence and sensor: mean ± std ATE (Sim(3)) per configuration, with the change
      against the baseline, its bootstrap 95% interval and the Mann-Whitney p;
@@ -11,7 +11,7 @@ Reads REPORT/results.csv (one row per run) and the analysis of evaluation/bench_
   3. keyframes created per rule (mean per run), the reason counts;
   4. the pooled significance sentences;
   5. when run k of every configuration replays the same rendering (round 2, issue 39): the
-     paired analysis of evaluation/paired_statistics.py (--compare CONFIG:BASELINE, repeatable);
+     paired analysis of bench/paired_statistics.py (--compare CONFIG:BASELINE, repeatable);
   6. --rate-pairs A:B,...: keyframes created per minute of A beside B's per sequence (e.g.
      pkslam's pks-released beside the authors' binary), and whether A is within 10% of B.
 
@@ -27,8 +27,9 @@ import math
 import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-import bench_statistics  # noqa: E402  (evaluation/bench_statistics.py)
+REPO = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..")
+sys.path.insert(0, os.path.join(REPO, "bench"))
+import bench_statistics  # noqa: E402  (bench/bench_statistics.py)
 
 
 num = bench_statistics.number  # float or NaN

@@ -29,7 +29,7 @@ run "$P eval --gt seq/mav0/state_groundtruth_estimate0/data.csv --est run/trajec
 run "$P view --run run --dataset seq"
 run "$P info seq"
 run "$P run --dataset seq --sensor stereo-inertial --out run_map --save-map run.map --quiet && $P map info run.map"
-run "$P bench evaluation/suites/smoke.yaml --out bench --quiet"
+run "$P bench bench/suites/smoke.yaml --out bench --quiet"
 run "$P dense --run run --dataset seq --out cloud.ply --mesh mesh.ply --quiet"
 run "$P cloud-compare --cloud mesh.ply --ref seq/reference_cloud.ply --align-run run --gt seq/mav0/state_groundtruth_estimate0/data.csv"
 run "$P export-colmap --run run --dataset seq --out colmap"

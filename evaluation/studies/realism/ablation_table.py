@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Reads the results.csv of evaluation/suites/realism-ablation.yaml and prints the ablation table:
+"""Reads the results.csv of bench/suites/realism-ablation.yaml and prints the ablation table:
 per trajectory, sensor and system the ATE (SE(3), m; median over runs, range in brackets when
 there are several; a failed run counts as the worst) with every error source on, with none, and
 with each source switched off in turn. Then, per source, whether switching it off is resolved

@@ -9,7 +9,7 @@
 # Resumes: a finished render or run is kept.
 #
 #   evaluation/studies/realism/machine_hall.sh OUT [SCENE|preset] [SEQUENCE] [SEED] [simulate args...]
-#   (defaults: preset, MH_02_easy, seed 2 as evaluation/suites/realism.yaml; RUNS=1)
+#   (defaults: preset, MH_02_easy, seed 2 as bench/suites/realism.yaml; RUNS=1)
 set -euo pipefail
 if [ $# -lt 1 ]; then sed -n '2,13p' "$0"; exit 2; fi
 out=$1 scene=${2:-preset} seq=${3:-MH_02_easy} seed=${4:-2}

@@ -3,7 +3,7 @@
 # The peer scores 9-11 mm on the euroc replay of V1_01 against 43 mm published on the real
 # flight. Each candidate source is added alone to the preset as it was before issue 38 (without
 # gain flicker, which issue 38 added to it), the full V1_01 replay rendered
-# once (sequence seed $SEED, default 3 as evaluation/suites/realism.yaml; another seed draws
+# once (sequence seed $SEED, default 3 as bench/suites/realism.yaml; another seed draws
 # another realisation of the same flight: sensor noise, IMU turn-on biases, texture placement)
 # and the peer run RUNS times mono-inertially on it (ATE after SE(3) alignment, as the harness):
 #   base        the preset without gain flicker

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Reads the results.csv of evaluation/suites/realism.yaml and prints, per trajectory and sensor,
+"""Reads the results.csv of bench/suites/realism.yaml and prints, per trajectory and sensor,
 each system's median ATE (SE(3), m) over its runs (a failed run counts as the worst),
 coverage and failures, the peer's ratio to
 its published real-EuRoC ATE (the preset's bar: 0.5x to 2x) and pkslam's ratio to the peer.

@@ -13,8 +13,9 @@ import math
 import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-from bench_statistics import number  # noqa: E402  (evaluation/bench_statistics.py)
+REPO = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..")
+sys.path.insert(0, os.path.join(REPO, "bench"))
+from bench_statistics import number  # noqa: E402  (bench/bench_statistics.py)
 
 
 def main():

@@ -11,12 +11,12 @@ root=$(cd "$(dirname "$0")/../../.." && pwd)
 old=${1:?usage: accuracy_before_after.sh OLD_PKSLAM OUT}
 out=${2:?usage: accuracy_before_after.sh OLD_PKSLAM OUT}
 new=$root/build/bin/pkslam
-suite=$root/evaluation/suites/sim-euroc.yaml
+suite=$root/bench/suites/sim-euroc.yaml
 mapfile -t ids < <("$new" bench "$suite" --list | grep -v -e pks-released -e '@' -e seed3)
 for which in before after; do
   exe=$new
   [ "$which" = before ] && exe=$old
-  "$new" bench "$root/evaluation/suites/smoke.yaml" --out "$out/$which-smoke" --pkslam "$exe" --quiet --no-plots
+  "$new" bench "$root/bench/suites/smoke.yaml" --out "$out/$which-smoke" --pkslam "$exe" --quiet --no-plots
   "$new" bench "$suite" --out "$out/$which-sim-euroc" --pkslam "$exe" --run-id "${ids[@]}" --quiet
   "$new" bench --out "$out/$which-sim-euroc" --collect "$out/$which-sim-euroc" --quiet --no-plots
 done

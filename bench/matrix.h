@@ -1,0 +1,54 @@
+// The run matrix of a suite: datasets x sensors x selector configurations (the suite's
+// selectors, then one configuration per sweep value) x runs.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bench/suite.h"
+
+namespace pkslam::bench {
+
+// One `pkslam run` of the matrix.
+struct RunSpec {
+  int index = 0;         // position in the matrix (tables and results.csv keep this order)
+  std::string id;        // unique, filesystem-safe: DATASET/SENSOR/CONFIG/seedN
+  std::string dataset;   // DatasetSpec::name
+  std::string sensor;    // passed through to pkslam run --sensor
+  std::string config;    // selector label, plus @PARAM=VALUE for sweep points
+  std::string selector;  // selector factory name
+  std::map<std::string, double> params;  // suite params, then selector params, then sweep
+  std::vector<std::string> run_args;     // the configuration's further `pkslam run` options
+  std::string sweep_param;               // empty unless a sweep point
+  double sweep_value = 0.0;
+  bool dense = false;  // build the run's dense cloud after it
+  int run = 0;         // 0 .. runs-1
+  std::uint64_t seed = 0;
+  std::optional<SimRecipe> sim;  // with the seed of this run's rendering
+  // A peer system's run: its command (placeholders not yet substituted, see PeerSpec);
+  // empty for `pkslam run`.
+  std::vector<std::string> peer_command;
+};
+
+// "a=1;b=0.5" (sorted by name; numbers in shortest round-trip form).
+std::string FormatParams(const std::map<std::string, double>& params);
+// Shortest text that reads back to the same double ("20", "0.35").
+std::string FormatNumber(double value);
+
+// Expands the suite in a fixed order: dataset, sensor, configuration, run.
+std::vector<RunSpec> ExpandSuite(const Suite& suite);
+
+// The runs of these sensors (all when `sensors` is empty), in their order: a study split over
+// sittings, one sensor first (`pkslam bench --sensor`). Throws OptionError for a sensor the
+// suite does not run.
+std::vector<RunSpec> SelectSensors(const std::vector<RunSpec>& runs,
+                                   const std::vector<std::string>& sensors);
+
+// The dataset spec of a run (throws Error when absent).
+const DatasetSpec& DatasetOf(const Suite& suite, const RunSpec& run);
+
+}  // namespace pkslam::bench
