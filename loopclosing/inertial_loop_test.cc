@@ -36,7 +36,7 @@ class InertialLoopTest : public testing::RevisitTest {
     Map* second_map = atlas_.current_map();
     if (merge) {
       auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-      second_map = atlas_.CreateNewMap();
+      second_map = atlas_.CreateNewMap(lock);
     }
     second_ = Revisit(second_map, scene_);
     Finish(second_);

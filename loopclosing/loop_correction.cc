@@ -325,8 +325,8 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     merged->mutable_imu_status().imu_initialized =
         merged->imu_status().imu_initialized && current->imu_status().imu_initialized;
     merged->RecordWorldChange({});
-    atlas_->SetCurrentMap(merged);
-    atlas_->RemoveMap(current);
+    atlas_->SetCurrentMap(lock, merged);
+    atlas_->RemoveMap(lock, current);
     merged->IncreaseChangeIndex();
   }
   ReleaseMapping();

@@ -73,7 +73,7 @@ TEST_P(LoopClosingRevisitTest, ClosesTheLoopOrMergesTheMaps) {
   Map* second_map = first_map;
   if (merge) {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    second_map = atlas_.CreateNewMap();
+    second_map = atlas_.CreateNewMap(lock);
   }
   const auto second = Revisit(second_map, scene_);
   Finish(second);

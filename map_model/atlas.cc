@@ -2,9 +2,12 @@
 
 #include <algorithm>
 
+#include "core/util/error.h"
+#include "map_model/map_editor.h"
+
 namespace pkslam {
 
-Atlas::Atlas() { CreateNewMap(); }
+Atlas::Atlas() { AddMap(); }
 
 Atlas::~Atlas() {
   // Maps erase their keyframes from the database while clearing; the database goes last.
@@ -17,27 +20,42 @@ void Atlas::SetDatabase(std::unique_ptr<KeyFrameDatabase> database) {
   for (auto& m : maps_) m->set_database(database_.get());
 }
 
-Map* Atlas::CreateNewMap() {
+void Atlas::RequireWriteLock(const MapWriteLock& lock, const char* operation) const {
+  PKSLAM_CHECK(lock.Holds(*this), "Atlas::{} without the Atlas's write lock", operation);
+}
+
+Map* Atlas::CreateNewMap(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "CreateNewMap");
+  return AddMap();
+}
+
+Map* Atlas::AddMap() {
   maps_.push_back(std::make_unique<Map>(next_map_id_++));
   current_ = maps_.back().get();
   current_->set_database(database_.get());
   return current_;
 }
 
-void Atlas::SetCurrentMap(Map* map) { current_ = map; }
+void Atlas::SetCurrentMap(const MapWriteLock& lock, Map* map) {
+  RequireWriteLock(lock, "SetCurrentMap");
+  current_ = map;
+}
 
-void Atlas::SetCalibration(RigCalibration calibration, RigSetup setup) {
+void Atlas::SetCalibration(const MapWriteLock& lock, RigCalibration calibration, RigSetup setup) {
+  RequireWriteLock(lock, "SetCalibration");
   calibration_ = std::move(calibration);
   rig_setup_ = std::move(setup);
   calibration_version_.fetch_add(1);
 }
 
-void Atlas::RemoveMap(const Map* map) {
+void Atlas::RemoveMap(const MapWriteLock& lock, const Map* map) {
+  RequireWriteLock(lock, "RemoveMap");
   std::erase_if(maps_, [map](const std::unique_ptr<Map>& m) { return m.get() == map; });
   if (current_ == map) current_ = maps_.empty() ? nullptr : maps_.back().get();
 }
 
-void Atlas::ResetCurrentMap() {
+void Atlas::ResetCurrentMap(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "ResetCurrentMap");
   if (current_ != nullptr) current_->Clear();
 }
 

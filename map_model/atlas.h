@@ -18,6 +18,8 @@
 
 namespace pkslam {
 
+class MapWriteLock;
+
 class Atlas {
  public:
   Atlas();
@@ -25,13 +27,14 @@ class Atlas {
   Atlas(const Atlas&) = delete;
   Atlas& operator=(const Atlas&) = delete;
 
-  // Requires the exclusive lock.
-  Map* CreateNewMap();
-  void SetCurrentMap(Map* map);
-  // Removes an (empty or merged) map; requires the exclusive lock.
-  void RemoveMap(const Map* map);
+  // Changes of the set of maps, each under this Atlas's write lock (checked: Error without it).
+  // A new empty map, which becomes current.
+  Map* CreateNewMap(const MapWriteLock& lock);
+  void SetCurrentMap(const MapWriteLock& lock, Map* map);
+  // Removes an (empty or merged) map.
+  void RemoveMap(const MapWriteLock& lock, const Map* map);
   // Clears the current map's content (a reset) keeping the map object.
-  void ResetCurrentMap();
+  void ResetCurrentMap(const MapWriteLock& lock);
 
   // Requires at least the shared lock.
   Map* current_map() const { return current_; }
@@ -52,11 +55,11 @@ class Atlas {
 
   // The calibration every keyframe's keypoints are in, and the rig built from it (online
   // calibration, mapping/calibration_refinement.h): each keyframe's rig() is rig_setup().rig.
-  // Read under the shared lock, set under the exclusive one; calibration_version() (bumped by
+  // Read under the shared lock, set under the write lock; calibration_version() (bumped by
   // every set) needs no lock, so tracking can poll it per frame.
   const RigCalibration& calibration() const { return calibration_; }
   const RigSetup& rig_setup() const { return rig_setup_; }
-  void SetCalibration(RigCalibration calibration, RigSetup setup);
+  void SetCalibration(const MapWriteLock& lock, RigCalibration calibration, RigSetup setup);
   int calibration_version() const { return calibration_version_.load(); }
 
   // Exclusive holds of the map lock so far, per kind of change (thread-safe; no lock needed).
@@ -68,6 +71,9 @@ class Atlas {
   friend class MapReader;
   friend class MapWriteLock;
   void RecordEdit(MapEdit edit, double held_s) const;
+  Map* AddMap();
+  // Throws Error unless `lock` holds this Atlas exclusively.
+  void RequireWriteLock(const MapWriteLock& lock, const char* operation) const;
 
   // Shared: read the map model. Exclusive: change it. Taken only by MapReader / MapEditor.
   mutable std::shared_mutex mutex_;

@@ -94,7 +94,7 @@ TEST_F(InertialChainTest, SpliceOutWithoutBothIntervalsCutsTheChain) {
 TEST_F(InertialChainTest, RefusesKeyframesOfAnotherMapAndChangesWithoutTheWriteLock) {
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    Map* other = atlas_.CreateNewMap();
+    Map* other = atlas_.CreateNewMap(lock);
     kf(5)->set_map(other);  // as if merged away
     EXPECT_THROW(chain().Append(lock, kf(4), kf(5), Interval(0.05)), Error);
     EXPECT_EQ(kf(4)->imu().next(), nullptr);

@@ -30,8 +30,8 @@ class KeyFrameDatabaseTest : public ::testing::Test {
         scene_(MakeScene(4000, 11, 30.0, 2.5, 4.0, 8.0)) {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     map_a_ = atlas_.current_map();
-    map_b_ = atlas_.CreateNewMap();
-    atlas_.SetCurrentMap(map_a_);
+    map_b_ = atlas_.CreateNewMap(lock);
+    atlas_.SetCurrentMap(lock, map_a_);
   }
 
   Frame QueryFrame(const SE3d& pose) {

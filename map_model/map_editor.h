@@ -36,6 +36,8 @@ class MapWriteLock {
   void unlock();
   void lock();
   bool owns_lock() const { return lock_.owns_lock(); }
+  // Whether this lock is held on `atlas` (a write lock of another Atlas proves nothing).
+  bool Holds(const Atlas& atlas) const { return atlas_ == &atlas && lock_.owns_lock(); }
   MapEdit edit() const { return edit_; }
 
  private:

@@ -2,6 +2,7 @@
 
 #include <mutex>
 
+#include "core/util/error.h"
 #include "map_model/keyframe.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
@@ -177,9 +178,35 @@ TEST_F(MapModelTest, ClearBreaksAllLinks) {
   std::weak_ptr<KeyFrame> weak_kf = map_.keyframes[1];
   map_.keyframes.clear();
   map_.point_of_scene_index.clear();
-  atlas_.ResetCurrentMap();
+  atlas_.ResetCurrentMap(lock);
   EXPECT_TRUE(weak_kf.expired());
   EXPECT_EQ(atlas_.current_map()->NumKeyFrames(), 0);
+}
+
+TEST_F(MapModelTest, TheSetOfMapsChangesOnlyUnderThisAtlasWriteLock) {
+  Map* first = atlas_.current_map();
+  {
+    auto not_yet = MapEditor(&atlas_).WriteLater(MapEdit::kFixture);
+    EXPECT_THROW(atlas_.CreateNewMap(not_yet), Error);
+    EXPECT_THROW(atlas_.ResetCurrentMap(not_yet), Error);
+  }
+  Atlas other;
+  {
+    auto lock_of_other = MapEditor(&other).Write(MapEdit::kFixture);
+    EXPECT_THROW(atlas_.CreateNewMap(lock_of_other), Error);
+    EXPECT_THROW(atlas_.SetCalibration(lock_of_other, {}, {}), Error);
+  }
+  EXPECT_EQ(atlas_.NumMaps(), 1);
+  EXPECT_EQ(atlas_.current_map(), first);
+  EXPECT_GT(first->NumKeyFrames(), 0);
+
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  Map* second = atlas_.CreateNewMap(lock);
+  EXPECT_EQ(atlas_.current_map(), second);
+  atlas_.SetCurrentMap(lock, first);
+  atlas_.RemoveMap(lock, second);
+  EXPECT_EQ(atlas_.NumMaps(), 1);
+  EXPECT_EQ(atlas_.current_map(), first);
 }
 
 }  // namespace

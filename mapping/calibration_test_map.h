@@ -19,7 +19,7 @@ struct CalibrationTestMap {
     setup = BuildRig(file, shape);
     {
       auto lock = MapEditor(&atlas).Write(MapEdit::kFixture);
-      atlas.SetCalibration(file, setup);
+      atlas.SetCalibration(lock, file, setup);
     }
     FrameOptions frames;
     frames.pixel_noise = 0.5;

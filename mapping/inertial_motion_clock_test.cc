@@ -95,7 +95,7 @@ TEST_F(InertialMotionClockTest, AKeyframeOfAnotherMapRestartsTheClocks) {
   const testing::SyntheticMap first = map_;  // keeps the first map's keyframes alive
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    atlas_.CreateNewMap();
+    atlas_.CreateNewMap(lock);
   }
   MakeChain({0.1});
   auto lock = MapReader(atlas_).Lock();

@@ -71,7 +71,7 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   atlas_.SetDatabase(std::make_unique<KeyFrameDatabase>(*vocabulary_));
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
-    atlas_.SetCalibration(file_calibration_, setup_);
+    atlas_.SetCalibration(lock, file_calibration_, setup_);
   }
   calibration_version_ = atlas_.calibration_version();
   mapper_ = std::make_unique<LocalMapper>(&atlas_, setup_.rig, options_.mapping);
@@ -269,9 +269,9 @@ SlamSystem::MapFileInfo SlamSystem::LoadMap(const std::filesystem::path& file) {
   if (record.maps.empty()) throw InputError(file, "the map file holds no map");
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kLoadMap);
-    atlas_.SetCalibration(calibration, setup);
+    atlas_.SetCalibration(lock, calibration, setup);
     try {
-      AtlasStorage::Restore(record, setup.rig, &atlas_);
+      AtlasStorage::Restore(lock, record, setup.rig, &atlas_);
     } catch (const InputError&) {
       throw;
     } catch (const Error& e) {
@@ -286,9 +286,10 @@ SlamSystem::MapFileInfo SlamSystem::LoadMap(const std::filesystem::path& file) {
     }
     if (options_.tracking.localise_only) {
       // Every loaded map still counts as this session's here: the largest one.
-      atlas_.SetCurrentMap(atlas_.FindMap(LargestMap()->id()));
+      atlas_.SetCurrentMap(lock, atlas_.FindMap(LargestMap()->id()));
     } else {
-      atlas_.CreateNewMap();  // this session's map; loop closing merges it when it recognises one
+      atlas_.CreateNewMap(
+          lock);  // this session's map; loop closing merges it when it recognises one
     }
   }
   SyncCalibration();

@@ -372,7 +372,7 @@ void Tracker::HandleLost() {
   mapping_->ResetQueue();
   {
     auto lock = MapEditor(atlas_).Write(MapEdit::kReset);
-    atlas_->CreateNewMap();
+    atlas_->CreateNewMap(lock);
   }
   StartOver();
 }
@@ -393,7 +393,7 @@ void Tracker::Reset() {
     last_kf_.reset();
     current_.reference_kf.reset();
     last_.reference_kf.reset();
-    atlas_->ResetCurrentMap();
+    atlas_->ResetCurrentMap(lock);
   }
   StartOver();
 }

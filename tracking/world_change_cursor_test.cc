@@ -79,7 +79,7 @@ TEST_F(WorldChangeCursorTest, ANewMapRestartsTheCursorAtItsEnd) {
   cursor_.Follow(map());
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    atlas_.CreateNewMap();
+    atlas_.CreateNewMap(lock);
   }
   Record(Transform(0.2, 4.0));
   const WorldChangesSeen seen = cursor_.Follow(map());

@@ -58,7 +58,7 @@ void MoveToCalibration(const MapWriteLock& lock, Atlas* atlas, const RigCalibrat
       }
     }
   }
-  atlas->SetCalibration(calibration, setup);
+  atlas->SetCalibration(lock, calibration, setup);
 }
 
 int RefinePointsToCalibration(Atlas* atlas, MapId map_id) {

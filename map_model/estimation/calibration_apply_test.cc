@@ -36,7 +36,7 @@ class CalibrationApplyTest : public ::testing::Test {
     setup_ = BuildRig(file_, StereoShape());
     {
       auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-      atlas_.SetCalibration(file_, setup_);
+      atlas_.SetCalibration(lock, file_, setup_);
     }
     scene_ = testing::MakeScene(500, 7);
     map_ = testing::MakeMap(&atlas_, scene_, setup_.rig, testing::MakeForwardPath(12, 0.15, 8),

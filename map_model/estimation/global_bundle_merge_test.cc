@@ -125,8 +125,8 @@ TEST_F(MergeGlobalBundleTest, KeyframesOfAnotherMapAreLeftAlone) {
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     moved = AddKeyFrame(map_.keyframes.back().get(), 0.2);
-    Map* other = atlas_.CreateNewMap();
-    atlas_.SetCurrentMap(map_.keyframes.front()->map());
+    Map* other = atlas_.CreateNewMap(lock);
+    atlas_.SetCurrentMap(lock, map_.keyframes.front()->map());
     moved->set_map(other);
     before = moved->camera_from_world();
   }

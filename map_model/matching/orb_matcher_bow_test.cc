@@ -155,7 +155,7 @@ TEST_F(MatcherBowTest, KeyFrameToKeyFrameAcrossTwoMaps) {
   lock_.unlock();
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    atlas_.CreateNewMap();
+    atlas_.CreateNewMap(lock);
   }
   FrameOptions o;
   o.pixel_noise = 0.5;

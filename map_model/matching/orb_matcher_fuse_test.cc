@@ -41,14 +41,14 @@ class MatcherFuseTest : public ::testing::Test {
     map_a_ = atlas_.current_map();
     {
       auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-      map_b_ptr_ = atlas_.CreateNewMap();
+      map_b_ptr_ = atlas_.CreateNewMap(lock);
     }
     o.seed = 99;
     map_b_ = MakeMap(&atlas_, TransformScene(scene_, kScaleB, kOffsetB), rig_,
                      TransformPoses(poses_, kScaleB, kOffsetB), o);
     {
       auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-      atlas_.SetCurrentMap(map_a_);
+      atlas_.SetCurrentMap(lock, map_a_);
     }
     scene_of_b_ = SceneIndexOf(map_b_);
     for (const auto& [id, p] : map_b_ptr_->map_points()) points_b_.push_back(p);

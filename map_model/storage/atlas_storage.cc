@@ -141,8 +141,9 @@ AtlasRecord AtlasStorage::Snapshot(const Atlas& atlas, const CameraRig& rig,
   return out;
 }
 
-void AtlasStorage::Restore(const AtlasRecord& record, std::shared_ptr<const CameraRig> rig,
-                           Atlas* atlas) {
+void AtlasStorage::Restore(const MapWriteLock& lock, const AtlasRecord& record,
+                           std::shared_ptr<const CameraRig> rig, Atlas* atlas) {
+  atlas->RequireWriteLock(lock, "Restore");
   std::map<KeyFrameId, double> time_offsets;
   if (record.calibration) {
     for (const auto& [id, offset] : record.calibration->keyframe_time_offsets) {
@@ -262,7 +263,7 @@ void AtlasStorage::Restore(const AtlasRecord& record, std::shared_ptr<const Came
   atlas->next_point_id_.store(record.next_point_id);
   if (atlas->current_ == nullptr) {
     if (atlas->maps_.empty()) {
-      atlas->CreateNewMap();
+      atlas->CreateNewMap(lock);
     } else {
       atlas->current_ = atlas->maps_.back().get();
     }

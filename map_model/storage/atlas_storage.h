@@ -22,10 +22,10 @@ class AtlasStorage {
   // Atlas): those are dropped, the loaded maps take their ids, the loaded current map becomes
   // current, the id counters continue after the loaded ones, and every keyframe enters the
   // Atlas's keyframe database. Every keyframe uses `rig` (checked against record.camera by the
-  // caller: map_file.h CheckCompatible). Caller holds the Atlas lock (exclusive) or owns the
-  // Atlas alone. Throws Error on a record whose links name missing objects.
-  static void Restore(const AtlasRecord& record, std::shared_ptr<const CameraRig> rig,
-                      Atlas* atlas);
+  // caller: map_file.h CheckCompatible). `lock` holds `atlas` (MapEdit::kLoadMap). Throws
+  // Error on a record whose links name missing objects.
+  static void Restore(const MapWriteLock& lock, const AtlasRecord& record,
+                      std::shared_ptr<const CameraRig> rig, Atlas* atlas);
 };
 
 // The calibration of a map file and back (AtlasRecord::calibration).

@@ -84,7 +84,10 @@ class MapFileTest : public ::testing::Test {
 TEST_F(MapFileTest, RoundTripGivesTheSameMapAndTheSameBytes) {
   const auto first = Save(atlas_, "first.pkmap");
   Atlas loaded;
-  AtlasStorage::Restore(ReadMapFile(first), rig_, &loaded);
+  {
+    auto lock = MapEditor(&loaded).Write(MapEdit::kLoadMap);
+    AtlasStorage::Restore(lock, ReadMapFile(first), rig_, &loaded);
+  }
   ASSERT_EQ(loaded.NumMaps(), 1);
   const Map* a = map();
   const Map* b = loaded.current_map();
@@ -190,9 +193,18 @@ TEST_F(MapFileTest, AnotherVocabularyOrCameraIsRefused) {
   EXPECT_THROW(CheckCompatible(file, record, kVocabulary, other), InputError);
 }
 
-TEST_F(MapFileTest, RestoreNeedsAnEmptyAtlas) {
+TEST_F(MapFileTest, RestoreNeedsAnEmptyAtlasAndItsWriteLock) {
   const auto file = Save(atlas_, "map.pkmap");
-  EXPECT_THROW(AtlasStorage::Restore(ReadMapFile(file), rig_, &atlas_), Error);
+  {
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kLoadMap);
+    EXPECT_THROW(AtlasStorage::Restore(lock, ReadMapFile(file), rig_, &atlas_), Error);
+  }
+  // An empty Atlas, but the lock is another Atlas's: refused before anything changes.
+  Atlas empty;
+  auto other_lock = MapEditor(&atlas_).Write(MapEdit::kLoadMap);
+  EXPECT_THROW(AtlasStorage::Restore(other_lock, ReadMapFile(file), rig_, &empty), Error);
+  EXPECT_EQ(empty.NumMaps(), 1);
+  EXPECT_EQ(empty.current_map()->NumKeyFrames(), 0);
 }
 
 }  // namespace
