@@ -42,9 +42,9 @@ class InertialLoopTest : public testing::RevisitTest {
     Finish(second_);
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (Map* map : atlas_.maps()) {
-      map->mutable_imu_status().imu_initialized = true;
-      map->mutable_imu_status().inertial_ba1_done = true;
-      map->mutable_imu_status().inertial_ba2_done = true;
+      map->mutable_imu_status(lock).imu_initialized = true;
+      map->mutable_imu_status(lock).inertial_ba1_done = true;
+      map->mutable_imu_status(lock).inertial_ba2_done = true;
       KeyFrame* previous = nullptr;
       for (const auto& kf : map->keyframes()) {
         if (previous != nullptr) {
@@ -158,8 +158,8 @@ class DriftBoundTest : public InertialLoopTest {
     Finish(second_);
     if (IsInertial(sensor)) {
       auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-      atlas_.current_map()->mutable_imu_status().imu_initialized = true;
-      atlas_.current_map()->mutable_imu_status().inertial_ba2_done = true;
+      atlas_.current_map()->mutable_imu_status(lock).imu_initialized = true;
+      atlas_.current_map()->mutable_imu_status(lock).inertial_ba2_done = true;
     }
     const Snapshot before = Take();
     const LoopClosingStats stats = Close(sensor);

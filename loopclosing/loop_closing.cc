@@ -341,7 +341,7 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
         }
         applied = true;
         if (IsInertial(sensor_) && map->imu_status().imu_initialized) {
-          map->RecordWorldChange({});
+          map->RecordWorldChange(lock, {});
           PKSLAM_LOG_INFO("global BA of map {}: largest keyframe tilt change {:.2e} rad", map->id(),
                           MaxTiltChange(*map, gravity_before));
         }

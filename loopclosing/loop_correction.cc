@@ -216,7 +216,7 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
     query->AddLoopEdge(region.matched.get());
     region.matched->AddLoopEdge(query);
     // Tracking predicts from its last keyframe (corrected pose and velocity) next time.
-    if (four_dof) map->RecordWorldChange({});
+    if (four_dof) map->RecordWorldChange(lock, {});
     PKSLAM_LOG_INFO(
         "loop correction of map {} ({}): yaw {:.4f} rad, largest keyframe tilt change "
         "{:.2e} rad",
@@ -276,17 +276,17 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     for (const auto& kf : live) {
       current->TakeKeyFrame(kf.get());
       kf->set_map(merged);
-      merged->AddKeyFrame(kf);
+      merged->AddKeyFrame(lock, kf);
     }
     for (const auto& kf : retired) {
       current->TakeKeyFrame(kf.get());
       kf->set_map(merged);
-      merged->AddRetiredKeyFrame(kf);
+      merged->AddRetiredKeyFrame(lock, kf);
     }
     for (const auto& mp : points) {
       current->TakeMapPoint(mp.get());
       mp->set_map(merged);
-      merged->AddMapPoint(mp);
+      merged->AddMapPoint(lock, mp);
     }
     for (const auto& mp : points) mp->UpdateNormalAndDepth();
 
@@ -322,12 +322,12 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     query->AddLoopEdge(region.matched.get());
     region.matched->AddLoopEdge(query);
 
-    merged->mutable_imu_status().imu_initialized =
+    merged->mutable_imu_status(lock).imu_initialized =
         merged->imu_status().imu_initialized && current->imu_status().imu_initialized;
-    merged->RecordWorldChange({});
+    merged->RecordWorldChange(lock, {});
     atlas_->SetCurrentMap(lock, merged);
     atlas_->RemoveMap(lock, current);
-    merged->IncreaseChangeIndex();
+    merged->IncreaseChangeIndex(lock);
   }
   ReleaseMapping();
   return merged;

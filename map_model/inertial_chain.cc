@@ -13,15 +13,12 @@
 namespace pkslam {
 namespace {
 
-void RequireWriteLock(const MapWriteLock& lock, const char* operation) {
-  PKSLAM_CHECK(lock.owns_lock(), "InertialChain::{} without the Atlas's write lock", operation);
-}
 
 }  // namespace
 
 void InertialChain::Append(const MapWriteLock& lock, KeyFrame* previous, KeyFrame* keyframe,
                            std::optional<PreintegratedImu> from_previous) const {
-  RequireWriteLock(lock, "Append");
+  RequireWriteLock(lock, "InertialChain::Append");
   PKSLAM_CHECK(previous != nullptr && keyframe != nullptr && previous != keyframe,
                "InertialChain::Append needs two keyframes");
   PKSLAM_CHECK(previous->map() == map_ && keyframe->map() == map_,
@@ -33,7 +30,7 @@ void InertialChain::Append(const MapWriteLock& lock, KeyFrame* previous, KeyFram
 }
 
 void InertialChain::SpliceOut(const MapWriteLock& lock, KeyFrame* keyframe) const {
-  RequireWriteLock(lock, "SpliceOut");
+  RequireWriteLock(lock, "InertialChain::SpliceOut");
   KeyFrame* previous = keyframe->imu_.previous_;
   KeyFrame* next = keyframe->imu_.next_;
   if (next != nullptr && next->imu_.previous_ == keyframe) {

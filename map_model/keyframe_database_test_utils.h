@@ -34,7 +34,7 @@ inline std::vector<KeyFramePtr> AddKeyFrames(Atlas* atlas, Map* map, const Synth
     f.ComputeBoW(vocabulary);
     f.SetPose(poses[k]);
     auto kf = std::make_shared<KeyFrame>(atlas->NextKeyFrameId(), f, map);
-    map->AddKeyFrame(kf);
+    map->AddKeyFrame(lock, kf);
     kfs.push_back(kf);
     for (int p : kp_points) ++seen[p];
     keypoint_points.push_back(std::move(kp_points));
@@ -47,7 +47,7 @@ inline std::vector<KeyFramePtr> AddKeyFrames(Atlas* atlas, Map* map, const Synth
       if (!points[p]) {
         points[p] = std::make_shared<MapPoint>(atlas->NextMapPointId(), scene.points_world[p],
                                                kfs[k].get(), map);
-        map->AddMapPoint(points[p]);
+        map->AddMapPoint(lock, points[p]);
       }
       points[p]->AddObservation(kfs[k].get(), static_cast<int>(i));
       kfs[k]->AddMapPoint(points[p], static_cast<int>(i));

@@ -2,24 +2,55 @@
 
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 
 namespace pkslam {
 
 Map::~Map() { Clear(); }
 
-void Map::AddKeyFrame(const KeyFramePtr& kf) {
+void Map::AddKeyFrame(const MapWriteLock& lock, const KeyFramePtr& kf) {
+  RequireWriteLock(lock, "Map::AddKeyFrame");
   if (keyframes_.empty() && origin_ == nullptr) origin_ = kf.get();
   keyframes_[kf->id()] = kf;
   if (kf->id() > max_kf_id_) max_kf_id_ = kf->id();
 }
 
-void Map::AddRetiredKeyFrame(const KeyFramePtr& kf) {
+void Map::AddRetiredKeyFrame(const MapWriteLock& lock, const KeyFramePtr& kf) {
+  RequireWriteLock(lock, "Map::AddRetiredKeyFrame");
   retired_[kf->id()] = kf;
   if (kf->id() > max_kf_id_) max_kf_id_ = kf->id();
 }
 
-void Map::AddMapPoint(const MapPointPtr& point) { map_points_[point->id()] = point; }
+void Map::AddMapPoint(const MapWriteLock& lock, const MapPointPtr& point) {
+  RequireWriteLock(lock, "Map::AddMapPoint");
+  map_points_[point->id()] = point;
+}
+
+MapPointPtr Map::CreateMapPoint(const MapWriteLock& lock, MapPointId id,
+                                const Eigen::Vector3d& position_world, KeyFrame* reference,
+                                std::initializer_list<MapPoint::Observation> observations) {
+  RequireWriteLock(lock, "Map::CreateMapPoint");
+  auto point = std::make_shared<MapPoint>(id, position_world, reference, this);
+  for (const MapPoint::Observation& o : observations) {
+    point->AddObservation(o.keyframe, o.index);
+    o.keyframe->AddMapPoint(point, o.index);
+  }
+  point->ComputeDistinctiveDescriptor();
+  point->UpdateNormalAndDepth();
+  map_points_[id] = point;
+  return point;
+}
+
+void Map::IncreaseChangeIndex(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "Map::IncreaseChangeIndex");
+  ++change_index_;
+}
+
+MapImuStatus& Map::mutable_imu_status(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "Map::mutable_imu_status");
+  return imu_status_;
+}
 
 void Map::EraseMapPoint(const MapPoint* point) { map_points_.erase(point->id()); }
 
@@ -78,7 +109,8 @@ MapPointPtr Map::Share(const MapPoint* point) const {
   return live.get() == point ? live : nullptr;
 }
 
-void Map::RecordWorldChange(const WorldChange& change) {
+void Map::RecordWorldChange(const MapWriteLock& lock, const WorldChange& change) {
+  RequireWriteLock(lock, "Map::RecordWorldChange");
   world_changes_.push_back(change);
   if (change.kind == WorldChange::Kind::kTransform) {
     applied_scale_ *= change.scale;

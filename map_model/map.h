@@ -3,7 +3,9 @@
 // change counter for loop corrections). Guarded by the Atlas mutex.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <vector>
@@ -11,11 +13,13 @@
 #include "core/geometry/so3.h"
 #include "map_model/inertial_chain.h"
 #include "map_model/map_ids.h"
+#include "map_model/map_point.h"
 #include "map_model/world_change.h"
 
 namespace pkslam {
 
 class KeyFrameDatabase;
+class MapWriteLock;
 
 // How far a map's IMU initialisation has come.
 struct MapImuStatus {
@@ -38,10 +42,18 @@ class Map {
 
   MapId id() const { return id_; }
 
-  void AddKeyFrame(const KeyFramePtr& kf);
+  // The changes below take the Atlas's write lock (map_editor.h) and throw Error without it.
+  void AddKeyFrame(const MapWriteLock& lock, const KeyFramePtr& kf);
   // Takes over a keyframe retired in another map (map merging).
-  void AddRetiredKeyFrame(const KeyFramePtr& kf);
-  void AddMapPoint(const MapPointPtr& point);
+  void AddRetiredKeyFrame(const MapWriteLock& lock, const KeyFramePtr& kf);
+  void AddMapPoint(const MapWriteLock& lock, const MapPointPtr& point);
+  // The one way a point is born (tracking's stereo/depth points and two-view start, local
+  // mapping's triangulation): a live point at `position_world` seen at each keyframe keypoint of
+  // `observations`, which take it in their (empty) slots; its descriptor, normal and depth range
+  // are computed from them. `reference`: the keyframe its scale range is measured from.
+  MapPointPtr CreateMapPoint(const MapWriteLock& lock, MapPointId id,
+                             const Eigen::Vector3d& position_world, KeyFrame* reference,
+                             std::initializer_list<MapPoint::Observation> observations);
   // Removes the point from the live set (callers mark it bad first).
   void EraseMapPoint(const MapPoint* point);
   // Moves a keyframe from the live set to the retired set (KeyFrame::SetBad calls this).
@@ -73,17 +85,16 @@ class Map {
   // Bumped by loop closing / global BA so tracking knows poses moved under it, and by local
   // mapping's full inertial BA (it invalidates the local inertial BA's marginalisation priors).
   int change_index() const { return change_index_; }
-  void IncreaseChangeIndex() { ++change_index_; }
+  void IncreaseChangeIndex(const MapWriteLock& lock);
 
   // Inertial state of the map: read by every thread under the Atlas lock, written by local
-  // mapping (IMU initialisation and refinements) and loop closing (merges) under it.
+  // mapping (IMU initialisation and refinements) and loop closing (merges) under its write lock.
   const MapImuStatus& imu_status() const { return imu_status_; }
-  MapImuStatus& mutable_imu_status() { return imu_status_; }
+  MapImuStatus& mutable_imu_status(const MapWriteLock& lock);
 
-  // World changes (world_change.h): recorded by whoever changed the map (holding the Atlas
-  // lock exclusively), read by tracking past its cursor. A transform also multiplies the
-  // applied scale.
-  void RecordWorldChange(const WorldChange& change);
+  // World changes (world_change.h): recorded by whoever changed the map, read by tracking past
+  // its cursor. A transform also multiplies the applied scale.
+  void RecordWorldChange(const MapWriteLock& lock, const WorldChange& change);
   int NumWorldChanges() const { return static_cast<int>(world_changes_.size()); }
   const WorldChange& world_change(int index) const { return world_changes_.at(index); }
   // Product of the scale factors applied to the map (monocular-inertial initialisation), so

@@ -67,6 +67,10 @@ MapEditor::MapEditor(Atlas* atlas) : atlas_(atlas) {
   PKSLAM_CHECK(atlas_ != nullptr, "MapEditor without an Atlas");
 }
 
+void RequireWriteLock(const MapWriteLock& lock, std::string_view operation) {
+  PKSLAM_CHECK(lock.owns_lock(), "{} without the Atlas's write lock", operation);
+}
+
 MapWriteLock MapEditor::Write(MapEdit edit) const {
   MapWriteLock lock(atlas_, edit, std::defer_lock);
   lock.lock();

@@ -17,6 +17,7 @@
 #include <chrono>
 #include <mutex>
 #include <shared_mutex>
+#include <string_view>
 
 #include "map_model/atlas.h"
 
@@ -49,6 +50,10 @@ class MapWriteLock {
   std::unique_lock<std::shared_mutex> lock_;
   std::chrono::steady_clock::time_point since_;
 };
+
+// Throws Error naming `operation` unless `lock` is held: the first line of every map change
+// that takes the lock as a parameter (a deferred or released lock proves nothing).
+void RequireWriteLock(const MapWriteLock& lock, std::string_view operation);
 
 class MapEditor {
  public:

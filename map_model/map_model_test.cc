@@ -209,5 +209,84 @@ TEST_F(MapModelTest, TheSetOfMapsChangesOnlyUnderThisAtlasWriteLock) {
   EXPECT_EQ(atlas_.current_map(), first);
 }
 
+TEST_F(MapModelTest, AMapChangesOnlyUnderTheWriteLock) {
+  Map* map = atlas_.current_map();
+  const int keyframes = map->NumKeyFrames();
+  const int points = map->NumMapPoints();
+  const int changes = map->NumWorldChanges();
+  const int change_index = map->change_index();
+  auto point = std::make_shared<MapPoint>(atlas_.NextMapPointId(), Eigen::Vector3d(0, 0, 5),
+                                          map_.keyframes.front().get(), map);
+  {
+    auto released = MapEditor(&atlas_).Write(MapEdit::kFixture);
+    released.unlock();
+    EXPECT_THROW(map->AddKeyFrame(released, map_.keyframes.front()), Error);
+    EXPECT_THROW(map->AddMapPoint(released, point), Error);
+    EXPECT_THROW(map->RecordWorldChange(released, {}), Error);
+    EXPECT_THROW(map->IncreaseChangeIndex(released), Error);
+    EXPECT_THROW(map->mutable_imu_status(released).imu_initialized = true, Error);
+  }
+  EXPECT_EQ(map->NumKeyFrames(), keyframes);
+  EXPECT_EQ(map->NumMapPoints(), points);
+  EXPECT_EQ(map->NumWorldChanges(), changes);
+  EXPECT_EQ(map->change_index(), change_index);
+  EXPECT_FALSE(map->imu_status().imu_initialized);
+
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  map->AddMapPoint(lock, point);
+  map->RecordWorldChange(lock, {});
+  map->IncreaseChangeIndex(lock);
+  EXPECT_EQ(map->NumMapPoints(), points + 1);
+  EXPECT_EQ(map->NumWorldChanges(), changes + 1);
+  EXPECT_EQ(map->change_index(), change_index + 1);
+}
+
+TEST_F(MapModelTest, APointIsBornSeenByItsKeyframesWithADescriptorAndADepthRange) {
+  Map* map = atlas_.current_map();
+  KeyFrame* a = map_.keyframes[0].get();
+  KeyFrame* b = map_.keyframes[1].get();
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  // A keypoint slot freed in each keyframe (their points retired).
+  const auto free_slot = [](KeyFrame* kf) {
+    for (int i = 0; i < static_cast<int>(kf->map_points().size()); ++i) {
+      if (kf->map_point(i)) {
+        kf->map_point(i)->SetBad();
+        return i;
+      }
+    }
+    return -1;
+  };
+  const int ia = free_slot(a);
+  const int ib = free_slot(b);
+  ASSERT_GE(ia, 0);
+  ASSERT_GE(ib, 0);
+  ASSERT_FALSE(a->map_point(ia));
+  const int points = map->NumMapPoints();
+  const Eigen::Vector3d position = b->world_from_camera() * Eigen::Vector3d(0.1, -0.2, 4.0);
+
+  {
+    auto released = MapEditor(&atlas_).WriteLater(MapEdit::kFixture);
+    EXPECT_THROW(map->CreateMapPoint(released, atlas_.NextMapPointId(), position, b, {{a, ia}}),
+                 Error);
+  }
+  EXPECT_FALSE(a->map_point(ia)) << "a refused point takes no slot";
+
+  const MapPointPtr p =
+      map->CreateMapPoint(lock, atlas_.NextMapPointId(), position, b, {{a, ia}, {b, ib}});
+  EXPECT_EQ(map->NumMapPoints(), points + 1);
+  EXPECT_EQ(map->MapPointById(p->id()), p);
+  EXPECT_EQ(a->map_point(ia), p);
+  EXPECT_EQ(b->map_point(ib), p);
+  EXPECT_EQ(p->IndexInKeyFrame(a), ia);
+  EXPECT_EQ(p->IndexInKeyFrame(b), ib);
+  EXPECT_EQ(p->reference_keyframe(), b);
+  EXPECT_EQ(p->NumObservations(), (a->HasDepth(ia) ? 2 : 1) + (b->HasDepth(ib) ? 2 : 1));
+  // The medoid of two descriptors is one of them; the range brackets the distance to b.
+  EXPECT_TRUE(p->descriptor() == a->descriptors()[ia] || p->descriptor() == b->descriptors()[ib]);
+  const double distance = (position - b->world_from_camera().translation()).norm();
+  EXPECT_LT(p->min_distance(), distance);
+  EXPECT_GT(p->max_distance(), distance);
+}
+
 }  // namespace
 }  // namespace pkslam

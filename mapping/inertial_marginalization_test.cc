@@ -45,7 +45,7 @@ class MarginalizationMapTest : public ::testing::Test {
       kf->mutable_imu(lock).state.valid = true;
     }
     testing::LinkWithImu(lock, map_.keyframes, samples, bias_, noise_);
-    map()->mutable_imu_status().imu_initialized = true;
+    map()->mutable_imu_status(lock).imu_initialized = true;
     options_.window = 5;
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
@@ -99,7 +99,7 @@ TEST_F(MarginalizationMapTest, ValidPriorFreesTheAnchorStalePriorIsIgnored) {
     EXPECT_EQ(p.marginalize_from, -1);
   }
   // A loop correction / merge / global or full inertial BA moved the map: stale.
-  map()->IncreaseChangeIndex();
+  map()->IncreaseChangeIndex(lock);
   EXPECT_FALSE(PriorIsValid(*anchor()->imu().prior, *map()));
   {
     const InertialBundleProblem p = CollectLocalInertialBundle(newest(), options_);
@@ -109,7 +109,7 @@ TEST_F(MarginalizationMapTest, ValidPriorFreesTheAnchorStalePriorIsIgnored) {
   // An IMU initialisation / refinement rotated the map: stale too.
   GiveAnchorPrior(lock, 1e4);
   EXPECT_TRUE(PriorIsValid(*anchor()->imu().prior, *map()));
-  map()->RecordWorldChange({WorldChange::Kind::kTransform, SO3d(), 1.0});
+  map()->RecordWorldChange(lock, {WorldChange::Kind::kTransform, SO3d(), 1.0});
   EXPECT_FALSE(PriorIsValid(*anchor()->imu().prior, *map()));
   // Another map.
   GiveAnchorPrior(lock, 1e4);
@@ -149,7 +149,7 @@ TEST_F(MarginalizationMapTest, SolveMarginalisesTheAnchorOntoTheNextKeyFrame) {
     EXPECT_TRUE(next->imu().prior->mean.velocity_world.allFinite());
     // Applying a result collected before a map-wide change stores nothing.
     next->mutable_imu(lock).prior.reset();
-    map()->IncreaseChangeIndex();
+    map()->IncreaseChangeIndex(lock);
     ApplyInertialBundle(lock, map(), p, r);
     EXPECT_FALSE(next->imu().prior.has_value());
   }

@@ -77,7 +77,7 @@ void InertialStages::Step(const KeyFramePtr& kf) {
   auto mark = [&](bool second) {
     auto lock = MapEditor(atlas_).Write(MapEdit::kInertialInitialisation);
     if (kf->map() == nullptr) return;
-    MapImuStatus& status = kf->map()->mutable_imu_status();
+    MapImuStatus& status = kf->map()->mutable_imu_status(lock);
     (second ? status.inertial_ba2_done : status.inertial_ba1_done) = true;
   };
   if (!ba1 && since > o.viba1_s) {

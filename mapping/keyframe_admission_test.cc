@@ -43,10 +43,10 @@ class KeyFrameAdmissionTest : public ::testing::Test {
       }
     }
     keyframe_ = std::make_shared<KeyFrame>(atlas_.NextKeyFrameId(), frame, map);
-    map->AddKeyFrame(keyframe_);
+    map->AddKeyFrame(lock, keyframe_);
     own_->AddObservation(keyframe_.get(), own_index_);
     keyframe_->AddMapPoint(own_, own_index_);
-    map->AddMapPoint(own_);
+    map->AddMapPoint(lock, own_);
   }
 
   Atlas atlas_;

@@ -53,7 +53,7 @@ bool LocalMapper::LocalInertialBundleAdjustment(const KeyFramePtr& kf) {
   Map* map = atlas_->FindMap(problem.visual.map_id);
   if (kf->map() == nullptr || map == nullptr) return true;
   ApplyInertialBundle(lock, map, problem, result);
-  kf->map()->RecordWorldChange({});
+  kf->map()->RecordWorldChange(lock, {});
   lock.unlock();
   PKSLAM_LOG_DEBUG(
       "local inertial BA at kf {}: {} iterations, cost {:.1f} -> {:.1f}, anchor {}, next prior "

@@ -40,7 +40,7 @@ class NeighbourFusionTest : public ::testing::Test {
       kf->AddMapPoint(copy, i);
       copy->ComputeDistinctiveDescriptor();
       copy->UpdateNormalAndDepth();
-      map->AddMapPoint(copy);
+      map->AddMapPoint(lock, copy);
       pairs_.push_back({original, copy, i});
     }
     for (const KeyFramePtr& k : map_.keyframes) k->UpdateConnections();

@@ -55,15 +55,8 @@ std::vector<MapPointPtr> AddTriangulatedPoints(const MapWriteLock& lock, Atlas* 
     if (c.other->IsBad() || keyframe->map_point(c.index1) || c.other->map_point(c.index2)) {
       continue;
     }
-    auto mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), c.position, keyframe, map);
-    mp->AddObservation(keyframe, c.index1);
-    mp->AddObservation(c.other, c.index2);
-    keyframe->AddMapPoint(mp, c.index1);
-    c.other->AddMapPoint(mp, c.index2);
-    mp->ComputeDistinctiveDescriptor();
-    mp->UpdateNormalAndDepth();
-    map->AddMapPoint(mp);
-    added.push_back(mp);
+    added.push_back(map->CreateMapPoint(lock, atlas->NextMapPointId(), c.position, keyframe,
+                                        {{keyframe, c.index1}, {c.other, c.index2}}));
   }
   return added;
 }

@@ -29,7 +29,7 @@ class RecentPointsTest : public ::testing::Test {
   }
   // A new point created at keyframe `first`, observed by keyframes first..first+observers-1
   // at an unused keypoint slot (stereo keypoints: each observation counts twice).
-  MapPointPtr NewPoint(int first, int observers) {
+  MapPointPtr NewPoint(const MapWriteLock& lock, int first, int observers) {
     KeyFrame* reference = map_.keyframes[first].get();
     auto mp = std::make_shared<MapPoint>(atlas_.NextMapPointId(), Eigen::Vector3d(0, 0, 5),
                                          reference, atlas_.current_map());
@@ -43,7 +43,7 @@ class RecentPointsTest : public ::testing::Test {
       }
     }
     EXPECT_EQ(mp->NumObservations(), 2 * observers) << "stereo observations count twice";
-    atlas_.current_map()->AddMapPoint(mp);
+    atlas_.current_map()->AddMapPoint(lock, mp);
     return mp;
   }
   KeyFrameId Id(int k) const { return map_.keyframes[k]->id(); }
@@ -56,8 +56,8 @@ class RecentPointsTest : public ::testing::Test {
 
 TEST_F(RecentPointsTest, APointSeldomFoundWhereExpectedIsRetiredAtOnce) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  const MapPointPtr seldom = NewPoint(0, 3);
-  const MapPointPtr often = NewPoint(0, 3);
+  const MapPointPtr seldom = NewPoint(lock, 0, 3);
+  const MapPointPtr often = NewPoint(lock, 0, 3);
   seldom->IncreaseVisible(4);  // found 1 of 5: 0.2
   often->IncreaseVisible(3);   // found 1 of 4: 0.25, not below
   recent_.Watch(seldom);
@@ -70,8 +70,8 @@ TEST_F(RecentPointsTest, APointSeldomFoundWhereExpectedIsRetiredAtOnce) {
 
 TEST_F(RecentPointsTest, TwoKeyframesLaterAPointNeedsMoreThanTheMinimumObservations) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  const MapPointPtr lonely = NewPoint(0, 1);  // 2 units
-  const MapPointPtr shared = NewPoint(0, 2);  // 4 units
+  const MapPointPtr lonely = NewPoint(lock, 0, 1);  // 2 units
+  const MapPointPtr shared = NewPoint(lock, 0, 2);  // 4 units
   recent_.Watch(lonely);
   recent_.Watch(shared);
   EXPECT_EQ(recent_.Cull(lock, Id(1), rule_), 0) << "one keyframe old: still on probation";
@@ -87,8 +87,8 @@ TEST_F(RecentPointsTest, TwoKeyframesLaterAPointNeedsMoreThanTheMinimumObservati
   // stereo keyframes (4 units) would pass, one seen once (2 units) would not.
   RecentPointRule monocular = rule_;
   monocular.min_observations = 2;
-  const MapPointPtr once = NewPoint(2, 1);
-  const MapPointPtr twice = NewPoint(2, 2);
+  const MapPointPtr once = NewPoint(lock, 2, 1);
+  const MapPointPtr twice = NewPoint(lock, 2, 2);
   recent_.Watch(once);
   recent_.Watch(twice);
   EXPECT_EQ(recent_.Cull(lock, Id(4), monocular), 1);
@@ -98,12 +98,12 @@ TEST_F(RecentPointsTest, TwoKeyframesLaterAPointNeedsMoreThanTheMinimumObservati
 
 TEST_F(RecentPointsTest, PointsRetiredElsewhereLeaveUncountedAndTheLockIsRequired) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  const MapPointPtr fused = NewPoint(0, 1);
+  const MapPointPtr fused = NewPoint(lock, 0, 1);
   recent_.Watch(fused);
   fused->SetBad();  // e.g. fused into another point
   EXPECT_EQ(recent_.Cull(lock, Id(4), rule_), 0);
   EXPECT_EQ(recent_.size(), 0u);
-  recent_.Watch(NewPoint(0, 1));
+  recent_.Watch(NewPoint(lock, 0, 1));
   lock.unlock();
   EXPECT_THROW(recent_.Cull(lock, Id(4), rule_), Error);
 }

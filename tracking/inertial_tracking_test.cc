@@ -104,7 +104,7 @@ TEST_F(InertialTrackingTest, AfterAnOptimisationTheNextFrameIsPredictedFromIt) {
   {
     auto write = MapEditor(&atlas_).Write(MapEdit::kFixture);
     tracking_.Follow(*atlas_.current_map());  // the first look at the map
-    atlas_.current_map()->RecordWorldChange({});
+    atlas_.current_map()->RecordWorldChange(write, {});
     EXPECT_TRUE(tracking_.Follow(*atlas_.current_map()).changed);
   }
   lock.lock();
@@ -119,7 +119,7 @@ TEST_F(InertialTrackingTest, ANewKeyframeTakesTheFramesStateAndJoinsTheChain) {
   Map* map = atlas_.current_map();
   current.SetPose(CameraFromWorld(2));
   auto with_state = std::make_shared<KeyFrame>(atlas_.NextKeyFrameId(), current, map);
-  map->AddKeyFrame(with_state);
+  map->AddKeyFrame(lock, with_state);
   ImuBias bias;
   bias.gyro = Eigen::Vector3d(0.01, 0, 0);
   current.imu.state.bias = bias;
@@ -134,7 +134,7 @@ TEST_F(InertialTrackingTest, ANewKeyframeTakesTheFramesStateAndJoinsTheChain) {
   Frame later = FrameAt(3);
   later.SetPose(CameraFromWorld(3));
   auto without = std::make_shared<KeyFrame>(atlas_.NextKeyFrameId(), later, map);
-  map->AddKeyFrame(without);
+  map->AddKeyFrame(lock, without);
   tracking_.Attach(lock, later, with_state.get(), without.get());
   EXPECT_FALSE(without->imu().state.valid);
   EXPECT_EQ(without->imu().state.bias.gyro, bias.gyro);

@@ -29,13 +29,7 @@ int AddClosePoints(const MapWriteLock& lock, Atlas* atlas, KeyFrame* keyframe,
     if (!slot || slot->NumObservations() < 1) {
       slot.reset();
       const auto p = frame->UnprojectStereo(i);
-      auto mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), *p, keyframe, map);
-      mp->AddObservation(keyframe, i);
-      keyframe->AddMapPoint(mp, i);
-      mp->ComputeDistinctiveDescriptor();
-      mp->UpdateNormalAndDepth();
-      map->AddMapPoint(mp);
-      slot = mp;
+      slot = map->CreateMapPoint(lock, atlas->NextMapPointId(), *p, keyframe, {{keyframe, i}});
       ++created;
     }
     ++count;

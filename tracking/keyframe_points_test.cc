@@ -27,10 +27,10 @@ class KeyFramePointsTest : public ::testing::Test {
                                 {}, &point_of_keypoint_);
     frame_.SetPose(pose);
   }
-  KeyFramePtr MakeKeyFrame() {
+  KeyFramePtr MakeKeyFrame(const MapWriteLock& lock) {
     Map* map = atlas_.current_map();
     auto kf = std::make_shared<KeyFrame>(atlas_.NextKeyFrameId(), frame_, map);
-    map->AddKeyFrame(kf);
+    map->AddKeyFrame(lock, kf);
     return kf;
   }
   // Keypoint indices with a depth reading, nearest first.
@@ -58,7 +58,7 @@ TEST_F(KeyFramePointsTest, AllCloseKeypointsBecomeObservedPointsAtTheirStereoPos
   ASSERT_GT(close, 20);
   ASSERT_LT(close, static_cast<int>(order.size())) << "the scene needs far points too";
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  KeyFramePtr kf = MakeKeyFrame();
+  KeyFramePtr kf = MakeKeyFrame(lock);
   const ClosePointRule rule{rig_->th_depth, 5};
   const int created = AddClosePoints(lock, &atlas_, kf.get(), rule, &frame_);
   // The close ones and the first far one, where the walk stops.
@@ -78,7 +78,7 @@ TEST_F(KeyFramePointsTest, AllCloseKeypointsBecomeObservedPointsAtTheirStereoPos
 
 TEST_F(KeyFramePointsTest, AtLeastTheNearestMinCloseEvenWhenNoneIsClose) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  KeyFramePtr kf = MakeKeyFrame();
+  KeyFramePtr kf = MakeKeyFrame(lock);
   const ClosePointRule rule{0.01, 10};  // nothing is closer than 1 cm
   EXPECT_EQ(AddClosePoints(lock, &atlas_, kf.get(), rule, &frame_), 11);
 }
@@ -86,7 +86,7 @@ TEST_F(KeyFramePointsTest, AtLeastTheNearestMinCloseEvenWhenNoneIsClose) {
 TEST_F(KeyFramePointsTest, MatchedPointsStayAndTemporaryOnesAreReplaced) {
   const std::vector<int> order = ByDepth();
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  KeyFramePtr older = MakeKeyFrame();
+  KeyFramePtr older = MakeKeyFrame(lock);
   const Eigen::Vector3d somewhere(0, 0, 5);
   auto matched = std::make_shared<MapPoint>(atlas_.NextMapPointId(), somewhere, older.get(),
                                             atlas_.current_map());
@@ -94,7 +94,7 @@ TEST_F(KeyFramePointsTest, MatchedPointsStayAndTemporaryOnesAreReplaced) {
   frame_.map_points[order[0]] = matched;
   const MapPointPtr temporary = MapPoint::Temporary(somewhere, frame_.descriptors()[order[1]]);
   frame_.map_points[order[1]] = temporary;
-  KeyFramePtr kf = MakeKeyFrame();
+  KeyFramePtr kf = MakeKeyFrame(lock);
   const ClosePointRule rule{0.01, 3};  // the nearest 4
   EXPECT_EQ(AddClosePoints(lock, &atlas_, kf.get(), rule, &frame_), 3);
   EXPECT_EQ(frame_.map_points[order[0]], matched);
@@ -106,7 +106,7 @@ TEST_F(KeyFramePointsTest, RefusesToChangeTheMapWithoutTheWriteLock) {
   KeyFramePtr kf;
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    kf = MakeKeyFrame();
+    kf = MakeKeyFrame(lock);
   }
   auto unlocked = MapEditor(&atlas_).WriteLater(MapEdit::kFixture);
   EXPECT_THROW(AddClosePoints(unlocked, &atlas_, kf.get(), ClosePointRule{}, &frame_), Error);

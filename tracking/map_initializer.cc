@@ -30,18 +30,12 @@ DepthMapStart StartDepthMap(const MapWriteLock& lock, Atlas* atlas, const Vocabu
   frame->ComputeBoW(vocabulary);
   start.keyframe = std::make_shared<KeyFrame>(atlas->NextKeyFrameId(), *frame, map);
   KeyFrame* kf = start.keyframe.get();
-  map->AddKeyFrame(start.keyframe);
+  map->AddKeyFrame(lock, start.keyframe);
   attach(lock, kf, nullptr, *frame);
   for (int i = 0; i < frame->size(); ++i) {
     const auto p = frame->UnprojectStereo(i);
     if (!p) continue;
-    auto mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), *p, kf, map);
-    mp->AddObservation(kf, i);
-    kf->AddMapPoint(mp, i);
-    mp->ComputeDistinctiveDescriptor();
-    mp->UpdateNormalAndDepth();
-    map->AddMapPoint(mp);
-    frame->map_points[i] = mp;
+    frame->map_points[i] = map->CreateMapPoint(lock, atlas->NextMapPointId(), *p, kf, {{kf, i}});
     ++start.points;
   }
   return start;
@@ -92,24 +86,17 @@ TwoViewKeyFrames CreateTwoViewMap(const MapWriteLock& lock, Atlas* atlas,
   TwoViewKeyFrames out;
   out.first = std::make_shared<KeyFrame>(atlas->NextKeyFrameId(), *first, map);
   out.second = std::make_shared<KeyFrame>(atlas->NextKeyFrameId(), *second, map);
-  map->AddKeyFrame(out.first);
-  map->AddKeyFrame(out.second);
+  map->AddKeyFrame(lock, out.first);
+  map->AddKeyFrame(lock, out.second);
   attach(lock, out.first.get(), nullptr, *first);
   attach(lock, out.second.get(), out.first.get(), *second);
   for (std::size_t i = 0; i < matches.size(); ++i) {
     const int j = matches[i];
     if (j < 0) continue;
-    auto mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), reconstruction.points[i],
-                                         out.second.get(), map);
-    out.first->AddMapPoint(mp, static_cast<int>(i));
-    out.second->AddMapPoint(mp, j);
-    mp->AddObservation(out.first.get(), static_cast<int>(i));
-    mp->AddObservation(out.second.get(), j);
-    mp->ComputeDistinctiveDescriptor();
-    mp->UpdateNormalAndDepth();
-    second->map_points[j] = mp;
+    second->map_points[j] = map->CreateMapPoint(
+        lock, atlas->NextMapPointId(), reconstruction.points[i], out.second.get(),
+        {{out.first.get(), static_cast<int>(i)}, {out.second.get(), j}});
     second->outliers[j] = 0;
-    map->AddMapPoint(mp);
   }
   out.first->UpdateConnections();
   out.second->UpdateConnections();

@@ -31,20 +31,6 @@ struct BuildTimer {
 
 }  // namespace
 
-const char* TrackingStateName(TrackingState s) {
-  switch (s) {
-    case TrackingState::kNotInitialized:
-      return "NOT_INITIALIZED";
-    case TrackingState::kOk:
-      return "OK";
-    case TrackingState::kRecentlyLost:
-      return "RECENTLY_LOST";
-    case TrackingState::kLost:
-      return "LOST";
-  }
-  return "?";
-}
-
 void TrackingOptions::Check() const {
   PKSLAM_CHECK_OPTION(min_features_stereo_init > 0, "Tracking.min_features_stereo_init", "{}",
                       min_features_stereo_init);
@@ -125,12 +111,7 @@ void Tracker::SetRig(const RigSetup& setup, const RigSetup& old_setup) {
   if (last_.size() > 0 || last_.HasPose()) last_.Recalibrate(rig_, warp, new_from_old);
   if (two_view_.started()) two_view_.first().Recalibrate(rig_, warp, new_from_old);
   if (velocity_) velocity_ = new_from_old * *velocity_ * old_from_new;
-  for (FrameRecord& r : records_) {
-    r.camera_from_reference = new_from_old * r.camera_from_reference * old_from_new;
-    if (r.camera_from_world_online) {
-      r.camera_from_world_online = new_from_old * *r.camera_from_world_online;
-    }
-  }
+  records_.MoveCamera(new_from_old);
 }
 
 TrackResult Tracker::Track(Frame frame) {
@@ -278,15 +259,8 @@ bool Tracker::ActOnDecision(const SelectorInput& selector_input, TrackResult* re
 }
 
 std::vector<FrameRecord::Observation> Tracker::LastFrameInliers() const {
-  std::vector<FrameRecord::Observation> out;
-  if (state_ != TrackingState::kOk) return out;
-  const auto& keypoints = last_.keypoints_undistorted();
-  for (std::size_t i = 0; i < last_.map_points.size() && i < keypoints.size(); ++i) {
-    const MapPointPtr& mp = last_.map_points[i];
-    if (!mp || (i < last_.outliers.size() && last_.outliers[i] != 0)) continue;
-    out.push_back({mp->id(), keypoints[i].pt.x, keypoints[i].pt.y});
-  }
-  return out;
+  if (state_ != TrackingState::kOk) return {};
+  return InlierObservations(last_);
 }
 
 void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
@@ -317,16 +291,9 @@ void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
     }
     r.reference = ref;
     r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
-    if (frame_tracks_enabled_) {
-      const auto& keypoints = current_.keypoints_undistorted();
-      for (std::size_t i = 0; i < current_.map_points.size(); ++i) {
-        const MapPointPtr& mp = current_.map_points[i];
-        if (!mp || current_.outliers[i] != 0) continue;
-        r.observations.push_back({mp->id(), keypoints[i].pt.x, keypoints[i].pt.y});
-      }
-    }
+    if (records_.observations_enabled()) r.observations = InlierObservations(current_);
   }
-  records_.push_back(std::move(r));
+  records_.Add(std::move(r));
 }
 
 void Tracker::StereoInitialization() {
@@ -383,9 +350,7 @@ void Tracker::Reset() {
     auto lock = MapEditor(atlas_).Write(MapEdit::kReset);
     // Records of the dropped map lose their reference (those frames end up without pose).
     Map* map = atlas_->current_map();
-    for (auto& r : records_) {
-      if (r.reference && r.reference->map() == map) r.reference.reset();
-    }
+    records_.Forget(map);
     last_.map_points.assign(last_.map_points.size(), nullptr);
     current_.map_points.assign(current_.map_points.size(), nullptr);
     local_map_.Clear();

@@ -2,9 +2,9 @@
 // from the images, initialises a map, tracks the camera against the last frame / reference
 // keyframe and the local map, asks the KeyframeSelector for keyframes and hands them to local
 // mapping. It keeps the state machine; the work is done by its parts (tracking/README.md:
-// map_initializer.h, frame_tracking.h, local_map.h, relocaliser.h, localisation_tracking.h,
-// selector_snapshot.h, keyframe_decision.h, keyframe_points.h, inertial_tracking.h). Owns its
-// frames; touches the map model only under the Atlas mutex.
+// frame_records.h, map_initializer.h, frame_tracking.h, local_map.h, relocaliser.h,
+// localisation_tracking.h, selector_snapshot.h, keyframe_decision.h, keyframe_points.h,
+// inertial_tracking.h). Owns its frames; touches the map model only under the Atlas mutex.
 #pragma once
 
 #include <cstdint>
@@ -20,6 +20,7 @@
 #include "map_model/map_editor.h"
 #include "map_model/mapping_backend.h"
 #include "tracking/frame_builder.h"
+#include "tracking/frame_records.h"
 #include "tracking/inertial_tracking.h"
 #include "tracking/keyframe_decision.h"
 #include "tracking/local_map.h"
@@ -30,41 +31,6 @@
 namespace pkslam {
 
 class Vocabulary;
-
-enum class TrackingState { kNotInitialized, kOk, kRecentlyLost, kLost };
-const char* TrackingStateName(TrackingState s);
-
-// One processed frame, kept for the trajectory: its pose relative to a reference keyframe so
-// later map optimisation moves it along (ORB-SLAM's mlRelativeFramePoses).
-struct FrameRecord {
-  std::int64_t t_ns = 0;
-  FrameId frame_id = kInvalidId;
-  TrackingState state = TrackingState::kNotInitialized;
-  KeyFramePtr reference;  // null when the frame has no pose
-  SE3d camera_from_reference;
-  // The pose as tracking estimated it then, in the world of that moment (later map
-  // optimisation does not move it): what a live user saw; inertial runs write it out.
-  std::optional<SE3d> camera_from_world_online;
-  bool keyframe = false;
-  // Localisation only: the pose came from visual odometry against the previous frame, not
-  // from the loaded map's points (tracking/localisation_tracking.h).
-  bool visual_odometry = false;
-  // Wall time from image to pose: building the frame (ORB extraction, stereo matching) and
-  // tracking it, as ORB-SLAM3's examples time Track*(); live-emulation waits excluded.
-  double tracking_ms = 0;
-  // CPU time of the tracking thread: building the frame (ORB, stereo matching) and tracking it
-  // (the wall-clock tracking_ms also counts waits for the Atlas lock and preemption).
-  double build_cpu_ms = 0;
-  double tracking_cpu_ms = 0;
-  int inliers = 0;
-  // With EnableFrameTracks: the frame's pose inliers, as (map point id, undistorted pixel):
-  // `pkslam run --frame-tracks` writes them as a tracks file (io/track_file.h).
-  struct Observation {
-    MapPointId point = kInvalidId;
-    float u = 0, v = 0;
-  };
-  std::vector<Observation> observations;
-};
 
 struct TrackResult {
   TrackingState state = TrackingState::kNotInitialized;
@@ -99,14 +65,14 @@ class Tracker {
   void AddImu(const std::vector<ImuMeasurement>& samples);
 
   TrackingState state() const { return state_; }
-  const std::vector<FrameRecord>& records() const { return records_; }
+  const std::vector<FrameRecord>& records() const { return records_.all(); }
   const KeyframeSelector& selector() const { return *selector_; }
   // Keyframe-decision traces (one per tracked frame), for --trace.
   using TraceRow = KeyFrameTraceRow;
   const std::vector<TraceRow>& trace() const { return decision_.trace(); }
   void EnableTrace(bool on) { decision_.EnableTrace(on); }
   // Record every frame's matched map points in its FrameRecord (for --frame-tracks).
-  void EnableFrameTracks(bool on) { frame_tracks_enabled_ = on; }
+  void EnableFrameTracks(bool on) { records_.EnableObservations(on); }
   // Localisation only (TrackingOptions::localise_only) on a map loaded into the Atlas: the
   // next frame is relocalised against the current map (tracking/tracker_localisation.cc).
   void StartLocalisation();
@@ -226,9 +192,8 @@ class Tracker {
   // Localisation only: map or visual odometry (tracking/localisation_tracking.h).
   LocalisationTracking localisation_;
 
-  std::vector<FrameRecord> records_;
+  FrameRecords records_;  // the trajectory (frame_records.h)
   double time_offset_s_ = 0.0;
-  bool frame_tracks_enabled_ = false;
   // The selector's decision with tracking's overrides, and its trace (keyframe_decision.h).
   KeyFrameDecision decision_;
   std::unique_ptr<InertialTracking> imu_;  // inertial sensors only

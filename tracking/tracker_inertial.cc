@@ -72,9 +72,7 @@ void Tracker::SyncWithInertialMapLocked(bool correct_current) {
     // Monocular-inertial initialisation rescaled the map: what tracking keeps relative to its
     // keyframes scales with it.
     const double ratio = *seen.scale_ratio;
-    for (FrameRecord& r : records_) {
-      if (r.reference && r.reference->map() == map) r.camera_from_reference.translation() *= ratio;
-    }
+    records_.Rescale(map, ratio);
     if (velocity_) velocity_->translation() *= ratio;
   }
 }

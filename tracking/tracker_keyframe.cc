@@ -43,7 +43,7 @@ void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
     Map* map = atlas_->current_map();
     current_.ComputeBoW(*vocabulary_);
     kf = std::make_shared<KeyFrame>(atlas_->NextKeyFrameId(), current_, map);
-    map->AddKeyFrame(kf);
+    map->AddKeyFrame(lock, kf);
     AttachImu(lock, kf.get(), last_kf_.get(), current_);
     if (!IsMonocular(rig_->sensor)) {
       const ClosePointRule rule{rig_->th_depth, options_.new_keyframe_min_close_points};

@@ -24,7 +24,7 @@ class WorldChangeCursorTest : public ::testing::Test {
  protected:
   void Record(const WorldChange& change) {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    atlas_.current_map()->RecordWorldChange(change);
+    atlas_.current_map()->RecordWorldChange(lock, change);
   }
   Map& map() { return *atlas_.current_map(); }
 

@@ -122,7 +122,7 @@ void ApplyCalibration(const MapWriteLock& lock, Atlas* atlas, Map* map,
         }
       },
       /*apply_sets_velocities=*/problem.inertial);
-  map->RecordWorldChange({});
+  map->RecordWorldChange(lock, {});
 }
 
 }  // namespace pkslam

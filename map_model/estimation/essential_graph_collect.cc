@@ -228,7 +228,7 @@ void ApplyEssentialGraph(const MapWriteLock& lock, Map* map, const EssentialGrap
     mp->SetPosition(correction[static_cast<std::size_t>(v)] * mp->position());
     mp->UpdateNormalAndDepth();
   }
-  map->IncreaseChangeIndex();
+  map->IncreaseChangeIndex(lock);
 }
 
 }  // namespace pkslam

@@ -114,12 +114,12 @@ TEST(EssentialGraphTest, KeyFramesAndPointsAddedAfterCollectFollowTheirAncestor)
                                  s.atlas.NextFrameId(), 0, {}, &unused);
     f.SetPose(late_from_anchor * anchor->camera_from_world());
     late = std::make_shared<KeyFrame>(s.atlas.NextKeyFrameId(), f, s.map);
-    s.map->AddKeyFrame(late);
+    s.map->AddKeyFrame(lock, late);
     late->ChangeParent(anchor);
     late_point = std::make_shared<MapPoint>(s.atlas.NextMapPointId(),
                                             late->world_from_camera() * Eigen::Vector3d(0, 0, 5),
                                             late.get(), s.map);
-    s.map->AddMapPoint(late_point);
+    s.map->AddMapPoint(lock, late_point);
   }
   const auto result = SolveEssentialGraph(problem, eg);
   auto lock = MapEditor(&s.atlas).Write(MapEdit::kFixture);

@@ -73,7 +73,7 @@ void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& 
     mp->SetPosition(ref->world_from_camera() * (ref_before->second * mp->position()));
     mp->UpdateNormalAndDepth();
   }
-  map->IncreaseChangeIndex();
+  map->IncreaseChangeIndex(lock);
 }
 
 std::map<KeyFrameId, Eigen::Vector3d> GravityInCameras(const Map& map) {

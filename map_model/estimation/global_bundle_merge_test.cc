@@ -44,14 +44,14 @@ class MergeGlobalBundleTest : public ::testing::Test {
   }
 
   // A keyframe created "while the BA ran": child of `parent`, posed `ahead` metres further.
-  KeyFramePtr AddKeyFrame(KeyFrame* parent, double ahead) {
+  KeyFramePtr AddKeyFrame(const MapWriteLock& lock, KeyFrame* parent, double ahead) {
     Map* map = atlas_.current_map();
     const SE3d pose = SE3d(SO3d(), Eigen::Vector3d(0, 0, -ahead)) * parent->camera_from_world();
     std::vector<int> unused;
     Frame frame = MakeFrame(scene_, rig_, pose, atlas_.NextFrameId(), 0, FrameOptions{}, &unused);
     frame.SetPose(pose);
     auto kf = std::make_shared<KeyFrame>(atlas_.NextKeyFrameId(), frame, map);
-    map->AddKeyFrame(kf);
+    map->AddKeyFrame(lock, kf);
     kf->ChangeParent(parent);
     return kf;
   }
@@ -96,12 +96,12 @@ TEST_F(MergeGlobalBundleTest, NewKeyframesFollowTheirParentAndNewPointsTheirRefe
   Eigen::Vector3d point_before;
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    a = AddKeyFrame(map_.keyframes.back().get(), 0.2);
-    b = AddKeyFrame(a.get(), 0.2);  // a chain of two new keyframes
+    a = AddKeyFrame(lock, map_.keyframes.back().get(), 0.2);
+    b = AddKeyFrame(lock, a.get(), 0.2);  // a chain of two new keyframes
     point_before = b->world_from_camera() * Eigen::Vector3d(0.1, -0.2, 4.0);
     point = std::make_shared<MapPoint>(atlas_.NextMapPointId(), point_before, b.get(),
                                        atlas_.current_map());
-    atlas_.current_map()->AddMapPoint(point);
+    atlas_.current_map()->AddMapPoint(lock, point);
     a_before = a->camera_from_world();
     b_before = b->camera_from_world();
   }
@@ -124,7 +124,7 @@ TEST_F(MergeGlobalBundleTest, KeyframesOfAnotherMapAreLeftAlone) {
   SE3d before;
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    moved = AddKeyFrame(map_.keyframes.back().get(), 0.2);
+    moved = AddKeyFrame(lock, map_.keyframes.back().get(), 0.2);
     Map* other = atlas_.CreateNewMap(lock);
     atlas_.SetCurrentMap(lock, map_.keyframes.front()->map());
     moved->set_map(other);

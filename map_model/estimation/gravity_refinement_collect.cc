@@ -55,8 +55,8 @@ double ApplyGravityRefinement(const MapWriteLock& lock, Map* map, const KeyFrame
       other->mutable_imu(lock).state.bias = keyframe.imu().state.bias;
     }
   }
-  map->mutable_imu_status().gravity_refinement_observability = problem.observability;
-  map->RecordWorldChange({});
+  map->mutable_imu_status(lock).gravity_refinement_observability = problem.observability;
+  map->RecordWorldChange(lock, {});
   return std::atan2(up_after.cross(up_before).norm(), up_after.dot(up_before));
 }
 

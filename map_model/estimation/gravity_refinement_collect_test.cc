@@ -29,7 +29,7 @@ class GravityRefinementTest : public ::testing::Test {
       state.velocity_world = truth_[k].velocity_world;
       state.valid = true;
     }
-    map()->mutable_imu_status().imu_initialized = true;
+    map()->mutable_imu_status(lock).imu_initialized = true;
     options_.gravity_magnitude = 9.81;
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
@@ -65,7 +65,7 @@ TEST_F(GravityRefinementTest, ARefinementIsDueOnlyOnceTheChainTurnedEnough) {
   lock.unlock();
   {
     auto write = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    map()->mutable_imu_status().gravity_refinement_observability = problem->observability;
+    map()->mutable_imu_status(write).gravity_refinement_observability = problem->observability;
   }
   lock.lock();
   EXPECT_FALSE(CollectGravityRefinement(kf(kNum - 2), rule, options_).has_value())

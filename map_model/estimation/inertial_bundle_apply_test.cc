@@ -60,7 +60,7 @@ TEST_F(InertialBundleApplyTest, AFullBundleIsWrittenBackAndMovesTheChangeIndex) 
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (int k = 0; k < kNum; ++k) GiveTrueState(lock, k);
-    map()->mutable_imu_status().imu_initialized = true;
+    map()->mutable_imu_status(lock).imu_initialized = true;
     problem = CollectFullInertialBundle(kf(kNum - 2), options);
   }
   problem.shared_bias = true;

@@ -241,8 +241,8 @@ void ApplyFullInertialBundle(const MapWriteLock& lock, Map* map, const KeyFrame&
       if (other->id() > newest.id()) other->mutable_imu(lock).state.bias = result.biases.front();
     }
   }
-  own->RecordWorldChange({});
-  own->IncreaseChangeIndex();
+  own->RecordWorldChange(lock, {});
+  own->IncreaseChangeIndex(lock);
 }
 
 }  // namespace pkslam

@@ -122,9 +122,9 @@ void ApplyInertialInit(const MapWriteLock& lock, Map* map, const InertialInitPro
     }
   }
   ApplyScaledRotation(lock, map, new_from_old, result.scale);
-  map->mutable_imu_status().imu_initialized = true;
-  if (!refinement) map->mutable_imu_status().imu_init_t_ns = t_ns;
-  map->RecordWorldChange({WorldChange::Kind::kTransform, new_from_old, result.scale});
+  map->mutable_imu_status(lock).imu_initialized = true;
+  if (!refinement) map->mutable_imu_status(lock).imu_init_t_ns = t_ns;
+  map->RecordWorldChange(lock, {WorldChange::Kind::kTransform, new_from_old, result.scale});
 }
 
 }  // namespace pkslam

@@ -129,7 +129,7 @@ inline SyntheticMap MakeBowMap(Atlas* atlas, const SyntheticScene& scene,
     f.ComputeBoW(vocabulary);
     for (int p : kp_points) ++seen[p];
     auto kf = std::make_shared<KeyFrame>(atlas->NextKeyFrameId(), f, map);
-    map->AddKeyFrame(kf);
+    map->AddKeyFrame(lock, kf);
     out.keyframes.push_back(kf);
     out.keypoint_points.push_back(kp_points);
   }
@@ -142,7 +142,7 @@ inline SyntheticMap MakeBowMap(Atlas* atlas, const SyntheticScene& scene,
       MapPointPtr& mp = out.point_of_scene_index[p];
       if (!mp) {
         mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), scene.points_world[p], kf, map);
-        map->AddMapPoint(mp);
+        map->AddMapPoint(lock, mp);
       }
       mp->AddObservation(kf, static_cast<int>(i));
       kf->AddMapPoint(mp, static_cast<int>(i));

@@ -87,7 +87,7 @@ TEST_F(MatcherFuseTest, FuseMergesDuplicatesKeepingTheBetterObservedPoint) {
     kf3->EraseMapPointMatch(i3);
     auto d = std::make_shared<MapPoint>(
         atlas_.NextMapPointId(), p->position() + Eigen::Vector3d(0.005, -0.003, 0.004), kf3, map);
-    map->AddMapPoint(d);
+    map->AddMapPoint(lock, d);
     d->AddObservation(kf3, i3);
     kf3->AddMapPoint(d, i3);
     d->ComputeDistinctiveDescriptor();

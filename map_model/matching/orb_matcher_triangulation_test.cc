@@ -42,7 +42,7 @@ class MatcherTriangulationTest : public ::testing::Test {
     f.ComputeBoW(vocabulary_);
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     auto kf = std::make_shared<KeyFrame>(atlas_.NextKeyFrameId(), f, atlas_.current_map());
-    atlas_.current_map()->AddKeyFrame(kf);
+    atlas_.current_map()->AddKeyFrame(lock, kf);
     return kf;
   }
   // Projection of kf1's centre into kf2 (the epipole) and of a world point.

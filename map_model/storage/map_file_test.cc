@@ -60,9 +60,9 @@ class MapFileTest : public ::testing::Test {
     prior.sqrt_information = Eigen::Matrix<double, 15, 15>::Identity() * std::sqrt(42.0);
     prior.map_id = map()->id();
     map_.keyframes[3]->mutable_imu(lock).prior = prior;
-    map()->mutable_imu_status().imu_initialized = true;
+    map()->mutable_imu_status(lock).imu_initialized = true;
     map()->RecordWorldChange(
-        {WorldChange::Kind::kTransform, SO3d::Exp(Eigen::Vector3d(0, 0, 1)), 1.5});
+        lock, {WorldChange::Kind::kTransform, SO3d::Exp(Eigen::Vector3d(0, 0, 1)), 1.5});
     map_.keyframes[6]->AddLoopEdge(map_.keyframes[1].get());
     map_.keyframes[1]->AddLoopEdge(map_.keyframes[6].get());
   }

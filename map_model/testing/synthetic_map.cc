@@ -99,7 +99,7 @@ SyntheticMap MakeMap(Atlas* atlas, const SyntheticScene& scene,
   }
   for (std::size_t k = 0; k < frames.size(); ++k) {
     auto kf = std::make_shared<KeyFrame>(atlas->NextKeyFrameId(), frames[k], map);
-    map->AddKeyFrame(kf);
+    map->AddKeyFrame(lock, kf);
     out.keyframes.push_back(kf);
   }
   for (std::size_t k = 0; k < frames.size(); ++k) {
@@ -111,7 +111,7 @@ SyntheticMap MakeMap(Atlas* atlas, const SyntheticScene& scene,
       MapPointPtr& mp = out.point_of_scene_index[p];
       if (!mp) {
         mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), scene.points_world[p], kf, map);
-        map->AddMapPoint(mp);
+        map->AddMapPoint(lock, mp);
       }
       mp->AddObservation(kf, static_cast<int>(i));
       kf->AddMapPoint(mp, static_cast<int>(i));
