@@ -309,7 +309,7 @@ void LoopClosing::RunGlobalBundle(Map* map, bool merge, std::size_t index) {
       if (newest != nullptr) inertial = CollectFullInertialBundle(newest, inertial_options);
       if (inertial.edges.empty()) inertial = InertialBundleProblem{};
     }
-    if (inertial.empty()) problem = CollectGlobalBundle(*map);
+    if (inertial.empty()) problem = CollectGlobalBundle(lock, *map);
   }
   const bool use_inertial = !inertial.empty();
   const BundleProblem& visual = use_inertial ? inertial.visual : problem;

@@ -69,6 +69,7 @@ class Atlas {
   friend class AtlasStorage;  // map files: map_model/storage/atlas_storage.h
   friend class MapEditor;
   friend class MapReader;
+  friend class MapReadLock;
   friend class MapWriteLock;
   void RecordEdit(MapEdit edit, double held_s) const;
   Map* AddMap();

@@ -81,8 +81,12 @@ MapWriteLock MapEditor::WriteLater(MapEdit edit) const {
   return MapWriteLock(atlas_, edit, std::defer_lock);
 }
 
-std::shared_lock<std::shared_mutex> MapReader::Lock() const {
-  return std::shared_lock<std::shared_mutex>(atlas_->mutex_);
+MapReadLock::MapReadLock(const Atlas* atlas) : atlas_(atlas), lock_(atlas->mutex_) {}
+
+MapReadLock MapReader::Lock() const { return MapReadLock(atlas_); }
+
+void RequireMapLock(const MapLock& lock, std::string_view operation) {
+  PKSLAM_CHECK(lock.owns_lock(), "{} without the Atlas's lock", operation);
 }
 
 }  // namespace pkslam

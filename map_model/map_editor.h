@@ -67,14 +67,54 @@ class MapEditor {
   Atlas* atlas_;
 };
 
+// The shared lock on the Atlas, for readers. Movable, not copyable; may be released early
+// (unlock) and taken again (lock) like std::shared_lock.
+class MapReadLock {
+ public:
+  MapReadLock() = default;  // holds nothing (a member locked later)
+  MapReadLock(MapReadLock&& other) noexcept = default;
+  MapReadLock& operator=(MapReadLock&& other) noexcept = default;
+  MapReadLock(const MapReadLock&) = delete;
+  MapReadLock& operator=(const MapReadLock&) = delete;
+
+  void unlock() { lock_.unlock(); }
+  void lock() { lock_.lock(); }
+  bool owns_lock() const { return lock_.owns_lock(); }
+  bool Holds(const Atlas& atlas) const { return atlas_ == &atlas && lock_.owns_lock(); }
+
+ private:
+  friend class MapReader;
+  explicit MapReadLock(const Atlas* atlas);
+
+  const Atlas* atlas_ = nullptr;
+  std::shared_lock<std::shared_mutex> lock_;
+};
+
 class MapReader {
  public:
   explicit MapReader(const Atlas& atlas) : atlas_(&atlas) {}
   // Shared: any number of readers, no writer, while it is held.
-  [[nodiscard]] std::shared_lock<std::shared_mutex> Lock() const;
+  [[nodiscard]] MapReadLock Lock() const;
 
  private:
   const Atlas* atlas_;
 };
+
+// What a reader of the map model takes as a parameter: the proof that its caller holds the
+// Atlas's lock, shared (MapReadLock) or exclusive (MapWriteLock); both convert to it. A view:
+// it must not outlive the lock it was made from.
+class MapLock {
+ public:
+  MapLock(const MapReadLock& lock) : read_(&lock) {}    // NOLINT(google-explicit-constructor)
+  MapLock(const MapWriteLock& lock) : write_(&lock) {}  // NOLINT(google-explicit-constructor)
+  bool owns_lock() const { return read_ != nullptr ? read_->owns_lock() : write_->owns_lock(); }
+
+ private:
+  const MapReadLock* read_ = nullptr;
+  const MapWriteLock* write_ = nullptr;
+};
+
+// Throws Error naming `operation` unless `lock` is held (shared or exclusive).
+void RequireMapLock(const MapLock& lock, std::string_view operation);
 
 }  // namespace pkslam

@@ -136,14 +136,14 @@ void LocalMapper::LocalBundleAdjustment(const KeyFramePtr& kf) {
   {
     auto lock = MapReader(*atlas_).Lock();
     if (kf->IsBad() || kf->map() == nullptr) return;
-    problem = CollectLocalBundle(kf.get(), options_.ba);
+    problem = CollectLocalBundle(lock, kf.get(), options_.ba);
   }
   if (problem.empty()) return;
   const BundleResult result = SolveBundle(problem, options_.ba, &abort_ba_, &work_);
   PaceToTracker();  // not StepBoundary: the result is written back over the states it read
   auto lock = MapEditor(atlas_).Write(MapEdit::kApplyBundle);
   // A map merged away while the solver ran takes its keyframes with it: nothing to write.
-  if (Map* map = atlas_->FindMap(problem.map_id)) ApplyBundle(map, problem, result);
+  if (Map* map = atlas_->FindMap(problem.map_id)) ApplyBundle(lock, map, problem, result);
   if (result.aborted) {
     lock.unlock();
     MutexLock stats_lock(mutex_);

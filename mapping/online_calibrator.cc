@@ -88,8 +88,8 @@ std::optional<OnlineCalibrator::Job> OnlineCalibrator::Gather(const KeyFramePtr&
     collect.max_observations_per_keyframe = options_.max_observations_per_keyframe;
     collect.gyro_scale_jacobians = options_.gyro_scale;
     job.setup = atlas_->rig_setup();
-    job.problem = CollectCalibrationBundle(kf.get(), inertial, job.setup, atlas_->calibration(),
-                                           prior_, collect);
+    job.problem = CollectCalibrationBundle(lock, kf.get(), inertial, job.setup,
+                                           atlas_->calibration(), prior_, collect);
     job.change_index = map->change_index();
   }
   due_s_ = job.stat.span_s * options_.growth;

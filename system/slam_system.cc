@@ -137,7 +137,7 @@ void SlamSystem::FinishCalibration() {
     collect.max_observations_per_keyframe = o.final_max_observations_per_keyframe;
     collect.gyro_scale_jacobians = o.gyro_scale;
     setup = atlas_.rig_setup();
-    problem = CollectCalibrationBundle(newest, inertial, setup, atlas_.calibration(),
+    problem = CollectCalibrationBundle(lock, newest, inertial, setup, atlas_.calibration(),
                                        file_calibration_, collect);
   }
   final_timing_.collect_ms = WallMsSince(collect_start);
@@ -368,7 +368,7 @@ CalibrationBundleResult SlamSystem::RefineCalibration(const CalibrationFreedom& 
     CalibrationCollectOptions collect;
     collect.max_observations_per_keyframe = max_observations_per_keyframe;
     collect.gyro_scale_jacobians = free.gyro_scale;
-    problem = CollectCalibrationBundle(newest, IsInertial(options_.sensor), setup_,
+    problem = CollectCalibrationBundle(lock, newest, IsInertial(options_.sensor), setup_,
                                        file_calibration_, file_calibration_, collect);
   }
   problem.free = free;

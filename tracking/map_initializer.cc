@@ -107,14 +107,14 @@ void RefineTwoViewMap(Atlas* atlas) {
   BundleProblem problem;
   {
     auto lock = MapReader(*atlas).Lock();
-    problem = CollectGlobalBundle(*atlas->current_map());
+    problem = CollectGlobalBundle(lock, *atlas->current_map());
   }
   BundleAdjustmentOptions ba;
   ba.iterations_first = 20;
   ba.iterations_second = 0;
   const BundleResult result = SolveBundle(problem, ba);
   auto lock = MapEditor(atlas).Write(MapEdit::kInitialise);
-  ApplyBundle(atlas->current_map(), problem, result);
+  ApplyBundle(lock, atlas->current_map(), problem, result);
 }
 
 TwoViewScaling NormaliseTwoViewScale(const MapWriteLock& lock, const TwoViewKeyFrames& map,

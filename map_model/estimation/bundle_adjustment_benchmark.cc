@@ -64,7 +64,7 @@ BundleProblem Perturbed(BundleProblem problem) {
 
 BundleProblem Collect(LocalMap& m) {
   auto lock = MapReader(m.atlas).Lock();
-  return CollectLocalBundle(m.map.keyframes.back().get(), {});
+  return CollectLocalBundle(lock, m.map.keyframes.back().get(), {});
 }
 
 void SetCounters(benchmark::State& state, const BundleProblem& p, int iterations) {
@@ -108,7 +108,7 @@ void BM_SolveGlobalBundle(benchmark::State& state) {
   BundleProblem problem;
   {
     auto lock = MapReader(m->atlas).Lock();
-    problem = Perturbed(CollectGlobalBundle(*m->atlas.current_map()));
+    problem = Perturbed(CollectGlobalBundle(lock, *m->atlas.current_map()));
   }
   internal::BundleSolverOverrides overrides;
   overrides.linear_solver = state.range(2) == 0 ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
@@ -147,7 +147,7 @@ void BM_ApplyBundle(benchmark::State& state) {
   const BundleResult result = SolveBundle(Perturbed(problem), {});
   for (auto _ : state) {
     auto lock = MapEditor(&m->atlas).Write(MapEdit::kFixture);
-    ApplyBundle(m->atlas.current_map(), problem, result);
+    ApplyBundle(lock, m->atlas.current_map(), problem, result);
   }
   SetCounters(state, problem, result.iterations);
 }

@@ -123,7 +123,7 @@ TEST_F(BundleAdjustmentTest, LocalBundleHasOrbSlamStructure) {
   options.max_local_keyframes = 4;
   auto lock = MapReader(atlas_).Lock();
   KeyFrame* kf = LastKeyFrame();
-  const BundleProblem problem = CollectLocalBundle(kf, options);
+  const BundleProblem problem = CollectLocalBundle(lock, kf, options);
   ASSERT_FALSE(problem.empty());
   EXPECT_EQ(problem.fx, rig_->fx);
   EXPECT_EQ(problem.bf, rig_->bf);
@@ -178,7 +178,7 @@ TEST_F(BundleAdjustmentTest, LocalBundleHasOrbSlamStructure) {
 TEST_F(BundleAdjustmentTest, OriginIsFixedEvenWhenLocal) {
   Build(true);
   auto lock = MapReader(atlas_).Lock();
-  const BundleProblem problem = CollectLocalBundle(map_.keyframes[0].get(), {});
+  const BundleProblem problem = CollectLocalBundle(lock, map_.keyframes[0].get(), {});
   ASSERT_FALSE(problem.empty());
   EXPECT_EQ(KeyFrameOf(problem.keyframes[0]), map_.keyframes[0].get());
   EXPECT_TRUE(problem.keyframes[0].fixed);
@@ -192,7 +192,7 @@ TEST_F(BundleAdjustmentTest, StereoLocalBundleReturnsToTruth) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), {});
+    problem = CollectLocalBundle(lock, LastKeyFrame(), {});
   }
   Perturb(&problem, 5);
   const Errors before = ErrorsOf(problem, InputAsResult(problem));
@@ -221,7 +221,7 @@ TEST_F(BundleAdjustmentTest, MonocularLocalBundleReturnsToTruth) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), options);
+    problem = CollectLocalBundle(lock, LastKeyFrame(), options);
   }
   int fixed = 0;
   for (const auto& k : problem.keyframes) fixed += k.fixed ? 1 : 0;
@@ -241,7 +241,7 @@ TEST_F(BundleAdjustmentTest, GlobalBundleFixesOnlyTheOrigin) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectGlobalBundle(*atlas_.current_map());
+    problem = CollectGlobalBundle(lock, *atlas_.current_map());
     EXPECT_EQ(problem.keyframes.size(), map_.keyframes.size());
     EXPECT_EQ(static_cast<int>(problem.points.size()), atlas_.current_map()->NumMapPoints());
   }
@@ -260,7 +260,7 @@ TEST_F(BundleAdjustmentTest, OutlierObservationsAreDetectedAndErased) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), {});
+    problem = CollectLocalBundle(lock, LastKeyFrame(), {});
   }
   // Ground truth: observations far (> 10 px) from the true projection were moved. Points
   // with as many moved observations as good ones are ambiguous and left out of `near`.
@@ -292,7 +292,7 @@ TEST_F(BundleAdjustmentTest, OutlierObservationsAreDetectedAndErased) {
   EXPECT_LT(e.max_translation, 5e-3);  // 0.5 px noise, gauge held by the origin only
 
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  ApplyBundle(atlas_.current_map(), problem, r);
+  ApplyBundle(lock, atlas_.current_map(), problem, r);
   for (int i : flagged) {
     const auto& o = problem.observations[i];
     const KeyFrame* kf = KeyFrameOf(problem.keyframes[o.keyframe_index]);
@@ -317,7 +317,7 @@ TEST_F(BundleAdjustmentTest, ApplyWritesFreeEntitiesAndSkipsBadOnes) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), {});
+    problem = CollectLocalBundle(lock, LastKeyFrame(), {});
   }
   Perturb(&problem, 9);
   const BundleResult r = SolveBundle(problem, {});
@@ -339,7 +339,7 @@ TEST_F(BundleAdjustmentTest, ApplyWritesFreeEntitiesAndSkipsBadOnes) {
   retired_kf->SetBad();  // leaves the map's live keyframes
   EXPECT_EQ(KeyFrameOf(problem.keyframes[retired]), nullptr);
   const SE3d retired_pose = retired_kf->camera_from_world();
-  ApplyBundle(atlas_.current_map(), problem, r);
+  ApplyBundle(lock, atlas_.current_map(), problem, r);
   EXPECT_EQ(culled->position(), culled_position);
   EXPECT_EQ(retired_kf->camera_from_world().Matrix(), retired_pose.Matrix());
   for (std::size_t i = 0; i < problem.keyframes.size(); ++i) {
@@ -359,7 +359,7 @@ TEST_F(BundleAdjustmentTest, AbortBeforeStartReturnsTheInput) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), {});
+    problem = CollectLocalBundle(lock, LastKeyFrame(), {});
   }
   Perturb(&problem, 10);
   const std::atomic<bool> abort{true};
@@ -390,7 +390,7 @@ TEST_F(BundleAdjustmentTest, AbortMidwayKeepsTheProgress) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), {});
+    problem = CollectLocalBundle(lock, LastKeyFrame(), {});
   }
   Perturb(&problem, 11);
   std::atomic<bool> abort{false};
@@ -413,7 +413,7 @@ TEST_F(BundleAdjustmentTest, WorkMeterCountsResidualEvaluations) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), {});
+    problem = CollectLocalBundle(lock, LastKeyFrame(), {});
   }
   Perturb(&problem, 11);
   std::int64_t residuals = 0;
@@ -443,7 +443,7 @@ TEST_F(BundleAdjustmentTest, SingleThreadedIsBitIdentical) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), {});
+    problem = CollectLocalBundle(lock, LastKeyFrame(), {});
   }
   Perturb(&problem, 12);
   const BundleResult a = SolveBundle(problem, {});
@@ -478,7 +478,7 @@ TEST_F(BundleAdjustmentTest, DenseAndSparseSchurAgree) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), {});
+    problem = CollectLocalBundle(lock, LastKeyFrame(), {});
   }
   Perturb(&problem, 13);
   internal::BundleSolverOverrides dense, sparse;
@@ -497,7 +497,7 @@ TEST_F(BundleAdjustmentTest, PointBehindACameraIsAnOutlierFromTheStart) {
   BundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectLocalBundle(LastKeyFrame(), {});
+    problem = CollectLocalBundle(lock, LastKeyFrame(), {});
   }
   // Mirror point 0 through the first observing camera's centre.
   const auto it = std::find_if(problem.observations.begin(), problem.observations.end(),
@@ -519,7 +519,13 @@ TEST_F(BundleAdjustmentTest, EmptyProblemsAndBadOptions) {
   o.iterations_first = 0;
   EXPECT_THROW(o.Check(), OptionError);
   Map empty_map(99);
-  EXPECT_TRUE(CollectGlobalBundle(empty_map).empty());
+  Build(true);
+  auto released = MapReader(atlas_).Lock();
+  released.unlock();
+  EXPECT_THROW(CollectGlobalBundle(released, *atlas_.current_map()), Error);
+  EXPECT_THROW(CollectLocalBundle(released, LastKeyFrame(), {}), Error);
+  const auto lock = MapReader(atlas_).Lock();
+  EXPECT_TRUE(CollectGlobalBundle(lock, empty_map).empty());
 }
 
 }  // namespace

@@ -65,7 +65,9 @@ bool AddBundlePoint(const MapPointPtr& point, const BundleKeyFrameIndex& index,
   return any;
 }
 
-BundleProblem CollectLocalBundle(KeyFrame* keyframe, const BundleAdjustmentOptions& options) {
+BundleProblem CollectLocalBundle(const MapLock& lock, KeyFrame* keyframe,
+                                 const BundleAdjustmentOptions& options) {
+  RequireMapLock(lock, "CollectLocalBundle");
   options.Check();
   BundleProblem problem;
   if (keyframe == nullptr || keyframe->IsBad()) return problem;
@@ -121,7 +123,8 @@ BundleProblem CollectLocalBundle(KeyFrame* keyframe, const BundleAdjustmentOptio
   return problem;
 }
 
-BundleProblem CollectGlobalBundle(const Map& map) {
+BundleProblem CollectGlobalBundle(const MapLock& lock, const Map& map) {
+  RequireMapLock(lock, "CollectGlobalBundle");
   BundleProblem problem;
   problem.map_id = map.id();
   BundleKeyFrameIndex index;
@@ -137,7 +140,9 @@ BundleProblem CollectGlobalBundle(const Map& map) {
   return problem;
 }
 
-void ApplyBundle(Map* map, const BundleProblem& problem, const BundleResult& result) {
+void ApplyBundle(const MapWriteLock& lock, Map* map, const BundleProblem& problem,
+                 const BundleResult& result) {
+  RequireWriteLock(lock, "ApplyBundle");
   PKSLAM_CHECK(map != nullptr, "ApplyBundle without a map");
   PKSLAM_CHECK(problem.map_id == kInvalidId || problem.map_id == map->id(),
                "bundle problem of map {} applied to map {}", problem.map_id, map->id());

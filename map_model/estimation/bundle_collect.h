@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "estimators/optim/bundle_adjustment.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_ids.h"
 
 namespace pkslam {
@@ -21,15 +22,16 @@ bool AddBundlePoint(const MapPointPtr& point, const BundleKeyFrameIndex& index,
                     BundleProblem* problem);
 
 // Local BA around `keyframe`: it and its covisibles are optimised, their points too, and
-// other keyframes observing those points are fixed. Requires the Atlas mutex (shared).
-BundleProblem CollectLocalBundle(KeyFrame* keyframe, const BundleAdjustmentOptions& options);
+// other keyframes observing those points are fixed.
+BundleProblem CollectLocalBundle(const MapLock& lock, KeyFrame* keyframe,
+                                 const BundleAdjustmentOptions& options);
 // Global BA over every live keyframe and point of `map`; the map's first keyframe is fixed.
-// Requires the Atlas mutex (shared).
-BundleProblem CollectGlobalBundle(const Map& map);
+BundleProblem CollectGlobalBundle(const MapLock& lock, const Map& map);
 
-// Requires the Atlas mutex (exclusive). `map` is the map the problem was collected from
-// (checked). Erases outlier observations (both directions), writes poses and positions of
-// keyframes/points that are still live in `map`, updates normals and depth ranges of the points.
-void ApplyBundle(Map* map, const BundleProblem& problem, const BundleResult& result);
+// `map` is the map the problem was collected from (checked). Erases outlier observations (both
+// directions), writes poses and positions of keyframes/points that are still live in `map`,
+// updates normals and depth ranges of the points.
+void ApplyBundle(const MapWriteLock& lock, Map* map, const BundleProblem& problem,
+                 const BundleResult& result);
 
 }  // namespace pkslam

@@ -68,7 +68,7 @@ int RefinePointsToCalibration(Atlas* atlas, MapId map_id) {
     auto lock = MapReader(*atlas).Lock();
     const Map* map = atlas->FindMap(map_id);
     if (map == nullptr) return 0;
-    problem = CollectGlobalBundle(*map);
+    problem = CollectGlobalBundle(lock, *map);
     refined = RefinePoints(problem);
   }
   auto lock = MapEditor(atlas).Write(MapEdit::kCalibration);
@@ -118,7 +118,7 @@ void ApplyCalibration(const MapWriteLock& lock, Atlas* atlas, Map* map,
         if (problem.inertial) {
           ApplyInertialBundle(lock, map, bundle, written);
         } else {
-          ApplyBundle(map, bundle.visual, written.visual);
+          ApplyBundle(lock, map, bundle.visual, written.visual);
         }
       },
       /*apply_sets_velocities=*/problem.inertial);

@@ -138,8 +138,8 @@ TEST_F(CalibrationApplyTest, AnAdjustmentOfAnExactMapMovesLittleAndAppliesCleanl
   CalibrationBundleProblem problem;
   {
     auto lock = MapReader(atlas_).Lock();
-    problem = CollectCalibrationBundle(map_.keyframes.back().get(), /*inertial=*/false, setup_,
-                                       file_, file_, CalibrationCollectOptions{});
+    problem = CollectCalibrationBundle(lock, map_.keyframes.back().get(), /*inertial=*/false,
+                                       setup_, file_, file_, CalibrationCollectOptions{});
   }
   ASSERT_FALSE(problem.empty());
   EXPECT_FALSE(problem.inertial);

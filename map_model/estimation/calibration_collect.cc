@@ -90,11 +90,12 @@ Eigen::Vector3d AngularVelocityAt(const KeyFrame& kf, double window_s) {
   return sum / span - kf.imu().state.bias.gyro;
 }
 
-CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertial,
-                                                  const RigSetup& setup,
+CalibrationBundleProblem CollectCalibrationBundle(const MapLock& lock, KeyFrame* newest,
+                                                  bool inertial, const RigSetup& setup,
                                                   const RigCalibration& current,
                                                   const RigCalibration& file,
                                                   const CalibrationCollectOptions& options) {
+  RequireMapLock(lock, "CollectCalibrationBundle");
   options.Check();
   CalibrationBundleProblem problem;
   problem.initial = current;
@@ -123,7 +124,7 @@ CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertia
   }
   if (!problem.inertial) {
     problem.bundle = {};
-    problem.bundle.visual = CollectGlobalBundle(map);
+    problem.bundle.visual = CollectGlobalBundle(lock, map);
     problem.bundle.camera_from_body = setup.rig->body_from_camera.Inverse();
     problem.bundle.inertial.assign(problem.bundle.visual.keyframes.size(), 0);
     problem.bundle.velocities.assign(problem.bundle.visual.keyframes.size(),

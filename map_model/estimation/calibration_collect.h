@@ -6,6 +6,7 @@
 
 #include "core/sensor/rig_calibration.h"
 #include "estimators/calibration/calibration_bundle.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_ids.h"
 
 namespace pkslam {
@@ -22,14 +23,14 @@ struct CalibrationCollectOptions {
   void Check() const;
 };
 
-// Requires the Atlas mutex (shared). Inertial maps (`inertial` and an initialised chain ending
+// Inertial maps (`inertial` and an initialised chain ending
 // at `newest`, or at the one of the ten keyframes before it with the longest chain): the chain
 // as a full visual-inertial BA (first keyframe fixed; keyframes off the chain fixed, visual
 // only); otherwise every live keyframe of newest's map (the first fixed).
 // `setup` is the rig the map's keypoints are in (all keyframes share it); `current` its
 // calibration, `file` the calibration file's (the prior). The problem's freedom is left empty.
-CalibrationBundleProblem CollectCalibrationBundle(KeyFrame* newest, bool inertial,
-                                                  const RigSetup& setup,
+CalibrationBundleProblem CollectCalibrationBundle(const MapLock& lock, KeyFrame* newest,
+                                                  bool inertial, const RigSetup& setup,
                                                   const RigCalibration& current,
                                                   const RigCalibration& file,
                                                   const CalibrationCollectOptions& options);

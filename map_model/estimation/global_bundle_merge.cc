@@ -17,7 +17,7 @@ namespace pkslam {
 void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& problem,
                        const BundleResult& result) {
   MergeGlobalBundle(
-      lock, map, problem, [&] { ApplyBundle(map, problem, result); }, false);
+      lock, map, problem, [&] { ApplyBundle(lock, map, problem, result); }, false);
 }
 
 void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& problem,

@@ -40,7 +40,7 @@ class MergeGlobalBundleTest : public ::testing::Test {
     poses_ = MakeForwardPath(6, 0.2, 6);
     map_ = MakeMap(&atlas_, scene_, rig_, poses_, FrameOptions{});
     auto lock = MapReader(atlas_).Lock();
-    problem_ = CollectGlobalBundle(*atlas_.current_map());
+    problem_ = CollectGlobalBundle(lock, *atlas_.current_map());
   }
 
   // A keyframe created "while the BA ran": child of `parent`, posed `ahead` metres further.

@@ -179,7 +179,7 @@ void ApplyInertialBundle(const MapWriteLock& lock, Map* map, const InertialBundl
   PKSLAM_CHECK(result.velocities.size() == problem.visual.keyframes.size() &&
                    result.biases.size() == problem.visual.keyframes.size(),
                "inertial result does not match the problem");
-  ApplyBundle(map, problem.visual, result.visual);
+  ApplyBundle(lock, map, problem.visual, result.visual);
   // The problem's keyframes as they are in the map now (null: moved to another map).
   auto keyframe = [&](int i) {
     return map->KeyFrameById(problem.visual.keyframes[static_cast<std::size_t>(i)].keyframe_id)

@@ -73,7 +73,7 @@ class MatcherBowTest : public ::testing::Test {
   Vocabulary vocabulary_;
   std::vector<SE3d> poses_;
   testing::SyntheticMap map_;
-  std::shared_lock<std::shared_mutex> lock_;
+  MapReadLock lock_;
 };
 
 TEST_F(MatcherBowTest, VocabularyGroupsFeatures) {

@@ -109,7 +109,7 @@ class MatcherProjectionTest : public ::testing::Test {
   testing::SyntheticScene scene_;
   std::vector<SE3d> poses_;
   testing::SyntheticMap map_;
-  std::shared_lock<std::shared_mutex> lock_;
+  MapReadLock lock_;
   std::vector<MapPointPtr> points_;
 };
 

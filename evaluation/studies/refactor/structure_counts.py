@@ -52,8 +52,8 @@ brace, parenthesis and template-bracket matching.
    mutex". A comment counts once, however many sentences match. "checked": function
    declarations in headers (members and free functions) that take a lock object (a parameter
    whose type names std::unique_lock, shared_lock, lock_guard, scoped_lock or a type whose
-   name ends in Lock, such as MapWriteLock; a lock class's own constructors and assignments
-   excluded) or carry a Clang thread-safety precondition (PKSLAM_REQUIRES,
+   name ends in Lock, such as MapWriteLock; the members of a lock class and the Require*
+   checks excluded) or carry a Clang thread-safety precondition (PKSLAM_REQUIRES,
    PKSLAM_REQUIRES_SHARED: core/util/annotated_mutex.h).
 5. Duplicated header names: header file names used by two or more libraries, as
    tests/layering/check_includes.py reads them (imported: parse_libraries and header_names;
@@ -242,7 +242,10 @@ def lock_signatures(models):
             params = h[k + 1:end]
             base = d["name"].split("::")[-1]
             why = None
-            if base != "operator=":
+            # A lock class's own members (constructors converting from another lock) and the
+            # checks that throw without a lock are not preconditions.
+            if base != "operator=" and not (d["cls"] or "").endswith("Lock") and \
+                    not base.startswith("Require"):
                 for p in split_params(params):
                     locks = [t.text for t in p if t.text in STD_LOCKS or
                              (is_ident(t.text) and t.text.endswith("Lock") and t.text != base)]

@@ -274,6 +274,13 @@ class MapWriteLock {
   MapWriteLock& operator=(const MapWriteLock&) = delete;
 };
 
+class MapLock {
+ public:
+  MapLock(const MapReadLock& lock);
+};
+void RequireMapLock(const MapLock& lock);
+void K(const MapLock& lock);
+
 class Queue {
  public:
   int Size() const PKSLAM_REQUIRES(mutex_);
@@ -298,9 +305,10 @@ class LockTest(unittest.TestCase):
         self.assertEqual(counts["lock_comments"], 5)
         self.assertEqual([(p["function"], p["by"]) for p in counts["lock_checked_places"]],
                          [("F", "lock parameter MapWriteLock"), ("G", "lock parameter unique_lock"),
-                          ("Size", "PKSLAM_REQUIRES"), ("Wait", "lock parameter MapReadLock")])
+                          ("K", "lock parameter MapLock"), ("Size", "PKSLAM_REQUIRES"),
+                          ("Wait", "lock parameter MapReadLock")])
         self.assertEqual((counts["lock_checked"], counts["lock_checked_by_parameter"],
-                          counts["lock_checked_by_annotation"]), (4, 3, 1))
+                          counts["lock_checked_by_annotation"]), (5, 4, 1))
 
 
 class HeaderNameTest(unittest.TestCase):
