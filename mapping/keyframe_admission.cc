@@ -10,7 +10,7 @@
 namespace pkslam {
 
 std::vector<MapPointPtr> AdmitKeyFrame(const MapWriteLock& lock, Atlas* atlas, KeyFrame* keyframe) {
-  PKSLAM_CHECK(lock.owns_lock(), "AdmitKeyFrame without the Atlas's write lock");
+  RequireWriteLock(lock, "AdmitKeyFrame");
   std::vector<MapPointPtr> created;
   if (keyframe->IsBad() || keyframe->map() == nullptr) return created;
   const auto& points = keyframe->map_points();

@@ -14,7 +14,7 @@ namespace pkslam {
 
 int FuseWithNeighbours(const MapWriteLock& lock, KeyFrame* keyframe,
                        const NeighbourFusionOptions& options) {
-  PKSLAM_CHECK(lock.owns_lock(), "FuseWithNeighbours without the Atlas's write lock");
+  RequireWriteLock(lock, "FuseWithNeighbours");
   if (keyframe->IsBad() || keyframe->map() == nullptr) return 0;
   std::vector<KeyFrame*> targets;
   std::unordered_set<KeyFrameId> in_targets{keyframe->id()};

@@ -45,7 +45,7 @@ std::vector<TriangulatedPoint> TriangulateWithNeighbours(
 std::vector<MapPointPtr> AddTriangulatedPoints(const MapWriteLock& lock, Atlas* atlas,
                                                KeyFrame* keyframe,
                                                const std::vector<TriangulatedPoint>& found) {
-  PKSLAM_CHECK(lock.owns_lock(), "AddTriangulatedPoints without the Atlas's write lock");
+  RequireWriteLock(lock, "AddTriangulatedPoints");
   std::vector<MapPointPtr> added;
   Map* map = keyframe->map();
   if (keyframe->IsBad() || map == nullptr) return added;

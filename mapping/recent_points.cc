@@ -7,7 +7,7 @@
 namespace pkslam {
 
 int RecentPoints::Cull(const MapWriteLock& lock, KeyFrameId newest, const RecentPointRule& rule) {
-  PKSLAM_CHECK(lock.owns_lock(), "RecentPoints::Cull without the Atlas's write lock");
+  RequireWriteLock(lock, "RecentPoints::Cull");
   int culled = 0;
   std::erase_if(points_, [&](const MapPointPtr& mp) {
     if (mp->IsBad()) return true;

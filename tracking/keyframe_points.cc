@@ -15,7 +15,7 @@ namespace pkslam {
 
 int AddClosePoints(const MapWriteLock& lock, Atlas* atlas, KeyFrame* keyframe,
                    const ClosePointRule& rule, Frame* frame) {
-  PKSLAM_CHECK(lock.owns_lock(), "AddClosePoints without the Atlas's write lock");
+  RequireWriteLock(lock, "AddClosePoints");
   Map* map = keyframe->map();
   std::vector<std::pair<float, int>> by_depth;
   for (int i = 0; i < frame->size(); ++i) {

@@ -23,7 +23,7 @@ bool CanStartDepthMap(const Frame& frame, const TrackingOptions& options) {
 
 DepthMapStart StartDepthMap(const MapWriteLock& lock, Atlas* atlas, const Vocabulary& vocabulary,
                             const AttachKeyFrame& attach, Frame* frame) {
-  PKSLAM_CHECK(lock.owns_lock(), "StartDepthMap without the Atlas's write lock");
+  RequireWriteLock(lock, "StartDepthMap");
   DepthMapStart start;
   Map* map = atlas->current_map();
   frame->SetPose(SE3d());
@@ -74,7 +74,7 @@ TwoViewKeyFrames CreateTwoViewMap(const MapWriteLock& lock, Atlas* atlas,
                                   const Vocabulary& vocabulary, const AttachKeyFrame& attach,
                                   const TwoViewResult& reconstruction,
                                   const std::vector<int>& matches, Frame* first, Frame* second) {
-  PKSLAM_CHECK(lock.owns_lock(), "CreateTwoViewMap without the Atlas's write lock");
+  RequireWriteLock(lock, "CreateTwoViewMap");
   PKSLAM_CHECK(matches.size() == reconstruction.points.size(),
                "CreateTwoViewMap: {} matches for {} reconstructed keypoints", matches.size(),
                reconstruction.points.size());
@@ -119,7 +119,7 @@ void RefineTwoViewMap(Atlas* atlas) {
 
 TwoViewScaling NormaliseTwoViewScale(const MapWriteLock& lock, const TwoViewKeyFrames& map,
                                      int min_points, Frame* second) {
-  PKSLAM_CHECK(lock.owns_lock(), "NormaliseTwoViewScale without the Atlas's write lock");
+  RequireWriteLock(lock, "NormaliseTwoViewScale");
   TwoViewScaling scaling;
   scaling.median_depth = map.first->SceneDepthQuantile(0.5);
   if (scaling.median_depth <= 0 || map.second->TrackedMapPoints(1) < min_points) return scaling;

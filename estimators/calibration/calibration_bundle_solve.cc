@@ -360,34 +360,28 @@ class CalibrationSolve {
 
   // Schur elimination: points first, then keyframes and the calibration blocks.
   ceres::Solver::Options Options() {
-    int free_poses = 0;
-    for (int i = 0; i < num_kf_; ++i) free_poses += pose_added_[i] && !visual_.keyframes[i].fixed;
-    ceres::Solver::Options solver_options =
-        SolverOptions(SchurSolverFor(free_poses), 0, options_.num_threads);
-    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    SchurBlocks schur;
     for (int i = 0; i < num_points_; ++i) {
-      if (point_added_[i]) ordering->AddElementToGroup(s_.point(i), 0);
+      if (point_added_[i]) schur.AddPoint(s_.point(i));
     }
     for (int i = 0; i < num_kf_; ++i) {
-      if (pose_added_[i]) ordering->AddElementToGroup(s_.pose(i), 1);
+      if (pose_added_[i]) {
+        schur.AddOther(s_.pose(i));
+        schur.free_poses += visual_.keyframes[i].fixed ? 0 : 1;
+      }
       if (inertial_added_[i]) {
-        ordering->AddElementToGroup(s_.v(i), 1);
-        ordering->AddElementToGroup(s_.bg(i), 1);
-        ordering->AddElementToGroup(s_.ba(i), 1);
+        for (double* block : {s_.v(i), s_.bg(i), s_.ba(i)}) schur.AddOther(block);
       }
     }
     for (std::size_t c = 0; c < problem_.initial.cameras.size() && c < 2; ++c) {
-      ordering->AddElementToGroup(s_.intrinsics(static_cast<int>(c)), 1);
+      schur.AddOther(s_.intrinsics(static_cast<int>(c)));
     }
     for (double* block :
          {s_.cam0_from_body(), s_.cam1_from_cam0(), s_.offset(), s_.no_velocity()}) {
-      ordering->AddElementToGroup(block, 1);
+      schur.AddOther(block);
     }
-    if (problem_.inertial && problem_.free.gyro_scale) {
-      ordering->AddElementToGroup(s_.gyro_scale(), 1);
-    }
-    solver_options.linear_solver_ordering = ordering;
-    return solver_options;
+    if (problem_.inertial && problem_.free.gyro_scale) schur.AddOther(s_.gyro_scale());
+    return SchurSolverOptions(schur, options_.num_threads);
   }
 
   // Outliers after the robust pass: whitened chi2 of the left keypoint or the right coordinate.

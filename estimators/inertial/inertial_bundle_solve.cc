@@ -289,26 +289,23 @@ class InertialSolve {
 
   // Schur elimination: points first, then poses and inertial blocks.
   ceres::Solver::Options Options() {
-    int free_poses = 0;
-    for (int i = 0; i < num_kf_; ++i) free_poses += pose_added_[i] && !visual_.keyframes[i].fixed;
-    ceres::Solver::Options solver_options =
-        SolverOptions(SchurSolverFor(free_poses), 0, options_.num_threads);
-    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    SchurBlocks schur;
     for (int i = 0; i < num_points_; ++i) {
-      if (point_added_[i]) ordering->AddElementToGroup(s_.point(i), 0);
+      if (point_added_[i]) schur.AddPoint(s_.point(i));
     }
     for (int i = 0; i < num_kf_; ++i) {
-      if (pose_added_[i]) ordering->AddElementToGroup(s_.pose(i), 1);
-      if (inertial_added_[i]) {
-        ordering->AddElementToGroup(s_.v(i), 1);
-        if (shared_index_ < 0 || i == shared_index_) {
-          ordering->AddElementToGroup(bg(i), 1);
-          ordering->AddElementToGroup(ba(i), 1);
-        }
+      if (pose_added_[i]) {
+        schur.AddOther(s_.pose(i));
+        schur.free_poses += visual_.keyframes[i].fixed ? 0 : 1;
+      }
+      if (!inertial_added_[i]) continue;
+      schur.AddOther(s_.v(i));
+      if (shared_index_ < 0 || i == shared_index_) {
+        schur.AddOther(bg(i));
+        schur.AddOther(ba(i));
       }
     }
-    solver_options.linear_solver_ordering = ordering;
-    return solver_options;
+    return SchurSolverOptions(schur, options_.num_threads);
   }
 
   // Outliers after the robust pass; removed before a second pass.

@@ -132,21 +132,17 @@ BundleResult SolveBundle(const BundleProblem& problem, const BundleAdjustmentOpt
     }
   }
 
-  int free_poses = 0;
-  for (int i = 0; i < num_keyframes; ++i) {
-    free_poses += pose_added[i] && !problem.keyframes[i].fixed ? 1 : 0;
-  }
-  ceres::Solver::Options solver_options = SolverOptions(
-      overrides.linear_solver.value_or(SchurSolverFor(free_poses)), 0, options.num_threads);
-  // Schur complement: eliminate the points (group 0), then solve for the poses.
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  SchurBlocks schur;
   for (int i = 0; i < num_points; ++i) {
-    if (point_added[i]) ordering->AddElementToGroup(state.point(i), 0);
+    if (point_added[i]) schur.AddPoint(state.point(i));
   }
   for (int i = 0; i < num_keyframes; ++i) {
-    if (pose_added[i]) ordering->AddElementToGroup(state.pose(i), 1);
+    if (!pose_added[i]) continue;
+    schur.AddOther(state.pose(i));
+    schur.free_poses += problem.keyframes[i].fixed ? 0 : 1;
   }
-  solver_options.linear_solver_ordering = ordering;
+  ceres::Solver::Options solver_options =
+      SchurSolverOptions(schur, options.num_threads, overrides.linear_solver);
   AbortCallback abort_callback(abort, overrides.work, &ceres_problem);
   if (overrides.callback != nullptr) solver_options.callbacks.push_back(overrides.callback);
   if (abort_callback.active()) solver_options.callbacks.push_back(&abort_callback);

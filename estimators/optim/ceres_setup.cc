@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <utility>
 
 #include "core/util/log.h"
 #include "estimators/optim/bundle_adjustment.h"
@@ -41,6 +43,17 @@ ceres::Solver::Options SolverOptions(ceres::LinearSolverType linear_solver, int 
   o.max_num_iterations = max_iterations;
   o.num_threads = num_threads;
   o.logging_type = ceres::SILENT;
+  return o;
+}
+
+ceres::Solver::Options SchurSolverOptions(const SchurBlocks& blocks, int num_threads,
+                                          std::optional<ceres::LinearSolverType> linear_solver) {
+  ceres::Solver::Options o =
+      SolverOptions(linear_solver.value_or(SchurSolverFor(blocks.free_poses)), 0, num_threads);
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (double* block : blocks.points) ordering->AddElementToGroup(block, 0);
+  for (double* block : blocks.others) ordering->AddElementToGroup(block, 1);
+  o.linear_solver_ordering = std::move(ordering);
   return o;
 }
 

@@ -10,6 +10,8 @@
 #include <ceres/types.h>
 
 #include <atomic>
+#include <optional>
+#include <vector>
 
 #include "core/util/work_meter.h"
 
@@ -63,6 +65,22 @@ ceres::LinearSolverType SchurSolverFor(int free_poses);
 // given problem and thread count is deterministic (--deterministic runs fix the counts).
 ceres::Solver::Options SolverOptions(ceres::LinearSolverType linear_solver, int max_iterations,
                                      int num_threads);
+
+// A bundle adjustment's Schur elimination: the points are eliminated first (group 0), then the
+// reduced system over everything else (poses, velocities, biases, calibration: group 1) is solved.
+// Ceres keeps each group as a set, so the order blocks are listed in does not matter.
+struct SchurBlocks {
+  std::vector<double*> points;
+  std::vector<double*> others;
+  int free_poses = 0;  // chooses dense or sparse Schur (SchurSolverFor)
+  void AddPoint(double* block) { points.push_back(block); }
+  void AddOther(double* block) { others.push_back(block); }
+};
+// SolverOptions (no iteration limit: each pass sets its own) with the ordering of `blocks` and
+// `linear_solver`, by default SchurSolverFor(blocks.free_poses).
+ceres::Solver::Options SchurSolverOptions(
+    const SchurBlocks& blocks, int num_threads,
+    std::optional<ceres::LinearSolverType> linear_solver = std::nullopt);
 
 // What a ceres::Problem borrows from its caller instead of owning (Ceres deletes what it owns).
 // Manifolds are always borrowed: every optimiser keeps them on its stack, shared by its blocks.

@@ -32,7 +32,7 @@ void RescaleKeyFrameGyro(const MapWriteLock& lock, const Eigen::Vector3d& factor
 
 void MoveToCalibration(const MapWriteLock& lock, Atlas* atlas, const RigCalibration& calibration,
                        const RigSetup& setup) {
-  PKSLAM_CHECK(lock.owns_lock(), "MoveToCalibration without the Atlas's write lock");
+  RequireWriteLock(lock, "MoveToCalibration");
   const RigSetup old = atlas->rig_setup();
   const Eigen::Vector3d gyro_factor = GyroRescale(atlas->calibration(), calibration);
   if (gyro_factor != Eigen::Vector3d::Ones()) {

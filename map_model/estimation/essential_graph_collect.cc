@@ -165,7 +165,7 @@ EssentialGraphProblem CollectEssentialGraph(Map* map, const LoopCorrection& corr
 
 void ApplyEssentialGraph(const MapWriteLock& lock, Map* map, const EssentialGraphProblem& problem,
                          const EssentialGraphResult& result) {
-  PKSLAM_CHECK(lock.owns_lock(), "ApplyEssentialGraph without the Atlas's write lock");
+  RequireWriteLock(lock, "ApplyEssentialGraph");
   PKSLAM_CHECK(map != nullptr, "ApplyEssentialGraph without a map");
   PKSLAM_CHECK(problem.map_id == kInvalidId || problem.map_id == map->id(),
                "essential graph of map {} applied to map {}", problem.map_id, map->id());

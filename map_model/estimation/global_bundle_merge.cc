@@ -22,7 +22,7 @@ void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& 
 
 void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& problem,
                        const std::function<void()>& apply, bool apply_sets_velocities) {
-  PKSLAM_CHECK(lock.owns_lock(), "MergeGlobalBundle without the Atlas's write lock");
+  RequireWriteLock(lock, "MergeGlobalBundle");
   if (map == nullptr || map->origin() == nullptr) return;
   // Poses before the write-back: what everything outside the problem is relative to.
   std::map<KeyFrameId, SE3d> before;

@@ -37,7 +37,7 @@ std::optional<GravityRefinementProblem> CollectGravityRefinement(
 double ApplyGravityRefinement(const MapWriteLock& lock, Map* map, const KeyFrame& keyframe,
                               const GravityRefinementProblem& problem,
                               const InertialBundleResult& result) {
-  PKSLAM_CHECK(lock.owns_lock(), "ApplyGravityRefinement without the Atlas's write lock");
+  RequireWriteLock(lock, "ApplyGravityRefinement");
   const InertialBundleProblem& bundle = problem.bundle;
   // Live or retired: the problem's first keyframe measures the tilt change either way.
   const KeyFramePtr first_kf = map->FindKeyFrame(bundle.visual.keyframes.front().keyframe_id);

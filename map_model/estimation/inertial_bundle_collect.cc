@@ -175,7 +175,7 @@ InertialBundleProblem CollectFullInertialBundle(KeyFrame* newest,
 
 void ApplyInertialBundle(const MapWriteLock& lock, Map* map, const InertialBundleProblem& problem,
                          const InertialBundleResult& result) {
-  PKSLAM_CHECK(lock.owns_lock(), "ApplyInertialBundle without the Atlas's write lock");
+  RequireWriteLock(lock, "ApplyInertialBundle");
   PKSLAM_CHECK(result.velocities.size() == problem.visual.keyframes.size() &&
                    result.biases.size() == problem.visual.keyframes.size(),
                "inertial result does not match the problem");
@@ -215,7 +215,7 @@ void ApplyInertialBundle(const MapWriteLock& lock, Map* map, const InertialBundl
 }
 
 int StartMissingInertialStates(const MapWriteLock& lock, KeyFrame* newest) {
-  PKSLAM_CHECK(lock.owns_lock(), "StartMissingInertialStates without the Atlas's write lock");
+  RequireWriteLock(lock, "StartMissingInertialStates");
   std::vector<KeyFrame*> missing;
   for (KeyFrame* k = newest; k != nullptr && !k->imu().state.valid; k = k->imu().previous()) {
     missing.push_back(k);

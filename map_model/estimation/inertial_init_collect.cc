@@ -30,7 +30,7 @@ std::vector<KeyFrame*> InertialChainThrough(KeyFrame* kf) {
 
 int PropagateVelocities(const MapWriteLock& lock, KeyFrame* last, const ImuBias& bias,
                         const Eigen::Vector3d& gravity_world, double scale) {
-  PKSLAM_CHECK(lock.owns_lock(), "PropagateVelocities without the Atlas's write lock");
+  RequireWriteLock(lock, "PropagateVelocities");
   int count = 0;
   for (KeyFrame* previous = last; previous->imu().state.valid; previous = previous->imu().next()) {
     KeyFrame* next = previous->imu().next();
@@ -76,7 +76,7 @@ std::optional<InertialInitProblem> CollectInertialInit(KeyFrame* keyframe,
 
 void ApplyScaledRotation(const MapWriteLock& lock, Map* map, const SO3d& new_from_old,
                          double scale) {
-  PKSLAM_CHECK(lock.owns_lock(), "ApplyScaledRotation without the Atlas's write lock");
+  RequireWriteLock(lock, "ApplyScaledRotation");
   for (const auto& [id, kf] : map->keyframes()) {
     const SE3d& tcw = kf->camera_from_world();
     SE3d updated(tcw.so3() * new_from_old.Inverse(), scale * tcw.translation());
@@ -93,7 +93,7 @@ void ApplyScaledRotation(const MapWriteLock& lock, Map* map, const SO3d& new_fro
 
 void ApplyInertialInit(const MapWriteLock& lock, Map* map, const InertialInitProblem& problem,
                        const InertialInitResult& result, bool refinement, std::int64_t t_ns) {
-  PKSLAM_CHECK(lock.owns_lock(), "ApplyInertialInit without the Atlas's write lock");
+  RequireWriteLock(lock, "ApplyInertialInit");
   const std::vector<KeyFrame*>& chain = problem.chain;
   PKSLAM_CHECK(result.velocities_world.size() == chain.size(),
                "ApplyInertialInit: {} velocities for {} keyframes", result.velocities_world.size(),
