@@ -52,4 +52,20 @@ void FrameRecords::Forget(const Map* map) {
   }
 }
 
+void FrameRecords::SetPose(const KeyFramePtr& reference, bool keyframe, Frame* frame,
+                           FrameRecord* record) const {
+  record->camera_from_world_online = frame->camera_from_world();
+  if (keyframe && reference->t_ns() == frame->t_ns() && !reference->IsBad()) {
+    // The frame is the keyframe's image, so it has the keyframe's pose. Local mapping may
+    // already have moved it (lock-step runs map before the record is made: the
+    // monocular-inertial initialisation rotates and rescales the world and then runs a full
+    // BA, more than the tracker's world-change sync can carry the frame across; a frame 19 cm
+    // off at the initialisation of a MH_01 replay).
+    frame->SetPose(reference->camera_from_world());
+  }
+  record->reference = reference;
+  record->camera_from_reference = frame->camera_from_world() * reference->world_from_camera();
+  if (observations_enabled_) record->observations = InlierObservations(*frame);
+}
+
 }  // namespace pkslam

@@ -67,6 +67,13 @@ class FrameRecords {
   const FrameRecord& back() const { return records_.back(); }
   FrameRecord& back() { return records_.back(); }
 
+  // The pose of a tracked `frame` into its `record`: the online pose, the pose relative to
+  // `reference` (alive), and with EnableObservations its inliers. A frame that became
+  // `reference` (`keyframe`: made a keyframe at its time) takes the keyframe's pose first.
+  // Atlas lock held (shared).
+  void SetPose(const KeyFramePtr& reference, bool keyframe, Frame* frame,
+               FrameRecord* record) const;
+
   // A new calibration moved the tracking camera in the body by new_from_old (the body keeps
   // its place): relative poses and the online poses move with it.
   void MoveCamera(const SE3d& new_from_old);

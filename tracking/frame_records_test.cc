@@ -128,5 +128,41 @@ TEST_F(FrameRecordsTest, ARescaleAndAResetTouchOnlyTheirMap) {
   EXPECT_EQ(records_.all()[2].reference, nullptr);
 }
 
+TEST_F(FrameRecordsTest, ARecordHoldsThePoseRelativeToItsReferenceAndAKeyframesOwnPose) {
+  const KeyFramePtr& reference = map_a_.keyframes[1];
+  const SE3d tracked = Pose(0.05, 0.1, 0.0, 0.4);
+  // A frame at `t_ns` tracked at `tracked`, one keypoint matched.
+  const auto tracked_frame = [&](std::int64_t t_ns) {
+    std::vector<int> point_of_keypoint;
+    Frame f = testing::MakeFrame(scene_, rig_, poses_[2], 8, t_ns, {}, &point_of_keypoint);
+    f.SetPose(tracked);
+    f.map_points.assign(f.size(), nullptr);
+    f.outliers.assign(f.size(), 0);
+    f.map_points[0] = map_a_.point_of_scene_index[point_of_keypoint[0]];
+    return f;
+  };
+  Frame frame = tracked_frame(reference->t_ns() + 1);
+  auto lock = MapReader(atlas_).Lock();
+  FrameRecord plain;
+  records_.SetPose(reference, /*keyframe=*/true, &frame, &plain);
+  EXPECT_TRUE(plain.camera_from_reference.Log().isApprox(
+      (tracked * reference->world_from_camera()).Log(), 1e-12))
+      << "a keyframe made at another time does not move the frame";
+  EXPECT_EQ(plain.reference, reference);
+  EXPECT_TRUE(plain.observations.empty()) << "observations only when enabled";
+
+  Frame image = tracked_frame(reference->t_ns());
+  records_.EnableObservations(true);
+  FrameRecord own;
+  records_.SetPose(reference, /*keyframe=*/true, &image, &own);
+  ASSERT_TRUE(own.camera_from_world_online.has_value());
+  EXPECT_TRUE(own.camera_from_world_online->Log().isApprox(tracked.Log(), 1e-12))
+      << "the online pose is the tracked one";
+  EXPECT_TRUE(own.camera_from_reference.Log().isZero(1e-12)) << "the keyframe's image";
+  EXPECT_TRUE(
+      image.camera_from_world().Log().isApprox(reference->camera_from_world().Log(), 1e-12));
+  EXPECT_EQ(own.observations.size(), 1u);
+}
+
 }  // namespace
 }  // namespace pkslam

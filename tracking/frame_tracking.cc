@@ -43,6 +43,50 @@ int MatchLastFrame(const Frame& last, double radius, bool monocular, int min_mat
   return n;
 }
 
+int MatchLastFramePredicted(const Frame& last, const TrackingOptions& options, bool monocular,
+                            Frame* frame) {
+  const double radius =
+      monocular ? options.motion_model_radius_mono : options.motion_model_radius_stereo;
+  return MatchLastFrame(last, radius, monocular, options.min_matches_motion_model, frame);
+}
+
+int CountLocalMapInliers(bool stereo, Frame* frame) {
+  int inliers = 0;
+  for (int i = 0; i < frame->size(); ++i) {
+    const auto& mp = frame->map_points[i];
+    if (!mp) continue;
+    if (!frame->outliers[i]) {
+      mp->IncreaseFound();
+      if (mp->NumObservations() > 0) ++inliers;
+    } else if (stereo) {
+      frame->map_points[i].reset();
+    }
+  }
+  return inliers;
+}
+
+void FollowReplacedPoints(Frame* frame) {
+  for (auto& mp : frame->map_points) {
+    while (mp && mp->replaced_by()) mp = mp->replaced_by();
+  }
+}
+
+void DropUnmappedMatches(Frame* frame) {
+  for (int i = 0; i < frame->size(); ++i) {
+    const auto& mp = frame->map_points[i];
+    if (mp && mp->NumObservations() < 1) {
+      frame->map_points[i].reset();
+      frame->outliers[i] = 0;
+    }
+  }
+}
+
+void DropOutlierMatches(Frame* frame) {
+  for (int i = 0; i < frame->size(); ++i) {
+    if (frame->map_points[i] && frame->outliers[i]) frame->map_points[i].reset();
+  }
+}
+
 std::optional<int> TrackToKeyFrame(const KeyFrame& reference, const Vocabulary& vocabulary,
                                    const SE3d& initial, const ReferenceMatching& matching,
                                    const PoseOptimizerOptions& options, Frame* frame) {

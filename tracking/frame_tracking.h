@@ -10,6 +10,7 @@
 #include "map_model/frame.h"
 #include "map_model/map_ids.h"
 #include "tracking/pose_optimizer.h"
+#include "tracking/tracking_options.h"
 
 namespace pkslam {
 
@@ -26,6 +27,23 @@ int OptimizeAndDiscard(const PoseOptimizerOptions& options, Frame* frame);
 // pixels (level 0); when fewer than `min_matches` are found, searches again with twice the
 // radius (ORB-SLAM3). `frame`'s previous matches are cleared. Returns the matches found.
 int MatchLastFrame(const Frame& last, double radius, bool monocular, int min_matches, Frame* frame);
+
+// The threshold MatchLastFrame searches within for a frame predicted by the motion model or the
+// IMU: `options`' monocular or stereo radius.
+int MatchLastFramePredicted(const Frame& last, const TrackingOptions& options, bool monocular,
+                            Frame* frame);
+
+// After the local map's pose optimisation: every inlier's point was found once more, a stereo
+// frame forgets its outliers' matches (a monocular one keeps them for its keyframe's BA).
+// Returns the inliers to points in the map.
+int CountLocalMapInliers(bool stereo, Frame* frame);
+
+// Matches of the last frame to points local mapping fused into others follow them.
+void FollowReplacedPoints(Frame* frame);
+// Matches to points that are no longer in the map (no observations) are dropped.
+void DropUnmappedMatches(Frame* frame);
+// Matches flagged as outliers are dropped (the next frame must not use them for its pose).
+void DropOutlierMatches(Frame* frame);
 
 struct ReferenceMatching {
   double ratio = 0.7;    // nearest / second-nearest descriptor distance ratio (BoW search)

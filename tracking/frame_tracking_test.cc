@@ -103,5 +103,72 @@ TEST_F(FrameTrackingTest, AFrameIsTrackedToItsReferenceKeyframeThroughBow) {
   for (const MapPointPtr& mp : unmatched.map_points) EXPECT_EQ(mp, nullptr);
 }
 
+TEST_F(FrameTrackingTest, AfterTheLocalMapOnlyInliersCountAndStereoDropsItsOutliers) {
+  Frame mono = LastFrame();
+  mono.outliers.assign(mono.size(), 0);
+  std::vector<int> matched;
+  for (int i = 0; i < mono.size(); ++i) {
+    if (mono.map_points[i]) matched.push_back(i);
+  }
+  ASSERT_GT(matched.size(), 20u);
+  const MapPointPtr flagged = mono.map_points[matched[0]];
+  const MapPointPtr kept = mono.map_points[matched[1]];
+  mono.outliers[matched[0]] = 1;
+  mono.outliers[matched[2]] = 1;
+  Frame stereo = mono;
+  auto lock = MapReader(bow_.atlas).Lock();
+  const int found_before = kept->found();
+  const int flagged_found_before = flagged->found();
+  EXPECT_EQ(CountLocalMapInliers(false, &mono), static_cast<int>(matched.size()) - 2);
+  EXPECT_EQ(kept->found(), found_before + 1) << "an inlier was found once more";
+  EXPECT_EQ(flagged->found(), flagged_found_before) << "an outlier was not";
+  EXPECT_EQ(mono.map_points[matched[0]], flagged) << "monocular keeps the outlier's match";
+  EXPECT_EQ(CountLocalMapInliers(true, &stereo), static_cast<int>(matched.size()) - 2);
+  EXPECT_EQ(stereo.map_points[matched[0]], nullptr) << "stereo drops it";
+  EXPECT_EQ(stereo.map_points[matched[1]], kept);
+
+  DropOutlierMatches(&mono);
+  EXPECT_EQ(mono.map_points[matched[0]], nullptr);
+  EXPECT_EQ(mono.map_points[matched[2]], nullptr);
+  EXPECT_EQ(mono.map_points[matched[1]], kept);
+}
+
+TEST_F(FrameTrackingTest, MatchesFollowFusedPointsAndForgetPointsOutsideTheMap) {
+  Frame frame = LastFrame();
+  frame.outliers.assign(frame.size(), 0);
+  int first = -1;
+  for (int i = 0; i < frame.size() && first < 0; ++i) {
+    if (frame.map_points[i]) first = i;
+  }
+  ASSERT_GE(first, 0);
+  const MapPointPtr temporary = MapPoint::Temporary(Eigen::Vector3d(0, 0, 3), Descriptor());
+  frame.map_points[first] = temporary;
+  frame.outliers[first] = 1;
+  {
+    auto lock = MapEditor(&bow_.atlas).Write(MapEdit::kFixture);
+    FollowReplacedPoints(&frame);  // nothing fused yet: unchanged
+    EXPECT_EQ(frame.map_points[first], temporary);
+    DropUnmappedMatches(&frame);
+    EXPECT_EQ(frame.map_points[first], nullptr) << "a point with no observations is dropped";
+    EXPECT_EQ(frame.outliers[first], 0);
+  }
+  // A point fused into another (and that one into a third) is followed to the end of the chain.
+  std::vector<int> matched;
+  for (int i = first + 1; i < frame.size() && matched.size() < 3; ++i) {
+    if (frame.map_points[i]) matched.push_back(i);
+  }
+  ASSERT_EQ(matched.size(), 3u);
+  const MapPointPtr fused = frame.map_points[matched[0]];
+  const MapPointPtr middle = frame.map_points[matched[1]];
+  const MapPointPtr survivor = frame.map_points[matched[2]];
+  auto lock = MapEditor(&bow_.atlas).Write(MapEdit::kFixture);
+  fused->Replace(middle);
+  middle->Replace(survivor);
+  FollowReplacedPoints(&frame);
+  EXPECT_EQ(frame.map_points[matched[0]], survivor);
+  EXPECT_EQ(frame.map_points[matched[1]], survivor);
+  EXPECT_EQ(frame.map_points[matched[2]], survivor);
+}
+
 }  // namespace
 }  // namespace pkslam

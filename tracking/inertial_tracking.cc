@@ -149,4 +149,30 @@ std::optional<SelectorImuInterval> InertialTracking::IntervalSinceLastFrame(
   return interval;
 }
 
+void InertialTracking::FillSelectorInput(const Frame& current, const Frame& last,
+                                         const CameraRig& rig, bool map_ready,
+                                         SelectorInput* in) const {
+  std::optional<SO3d> world_from_last_body;
+  if (map_ready && last.HasPose()) {
+    world_from_last_body =
+        (last.camera_from_world().Inverse() * rig.body_from_camera.Inverse()).so3();
+  }
+  if (auto interval = IntervalSinceLastFrame(current, world_from_last_body)) {
+    in->imu_since_last_frame = *interval;
+  }
+}
+
+ImuBias InertialTracking::IntegrationBias(const Frame& last, const KeyFrame* last_keyframe) {
+  if (last.imu.state.valid) return last.imu.state.bias;
+  if (last_keyframe != nullptr) return last_keyframe->imu().state.bias;
+  return ImuBias();
+}
+
+void InertialTracking::CarryAcross(const WorldChange& change, Frame* frame) {
+  const SE3d& tcw = frame->camera_from_world();
+  frame->SetPose(SE3d(tcw.so3() * change.rotation.Inverse(), change.scale * tcw.translation()));
+  frame->imu.state.velocity_world =
+      change.scale * (change.rotation * frame->imu.state.velocity_world);
+}
+
 }  // namespace pkslam

@@ -70,6 +70,19 @@ class InertialTracking {
   std::optional<SelectorImuInterval> IntervalSinceLastFrame(
       const Frame& current, const std::optional<SO3d>& world_from_last_body) const;
 
+  // The same into the selector's input: with the last body's world orientation once the map's
+  // IMU is initialised (`map_ready`) and the last frame has a pose.
+  void FillSelectorInput(const Frame& current, const Frame& last, const CameraRig& rig,
+                         bool map_ready, SelectorInput* in) const;
+
+  // The bias tracking integrates with: the last frame's estimate, else the last keyframe's
+  // (may be null), else zero. Atlas lock held (shared).
+  static ImuBias IntegrationBias(const Frame& last, const KeyFrame* last_keyframe);
+
+  // `frame` was tracked in the world before `change` (a rotation and rescale of the map):
+  // its pose and velocity move into the new world.
+  static void CarryAcross(const WorldChange& change, Frame* frame);
+
   double gravity_magnitude() const { return gravity_magnitude_; }
 
  private:

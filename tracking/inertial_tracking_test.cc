@@ -157,5 +157,57 @@ TEST_F(InertialTrackingTest, TheSelectorSeesTheBodysOwnAccelerationOnceGravityIs
   EXPECT_LT((*world->mean_accel_world_no_gravity - motion_.Acceleration(0.125)).norm(), 0.1);
 }
 
+TEST_F(InertialTrackingTest, TheSelectorsIntervalTakesTheLastBodysOrientationOnceReady) {
+  Frame last = FrameAt(2);
+  last.SetPose(CameraFromWorld(2));
+  Frame current = FrameAt(3);
+  tracking_.Preintegrate(ImuBias(), 0, &last);
+  tracking_.Preintegrate(ImuBias(), 0, &current);
+  SelectorInput before_ready;
+  tracking_.FillSelectorInput(current, last, *rig_, /*map_ready=*/false, &before_ready);
+  ASSERT_TRUE(before_ready.imu_since_last_frame.has_value());
+  EXPECT_FALSE(before_ready.imu_since_last_frame->mean_accel_world_no_gravity.has_value());
+  SelectorInput ready;
+  tracking_.FillSelectorInput(current, last, *rig_, /*map_ready=*/true, &ready);
+  const SO3d world_from_body =
+      (last.camera_from_world().Inverse() * rig_->body_from_camera.Inverse()).so3();
+  const auto expected = tracking_.IntervalSinceLastFrame(current, world_from_body);
+  ASSERT_TRUE(ready.imu_since_last_frame->mean_accel_world_no_gravity.has_value());
+  EXPECT_TRUE(ready.imu_since_last_frame->mean_accel_world_no_gravity->isApprox(
+      *expected->mean_accel_world_no_gravity, 1e-12));
+}
+
+TEST_F(InertialTrackingTest, TheIntegrationBiasIsTheLastFramesElseTheKeyframesElseZero) {
+  Frame last = FrameAt(2);
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  keyframe()->mutable_imu(lock).state.bias.gyro = Eigen::Vector3d(0.01, 0, 0);
+  EXPECT_TRUE(InertialTracking::IntegrationBias(last, nullptr).gyro.isZero());
+  EXPECT_EQ(InertialTracking::IntegrationBias(last, keyframe()).gyro.x(), 0.01);
+  last.imu.state.valid = true;
+  last.imu.state.bias.gyro = Eigen::Vector3d(0, 0.02, 0);
+  EXPECT_EQ(InertialTracking::IntegrationBias(last, keyframe()).gyro.y(), 0.02);
+}
+
+TEST_F(InertialTrackingTest, AFrameIsCarriedIntoARotatedAndRescaledWorld) {
+  Frame frame = FrameAt(2);
+  frame.SetPose(CameraFromWorld(2));
+  frame.imu.state.velocity_world = Eigen::Vector3d(0.3, -0.2, 0.1);
+  const Eigen::Vector3d centre = frame.camera_from_world().Inverse().translation();
+  WorldChange change;
+  change.kind = WorldChange::Kind::kTransform;
+  change.rotation = SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.3));
+  change.scale = 1.5;
+  const Eigen::Vector3d direction =
+      frame.camera_from_world().so3().Inverse() * Eigen::Vector3d::UnitZ();
+  InertialTracking::CarryAcross(change, &frame);
+  const SE3d world_from_camera = frame.camera_from_world().Inverse();
+  EXPECT_TRUE(world_from_camera.translation().isApprox(1.5 * (change.rotation * centre), 1e-12));
+  EXPECT_TRUE((world_from_camera.so3() * Eigen::Vector3d::UnitZ())
+                  .isApprox(change.rotation * direction, 1e-12))
+      << "the viewing direction turns with the world";
+  EXPECT_TRUE(frame.imu.state.velocity_world.isApprox(
+      1.5 * (change.rotation * Eigen::Vector3d(0.3, -0.2, 0.1)), 1e-12));
+}
+
 }  // namespace
 }  // namespace pkslam

@@ -1,9 +1,11 @@
 #include "tracking/keyframe_points.h"
 
 #include <algorithm>
+#include <memory>
 #include <utility>
 #include <vector>
 
+#include "core/bow/vocabulary.h"
 #include "core/util/error.h"
 #include "map_model/atlas.h"
 #include "map_model/keyframe.h"
@@ -36,6 +38,19 @@ int AddClosePoints(const MapWriteLock& lock, Atlas* atlas, KeyFrame* keyframe,
     if (z > rule.th_depth && count > rule.min_close) break;
   }
   return created;
+}
+
+KeyFramePtr CreateKeyFrame(const MapWriteLock& lock, Atlas* atlas, const Vocabulary& vocabulary,
+                           const AttachKeyFrame& attach, KeyFrame* previous,
+                           const std::optional<ClosePointRule>& close_points, Frame* frame) {
+  RequireWriteLock(lock, "CreateKeyFrame");
+  Map* map = atlas->current_map();
+  frame->ComputeBoW(vocabulary);
+  auto keyframe = std::make_shared<KeyFrame>(atlas->NextKeyFrameId(), *frame, map);
+  map->AddKeyFrame(lock, keyframe);
+  attach(lock, keyframe.get(), previous, *frame);
+  if (close_points) AddClosePoints(lock, atlas, keyframe.get(), *close_points, frame);
+  return keyframe;
 }
 
 }  // namespace pkslam

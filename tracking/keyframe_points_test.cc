@@ -13,10 +13,15 @@
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
+#include "map_model/matching/matching_test_utils.h"
 #include "map_model/testing/synthetic_map.h"
 
 namespace pkslam {
 namespace {
+
+SE3d CorrectedPose(double x, double y, double z) {
+  return SE3d(SO3d::Exp(Eigen::Vector3d(0.01, -0.02, 0.03)), Eigen::Vector3d(x, y, z));
+}
 
 class KeyFramePointsTest : public ::testing::Test {
  protected:
@@ -111,6 +116,39 @@ TEST_F(KeyFramePointsTest, RefusesToChangeTheMapWithoutTheWriteLock) {
   auto unlocked = MapEditor(&atlas_).WriteLater(MapEdit::kFixture);
   EXPECT_THROW(AddClosePoints(unlocked, &atlas_, kf.get(), ClosePointRule{}, &frame_), Error);
   EXPECT_EQ(atlas_.current_map()->NumMapPoints(), 0);
+}
+
+TEST_F(KeyFramePointsTest, ANewKeyframeJoinsTheMapTheChainAndBringsItsClosePoints) {
+  const testing::SyntheticScene scene = testing::MakeScene(600, 4, 4.0, 2.5, 1.5, 10.0);
+  const Vocabulary vocabulary = testing::TrainSceneVocabulary(scene);
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  KeyFramePtr previous = MakeKeyFrame(lock);
+  std::vector<std::pair<KeyFrame*, KeyFrame*>> attached;
+  const SE3d corrected = CorrectedPose(0.01, 0.02, 0.03);
+  const AttachKeyFrame attach = [&](const MapWriteLock&, KeyFrame* kf, KeyFrame* prev,
+                                    const Frame&) {
+    attached.emplace_back(kf, prev);
+    kf->SetPose(corrected);  // as the inertial attach does after a world change
+  };
+  Frame monocular = frame_;
+  const KeyFramePtr plain =
+      CreateKeyFrame(lock, &atlas_, vocabulary, attach, previous.get(), std::nullopt, &monocular);
+  ASSERT_NE(plain, nullptr);
+  EXPECT_EQ(atlas_.current_map()->NumKeyFrames(), 2);
+  EXPECT_FALSE(plain->bow().empty()) << "the BoW was computed";
+  ASSERT_EQ(attached.size(), 1u);
+  EXPECT_EQ(attached[0], std::make_pair(plain.get(), previous.get()));
+  EXPECT_TRUE(plain->camera_from_world().Log().isApprox(corrected.Log(), 1e-12));
+  EXPECT_EQ(atlas_.current_map()->NumMapPoints(), 0) << "no close points asked for";
+
+  const KeyFramePtr stereo = CreateKeyFrame(lock, &atlas_, vocabulary, attach, plain.get(),
+                                            ClosePointRule{rig_->th_depth, 5}, &frame_);
+  EXPECT_EQ(attached.back().second, plain.get());
+  EXPECT_GT(atlas_.current_map()->NumMapPoints(), 20);
+  EXPECT_EQ(static_cast<int>(stereo->GoodMapPoints().size()), atlas_.current_map()->NumMapPoints());
+  lock.unlock();
+  EXPECT_THROW(CreateKeyFrame(lock, &atlas_, vocabulary, attach, nullptr, std::nullopt, &frame_),
+               Error);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/bow/vocabulary.h"
+#include "core/util/log.h"
 #include "map_model/estimation/ransac_inputs.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
@@ -123,6 +124,38 @@ RelocalisationResult RelocaliseFrame(const KeyFrameDatabase& database, const Map
     }
   }
   std::fill(frame->map_points.begin(), frame->map_points.end(), nullptr);
+  return result;
+}
+
+RelocalisationResult RelocalisationAttempts::Try(const KeyFrameDatabase& database, const Map* map,
+                                                 const Vocabulary& vocabulary, const CameraRig& rig,
+                                                 std::uint64_t seed, Frame* frame) {
+  RelocalisationOptions options;
+  options.wide = NextIsWide();
+  options.wide_candidates = wide_candidates_;
+  options.seed = seed;
+  options.pose = pose_;
+  if (failures_in_a_row_ == widen_after_) {
+    PKSLAM_LOG_INFO(
+        "relocalisation: {} attempts in a row failed (t = {:.3f} s); widening the "
+        "place search",
+        failures_in_a_row_, frame->t_s());
+  }
+  const RelocalisationResult result =
+      RelocaliseFrame(database, map, vocabulary, rig, options, frame);
+  if (!result.success) {
+    ++failures_in_a_row_;
+    if (result.places > 0) {
+      PKSLAM_LOG_DEBUG(
+          "relocalisation failed at t = {:.3f} s: {} place(s), {} with 15+ BoW matches{}",
+          frame->t_s(), result.places, result.candidates, options.wide ? " (wide)" : "");
+    }
+    return result;
+  }
+  PKSLAM_LOG_INFO("relocalised at t = {:.3f} s against keyframe {} ({} inliers)", frame->t_s(),
+                  result.keyframe, result.inliers);
+  ++successes_;
+  failures_in_a_row_ = 0;
   return result;
 }
 

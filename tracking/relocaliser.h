@@ -46,4 +46,29 @@ RelocalisationResult RelocaliseFrame(const KeyFrameDatabase& database, const Map
                                      const Vocabulary& vocabulary, const CameraRig& rig,
                                      const RelocalisationOptions& options, Frame* frame);
 
+// Tracking's attempts in a row (ORB-SLAM3 retries every frame while lost): after
+// `widen_after` failures the place search widens (RelocalisationOptions::wide) until one
+// succeeds; successes are counted. Tracking thread.
+class RelocalisationAttempts {
+ public:
+  RelocalisationAttempts(int widen_after, int wide_candidates, const PoseOptimizerOptions& pose)
+      : widen_after_(widen_after), wide_candidates_(wide_candidates), pose_(pose) {}
+
+  // RelocaliseFrame for `frame`, its RANSAC seeded by `seed`; logged. Atlas lock held (shared).
+  RelocalisationResult Try(const KeyFrameDatabase& database, const Map* map,
+                           const Vocabulary& vocabulary, const CameraRig& rig, std::uint64_t seed,
+                           Frame* frame);
+
+  int successes() const { return successes_; }
+  int failures_in_a_row() const { return failures_in_a_row_; }
+  bool NextIsWide() const { return failures_in_a_row_ >= widen_after_; }
+
+ private:
+  int widen_after_;
+  int wide_candidates_;
+  PoseOptimizerOptions pose_;
+  int successes_ = 0;
+  int failures_in_a_row_ = 0;
+};
+
 }  // namespace pkslam

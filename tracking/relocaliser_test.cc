@@ -90,5 +90,28 @@ TEST_F(RelocaliserTest, AFrameOfAnotherPlaceIsNotRelocalised) {
   for (const MapPointPtr& mp : frame.map_points) EXPECT_EQ(mp, nullptr);
 }
 
+TEST_F(RelocaliserTest, FailuresInARowWidenTheSearchUntilOneSucceeds) {
+  RelocalisationAttempts attempts(/*widen_after=*/2, /*wide_candidates=*/3, options_.pose);
+  const testing::SyntheticScene elsewhere = testing::MakeScene(800, 1234);
+  auto lock = MapReader(bow_.atlas).Lock();
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(attempts.NextIsWide(), k >= 2) << "attempt " << k;
+    Frame lost = Query(elsewhere);
+    EXPECT_FALSE(
+        attempts.Try(*database_, bow_.atlas.current_map(), bow_.vocabulary, *bow_.rig, 5, &lost)
+            .success);
+    EXPECT_EQ(attempts.failures_in_a_row(), k + 1);
+  }
+  EXPECT_EQ(attempts.successes(), 0);
+  Frame found = Query(bow_.scene);
+  const RelocalisationResult wide =
+      attempts.Try(*database_, bow_.atlas.current_map(), bow_.vocabulary, *bow_.rig, 5, &found);
+  ASSERT_TRUE(wide.success);
+  EXPECT_LE(wide.places, 3u) << "the wide search's candidate cap";
+  EXPECT_EQ(attempts.successes(), 1);
+  EXPECT_EQ(attempts.failures_in_a_row(), 0);
+  EXPECT_FALSE(attempts.NextIsWide()) << "a success narrows the search again";
+}
+
 }  // namespace
 }  // namespace pkslam

@@ -4,6 +4,7 @@
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_point.h"
+#include "map_model/mapping_backend.h"
 
 namespace pkslam {
 namespace {
@@ -80,6 +81,21 @@ SelectorInput SnapshotTrackedFrame(const TrackedFrameView& view, const KeyframeS
     AddTrackedPoints(frame, view.last_keyframe, selector.NeedsOutliers(), &in);
   }
   return in;
+}
+
+void NoteLocalMapping(const MappingBackend& mapping, bool idle, SelectorInput* in) {
+  in->local_mapping_stopped = mapping.IsStoppedOrStopRequested();
+  in->local_mapping_idle = idle;
+  in->local_mapping_initializing = mapping.IsInitializingImu();
+  in->local_mapping_queue = mapping.QueueSize();
+}
+
+void RestartSelector(const Frame& frame, KeyframeSelector* selector) {
+  selector->Reset();
+  SelectorInput input;
+  input.frame_id = frame.id();
+  input.t_ns = frame.t_ns();
+  selector->OnKeyFrameInserted(input);
 }
 
 }  // namespace pkslam

@@ -13,6 +13,8 @@
 
 namespace pkslam {
 
+class MappingBackend;
+
 struct TrackedFrameView {
   const CameraRig* rig = nullptr;
   const Map* map = nullptr;      // the current map
@@ -29,5 +31,12 @@ struct TrackedFrameView {
 // `selector.NeedsTrackedPoints()`: one SelectorPoint per matched good point (outliers too if
 // `selector.NeedsOutliers()`).
 SelectorInput SnapshotTrackedFrame(const TrackedFrameView& view, const KeyframeSelector& selector);
+
+// Local mapping's state as the selector sees it: stopped, idle (`idle`: as the caller read it for
+// this frame), initialising the IMU, its queue.
+void NoteLocalMapping(const MappingBackend& mapping, bool idle, SelectorInput* in);
+
+// A new map's first keyframe is `frame`: the selector starts over from it.
+void RestartSelector(const Frame& frame, KeyframeSelector* selector);
 
 }  // namespace pkslam

@@ -13,6 +13,7 @@
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
+#include "map_model/mapping_backend.h"
 #include "map_model/testing/synthetic_map.h"
 
 namespace pkslam {
@@ -121,6 +122,69 @@ TEST_F(SelectorSnapshotTest, TrackedPointsComeWithOutliersOnlyWhenAskedFor) {
     EXPECT_FALSE(p.in_last_keyframe);
   }
   EXPECT_THROW(SnapshotTrackedFrame(TrackedFrameView{}, NeedsSelector(true, true)), Error);
+}
+
+// Local mapping as a table of answers.
+class ScriptedMapping final : public MappingBackend {
+ public:
+  bool stopped = false;
+  bool initialising = false;
+  int queue = 0;
+  void InsertKeyFrame(const KeyFramePtr&) override {}
+  bool AcceptsKeyFrames() const override { return true; }
+  bool IsStoppedOrStopRequested() const override { return stopped; }
+  bool IsInitializingImu() const override { return initialising; }
+  int QueueSize() const override { return queue; }
+  bool QueueFull() const override { return false; }
+  void InterruptBundleAdjustment() override {}
+  void WaitUntilIdle() override {}
+  bool AcceptsKeyFramesAt(std::int64_t) override { return true; }
+  bool EmulatesLive() const override { return false; }
+  void ResetQueue() override {}
+};
+
+// Records what the tracker tells a selector.
+class ListeningSelector final : public KeyframeSelector {
+ public:
+  std::string_view name() const override { return "listening"; }
+  SelectorDecision Decide(const SelectorInput&) override { return {}; }
+  void OnKeyFrameInserted(const SelectorInput& input) override { inserted.push_back(input); }
+  void Reset() override {
+    ++resets;
+    inserted.clear();
+  }
+  int resets = 0;
+  std::vector<SelectorInput> inserted;
+};
+
+TEST(SelectorSnapshotNotes, LocalMappingsStateIsCopiedAsRead) {
+  ScriptedMapping mapping;
+  mapping.stopped = true;
+  mapping.initialising = true;
+  mapping.queue = 3;
+  SelectorInput in;
+  NoteLocalMapping(mapping, /*idle=*/false, &in);
+  EXPECT_TRUE(in.local_mapping_stopped);
+  EXPECT_FALSE(in.local_mapping_idle);
+  EXPECT_TRUE(in.local_mapping_initializing);
+  EXPECT_EQ(in.local_mapping_queue, 3);
+  mapping.stopped = false;
+  NoteLocalMapping(mapping, /*idle=*/true, &in);
+  EXPECT_FALSE(in.local_mapping_stopped);
+  EXPECT_TRUE(in.local_mapping_idle);
+}
+
+TEST(SelectorSnapshotNotes, ANewMapRestartsTheSelectorFromItsFirstFrame) {
+  ListeningSelector selector;
+  selector.inserted.emplace_back();
+  std::vector<int> unused;
+  const Frame frame = testing::MakeFrame(testing::MakeScene(50, 2), testing::MakeStereoRig(),
+                                         SE3d(), 42, 7'000'000'000, {}, &unused);
+  RestartSelector(frame, &selector);
+  EXPECT_EQ(selector.resets, 1);
+  ASSERT_EQ(selector.inserted.size(), 1u) << "the old state is gone, the new keyframe in";
+  EXPECT_EQ(selector.inserted[0].frame_id, 42);
+  EXPECT_EQ(selector.inserted[0].t_ns, 7'000'000'000);
 }
 
 }  // namespace

@@ -13,13 +13,14 @@
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
+#include "tracking/frame_tracking.h"
 #include "tracking/pose_optimizer.h"
 
 namespace pkslam {
 namespace {
 
-// CPU and wall time of building a frame (for its FrameRecord).
-struct BuildTimer {
+// CPU and wall time of building or tracking a frame (for its FrameRecord).
+struct StepTimer {
   double cpu_start = ThreadCpuSeconds();
   std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
 
@@ -31,26 +32,6 @@ struct BuildTimer {
 
 }  // namespace
 
-void TrackingOptions::Check() const {
-  PKSLAM_CHECK_OPTION(min_features_stereo_init > 0, "Tracking.min_features_stereo_init", "{}",
-                      min_features_stereo_init);
-  PKSLAM_CHECK_OPTION(min_depth_points_stereo_init > 0, "Tracking.min_depth_points_stereo_init",
-                      "{}", min_depth_points_stereo_init);
-  PKSLAM_CHECK_OPTION(starving_inliers >= 0 && starving_ratio >= 0 && starving_ratio < 1,
-                      "Tracking.starving", "{} / {}", starving_inliers, starving_ratio);
-  PKSLAM_CHECK_OPTION(max_local_keyframes > 0, "Tracking.max_local_keyframes", "{}",
-                      max_local_keyframes);
-  PKSLAM_CHECK_OPTION(min_inliers > 0 && min_inliers_after_reloc > 0, "Tracking.min_inliers",
-                      "{} / {}", min_inliers, min_inliers_after_reloc);
-  PKSLAM_CHECK_OPTION(motion_model_radius_stereo > 0 && motion_model_radius_mono > 0,
-                      "Tracking.motion_model_radius", "{} / {}", motion_model_radius_stereo,
-                      motion_model_radius_mono);
-  PKSLAM_CHECK_OPTION(relocalisation_widen_after >= 0 && relocalisation_wide_candidates > 0,
-                      "Tracking.relocalisation_widen_after", "{} / {}",
-                      relocalisation_widen_after, relocalisation_wide_candidates);
-  pose.Check();
-}
-
 Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<const CameraRig> rig,
                  std::unique_ptr<KeyframeSelector> selector, MappingBackend* mapping,
                  TrackingOptions options, OrbOptions orb_options)
@@ -61,6 +42,9 @@ Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<con
       mapping_(mapping),
       options_(options),
       builder_(rig_, orb_options),
+      starter_(atlas_, vocabulary_, IsMonocular(rig_->sensor), options_),
+      relocalisation_(options_.relocalisation_widen_after, options_.relocalisation_wide_candidates,
+                      options_.pose),
       local_map_(options_.max_local_keyframes),
       decision_(IsMonocular(rig_->sensor),
                 StarvingRule{options_.starving_inliers, options_.starving_ratio}) {
@@ -78,7 +62,7 @@ Tracker::~Tracker() = default;
 
 TrackResult Tracker::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
   PKSLAM_CHECK(IsStereo(rig_->sensor), "TrackStereo with a {} rig", SensorName(rig_->sensor));
-  const BuildTimer timer;
+  const StepTimer timer;
   Frame frame = builder_.BuildStereo(atlas_->NextFrameId(), t_ns, left, right);
   timer.Stop(&build_cpu_ms_, &build_ms_);
   return Track(std::move(frame));
@@ -86,7 +70,7 @@ TrackResult Tracker::TrackStereo(const cv::Mat& left, const cv::Mat& right, std:
 
 TrackResult Tracker::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::int64_t t_ns) {
   PKSLAM_CHECK(IsRgbd(rig_->sensor), "TrackRgbd with a {} rig", SensorName(rig_->sensor));
-  const BuildTimer timer;
+  const StepTimer timer;
   Frame frame = builder_.BuildRgbd(atlas_->NextFrameId(), t_ns, image, depth);
   timer.Stop(&build_cpu_ms_, &build_ms_);
   return Track(std::move(frame));
@@ -95,7 +79,7 @@ TrackResult Tracker::TrackRgbd(const cv::Mat& image, const cv::Mat& depth, std::
 TrackResult Tracker::TrackMonocular(const cv::Mat& image, std::int64_t t_ns) {
   PKSLAM_CHECK(IsMonocular(rig_->sensor), "TrackMonocular with a {} rig", SensorName(rig_->sensor));
   const bool initialising = state_ == TrackingState::kNotInitialized;
-  const BuildTimer timer;
+  const StepTimer timer;
   Frame frame = builder_.BuildMonocular(atlas_->NextFrameId(), t_ns, image, initialising);
   timer.Stop(&build_cpu_ms_, &build_ms_);
   return Track(std::move(frame));
@@ -109,16 +93,15 @@ void Tracker::SetRig(const RigSetup& setup, const RigSetup& old_setup) {
   builder_.SetRig(rig_);
   if (imu_) imu_->samples().SetNoise(*rig_->imu);
   if (last_.size() > 0 || last_.HasPose()) last_.Recalibrate(rig_, warp, new_from_old);
-  if (two_view_.started()) two_view_.first().Recalibrate(rig_, warp, new_from_old);
+  if (Frame* first = starter_.pair_first()) first->Recalibrate(rig_, warp, new_from_old);
   if (velocity_) velocity_ = new_from_old * *velocity_ * old_from_new;
   records_.MoveCamera(new_from_old);
 }
 
 TrackResult Tracker::Track(Frame frame) {
   frame.imu.time_offset_s = time_offset_s_;
-  const auto start = std::chrono::steady_clock::now();
+  const StepTimer timer;
   double frame_wait_ms = 0;
-  const double cpu_start = ThreadCpuSeconds();
   current_ = std::move(frame);
   mapping_->NoteFrameTime(current_.t_ns());
   if (imu_) PreintegrateImu();
@@ -126,11 +109,7 @@ TrackResult Tracker::Track(Frame frame) {
   bool new_keyframe = false;
 
   if (state_ == TrackingState::kNotInitialized) {
-    if (IsMonocular(rig_->sensor)) {
-      MonocularInitialization();
-    } else {
-      StereoInitialization();
-    }
+    StartMap();
     new_keyframe = state_ == TrackingState::kOk;
     if (new_keyframe) result.keyframe_reason = "initialisation";
   } else {
@@ -148,20 +127,11 @@ TrackResult Tracker::Track(Frame frame) {
       auto lock = MapReader(*atlas_).Lock();
       if (imu_) SyncWithInertialMapLocked(/*correct_current=*/false);  // the world tracked in
       // Local mapping may have fused points of the last frame into others meanwhile.
-      for (auto& mp : last_.map_points) {
-        while (mp && mp->replaced_by()) mp = mp->replaced_by();
-      }
+      FollowReplacedPoints(&last_);
       ok = options_.localise_only ? TrackLocalisationOnly() : TrackInMap();
       if (ok) {
         velocity_ = current_.camera_from_world() * last_.world_from_camera();
-        // Matches to points that are not in the map (no observations) are dropped.
-        for (int i = 0; i < current_.size(); ++i) {
-          const auto& mp = current_.map_points[i];
-          if (mp && mp->NumObservations() < 1) {
-            current_.map_points[i].reset();
-            current_.outliers[i] = 0;
-          }
-        }
+        DropUnmappedMatches(&current_);
       }
       if (ok && !options_.localise_only) {
         selector_input =
@@ -178,10 +148,9 @@ TrackResult Tracker::Track(Frame frame) {
   // Localisation only keeps the loaded map whatever happens: the next frame relocalises.
   if (state_ == TrackingState::kLost && !options_.localise_only) HandleLost();
 
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() -
-      frame_wait_ms;
-  RecordFrame(new_keyframe, ms, 1e3 * (ThreadCpuSeconds() - cpu_start));
+  double cpu_ms = 0, ms = 0;
+  timer.Stop(&cpu_ms, &ms);
+  RecordFrame(new_keyframe, ms - frame_wait_ms, cpu_ms);
   records_.back().visual_odometry =
       options_.localise_only && localisation_.visual_odometry() && state_ == TrackingState::kOk;
   result.state = state_;
@@ -219,7 +188,8 @@ bool Tracker::TrackInMap() {
   if (ok) {
     state_ = TrackingState::kOk;
   } else if (state_ == TrackingState::kOk) {
-    const bool keep = atlas_->current_map()->NumKeyFrames() > MinKeyFramesToKeepMap();
+    const bool keep = atlas_->current_map()->NumKeyFrames() >
+                      options_.MinKeyFramesToKeepMap(IsMonocular(rig_->sensor));
     state_ = keep ? TrackingState::kRecentlyLost : TrackingState::kLost;
     lost_since_t_ns_ = current_.t_ns();
   } else if (state_ == TrackingState::kRecentlyLost &&
@@ -247,11 +217,8 @@ bool Tracker::ActOnDecision(const SelectorInput& selector_input, TrackResult* re
     CreateNewKeyFrame(selector_input);
     new_keyframe = true;
   }
-  // Outliers went into the keyframe (BA decides on them); the next frame must not use
-  // them for its pose.
-  for (int i = 0; i < current_.size(); ++i) {
-    if (current_.map_points[i] && current_.outliers[i]) current_.map_points[i].reset();
-  }
+  // Outliers went into the keyframe (BA decides on them), not into the next frame's pose.
+  DropOutlierMatches(&current_);
   result->keyframe_reason = decision.reason;
   result->selector_decided = !options_.localise_only;
   result->criteria_held = CriteriaHeld(decision);
@@ -280,47 +247,9 @@ void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
   if (posed && current_.HasPose() && ref) {
     auto lock = MapReader(*atlas_).Lock();
     if (imu_) SyncWithInertialMapLocked(/*correct_current=*/true);
-    r.camera_from_world_online = current_.camera_from_world();
-    if (keyframe && ref->t_ns() == current_.t_ns() && !ref->IsBad()) {
-      // The frame became this keyframe: it is the keyframe's image, so it has the keyframe's
-      // pose. Local mapping may already have moved it (lock-step runs map before this point:
-      // the monocular-inertial initialisation rotates and rescales the world and then runs a
-      // full BA, more than SyncWithInertialMapLocked can carry the frame across; a frame 19 cm
-      // off at the initialisation of a MH_01 replay).
-      current_.SetPose(ref->camera_from_world());
-    }
-    r.reference = ref;
-    r.camera_from_reference = current_.camera_from_world() * ref->world_from_camera();
-    if (records_.observations_enabled()) r.observations = InlierObservations(current_);
+    records_.SetPose(ref, keyframe, &current_, &r);
   }
   records_.Add(std::move(r));
-}
-
-void Tracker::StereoInitialization() {
-  if (!CanStartDepthMap(current_, options_)) return;
-  DepthMapStart start;
-  {
-    auto lock = MapEditor(atlas_).Write(MapEdit::kInitialise);
-    start = StartDepthMap(lock, atlas_, *vocabulary_, AttachKeyFrameFunction(), &current_);
-    local_map_.Reset({start.keyframe.get()}, start.keyframe->GoodMapPoints());
-  }
-  PKSLAM_LOG_INFO("new map {} initialised from stereo/depth with {} points",
-                  atlas_->current_map()->id(), start.points);
-  mapping_->InsertKeyFrame(start.keyframe);
-  if (options_.lockstep) mapping_->WaitUntilIdle();
-  last_kf_ = start.keyframe;
-  reference_kf_ = start.keyframe;
-  current_.reference_kf = start.keyframe;
-  inliers_ = start.points;
-  BeginTrackingNewMap();
-}
-
-int Tracker::MinKeyFramesToKeepMap() const {
-  // A monocular map of a few keyframes is mostly its two-view initialisation, with a scale of its
-  // own: ORB-SLAM3 resets it. A stereo or RGB-D map is metric from its first keyframe: it is
-  // kept, so a short loss (20 black frames) no longer drops the frames tracked before it, and the
-  // next map may be merged with it.
-  return IsMonocular(rig_->sensor) ? options_.min_keyframes_to_keep_map : 0;
 }
 
 void Tracker::HandleLost() {
@@ -329,7 +258,7 @@ void Tracker::HandleLost() {
     auto lock = MapReader(*atlas_).Lock();
     keyframes = atlas_->current_map()->NumKeyFrames();
   }
-  if (keyframes <= MinKeyFramesToKeepMap()) {
+  if (keyframes <= options_.MinKeyFramesToKeepMap(IsMonocular(rig_->sensor))) {
     PKSLAM_LOG_WARN("tracking lost at t = {:.3f} s with {} keyframes: resetting the map",
                     current_.t_s(), keyframes);
     Reset();
@@ -366,7 +295,7 @@ void Tracker::Reset() {
 void Tracker::StartOver() {
   state_ = TrackingState::kNotInitialized;
   velocity_.reset();
-  two_view_.Reset();
+  starter_.Reset();
   reference_kf_.reset();
   last_kf_.reset();
   local_map_.Clear();

@@ -2,7 +2,7 @@
 // from the images, initialises a map, tracks the camera against the last frame / reference
 // keyframe and the local map, asks the KeyframeSelector for keyframes and hands them to local
 // mapping. It keeps the state machine; the work is done by its parts (tracking/README.md:
-// frame_records.h, map_initializer.h, frame_tracking.h, local_map.h, relocaliser.h,
+// frame_records.h, map_starter.h, frame_tracking.h, local_map.h, relocaliser.h,
 // localisation_tracking.h, selector_snapshot.h, keyframe_decision.h, keyframe_points.h,
 // inertial_tracking.h). Owns its frames; touches the map model only under the Atlas mutex.
 #pragma once
@@ -25,7 +25,8 @@
 #include "tracking/keyframe_decision.h"
 #include "tracking/local_map.h"
 #include "tracking/localisation_tracking.h"
-#include "tracking/map_initializer.h"
+#include "tracking/map_starter.h"
+#include "tracking/relocaliser.h"
 #include "tracking/tracking_options.h"
 
 namespace pkslam {
@@ -76,7 +77,7 @@ class Tracker {
   // Localisation only (TrackingOptions::localise_only) on a map loaded into the Atlas: the
   // next frame is relocalised against the current map (tracking/tracker_localisation.cc).
   void StartLocalisation();
-  int relocalisations() const { return relocalisations_; }
+  int relocalisations() const { return relocalisation_.successes(); }
   // Localisation mode switched at run time (the library's SetLocalisationMode, as ORB-SLAM3's
   // ActivateLocalizationMode): from the next frame on, tracking only against the current map,
   // no keyframes, visual tracking (ImuReady() is false while on). Tracking thread, between
@@ -116,14 +117,11 @@ class Tracker {
   // Carries out the decision (interrupting local BA, creating the keyframe) after the lock is
   // released. Returns whether a keyframe was created.
   bool ActOnDecision(const SelectorInput& selector_input, TrackResult* result);
-  // Map initialisation (its parts in tracking/map_initializer.h).
-  void StereoInitialization();
-  void MonocularInitialization();
-  void CreateInitialMapMonocular(const TwoViewResult& reconstruction);
-  // AttachImu as the map initialiser's callback.
-  AttachKeyFrame AttachKeyFrameFunction();
-  // A new map's first keyframe was made: the selector starts over from it, tracking is OK.
-  void BeginTrackingNewMap();
+  // Map initialisation (tracking/map_starter.h): a new map's keyframes go to local mapping, the
+  // selector starts over from the newest, tracking is OK; a refused one is reset.
+  void StartMap();
+  // AttachImu as the callback of the map's keyframe makers.
+  AttachKeyFrame ImuAttacher();
   bool TrackReferenceKeyFrame();
   bool TrackWithMotionModel();
   bool TrackLocalMap();
@@ -133,17 +131,12 @@ class Tracker {
   // The last frame's pose moves with its reference keyframe; localisation only (stereo/RGB-D),
   // it gets visual-odometry points.
   void UpdateLastFrame();
-  // The local map's search radius for this frame (pixels at level 0).
-  double LocalSearchRadius() const;
   // `mapping_idle`: whether local mapping takes keyframes at this frame's time.
   // The selector's view of the current frame (caller holds the Atlas lock, shared).
   SelectorInput BuildSelectorInput(bool mapping_idle) const;
   void CreateNewKeyFrame(const SelectorInput& input);
-  // Finds the frame's pose in the current map (RelocaliseFrame, tracking/relocaliser.h), with
-  // the failure count that widens the place search (tracking/relocalization.cc).
+  // Finds the frame's pose in the current map (tracking/relocaliser.h).
   bool Relocalize();
-  // Keyframes a lost map needs to be kept (else reset): options' for monocular maps, 0 else.
-  int MinKeyFramesToKeepMap() const;
   void HandleLost();
   // Back to NOT_INITIALIZED on the current (new or cleared) map.
   void StartOver();
@@ -152,9 +145,9 @@ class Tracker {
   // --- inertial sensors (tracking/tracker_inertial.cc; the work: tracking/inertial_tracking.h) ---
   bool ImuReady() const;  // the current map's IMU is initialised (Atlas lock held)
   void PreintegrateImu();
-  void SyncWithInertialMap();
-  // The same with the Atlas lock held; `correct_current` carries the current frame's pose and
-  // velocity across a world change (rotation / rescale) made since it was tracked.
+  // Follows the map's world changes (Atlas lock held); `correct_current` carries the current
+  // frame's pose and velocity across a world change (rotation / rescale) made since it was
+  // tracked.
   void SyncWithInertialMapLocked(bool correct_current);
   bool PredictWithImu();
   bool TrackWithImu();
@@ -162,7 +155,6 @@ class Tracker {
   void OptimizeCurrentPose();
   // Tracking's keyframe joins the map's inertial chain after `previous` (map write lock held).
   void AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previous, const Frame& frame);
-  void FillImuSelectorInput(SelectorInput* in) const;
 
   Atlas* atlas_;
   const Vocabulary* vocabulary_;
@@ -171,7 +163,7 @@ class Tracker {
   MappingBackend* mapping_;
   TrackingOptions options_;
   FrameBuilder builder_;
-  TwoViewStart two_view_;  // monocular: the first frame of the initial pair
+  MapStarter starter_;  // while NOT_INITIALIZED
 
   TrackingState state_ = TrackingState::kNotInitialized;
   Frame current_;
@@ -185,8 +177,7 @@ class Tracker {
   double build_ms_ = 0;
   int inliers_ = 0;
   std::int64_t lost_since_t_ns_ = 0;
-  int relocalisations_ = 0;
-  int failed_relocalisations_ = 0;  // in a row; reset by a success (Relocalize)
+  RelocalisationAttempts relocalisation_;
 
   LocalMap local_map_;  // rebuilt every frame
   // Localisation only: map or visual odometry (tracking/localisation_tracking.h).

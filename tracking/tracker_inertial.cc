@@ -31,27 +31,17 @@ bool Tracker::ImuReady() const {
 }
 
 void Tracker::PreintegrateImu() {
-  SyncWithInertialMap();
-  // The bias tracking integrates with: the last frame's estimate, else the last keyframe's.
   ImuBias bias;
   {
     auto lock = MapReader(*atlas_).Lock();
-    if (last_.imu.state.valid) {
-      bias = last_.imu.state.bias;
-    } else if (last_kf_) {
-      bias = last_kf_->imu().state.bias;
-    }
+    SyncWithInertialMapLocked(/*correct_current=*/false);
+    bias = InertialTracking::IntegrationBias(last_, last_kf_.get());
   }
   // Keep what the oldest anchor still needs.
   std::int64_t anchor = current_.t_ns();
   if (last_kf_) anchor = std::min(anchor, last_kf_->t_ns());
-  if (two_view_.started()) anchor = std::min(anchor, two_view_.first().t_ns());
+  if (const Frame* first = starter_.pair_first()) anchor = std::min(anchor, first->t_ns());
   imu_->Preintegrate(bias, anchor, &current_);
-}
-
-void Tracker::SyncWithInertialMap() {
-  auto lock = MapReader(*atlas_).Lock();
-  SyncWithInertialMapLocked(false);
 }
 
 void Tracker::SyncWithInertialMapLocked(bool correct_current) {
@@ -61,12 +51,7 @@ void Tracker::SyncWithInertialMapLocked(bool correct_current) {
   // Local mapping rotated / rescaled the map after the current frame was tracked: its pose is
   // in the old world (WorldChangesSeen::single_transform).
   if (correct_current && current_.HasPose() && seen.single_transform) {
-    const WorldChange& transform = *seen.single_transform;
-    const SE3d& tcw = current_.camera_from_world();
-    current_.SetPose(
-        SE3d(tcw.so3() * transform.rotation.Inverse(), transform.scale * tcw.translation()));
-    current_.imu.state.velocity_world =
-        transform.scale * (transform.rotation * current_.imu.state.velocity_world);
+    InertialTracking::CarryAcross(*seen.single_transform, &current_);
   }
   if (seen.scale_ratio) {
     // Monocular-inertial initialisation rescaled the map: what tracking keeps relative to its
@@ -82,9 +67,7 @@ bool Tracker::PredictWithImu() { return imu_->Predict(last_, last_kf_.get(), *ri
 bool Tracker::TrackWithImu() {
   UpdateLastFrame();
   if (!PredictWithImu()) return false;
-  const bool mono = IsMonocular(rig_->sensor);
-  const double th = mono ? options_.motion_model_radius_mono : options_.motion_model_radius_stereo;
-  MatchLastFrame(last_, th, mono, options_.min_matches_motion_model, &current_);
+  MatchLastFramePredicted(last_, options_, IsMonocular(rig_->sensor), &current_);
   current_.outliers.assign(current_.size(), 0);
   // The IMU prediction stands: the matches are classified by the visual-inertial optimisation
   // after the local map search (ORB-SLAM3 runs a visual-only optimisation here first; with the
@@ -110,18 +93,6 @@ void Tracker::AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previo
     kf->SetPose(current_.camera_from_world());
   }
   imu_->Attach(lock, frame, previous, kf);
-}
-
-void Tracker::FillImuSelectorInput(SelectorInput* in) const {
-  if (!imu_) return;
-  std::optional<SO3d> world_from_last_body;
-  if (ImuReady() && last_.HasPose()) {
-    world_from_last_body =
-        (last_.camera_from_world().Inverse() * rig_->body_from_camera.Inverse()).so3();
-  }
-  if (auto interval = imu_->IntervalSinceLastFrame(current_, world_from_last_body)) {
-    in->imu_since_last_frame = *interval;
-  }
 }
 
 }  // namespace pkslam

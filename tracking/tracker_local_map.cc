@@ -1,6 +1,6 @@
 // Frame-to-map tracking: motion model, reference keyframe, local map (ORB-SLAM3's
 // TrackWithMotionModel, TrackReferenceKeyFrame, TrackLocalMap; the local map itself is
-// tracking/local_map.h). Runs under the Atlas shared
+// tracking/local_map.h) and relocalisation (tracking/relocaliser.h). Runs under the Atlas shared
 // lock taken in Tracker::Track.
 #include <algorithm>
 
@@ -11,6 +11,7 @@
 #include "tracking/frame_tracking.h"
 #include "tracking/localisation_tracking.h"
 #include "tracking/pose_optimizer.h"
+#include "tracking/relocaliser.h"
 #include "tracking/tracker.h"
 
 namespace pkslam {
@@ -38,8 +39,7 @@ bool Tracker::TrackWithMotionModel() {
   UpdateLastFrame();
   current_.SetPose(*velocity_ * last_.camera_from_world());
   const bool mono = IsMonocular(rig_->sensor);
-  const double th = mono ? options_.motion_model_radius_mono : options_.motion_model_radius_stereo;
-  const int n = MatchLastFrame(last_, th, mono, options_.min_matches_motion_model, &current_);
+  const int n = MatchLastFramePredicted(last_, options_, mono, &current_);
   if (n < options_.min_matches_motion_model) return false;
   const int in_map = OptimizeAndDiscard(options_.pose, &current_);
   if (options_.localise_only && !mono) {
@@ -56,20 +56,13 @@ bool Tracker::TrackLocalMap() {
     if (!reference_kf_) reference_kf_ = best->map() != nullptr ? best->map()->Share(best) : nullptr;
     current_.reference_kf = reference_kf_;
   }
-  local_map_.Search(&current_, *rig_, LocalSearchRadius());
+  const bool lost = state_ == TrackingState::kRecentlyLost || state_ == TrackingState::kLost;
+  const double radius = options_.LocalSearchRadius(IsRgbd(rig_->sensor),
+                                                   current_.id() < last_reloc_frame_id_ + 2, lost);
+  local_map_.Search(&current_, *rig_, radius);
   current_.outliers.assign(current_.size(), 0);
   OptimizeCurrentPose();
-  inliers_ = 0;
-  for (int i = 0; i < current_.size(); ++i) {
-    const auto& mp = current_.map_points[i];
-    if (!mp) continue;
-    if (!current_.outliers[i]) {
-      mp->IncreaseFound();
-      if (mp->NumObservations() > 0) ++inliers_;
-    } else if (IsStereo(rig_->sensor)) {
-      current_.map_points[i].reset();
-    }
-  }
+  inliers_ = CountLocalMapInliers(IsStereo(rig_->sensor), &current_);
   const int max_frames = static_cast<int>(rig_->fps + 0.5);
   if (current_.id() < last_reloc_frame_id_ + max_frames &&
       inliers_ < options_.min_inliers_after_reloc) {
@@ -79,11 +72,14 @@ bool Tracker::TrackLocalMap() {
   return inliers_ >= options_.min_inliers;
 }
 
-double Tracker::LocalSearchRadius() const {
-  double radius = IsRgbd(rig_->sensor) ? 3.0 : options_.local_map_radius;
-  if (current_.id() < last_reloc_frame_id_ + 2) radius = options_.local_map_radius_after_reloc;
-  if (state_ == TrackingState::kRecentlyLost || state_ == TrackingState::kLost) radius = 15.0;
-  return radius;
+bool Tracker::Relocalize() {
+  const KeyFrameDatabase* database = atlas_->database();
+  if (database == nullptr) return false;
+  const std::uint64_t seed = MixSeed(options_.seed, static_cast<std::uint64_t>(current_.id()));
+  const RelocalisationResult result =
+      relocalisation_.Try(*database, atlas_->current_map(), *vocabulary_, *rig_, seed, &current_);
+  if (result.success) last_reloc_frame_id_ = current_.id();
+  return result.success;
 }
 
 }  // namespace pkslam

@@ -74,6 +74,23 @@ struct TrackingOptions {
   PoseOptimizerOptions pose;
 
   void Check() const;
+
+  // Keyframes a lost map needs to be kept (else it is reset). A monocular map of a few
+  // keyframes is mostly its two-view initialisation, with a scale of its own: ORB-SLAM3 resets
+  // it. A stereo or RGB-D map is metric from its first keyframe: it is kept, so a short loss (20
+  // black frames) no longer drops the frames tracked before it, and the next map may be merged
+  // with it.
+  int MinKeyFramesToKeepMap(bool monocular) const {
+    return monocular ? min_keyframes_to_keep_map : 0;
+  }
+  // The local map's search radius (pixels at level 0) for a frame: RGB-D's narrow one, wider
+  // right after a relocalisation, widest while lost (ORB-SLAM3's SearchLocalPoints).
+  double LocalSearchRadius(bool rgbd, bool just_relocalised, bool lost) const {
+    double radius = rgbd ? 3.0 : local_map_radius;
+    if (just_relocalised) radius = local_map_radius_after_reloc;
+    if (lost) radius = 15.0;
+    return radius;
+  }
 };
 
 // A RANSAC seed from the run seed and a per-call value (a frame id). Run seed 0 gives the

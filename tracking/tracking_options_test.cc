@@ -1,0 +1,50 @@
+// Tracking's options: their check, and the two rules they carry (which lost maps are kept, how
+// wide the local map is searched).
+#include "tracking/tracking_options.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/util/error.h"
+
+namespace pkslam {
+namespace {
+
+TEST(TrackingOptions, CheckNamesTheBadOption) {
+  EXPECT_NO_THROW(TrackingOptions().Check());
+  TrackingOptions bad;
+  bad.min_inliers = 0;
+  try {
+    bad.Check();
+    FAIL() << "min_inliers 0 accepted";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("Tracking.min_inliers"), std::string::npos) << e.what();
+  }
+  bad = TrackingOptions();
+  bad.starving_ratio = 1.0;
+  EXPECT_THROW(bad.Check(), OptionError);
+  bad = TrackingOptions();
+  bad.pose.rounds = 0;
+  EXPECT_THROW(bad.Check(), OptionError) << "the pose optimiser's options are checked too";
+}
+
+TEST(TrackingOptions, OnlySmallMonocularMapsAreDroppedWhenLost) {
+  TrackingOptions options;
+  options.min_keyframes_to_keep_map = 7;
+  EXPECT_EQ(options.MinKeyFramesToKeepMap(/*monocular=*/true), 7);
+  EXPECT_EQ(options.MinKeyFramesToKeepMap(/*monocular=*/false), 0);
+}
+
+TEST(TrackingOptions, TheLocalMapSearchWidensAfterRelocalisationAndWhileLost) {
+  TrackingOptions options;
+  options.local_map_radius = 1.5;
+  options.local_map_radius_after_reloc = 6.0;
+  EXPECT_EQ(options.LocalSearchRadius(false, false, false), 1.5);
+  EXPECT_EQ(options.LocalSearchRadius(true, false, false), 3.0) << "RGB-D";
+  EXPECT_EQ(options.LocalSearchRadius(true, true, false), 6.0);
+  EXPECT_EQ(options.LocalSearchRadius(false, true, true), 15.0) << "lost wins";
+}
+
+}  // namespace
+}  // namespace pkslam
