@@ -7,6 +7,7 @@
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
+#include "map_model/world_transform.h"
 
 namespace pkslam {
 namespace {
@@ -169,10 +170,9 @@ ImuBias InertialTracking::IntegrationBias(const Frame& last, const KeyFrame* las
 }
 
 void InertialTracking::CarryAcross(const WorldChange& change, Frame* frame) {
-  const SE3d& tcw = frame->camera_from_world();
-  frame->SetPose(SE3d(tcw.so3() * change.rotation.Inverse(), change.scale * tcw.translation()));
+  frame->SetPose(CameraFromMovedWorld(frame->camera_from_world(), change.rotation, change.scale));
   frame->imu.state.velocity_world =
-      change.scale * (change.rotation * frame->imu.state.velocity_world);
+      VelocityInMovedWorld(frame->imu.state.velocity_world, change.rotation, change.scale);
 }
 
 }  // namespace pkslam

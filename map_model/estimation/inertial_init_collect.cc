@@ -8,6 +8,7 @@
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
 #include "map_model/map_point.h"
+#include "map_model/world_transform.h"
 
 namespace pkslam {
 namespace {
@@ -78,11 +79,9 @@ void ApplyScaledRotation(const MapWriteLock& lock, Map* map, const SO3d& new_fro
                          double scale) {
   RequireWriteLock(lock, "ApplyScaledRotation");
   for (const auto& [id, kf] : map->keyframes()) {
-    const SE3d& tcw = kf->camera_from_world();
-    SE3d updated(tcw.so3() * new_from_old.Inverse(), scale * tcw.translation());
-    kf->SetPose(updated);
+    kf->SetPose(CameraFromMovedWorld(kf->camera_from_world(), new_from_old, scale));
     kf->mutable_imu(lock).state.velocity_world =
-        scale * (new_from_old * kf->imu().state.velocity_world);
+        VelocityInMovedWorld(kf->imu().state.velocity_world, new_from_old, scale);
   }
   for (const auto& [id, point] : map->map_points()) {
     if (point->IsBad()) continue;
