@@ -1,6 +1,6 @@
 // Keyframe culling in inertial maps (ORB-SLAM3's LocalMapping::KeyFrameCulling, IMU branch).
 //
-// A redundant keyframe (its close points seen elsewhere, see LocalMapper::CullKeyFrames) of an
+// A redundant keyframe (its close points seen elsewhere, see KeyFrameSteps::CullKeyFrames) of an
 // inertial map is retired only if the temporal chain stays dense enough for the IMU factors:
 // its neighbours in the chain must be less than `max_gap_recent_s` apart, or, for keyframes
 // older than the newest `window` of the chain once the IMU is initialised, less than

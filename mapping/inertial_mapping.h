@@ -1,4 +1,4 @@
-// Options of local mapping's inertial work (mapping/inertial_stages.h, local_mapper_inertial.cc):
+// Options of local mapping's inertial work (mapping/inertial_stages.h, keyframe_steps.cc):
 // the staged IMU initialisation of ORB-SLAM3 (../shared/docs/ORBSLAM3_FACTS.md "IMU") and local
 // inertial BA.
 //

@@ -1,7 +1,9 @@
-// LocalMapper: the thread, its queue and the stop/reset handshakes.
+// LocalMapper: the thread, its queue, live emulation's pacing and the stop/reset handshakes;
+// the keyframe's own steps are mapping/keyframe_steps.h.
 #include "mapping/local_mapper.h"
 
 #include <algorithm>
+#include <chrono>
 
 #include "core/util/cpu_time.h"
 #include "core/util/error.h"
@@ -10,43 +12,16 @@
 
 namespace pkslam {
 
-// Fitted by evaluation/studies/coupling/fit_work_model.py to 1568 keyframes of six runs
-// (60 s realistic replays of V1_02, V1_03 and V2_02, mono-inertial and stereo-inertial, CPU
-// clock, 2 cores; 2026-11-28): a keyframe 0.66 ms, a fused projection 0.14 us, a scalar solver
-// residual per iteration 0.29 us; triangulation keypoints got no weight of their own (they
-// grow with the keyframe count). Totals per run: 0.96-1.02x the measured CPU seconds
-// mono-inertial, 0.83-0.88x stereo-inertial; median error per keyframe 9-15%.
-const WorkModel kReferenceWork{{6.593e-4, 0.0, 1.351e-7, 2.854e-7}};
-
-std::optional<LiveClock> ParseLiveClock(std::string_view name) {
-  if (name == "work") return LiveClock::kWork;
-  if (name == "cpu") return LiveClock::kCpu;
-  if (name == "wall") return LiveClock::kWall;
-  return std::nullopt;
-}
-
-void LocalMappingOptions::Check() const {
-  PKSLAM_CHECK_OPTION(triangulation_neighbours_stereo > 0 && triangulation_neighbours_mono > 0,
-                      "LocalMapping.triangulation_neighbours", "{} / {}",
-                      triangulation_neighbours_stereo, triangulation_neighbours_mono);
-  PKSLAM_CHECK_OPTION(culling_redundancy > 0 && culling_redundancy <= 1,
-                      "LocalMapping.culling_redundancy", "{}", culling_redundancy);
-  PKSLAM_CHECK_OPTION(culling_observers > 0, "LocalMapping.culling_observers", "{}",
-                      culling_observers);
-  PKSLAM_CHECK_OPTION(min_found_ratio >= 0 && min_found_ratio < 1, "LocalMapping.min_found_ratio",
-                      "{}", min_found_ratio);
-  PKSLAM_CHECK_OPTION(max_queued_keyframes >= 2, "LocalMapping.max_queued_keyframes",
-                      "{} (a map's initialisation inserts two keyframes)", max_queued_keyframes);
-  ba.Check();
-  inertial.Check();
-  calibration.Check();
-}
-
 LocalMapper::LocalMapper(Atlas* atlas, std::shared_ptr<const CameraRig> rig,
                          LocalMappingOptions options)
     : atlas_(atlas),
       rig_(std::move(rig)),
       options_(options),
+      timeline_(live_, &work_),
+      steps_(atlas, rig_, options_,
+             KeyFrameStepHooks{
+                 [this] { return HasQueued(); }, [this] { return IsStoppedOrStopRequested(); },
+                 [this] { StepBoundary(); }, [this] { PaceToTracker(); }, &abort_ba_, &work_}),
       calibrator_(atlas, rig_->sensor, options_.calibration, options_.ba.num_threads),
       inertial_stages_(
           atlas, rig_->sensor, options_.inertial, options_.ba.num_threads,
@@ -148,20 +123,22 @@ void LocalMapper::WaitUntilIdle() {
 
 void LocalMapper::EmulateLive(bool on, double pace, LiveClock clock) {
   PKSLAM_CHECK(!thread_.joinable(), "live emulation is set before Start()");
-  emulate_live_ = on;
-  live_pace_ = pace;
-  live_clock_ = clock;
+  live_ = LiveEmulation{on, pace, clock};
+  {
+    MutexLock lock(mutex_);
+    timeline_ = LiveTimeline(live_, &work_);
+  }
   CalibrationPacing calibration;
   calibration.paced = Paced();
   if (Paced()) {
     work_.SetPacer([this] { PaceToTracker(); });
     calibration.position = [this] {
       MutexLock lock(mutex_);
-      return LiveDataPosition{LiveReachedNs(),
+      return LiveDataPosition{timeline_.ReachedNs(),
                               stop_requested_ || finish_requested_ || reset_requested_};
     };
     calibration.data_ns = [this](const WorkCounts& work) {
-      return DataNs(kReferenceWork.Seconds(work));
+      return live_.DataNs(kReferenceWork.Seconds(work));
     };
   } else {
     work_.SetPacer(nullptr);
@@ -173,74 +150,50 @@ void LocalMapper::NoteFrameTime(std::int64_t t_ns) {
   if (!Paced()) return;
   {
     MutexLock lock(mutex_);
-    tracker_ns_ = std::max(tracker_ns_, t_ns);
+    timeline_.AdvanceTracker(t_ns);
   }
   paced_.notify_all();
-}
-
-std::int64_t LocalMapper::LiveReachedNs() const {
-  return live_job_start_ns_ + DataNs(LiveClockSeconds() - live_job_clock_start_);
 }
 
 void LocalMapper::PaceToTracker() {
   if (!Paced() || !thread_.joinable() || std::this_thread::get_id() != thread_.get_id()) return;
   MutexLock lock(mutex_);
-  const std::int64_t reached = LiveReachedNs();
+  const std::int64_t reached = timeline_.ReachedNs();
   idle_.notify_all();  // tracking may be waiting for the work to reach its frame's time
-  while (tracker_ns_ < reached && idle_waiters_ == 0 && !stop_requested_ && !finish_requested_ &&
-         !reset_requested_) {
+  while (timeline_.TrackerBefore(reached) && idle_waiters_ == 0 && !stop_requested_ &&
+         !finish_requested_ && !reset_requested_) {
     paced_.wait(lock);
   }
 }
 
 bool LocalMapper::AcceptsKeyFramesAt(std::int64_t t_ns) {
-  if (!emulate_live_ || !thread_.joinable()) return AcceptsKeyFrames();
+  if (!live_.on || !thread_.joinable()) return AcceptsKeyFrames();
   const auto wait_start = std::chrono::steady_clock::now();
   MutexLock lock(mutex_);
-  if (Paced() && t_ns > tracker_ns_) {
-    // The caller is at this frame (NoteFrameTime's contract): paced work must not wait for it.
-    tracker_ns_ = t_ns;
-    paced_.notify_all();
-  }
+  // The caller is at this frame (NoteFrameTime's contract): paced work must not wait for it.
+  if (Paced() && timeline_.AdvanceTracker(t_ns)) paced_.notify_all();
   while (true) {
     if (stopped_ || stop_requested_ || finish_requested_ || reset_requested_) break;
     if (!busy_ && queue_.empty()) break;
     if (busy_) {
       // Where the current keyframe's processing has got to on the data clock, at least.
-      const std::int64_t reached = LiveReachedNs();
+      const std::int64_t reached = timeline_.ReachedNs();
       if (reached >= t_ns) break;  // still busy at t_ns, for certain
-      // The CPU and wall clocks cannot run faster than real time: wait until the job could
-      // have reached t_ns. Work is counted, and PaceToTracker notifies after each step and
-      // solver iteration; the short timeout only bounds a missed case.
-      const double wait_s = live_clock_ == LiveClock::kWork
-                                ? 0.002
-                                : static_cast<double>(t_ns - reached) * 1e-9 / live_pace_;
-      idle_.wait_for(lock, std::chrono::duration<double>(wait_s));
+      // PaceToTracker notifies after each step and solver iteration.
+      idle_.wait_for(lock, std::chrono::duration<double>(timeline_.RecheckSeconds(t_ns, reached)));
     } else {
       idle_.wait(lock);  // a queued keyframe is about to be taken
     }
   }
   stats_.live_wait_ms += WallMsSince(wait_start);
-  return !busy_ && queue_.empty() && !stopped_ && !stop_requested_ && live_free_ns_ <= t_ns;
-}
-
-double LocalMapper::LiveClockSeconds() const {
-  if (live_clock_ == LiveClock::kWork) return kReferenceWork.Seconds(work_.Snapshot());
-  if (live_clock_ == LiveClock::kCpu && mapping_cpu_clock_) {
-    return ClockSeconds(*mapping_cpu_clock_);
-  }
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-std::int64_t LocalMapper::DataNs(double work_s) const {
-  return static_cast<std::int64_t>(work_s * live_pace_ * 1e9);
+  return !busy_ && queue_.empty() && !stopped_ && !stop_requested_ && timeline_.FreeBy(t_ns);
 }
 
 void LocalMapper::ResetQueue() {
   if (!thread_.joinable()) {
     MutexLock lock(mutex_);
     queue_.clear();
-    recent_points_.Clear();
+    steps_.ForgetRecentPoints();
     return;
   }
   MutexLock lock(mutex_);
@@ -291,9 +244,52 @@ LocalMappingStats LocalMapper::stats() const {
   return stats;
 }
 
+void LocalMapper::ProcessNext() {
+  KeyFramePtr kf;
+  {
+    MutexLock lock(mutex_);
+    if (queue_.empty()) return;
+    kf = queue_.front();
+    queue_.pop_front();
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = ThreadCpuSeconds();
+  const WorkCounts work_start = work_.Snapshot();
+  work_.Add(WorkKind::kKeyFrame, 1);
+  abort_ba_.store(false);
+  const KeyFrameStepReport steps = steps_.Run(kf);
+  // A step boundary before each whole-map step too: it changes the map at a data time tracking
+  // has reached, as does applying an adjustment solved in the calibration thread.
+  StepBoundary();
+  if (IsInertial(rig_->sensor) && !IsStoppedOrStopRequested()) inertial_stages_.Step(kf);
+  StepBoundary();
+  if (options_.calibration.enabled && !IsStoppedOrStopRequested()) {
+    calibrator_.Step(kf, HasQueued(), !options_.calibration.own_thread || !thread_.joinable(),
+                     &abort_ba_, &work_);
+  }
+  StepBoundary();
+  {
+    MutexLock lock(mutex_);
+    stats_.points_culled += steps.points_culled;
+    stats_.points_created += steps.points_created;
+    stats_.keyframes_culled += steps.keyframes_culled;
+    if (steps.ba_aborted) ++stats_.ba_aborted;
+    if (steps.inertial_ba) {
+      ++(steps.inertial_ba_with_prior ? stats_.inertial_ba_with_prior
+                                      : stats_.inertial_ba_fixed_anchor);
+    }
+    stats_.keyframe_ms.push_back(WallMsSince(start));
+    stats_.ba_ms.push_back(steps.ba_ms);
+    stats_.keyframe_cpu_ms.push_back(1e3 * (ThreadCpuSeconds() - cpu_start));
+    stats_.ba_cpu_ms.push_back(steps.ba_cpu_ms);
+    stats_.keyframe_work.push_back(work_.Snapshot() - work_start);
+  }
+  if (consumer_) consumer_(kf);
+}
+
 void LocalMapper::Run() {
   MutexLock lock(mutex_);
-  mapping_cpu_clock_ = CallingThreadCpuClock();
+  timeline_.SetCpuClock(CallingThreadCpuClock());
   while (true) {
     while (!(finish_requested_ || reset_requested_ || stop_requested_ || !queue_.empty())) {
       wake_.wait(lock);
@@ -302,9 +298,9 @@ void LocalMapper::Run() {
       lock.unlock();
       calibrator_.Stop();  // its map is about to go
       lock.lock();
-      live_free_ns_ = std::numeric_limits<std::int64_t>::min();
+      timeline_.Reset();
       queue_.clear();
-      recent_points_.Clear();
+      steps_.ForgetRecentPoints();
       reset_requested_ = false;
       idle_.notify_all();
       continue;
@@ -324,13 +320,12 @@ void LocalMapper::Run() {
     }
     busy_ = true;
     accept_keyframes_.store(false);
-    live_job_start_ns_ = std::max(queue_.front()->t_ns(), live_free_ns_);
-    live_job_clock_start_ = LiveClockSeconds();
+    timeline_.StartJob(queue_.front()->t_ns());
     idle_.notify_all();  // AcceptsKeyFramesAt waits for a queued keyframe to be taken
     lock.unlock();
     ProcessNext();
     lock.lock();
-    live_free_ns_ = LiveReachedNs();
+    timeline_.EndJob();
     busy_ = false;
     if (queue_.empty()) accept_keyframes_.store(true);
     idle_.notify_all();

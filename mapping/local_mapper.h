@@ -1,7 +1,10 @@
 // The LocalMapping thread (ORB-SLAM3's LocalMapping): for each new keyframe it completes the
 // point associations, culls recent points, triangulates new points with covisible keyframes,
 // fuses duplicates, runs local bundle adjustment and culls redundant keyframes, then hands the
-// keyframe on (to loop closing).
+// keyframe on (to loop closing). This class is the thread, its bounded queue, the stop/reset
+// handshakes and live emulation's pacing (mapping/live_timeline.h); the keyframe's steps are
+// KeyFrameSteps (mapping/keyframe_steps.h), the whole-map inertial ones InertialStages, online
+// calibration OnlineCalibrator.
 //
 // Threads: the queue and flags are guarded by `mutex_` (PKSLAM_GUARDED_BY, checked by Clang
 // in CTest layering.thread_safety; plus atomics for flags read on hot paths); the map model by the
@@ -9,20 +12,12 @@
 // (docs/architecture.md). Owned by System; Stop() joins the thread.
 #pragma once
 
-#include <time.h>
-
 #include <atomic>
-#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <functional>
-#include <limits>
 #include <memory>
-#include <optional>
-#include <string>
-#include <string_view>
 #include <thread>
-#include <utility>
 #include <vector>
 
 #include "core/imu/imu_types.h"
@@ -36,37 +31,12 @@
 #include "mapping/calibration_refinement.h"
 #include "mapping/inertial_mapping.h"
 #include "mapping/inertial_stages.h"
+#include "mapping/keyframe_steps.h"
+#include "mapping/live_timeline.h"
+#include "mapping/local_mapping_options.h"
 #include "mapping/online_calibrator.h"
-#include "mapping/recent_points.h"
 
 namespace pkslam {
-
-struct LocalMappingOptions {
-  // Covisible keyframes used for triangulation (stereo/RGB-D, monocular).
-  int triangulation_neighbours_stereo = 10;
-  int triangulation_neighbours_mono = 20;
-  // Keyframe culling: a keyframe is redundant when this share of its (close) points is seen
-  // by at least `culling_observers` other keyframes at the same or a finer scale.
-  double culling_redundancy = 0.9;
-  int culling_observers = 3;
-  bool cull_keyframes = true;
-  // Recent points: culled when found/visible < this ratio.
-  double min_found_ratio = 0.25;
-  // The keyframe queue's bound (backpressure, MappingBackend::QueueFull): tracking declines a
-  // keyframe while this many wait, and a keyframe it cannot decline (a new map's first two)
-  // waits for room. ORB-SLAM3's rule already keeps the queue at 3 or fewer (it declines while
-  // three wait, or while mapping is busy for monocular), so in ordinary runs the bound is
-  // never reached; it holds for every selector and for mapping held by loop closing too.
-  // At least 2: a map's initialisation inserts two keyframes at once.
-  int max_queued_keyframes = 8;
-  BundleAdjustmentOptions ba;
-  // Inertial sensors: IMU initialisation stages and local inertial BA.
-  InertialMappingOptions inertial;
-  // Online calibration (mapping/calibration_refinement.h); off by default.
-  OnlineCalibrationOptions calibration;
-
-  void Check() const;
-};
 
 struct LocalMappingStats {
   std::vector<double> keyframe_ms;  // processing time per keyframe
@@ -94,24 +64,6 @@ struct LocalMappingStats {
   int gravity_refinements_dropped = 0;  // results dropped: the map moved meanwhile
   std::vector<CalibrationRefinementStat> calibration_refinements;
 };
-
-// How live emulation measures local mapping's work on a keyframe.
-enum class LiveClock {
-  // Units of work priced by kReferenceWork (core/util/work_meter.h): the same emulated machine
-  // on every machine, loaded or not, fast or slow.
-  kWork,
-  // The mapping thread's CPU time: this machine, however loaded it is.
-  kCpu,
-  // Wall time: this machine under its present load.
-  kWall,
-};
-// "work", "cpu" or "wall"; nullopt for anything else.
-std::optional<LiveClock> ParseLiveClock(std::string_view name);
-
-// The work clock's prices: CPU seconds per unit of work of local mapping on the machine the
-// defaults were tuned on (2 cores, 2026-11; fitted to per-keyframe CPU times by
-// evaluation/studies/coupling/fit_work_model.py, docs/speed.md "One core or two").
-extern const WorkModel kReferenceWork;
 
 class LocalMapper : public MappingBackend {
  public:
@@ -142,7 +94,7 @@ class LocalMapper : public MappingBackend {
   void InterruptBundleAdjustment() override { abort_ba_.store(true); }
   void WaitUntilIdle() override;
   bool AcceptsKeyFramesAt(std::int64_t t_ns) override;
-  bool EmulatesLive() const override { return emulate_live_; }
+  bool EmulatesLive() const override { return live_.on; }
   void NoteFrameTime(std::int64_t t_ns) override;
   // Offline runs: emulate a live run's timing (AcceptsKeyFramesAt); set before Start().
   // `pace`: playback speed of the emulated live run (2: frames arrive twice as fast as their
@@ -168,8 +120,6 @@ class LocalMapper : public MappingBackend {
 
  private:
   void Run();
-  // Live emulation: data-clock nanoseconds spanned by `work_s` seconds of work (emulation clock).
-  std::int64_t DataNs(double work_s) const;
   bool HasQueued() const;
   // Live emulation on the work clock: blocks until tracking has reached the data time local
   // mapping's work has got to (or a stop, reset or finish is requested). Called by the mapping
@@ -181,20 +131,9 @@ class LocalMapper : public MappingBackend {
     PaceToTracker();
     calibrator_.ApplyDue();
   }
-  // Live emulation: the data time the current keyframe's processing has reached.
-  std::int64_t LiveReachedNs() const PKSLAM_REQUIRES(mutex_);
-  bool Paced() const { return emulate_live_ && live_clock_ == LiveClock::kWork; }
+  bool Paced() const { return live_.paced(); }
+  // Takes the oldest queued keyframe and runs the steps on it.
   void ProcessNext();
-  void ProcessNewKeyFrame(const KeyFramePtr& kf);
-  void CullRecentPoints(const KeyFramePtr& kf);
-  void CreateNewMapPoints(const KeyFramePtr& kf);
-  void SearchInNeighbours(const KeyFramePtr& kf);
-  void LocalBundleAdjustment(const KeyFramePtr& kf);
-  void CullKeyFrames(const KeyFramePtr& kf);
-
-  // Local inertial BA once the map's IMU is initialised (mapping/local_mapper_inertial.cc);
-  // false if it did not apply (then the visual local BA runs).
-  bool LocalInertialBundleAdjustment(const KeyFramePtr& kf);
 
   Atlas* atlas_;
   std::shared_ptr<const CameraRig> rig_;
@@ -209,28 +148,17 @@ class LocalMapper : public MappingBackend {
   // The thread runs (from Start until Run returns): an insert into a full queue waits for it.
   bool running_ PKSLAM_GUARDED_BY(mutex_) = false;
   bool busy_ PKSLAM_GUARDED_BY(mutex_) = false;
-  // Live emulation: the switch and pace are set before Start() and read-only afterwards; the
-  // data-clock time at which the last finished keyframe's processing ends, and the data-clock
-  // start and emulation-clock start of the current one, are guarded.
-  bool emulate_live_ = false;
-  double live_pace_ = 1.0;
-  std::int64_t live_free_ns_ PKSLAM_GUARDED_BY(mutex_) = std::numeric_limits<std::int64_t>::min();
-  std::int64_t live_job_start_ns_ PKSLAM_GUARDED_BY(mutex_) = 0;
-  LiveClock live_clock_ = LiveClock::kWork;
+  // Live emulation: the settings are set before Start() and read-only afterwards; the data
+  // clock (where the current and the last keyframe's processing fall, tracking's data time)
+  // is guarded.
+  LiveEmulation live_;
   // Local mapping's work so far: added to by the mapping thread (its solvers' callbacks
-  // included), read by tracking through LiveClockSeconds.
+  // included), read by tracking through the timeline's work clock.
   WorkMeter work_;
-  // The mapping thread's CPU clock (set by Run() before it takes a keyframe).
-  std::optional<clockid_t> mapping_cpu_clock_ PKSLAM_GUARDED_BY(mutex_);
-  // The emulation clock (mapping CPU or wall seconds) when the current keyframe was taken.
-  double live_job_clock_start_ PKSLAM_GUARDED_BY(mutex_) = 0;
-  // Paced emulation: the data time of the frame tracking processes (every earlier one done),
-  // and the condition local mapping waits on for it to grow.
-  std::int64_t tracker_ns_ PKSLAM_GUARDED_BY(mutex_) = std::numeric_limits<std::int64_t>::min();
+  LiveTimeline timeline_ PKSLAM_GUARDED_BY(mutex_);
+  // Paced emulation: the condition local mapping waits on for tracking's data time to grow.
   ConditionVariable paced_;
   int idle_waiters_ PKSLAM_GUARDED_BY(mutex_) = 0;  // threads in WaitUntilIdle
-  // Seconds on the emulation clock: priced work, the mapping thread's CPU time, or wall time.
-  double LiveClockSeconds() const PKSLAM_REQUIRES(mutex_);
   bool finish_requested_ PKSLAM_GUARDED_BY(mutex_) = false;
   bool stop_requested_ PKSLAM_GUARDED_BY(mutex_) = false;
   bool stopped_ PKSLAM_GUARDED_BY(mutex_) = false;
@@ -240,8 +168,8 @@ class LocalMapper : public MappingBackend {
   std::atomic<bool> accept_keyframes_{true};
   std::atomic<bool> abort_ba_{false};
 
-  // Owned by the mapping thread: points created recently, checked by CullRecentPoints.
-  RecentPoints recent_points_;
+  // The per-keyframe work (mapping/keyframe_steps.h), run by the mapping thread.
+  KeyFrameSteps steps_;
 
   // Online calibration's schedule and thread (mapping/online_calibrator.h), driven by the
   // mapping thread; Finish and the reset stop it.
