@@ -88,9 +88,6 @@ TwoViewKeyFrames CreateTwoViewMap(const MapWriteLock& lock, Atlas* atlas,
 // scale is fixed. Takes the Atlas locks itself.
 void RefineTwoViewMap(Atlas* atlas);
 
-// The fewest points the second keyframe of a two-view map must track for the map to be kept.
-constexpr int kMinTwoViewMapPoints = 50;
-
 // Makes the map's unit the first keyframe's median scene depth: the second keyframe, its frame
 // `second` and the points are scaled. Refused (nothing changes) when the map is unusable: no
 // positive median depth, or the second keyframe tracks fewer than `min_points` points.

@@ -14,6 +14,7 @@
 #include "map_model/map_point.h"
 #include "map_model/matching/matching_test_utils.h"
 #include "map_model/testing/synthetic_map.h"
+#include "tracking/tracking_options.h"
 
 namespace pkslam {
 namespace {
@@ -169,7 +170,8 @@ TEST_F(MapInitializerTest, ATwoViewMapIsRefinedAndScaledToAUnitMedianDepth) {
   EXPECT_GT(refused.median_depth, 0);
   EXPECT_TRUE(map.second->camera_from_world().translation().isApprox(before.translation()));
 
-  const TwoViewScaling scaling = NormaliseTwoViewScale(lock, map, kMinTwoViewMapPoints, &second);
+  const TwoViewScaling scaling =
+      NormaliseTwoViewScale(lock, map, TrackingOptions{}.min_two_view_map_points, &second);
   ASSERT_TRUE(scaling.accepted);
   EXPECT_NEAR(map.first->SceneDepthQuantile(0.5), 1.0, 1e-6);
   EXPECT_NEAR(map.second->camera_from_world().translation().norm(),

@@ -52,7 +52,8 @@ StartedMap MapStarter::StartFromTwoViews(const TwoViewResult& reconstruction, Fr
   StartedMap started;
   {
     auto lock = MapEditor(atlas_).Write(MapEdit::kInitialise);
-    const TwoViewScaling scaling = NormaliseTwoViewScale(lock, map, kMinTwoViewMapPoints, current);
+    const TwoViewScaling scaling =
+        NormaliseTwoViewScale(lock, map, options_.min_two_view_map_points, current);
     if (!scaling.accepted) {
       lock.unlock();
       PKSLAM_LOG_WARN("monocular initialisation rejected (median depth {:.3f}); retrying",

@@ -92,7 +92,7 @@ TEST_F(MapStarterTest, TwoMonocularViewsStartAMapWithThePairsFirstFrame) {
   EXPECT_EQ(started.first_of_pair->id(), 0);
   EXPECT_EQ(starter.pair_first(), nullptr) << "the pair is used up";
   EXPECT_EQ(attached_, 2);
-  EXPECT_GE(started.TrackedPoints(), kMinTwoViewMapPoints);
+  EXPECT_GE(started.TrackedPoints(), TrackingOptions{}.min_two_view_map_points);
   EXPECT_EQ(started.TrackedPoints(), atlas_.current_map()->NumMapPoints());
   EXPECT_EQ(local_map_.keyframes().size(), 2u);
   // Scaled to a unit median depth, and the frame sits where its keyframe is.
@@ -102,6 +102,30 @@ TEST_F(MapStarterTest, TwoMonocularViewsStartAMapWithThePairsFirstFrame) {
 
   starter.Reset();
   EXPECT_EQ(starter.pair_first(), nullptr);
+}
+
+// A pair that reconstructs but leaves the second keyframe fewer points than the options ask is
+// refused: no keyframes are handed back and the local map is not seeded; the two keyframes
+// stay in the map for the caller to reset it (the Tracker does, as ORB-SLAM3).
+TEST_F(MapStarterTest, ATwoViewMapWithTooFewPointsIsRefusedForTheCallerToReset) {
+  TrackingOptions options;
+  options.min_two_view_map_points = 100'000;
+  MapStarter starter(&atlas_, &vocabulary_, /*monocular=*/true, options);
+  Frame first = MakeSceneFrame(SE3d(), 0, /*stereo=*/false);
+  EXPECT_FALSE(starter.Offer(&first, CountAttach(), &local_map_).refused);
+  const SE3d camera2_from_camera1(SO3d::Exp(Eigen::Vector3d(0.0, 0.02, 0.0)),
+                                  Eigen::Vector3d(-0.4, 0.05, 0.0));
+  Frame second = MakeSceneFrame(camera2_from_camera1, 1, /*stereo=*/false);
+  const StartedMap refused = starter.Offer(&second, CountAttach(), &local_map_);
+  EXPECT_TRUE(refused.refused);
+  EXPECT_FALSE(refused.started());
+  EXPECT_FALSE(refused.first_of_pair.has_value());
+  EXPECT_TRUE(local_map_.keyframes().empty());
+  EXPECT_EQ(attached_, 2) << "the map was built before it was judged";
+  auto lock = MapReader(atlas_).Lock();
+  EXPECT_EQ(atlas_.current_map()->NumKeyFrames(), 2);
+  EXPECT_GE(atlas_.current_map()->NumMapPoints(), TrackingOptions{}.min_two_view_map_points)
+      << "the same pair is accepted with the default bound";
 }
 
 }  // namespace

@@ -9,6 +9,8 @@ void TrackingOptions::Check() const {
                       min_features_stereo_init);
   PKSLAM_CHECK_OPTION(min_depth_points_stereo_init > 0, "Tracking.min_depth_points_stereo_init",
                       "{}", min_depth_points_stereo_init);
+  PKSLAM_CHECK_OPTION(min_two_view_map_points > 0, "Tracking.min_two_view_map_points", "{}",
+                      min_two_view_map_points);
   PKSLAM_CHECK_OPTION(starving_inliers >= 0 && starving_ratio >= 0 && starving_ratio < 1,
                       "Tracking.starving", "{} / {}", starving_inliers, starving_ratio);
   PKSLAM_CHECK_OPTION(max_local_keyframes > 0, "Tracking.max_local_keyframes", "{}",

@@ -15,6 +15,9 @@ struct TrackingOptions {
   // frames as tracked while it wrote an empty trajectory. (ORB-SLAM3 checks the feature count
   // only.)
   int min_depth_points_stereo_init = 50;
+  // Monocular: the fewest points the second keyframe of a two-view map must track after its
+  // refinement for the map to be kept (ORB-SLAM3: 50); a map below it is refused and reset.
+  int min_two_view_map_points = 50;
   // Stereo/RGB-D initialisation creates points for keypoints closer than this many
   // th_depth... ORB-SLAM uses every keypoint with positive depth; kept as a switch.
   bool init_only_close_points = false;

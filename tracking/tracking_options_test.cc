@@ -25,6 +25,9 @@ TEST(TrackingOptions, CheckNamesTheBadOption) {
   bad.starving_ratio = 1.0;
   EXPECT_THROW(bad.Check(), OptionError);
   bad = TrackingOptions();
+  bad.min_two_view_map_points = 0;
+  EXPECT_THROW(bad.Check(), OptionError);
+  bad = TrackingOptions();
   bad.pose.rounds = 0;
   EXPECT_THROW(bad.Check(), OptionError) << "the pose optimiser's options are checked too";
 }
