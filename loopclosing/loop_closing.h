@@ -160,9 +160,10 @@ class LoopClosing {
   Map* MergeMaps(const CommonRegion& region, LoopEvent* event);
   // Moves the query's points onto the matched side (the query's matches and a projection of
   // the window points into every keyframe of `neighbourhood`, posed by `camera_from_world`),
-  // updates their connections and returns the links that are new. Exclusive lock.
+  // updates their connections and returns the links that are new.
   std::map<KeyFrameId, std::vector<KeyFrameId>> FuseRegion(
-      const CommonRegion& region, const std::vector<KeyFrame*>& neighbourhood,
+      const MapWriteLock& lock, const CommonRegion& region,
+      const std::vector<KeyFrame*>& neighbourhood,
       const std::map<KeyFrameId, Sim3d>& camera_from_world);
   // Global BA of `map` (inline or in its own thread); stops a running one first. The time is
   // written into the event stats_.loops/merges[index].

@@ -96,7 +96,8 @@ bool LoopClosing::AcceptsLoopCorrection(const CommonRegion& region) const {
 }
 
 std::map<KeyFrameId, std::vector<KeyFrameId>> LoopClosing::FuseRegion(
-    const CommonRegion& region, const std::vector<KeyFrame*>& neighbourhood,
+    const MapWriteLock& lock, const CommonRegion& region,
+    const std::vector<KeyFrame*>& neighbourhood,
     const std::map<KeyFrameId, Sim3d>& camera_from_world) {
   std::map<KeyFrameId, std::set<KeyFrameId>> before;
   std::set<KeyFrameId> in_neighbourhood;
@@ -112,7 +113,7 @@ std::map<KeyFrameId, std::vector<KeyFrameId>> LoopClosing::FuseRegion(
     if (!other) continue;
     const MapPointPtr mine = query->map_point(i);
     if (mine && !mine->IsBad()) {
-      if (mine != other) mine->Replace(other);
+      if (mine != other) mine->Replace(lock, other);
     } else if (!other->IsInKeyFrame(query)) {
       query->AddMapPoint(other, i);
       other->AddObservation(query, i);
@@ -130,10 +131,10 @@ std::map<KeyFrameId, std::vector<KeyFrameId>> LoopClosing::FuseRegion(
   for (KeyFrame* kf : neighbourhood) {
     if (kf->IsBad()) continue;
     std::vector<MapPointPtr> replace;
-    matcher.Fuse(kf, camera_from_world.at(kf->id()), others, options_.fuse_radius, &replace);
+    matcher.Fuse(lock, kf, camera_from_world.at(kf->id()), others, options_.fuse_radius, &replace);
     for (std::size_t i = 0; i < others.size(); ++i) {
       if (replace[i] && !replace[i]->IsBad() && !others[i]->IsBad() && replace[i] != others[i]) {
-        replace[i]->Replace(others[i]);
+        replace[i]->Replace(lock, others[i]);
       }
     }
   }
@@ -206,7 +207,7 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
     event->correction_m = (query->CameraCenter() - query_centre_before).norm();
 
     correction.loop_connections =
-        FuseRegion(region, neighbourhood, correction.corrected_camera_from_world);
+        FuseRegion(lock, region, neighbourhood, correction.corrected_camera_from_world);
 
     EssentialGraphOptions graph;
     graph.dof = GraphDof(*map);
@@ -312,7 +313,7 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
       correction.non_corrected_camera_from_world[kf->id()] = pose;
     }
     correction.loop_connections =
-        FuseRegion(region, neighbourhood, correction.corrected_camera_from_world);
+        FuseRegion(lock, region, neighbourhood, correction.corrected_camera_from_world);
     EssentialGraphOptions graph;
     graph.dof = four_dof ? PoseGraphDof::kYawTranslation
                          : (options_.verifier.fix_scale ? PoseGraphDof::kSE3 : PoseGraphDof::kSim3);

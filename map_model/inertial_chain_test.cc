@@ -66,7 +66,7 @@ TEST_F(InertialChainTest, SpliceOutMergesTheIntervalAndDropsThePrior) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Link(lock, 4);
   kf(2)->mutable_imu(lock).prior = InertialStatePrior();
-  kf(2)->SetBad();
+  kf(2)->SetBad(lock);
   chain().SpliceOut(lock, kf(2));
   EXPECT_EQ(kf(1)->imu().next(), kf(3));
   EXPECT_EQ(kf(3)->imu().previous(), kf(1));

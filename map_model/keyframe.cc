@@ -232,11 +232,12 @@ void KeyFrame::AddLoopEdge(KeyFrame* kf) {
 
 void KeyFrame::SetNotErase() { not_erase_ = true; }
 
-bool KeyFrame::SetErase() {
+bool KeyFrame::SetErase(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "KeyFrame::SetErase");
   if (!loop_edges_.empty()) return false;  // loop keyframes stay for the essential graph
   not_erase_ = false;
   if (to_be_erased_) {
-    SetBad();
+    SetBad(lock);
     return true;
   }
   return false;
@@ -248,7 +249,8 @@ KeyFrameImu& KeyFrame::mutable_imu(const MapWriteLock& lock) {
   return imu_;
 }
 
-void KeyFrame::SetBad() {
+void KeyFrame::SetBad(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "KeyFrame::SetBad");
   if (bad_) return;
   if (map_ != nullptr && map_->origin() == this) return;
   if (not_erase_) {

@@ -115,10 +115,12 @@ class KeyFrame {
   // Loop closing protects keyframes it is working on; a retire request is then deferred.
   void SetNotErase();
   // Lifts the protection; retires the keyframe if a retire request was deferred (returns true).
-  bool SetErase();
+  // Throws without the write lock.
+  bool SetErase(const MapWriteLock& lock);
   // Retires the keyframe (see docs/architecture.md): leaves the graph and the live set, keeps
-  // its pose relative to its parent. The map's first keyframe is never retired.
-  void SetBad();
+  // its pose relative to its parent. The map's first keyframe is never retired. Throws without
+  // the write lock.
+  void SetBad(const MapWriteLock& lock);
   bool IsBad() const { return bad_; }
   // For a retired keyframe: camera_from_parent at retirement.
   const SE3d& camera_from_parent() const { return camera_from_parent_; }

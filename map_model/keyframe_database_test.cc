@@ -131,7 +131,7 @@ TEST_F(KeyFrameDatabaseTest, EraseWorksAfterRetirementAndClearIsPerMap) {
 
   // Retire keyframe 12: its BoW is released, erasing must still unlink it everywhere.
   KeyFrame* retired = a[12].get();
-  retired->SetBad();
+  retired->SetBad(lock);
   ASSERT_TRUE(retired->IsBad());
   ASSERT_TRUE(retired->bow().empty());
   db.Erase(retired);

@@ -66,7 +66,7 @@ TEST_F(MapModelTest, RetiringAKeyFrameReparentsChildrenAndKeepsItsRelativePose) 
   const auto children = victim->children();
   KeyFrame* parent = victim->parent();
   const SE3d expected_relative = victim->camera_from_world() * parent->world_from_camera();
-  victim->SetBad();
+  victim->SetBad(lock);
   EXPECT_TRUE(victim->IsBad());
   EXPECT_EQ(map->keyframes().count(victim->id()), 0u);
   EXPECT_EQ(map->retired_keyframes().count(victim->id()), 1u);
@@ -85,7 +85,7 @@ TEST_F(MapModelTest, RetiringAKeyFrameReparentsChildrenAndKeepsItsRelativePose) 
 
 TEST_F(MapModelTest, OriginIsNeverRetired) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  map_.keyframes[0]->SetBad();
+  map_.keyframes[0]->SetBad(lock);
   EXPECT_FALSE(map_.keyframes[0]->IsBad());
 }
 
@@ -93,9 +93,9 @@ TEST_F(MapModelTest, NotEraseDefersRetirement) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   KeyFrame* kf = map_.keyframes[3].get();
   kf->SetNotErase();
-  kf->SetBad();
+  kf->SetBad(lock);
   EXPECT_FALSE(kf->IsBad());
-  EXPECT_TRUE(kf->SetErase());
+  EXPECT_TRUE(kf->SetErase(lock));
   EXPECT_TRUE(kf->IsBad());
 }
 
@@ -126,6 +126,34 @@ TEST_F(MapModelTest, ErasingObservationsMakesAPointBadAtTwoUnits) {
   for (const auto& mp : remaining->map_points()) EXPECT_NE(mp, target);
 }
 
+// Retiring and fusing change the graph every thread reads: without the write lock they throw
+// and leave the map as it was.
+TEST_F(MapModelTest, RetiringAndFusingRefuseToRunWithoutTheWriteLock) {
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  KeyFrame* kf = map_.keyframes[3].get();
+  MapPointPtr a, b;
+  for (const auto& mp : map_.point_of_scene_index) {
+    if (!mp) continue;
+    (a ? b : a) = mp;
+    if (b) break;
+  }
+  ASSERT_TRUE(a && b);
+  const int points = atlas_.current_map()->NumMapPoints();
+  lock.unlock();
+  EXPECT_THROW(kf->SetBad(lock), Error);
+  EXPECT_THROW(kf->SetErase(lock), Error);
+  EXPECT_THROW(a->SetBad(lock), Error);
+  EXPECT_THROW(b->Replace(lock, a), Error);
+  lock.lock();
+  EXPECT_FALSE(kf->IsBad());
+  EXPECT_FALSE(a->IsBad());
+  EXPECT_FALSE(b->IsBad());
+  EXPECT_EQ(atlas_.current_map()->NumMapPoints(), points);
+  a->SetBad(lock);
+  EXPECT_TRUE(a->IsBad());
+  EXPECT_EQ(atlas_.current_map()->NumMapPoints(), points - 1);
+}
+
 TEST_F(MapModelTest, ReplaceMovesObservationsToTheSurvivor) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   Map* map = atlas_.current_map();
@@ -141,7 +169,7 @@ TEST_F(MapModelTest, ReplaceMovesObservationsToTheSurvivor) {
   }
   ASSERT_TRUE(a && b);
   const auto a_obs = a->observations();
-  b->Replace(a);
+  b->Replace(lock, a);
   EXPECT_TRUE(b->IsBad());
   EXPECT_EQ(b->replaced_by(), a);
   EXPECT_EQ(map->map_points().count(b->id()), 0u);
@@ -247,10 +275,10 @@ TEST_F(MapModelTest, APointIsBornSeenByItsKeyframesWithADescriptorAndADepthRange
   KeyFrame* b = map_.keyframes[1].get();
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   // A keypoint slot freed in each keyframe (their points retired).
-  const auto free_slot = [](KeyFrame* kf) {
+  const auto free_slot = [&lock](KeyFrame* kf) {
     for (int i = 0; i < static_cast<int>(kf->map_points().size()); ++i) {
       if (kf->map_point(i)) {
-        kf->map_point(i)->SetBad();
+        kf->map_point(i)->SetBad(lock);
         return i;
       }
     }

@@ -6,6 +6,7 @@
 
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
+#include "map_model/map_editor.h"
 
 namespace pkslam {
 
@@ -40,7 +41,7 @@ bool MapPoint::EraseObservation(KeyFrame* kf) {
   }
   // Fewer than three observation units cannot constrain the point any more.
   if (num_obs_ <= 2) {
-    SetBad();
+    Retire();
     return true;
   }
   return false;
@@ -53,7 +54,12 @@ int MapPoint::IndexInKeyFrame(const KeyFrame* kf) const {
   return it == observations_.end() ? -1 : it->second.index;
 }
 
-void MapPoint::SetBad() {
+void MapPoint::SetBad(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "MapPoint::SetBad");
+  Retire();
+}
+
+void MapPoint::Retire() {
   if (bad_) return;
   const MapPointPtr keep_alive = shared_from_this();
   bad_ = true;
@@ -64,7 +70,8 @@ void MapPoint::SetBad() {
   if (map_ != nullptr) map_->EraseMapPoint(this);
 }
 
-void MapPoint::Replace(const MapPointPtr& other) {
+void MapPoint::Replace(const MapWriteLock& lock, const MapPointPtr& other) {
+  RequireWriteLock(lock, "MapPoint::Replace");
   if (other.get() == this || bad_) return;
   const MapPointPtr keep_alive = shared_from_this();
   const auto observations = std::move(observations_);

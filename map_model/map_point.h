@@ -18,6 +18,8 @@
 
 namespace pkslam {
 
+class MapWriteLock;
+
 class MapPoint : public std::enable_shared_from_this<MapPoint> {
  public:
   MapPoint(MapPointId id, const Eigen::Vector3d& position_world, KeyFrame* reference_kf, Map* map);
@@ -58,12 +60,14 @@ class MapPoint : public std::enable_shared_from_this<MapPoint> {
 
   KeyFrame* reference_keyframe() const { return reference_kf_; }
 
-  // Marks the point bad and removes it from all observing keyframes and from its map.
-  // Must be owned by a MapPointPtr (the call keeps itself alive while unlinking).
-  void SetBad();
+  // Marks the point bad and removes it from all observing keyframes and from its map; throws
+  // without the write lock. Must be owned by a MapPointPtr (the call keeps itself alive while
+  // unlinking).
+  void SetBad(const MapWriteLock& lock);
   bool IsBad() const { return bad_; }
-  // Fuse: moves all observations to `other` (which survives) and marks this one bad.
-  void Replace(const MapPointPtr& other);
+  // Fuse: moves all observations to `other` (which survives) and marks this one bad; throws
+  // without the write lock.
+  void Replace(const MapWriteLock& lock, const MapPointPtr& other);
   // The point this one was fused into (follow the chain), or nullptr.
   MapPointPtr replaced_by() const { return replaced_by_; }
 
@@ -83,6 +87,10 @@ class MapPoint : public std::enable_shared_from_this<MapPoint> {
 
  private:
   friend class AtlasStorage;  // map files: map_model/storage/atlas_storage.h
+  // SetBad's work; EraseObservation retires a point left with too few observations under its
+  // caller's lock.
+  void Retire();
+
   MapPointId id_;
   KeyFrameId first_kf_id_;
   Map* map_;

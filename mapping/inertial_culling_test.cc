@@ -45,7 +45,7 @@ class InertialCullingTest : public ::testing::Test {
   }
   KeyFrame* kf(int k) { return map_.keyframes[k].get(); }
   void Retire(const MapWriteLock& lock, int k) {
-    kf(k)->SetBad();
+    kf(k)->SetBad(lock);
     ASSERT_TRUE(kf(k)->IsBad());
     map_.keyframes[0]->map()->inertial_chain().SpliceOut(lock, kf(k));
   }
@@ -129,8 +129,8 @@ TEST_F(InertialCullingTest, TimeSpacingDecidesWhichRedundantKeyFramesMayGo) {
 
 TEST_F(InertialCullingTest, RepairSplicesKeyFramesRetiredWithoutSplicing) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  kf(15)->SetBad();
-  kf(16)->SetBad();
+  kf(15)->SetBad(lock);
+  kf(16)->SetBad(lock);
   ASSERT_EQ(kf(17)->imu().previous(), kf(16));
   EXPECT_EQ(RepairInertialChain(lock, kf(29), 42), 2);
   EXPECT_EQ(kf(17)->imu().previous(), kf(14));

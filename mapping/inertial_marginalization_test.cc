@@ -122,7 +122,7 @@ TEST_F(MarginalizationMapTest, CulledKeyFrameDropsItsPrior) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   GiveAnchorPrior(lock, 1e4);
   KeyFrame* k = anchor();
-  k->SetBad();
+  k->SetBad(lock);
   map()->inertial_chain().SpliceOut(lock, k);
   EXPECT_FALSE(k->imu().prior.has_value());
 }

@@ -85,7 +85,7 @@ TEST_F(KeyFrameAdmissionTest, ARetiredKeyframeIsLeftAloneAndTheLockIsRequired) {
   lock.unlock();
   EXPECT_THROW(AdmitKeyFrame(lock, &atlas_, keyframe_.get()), Error);
   lock.lock();
-  keyframe_->SetBad();
+  keyframe_->SetBad(lock);
   EXPECT_TRUE(AdmitKeyFrame(lock, &atlas_, keyframe_.get()).empty());
   EXPECT_FALSE(map_.point_of_scene_index[0] &&
                map_.point_of_scene_index[0]->IsInKeyFrame(keyframe_.get()));

@@ -55,7 +55,7 @@ int CullRedundantKeyFrames(const MapWriteLock& lock, KeyFrame* newest,
     }
     if (inertial != nullptr && !InertialCullingAllowed(*candidate, context, *inertial)) continue;
     if (!IsRedundant(*candidate, input.redundancy)) continue;
-    candidate->SetBad();
+    candidate->SetBad(lock);
     if (!candidate->IsBad()) continue;  // protected by loop closing for now
     if (inertial != nullptr) candidate->map()->inertial_chain().SpliceOut(lock, candidate);
     ++culled;

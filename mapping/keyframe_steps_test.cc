@@ -26,7 +26,7 @@ class KeyFrameStepsTest : public ::testing::Test {
     auto lock = MapEditor(&fixture_.atlas).Write(MapEdit::kFixture);
     for (std::size_t s = 0; s < fixture_.map.point_of_scene_index.size(); s += 2) {
       if (!fixture_.map.point_of_scene_index[s]) continue;
-      fixture_.map.point_of_scene_index[s]->SetBad();
+      fixture_.map.point_of_scene_index[s]->SetBad(lock);
       ++dropped_;
     }
     for (const KeyFramePtr& kf : fixture_.map.keyframes) kf->UpdateConnections();

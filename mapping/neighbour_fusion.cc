@@ -32,7 +32,7 @@ int FuseWithNeighbours(const MapWriteLock& lock, KeyFrame* keyframe,
   const OrbMatcher matcher;
   // Our points into the neighbours...
   const std::vector<MapPointPtr> ours = keyframe->GoodMapPoints();
-  for (KeyFrame* target : targets) matcher.Fuse(target, ours);
+  for (KeyFrame* target : targets) matcher.Fuse(lock, target, ours);
   // ...and the neighbours' points into us.
   std::vector<MapPointPtr> candidates;
   std::unordered_set<MapPointId> seen;
@@ -43,7 +43,7 @@ int FuseWithNeighbours(const MapWriteLock& lock, KeyFrame* keyframe,
       candidates.push_back(mp);
     }
   }
-  matcher.Fuse(keyframe, candidates);
+  matcher.Fuse(lock, keyframe, candidates);
   if (options.work != nullptr) {
     options.work->Add(WorkKind::kFuseProjection,
                       static_cast<std::int64_t>(ours.size() * targets.size() + candidates.size()));

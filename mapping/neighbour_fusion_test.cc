@@ -83,7 +83,7 @@ TEST_F(NeighbourFusionTest, ARetiredKeyframeFusesNothingAndTheLockIsRequired) {
   lock.unlock();
   EXPECT_THROW(FuseWithNeighbours(lock, kf, {}), Error);
   lock.lock();
-  kf->SetBad();
+  kf->SetBad(lock);
   EXPECT_EQ(FuseWithNeighbours(lock, kf, {}), 0);
   for (const Duplicate& d : pairs_) EXPECT_FALSE(d.original->IsBad());
 }

@@ -31,7 +31,7 @@ class NeighbourTriangulationTest : public ::testing::Test {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (std::size_t s = 0; s < map_.point_of_scene_index.size(); s += 2) {
       if (!map_.point_of_scene_index[s]) continue;
-      map_.point_of_scene_index[s]->SetBad();
+      map_.point_of_scene_index[s]->SetBad(lock);
       ++dropped_;
     }
     for (const KeyFramePtr& kf : map_.keyframes) kf->UpdateConnections();

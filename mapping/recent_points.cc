@@ -13,12 +13,12 @@ int RecentPoints::Cull(const MapWriteLock& lock, KeyFrameId newest, const Recent
     if (mp->IsBad()) return true;
     const KeyFrameId age = newest - mp->first_keyframe_id();
     if (mp->FoundRatio() < rule.min_found_ratio) {
-      mp->SetBad();
+      mp->SetBad(lock);
       ++culled;
       return true;
     }
     if (age >= 2 && mp->NumObservations() <= rule.min_observations) {
-      mp->SetBad();
+      mp->SetBad(lock);
       ++culled;
       return true;
     }

@@ -24,7 +24,7 @@ class RecentPointsTest : public ::testing::Test {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     int freed = 0;
     for (const MapPointPtr& mp : map_.point_of_scene_index) {
-      if (mp && freed++ < 60) mp->SetBad();
+      if (mp && freed++ < 60) mp->SetBad(lock);
     }
   }
   // A new point created at keyframe `first`, observed by keyframes first..first+observers-1
@@ -100,7 +100,7 @@ TEST_F(RecentPointsTest, PointsRetiredElsewhereLeaveUncountedAndTheLockIsRequire
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   const MapPointPtr fused = NewPoint(lock, 0, 1);
   recent_.Watch(fused);
-  fused->SetBad();  // e.g. fused into another point
+  fused->SetBad(lock);  // e.g. fused into another point
   EXPECT_EQ(recent_.Cull(lock, Id(4), rule_), 0);
   EXPECT_EQ(recent_.size(), 0u);
   recent_.Watch(NewPoint(lock, 0, 1));

@@ -162,8 +162,8 @@ TEST_F(FrameTrackingTest, MatchesFollowFusedPointsAndForgetPointsOutsideTheMap) 
   const MapPointPtr middle = frame.map_points[matched[1]];
   const MapPointPtr survivor = frame.map_points[matched[2]];
   auto lock = MapEditor(&bow_.atlas).Write(MapEdit::kFixture);
-  fused->Replace(middle);
-  middle->Replace(survivor);
+  fused->Replace(lock, middle);
+  middle->Replace(lock, survivor);
   FollowReplacedPoints(&frame);
   EXPECT_EQ(frame.map_points[matched[0]], survivor);
   EXPECT_EQ(frame.map_points[matched[1]], survivor);

@@ -128,7 +128,7 @@ TEST_F(LocalMapTest, DropsMatchesToRetiredPointsAndKeepsTheLastKeyframesWithoutM
   ASSERT_GE(retired_slot, 0);
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    frame.map_points[retired_slot]->SetBad();
+    frame.map_points[retired_slot]->SetBad(lock);
   }
   auto lock = MapReader(atlas_).Lock();
   LocalMap local(80);

@@ -325,7 +325,7 @@ TEST_F(BundleAdjustmentTest, ApplyWritesFreeEntitiesAndSkipsBadOnes) {
   // Between Solve and Apply, local mapping culled a point and a keyframe.
   const MapPointPtr culled = PointOf(problem.points[3]);
   const Eigen::Vector3d culled_position = culled->position();
-  culled->SetBad();
+  culled->SetBad(lock);
   int retired = -1;
   for (std::size_t i = 1; i < problem.keyframes.size(); ++i) {
     if (!problem.keyframes[i].fixed) {
@@ -336,7 +336,7 @@ TEST_F(BundleAdjustmentTest, ApplyWritesFreeEntitiesAndSkipsBadOnes) {
   ASSERT_GT(retired, 0);
   const KeyFramePtr retired_kf =
       atlas_.current_map()->KeyFrameById(problem.keyframes[retired].keyframe_id);
-  retired_kf->SetBad();  // leaves the map's live keyframes
+  retired_kf->SetBad(lock);  // leaves the map's live keyframes
   EXPECT_EQ(KeyFrameOf(problem.keyframes[retired]), nullptr);
   const SE3d retired_pose = retired_kf->camera_from_world();
   ApplyBundle(lock, atlas_.current_map(), problem, r);

@@ -1,7 +1,7 @@
 // Descriptor matching primitives of the ORB-SLAM family: search by projection, by BoW node,
 // for triangulation (epipolar), for initialisation (window), fusion of duplicates, and Sim3
 // guided search. All functions read the map model and therefore need the Atlas mutex held
-// (shared) by the caller, except Fuse, which changes the map (exclusive).
+// (shared) by the caller, except Fuse, which changes the map and takes the write lock.
 #pragma once
 
 #include <Eigen/Core>
@@ -15,6 +15,8 @@
 #include "map_model/map_ids.h"
 
 namespace pkslam {
+
+class MapWriteLock;
 
 // ORB-SLAM's thresholds on 256-bit Hamming distances.
 inline constexpr int kOrbThHigh = 100;
@@ -98,14 +100,16 @@ class OrbMatcher {
 
   // Fusion: projects `points` into `keyframe`; a match to an occupied slot fuses the two map
   // points (the one with more observations survives), to an empty slot adds an observation.
-  // Requires the exclusive lock. Returns the number of fused/added points.
-  int Fuse(KeyFrame* keyframe, const std::vector<MapPointPtr>& points, double th = 3.0) const;
+  // Throws without the write lock. Returns the number of fused/added points.
+  int Fuse(const MapWriteLock& lock, KeyFrame* keyframe, const std::vector<MapPointPtr>& points,
+           double th = 3.0) const;
 
   // Loop fusion with a Sim3 camera_from_world: returns, per point, the keyframe's point it
-  // should be replaced by (or nullptr); adds observations for empty slots. Exclusive lock.
+  // should be replaced by (or nullptr); adds observations for empty slots. Throws without the
+  // write lock.
   // replace_with is reset to points.size() nullptrs unless it already has that size (then
   // entries are only overwritten where a replacement is found).
-  int Fuse(KeyFrame* keyframe, const Sim3d& camera_from_world,
+  int Fuse(const MapWriteLock& lock, KeyFrame* keyframe, const Sim3d& camera_from_world,
            const std::vector<MapPointPtr>& points, double th,
            std::vector<MapPointPtr>* replace_with) const;
 

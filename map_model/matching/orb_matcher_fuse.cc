@@ -5,6 +5,7 @@
 
 #include "core/util/error.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 #include "map_model/map_point.h"
 #include "map_model/matching/orb_matcher.h"
 #include "map_model/matching/orb_matcher_internal.h"
@@ -78,7 +79,9 @@ FuseCandidate FindFuseCandidate(const KeyFrame& keyframe, const PinholeView& vie
 
 }  // namespace
 
-int OrbMatcher::Fuse(KeyFrame* keyframe, const std::vector<MapPointPtr>& points, double th) const {
+int OrbMatcher::Fuse(const MapWriteLock& lock, KeyFrame* keyframe,
+                     const std::vector<MapPointPtr>& points, double th) const {
+  RequireWriteLock(lock, "OrbMatcher::Fuse");
   PKSLAM_CHECK(keyframe != nullptr, "null keyframe");
   const PinholeView view(keyframe->camera_from_world(), keyframe->rig());
   int fused = 0;
@@ -92,9 +95,9 @@ int OrbMatcher::Fuse(KeyFrame* keyframe, const std::vector<MapPointPtr>& points,
       if (!in_keyframe->IsBad()) {
         // The better-observed point survives and inherits the other's observations.
         if (in_keyframe->NumObservations() > point->NumObservations()) {
-          point->Replace(in_keyframe);
+          point->Replace(lock, in_keyframe);
         } else {
-          in_keyframe->Replace(point);
+          in_keyframe->Replace(lock, point);
         }
       }
     } else {
@@ -106,9 +109,10 @@ int OrbMatcher::Fuse(KeyFrame* keyframe, const std::vector<MapPointPtr>& points,
   return fused;
 }
 
-int OrbMatcher::Fuse(KeyFrame* keyframe, const Sim3d& camera_from_world,
+int OrbMatcher::Fuse(const MapWriteLock& lock, KeyFrame* keyframe, const Sim3d& camera_from_world,
                      const std::vector<MapPointPtr>& points, double th,
                      std::vector<MapPointPtr>* replace_with) const {
+  RequireWriteLock(lock, "OrbMatcher::Fuse");
   PKSLAM_CHECK(keyframe != nullptr && replace_with != nullptr, "null argument");
   if (replace_with->size() != points.size()) replace_with->assign(points.size(), nullptr);
   const PinholeView view(camera_from_world, keyframe->rig());

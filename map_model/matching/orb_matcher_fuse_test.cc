@@ -101,8 +101,8 @@ TEST_F(MatcherFuseTest, FuseMergesDuplicatesKeepingTheBetterObservedPoint) {
   std::vector<MapPointPtr> into_kf0(duplicates.begin(), duplicates.begin() + 30);
   std::vector<MapPointPtr> into_kf3(originals.begin() + 30, originals.end());
   const OrbMatcher matcher;
-  EXPECT_EQ(matcher.Fuse(kf0, into_kf0), 30);
-  EXPECT_EQ(matcher.Fuse(kf3, into_kf3), 30);
+  EXPECT_EQ(matcher.Fuse(lock, kf0, into_kf0), 30);
+  EXPECT_EQ(matcher.Fuse(lock, kf3, into_kf3), 30);
   for (std::size_t k = 0; k < originals.size(); ++k) {
     const MapPointPtr& p = originals[k];
     const MapPointPtr& d = duplicates[k];
@@ -146,15 +146,15 @@ TEST_F(MatcherFuseTest, FuseAddsMissingObservationsWithinTheReprojectionGate) {
     p->SetPosition(p->position() +
                    world_from_camera_rotation * Eigen::Vector3d(pixels * z / rig_->fx, 0, 0));
   }
-  EXPECT_EQ(matcher.Fuse(kf0, dropped), 0);
+  EXPECT_EQ(matcher.Fuse(lock, kf0, dropped), 0);
   for (std::size_t k = 0; k < dropped.size(); ++k) dropped[k]->SetPosition(positions[k]);
-  EXPECT_EQ(matcher.Fuse(kf0, dropped), 40);
+  EXPECT_EQ(matcher.Fuse(lock, kf0, dropped), 40);
   for (std::size_t k = 0; k < dropped.size(); ++k) {
     EXPECT_EQ(dropped[k]->IndexInKeyFrame(kf0), slots[k]);
     EXPECT_EQ(kf0->map_point(slots[k]), dropped[k]);
   }
   // Already observed: nothing to do.
-  EXPECT_EQ(matcher.Fuse(kf0, dropped), 0);
+  EXPECT_EQ(matcher.Fuse(lock, kf0, dropped), 0);
 }
 
 TEST_F(MatcherFuseTest, FuseIgnoresPointsWhoseDescriptorDiffers) {
@@ -175,7 +175,7 @@ TEST_F(MatcherFuseTest, FuseIgnoresPointsWhoseDescriptorDiffers) {
     impostors.push_back(q);
   }
   ASSERT_EQ(impostors.size(), 40u);
-  EXPECT_EQ(OrbMatcher().Fuse(kf0, impostors), 0);
+  EXPECT_EQ(OrbMatcher().Fuse(lock, kf0, impostors), 0);
   for (const auto& q : impostors) EXPECT_FALSE(q->IsInKeyFrame(kf0));
 }
 
@@ -229,7 +229,7 @@ TEST_F(MatcherFuseTest, LoopFuseWithSim3ReportsReplacementsAndFillsEmptySlots) {
   }
   const std::vector<MapPointPtr>& points_b = points_b_;
   std::vector<MapPointPtr> replace_with;
-  const int n = OrbMatcher().Fuse(kf, CameraFromWorldB(1), points_b, 4.0, &replace_with);
+  const int n = OrbMatcher().Fuse(lock, kf, CameraFromWorldB(1), points_b, 4.0, &replace_with);
   ASSERT_EQ(replace_with.size(), points_b.size());
   int replaced_correct = 0;
   int replaced_wrong = 0;

@@ -3,8 +3,9 @@
 
   check_live.py PKSLAM WORK
 
-Simulates a 16 s random flight, runs stereo SLAM on it at real-time pace with --live-view on a
-free port, and while it runs:
+Simulates a 40 s random flight, runs stereo SLAM on it at real-time pace with --live-view on a
+free port, and while it runs (headless Chromium with a software GPU takes 7-10 s per opening on
+a 2-core machine, so the flight outlasts both openings and the wait between them):
   - data.json answers, and its pose count grows between two requests 4 s apart;
   - frame.jpg is a JPEG of the camera's size, and the frame's tracked keypoints are sent;
   - the page, opened twice in headless Chromium 4 s apart, reports "drawn" without script errors
@@ -50,7 +51,7 @@ def main():
     os.makedirs(work, exist_ok=True)
     seq = os.path.join(work, "seq")
     subprocess.run([pkslam, "--log-level", "warn", "simulate", "--out", seq, "--motion", "medium",
-                    "--duration", "16", "--quality", "fast", "--quiet", "--no-cloud", "--seed",
+                    "--duration", "40", "--quality", "fast", "--quiet", "--no-cloud", "--seed",
                     "3"], check=True, capture_output=True)
     port = free_port()
     base = f"http://127.0.0.1:{port}/"
@@ -74,9 +75,9 @@ def main():
         first = page_status(base)
         poses_a = json.loads(get(base + "data.json"))["pose_count"]
         time.sleep(4)
-        second = page_status(base)
         later = json.loads(get(base + "data.json?since=%d" % poses_a))
         jpeg = get(base + "frame.jpg")
+        second = page_status(base)
         if later["pose_count"] <= poses_a:
             failures.append(f"data.json: {poses_a} poses, then {later['pose_count']} 4 s later")
         if len(later["poses"]) != 3 * (later["pose_count"] - poses_a):
