@@ -47,7 +47,7 @@ class RevisitTest : public ::testing::Test {
   void Finish(const std::vector<KeyFramePtr>& kfs) {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (const auto& kf : kfs) {
-      atlas_.database()->Add(kf.get());
+      atlas_.database()->Add(lock, kf.get());
       for (const auto& mp : kf->map_points()) {
         if (!mp) continue;
         mp->ComputeDistinctiveDescriptor();

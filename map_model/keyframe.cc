@@ -305,7 +305,7 @@ void KeyFrame::SetBad(const MapWriteLock& lock) {
   }
   bad_ = true;
   ReleaseFeatures();
-  if (map_ != nullptr) map_->RetireKeyFrame(this);
+  if (map_ != nullptr) map_->RetireKeyFrame(lock, this);
 }
 
 void KeyFrame::ReleaseFeatures() {

@@ -7,6 +7,7 @@
 #include "core/util/error.h"
 #include "map_model/frame.h"
 #include "map_model/keyframe.h"
+#include "map_model/map_editor.h"
 
 namespace pkslam {
 namespace {
@@ -32,13 +33,14 @@ KeyFrameDatabase::KeyFrameDatabase(const Vocabulary& vocabulary, KeyFrameDatabas
   options_.Check();
 }
 
-void KeyFrameDatabase::Add(KeyFrame* keyframe) {
+void KeyFrameDatabase::Add(const MapWriteLock& lock, KeyFrame* keyframe) {
+  RequireWriteLock(lock, "KeyFrameDatabase::Add");
   PKSLAM_CHECK(keyframe != nullptr, "null keyframe");
   for (const BowEntry& entry : keyframe->bow()) {
     PKSLAM_CHECK(entry.word_id < inverted_.size(), "keyframe {} has word {} >= word count {}",
                  keyframe->id(), entry.word_id, inverted_.size());
   }
-  Erase(keyframe);
+  Unindex(keyframe);
   std::vector<WordId> words;
   words.reserve(keyframe->bow().size());
   for (const BowEntry& entry : keyframe->bow()) {
@@ -48,7 +50,12 @@ void KeyFrameDatabase::Add(KeyFrame* keyframe) {
   words_of_[keyframe->id()] = {keyframe, std::move(words)};
 }
 
-void KeyFrameDatabase::Erase(const KeyFrame* keyframe) {
+void KeyFrameDatabase::Erase(const MapWriteLock& lock, const KeyFrame* keyframe) {
+  RequireWriteLock(lock, "KeyFrameDatabase::Erase");
+  Unindex(keyframe);
+}
+
+void KeyFrameDatabase::Unindex(const KeyFrame* keyframe) {
   auto it = words_of_.find(keyframe->id());
   if (it == words_of_.end() || it->second.first != keyframe) return;
   for (const WordId word : it->second.second) {
@@ -63,7 +70,7 @@ void KeyFrameDatabase::Clear(const Map* map) {
   for (const auto& [id, entry] : words_of_) {
     if (entry.first->map() == map) doomed.push_back(entry.first);
   }
-  for (const KeyFrame* kf : doomed) Erase(kf);
+  for (const KeyFrame* kf : doomed) Unindex(kf);
 }
 
 void KeyFrameDatabase::Clear() {

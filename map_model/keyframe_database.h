@@ -3,7 +3,8 @@
 // candidates for a frame, loop and merge candidates for a keyframe).
 //
 // Threading (docs/architecture.md): the database is part of the map model and is guarded by
-// the Atlas mutex. Add / Erase / Clear need the exclusive lock; the queries need the shared
+// the Atlas mutex. Add and Erase take the write lock and throw without it; Clear is called by a
+// map being cleared or destroyed, under its caller's exclusive lock; the queries need the shared
 // lock (they also read keyframes' BoW vectors, covisibility and maps). Queries keep all their
 // scratch state in locals, so several readers may query at once.
 //
@@ -24,6 +25,7 @@
 
 namespace pkslam {
 
+class MapWriteLock;
 class Vocabulary;
 
 struct KeyFrameDatabaseOptions {
@@ -60,11 +62,11 @@ class KeyFrameDatabase {
   KeyFrameDatabase& operator=(const KeyFrameDatabase&) = delete;
 
   // Indexes the keyframe under every word of its BoW vector (which must already be computed).
-  // Adding a keyframe twice re-indexes it. Exclusive lock.
-  void Add(KeyFrame* keyframe);
+  // Adding a keyframe twice re-indexes it.
+  void Add(const MapWriteLock& lock, KeyFrame* keyframe);
   // Removes the keyframe from the index (works after its features were released, because the
-  // database remembers the words it indexed). No-op for unknown keyframes. Exclusive lock.
-  void Erase(const KeyFrame* keyframe);
+  // database remembers the words it indexed). No-op for unknown keyframes.
+  void Erase(const MapWriteLock& lock, const KeyFrame* keyframe);
   // Removes every keyframe currently belonging to `map` (call before the map is cleared or
   // destroyed: the map's keyframes are recognised by KeyFrame::map()). Exclusive lock.
   void Clear(const Map* map);
@@ -96,6 +98,8 @@ class KeyFrameDatabase {
   LoopAndMergeCandidates DetectLoopAndMergeCandidates(const KeyFrame* keyframe, int n = 3) const;
 
  private:
+  // Erase's work (Clear's too).
+  void Unindex(const KeyFrame* keyframe);
   struct Scored {
     KeyFrame* keyframe;
     double score;

@@ -58,8 +58,8 @@ TEST_F(KeyFrameDatabaseTest, RelocalisationFindsTheKeyFramesOfThePlace) {
   const auto poses = Strip(-24.0, 1.2, 20);
   const auto kfs = AddKeyFrames(&atlas_, map_a_, scene_, rig_, poses, vocabulary_, 1);
   KeyFrameDatabase db(vocabulary_);
-  auto lock = MapReader(atlas_).Lock();
-  for (const auto& kf : kfs) db.Add(kf.get());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  for (const auto& kf : kfs) db.Add(lock, kf.get());
   ASSERT_EQ(db.size(), 20u);
 
   const Frame query =
@@ -91,9 +91,9 @@ TEST_F(KeyFrameDatabaseTest, LoopAndMergeCandidatesExcludeConnectedKeyFrames) {
   const auto other =
       AddKeyFrames(&atlas_, map_b_, scene_, rig_, Strip(-10.5, 1.2, 6, -0.1), vocabulary_, 200);
   KeyFrameDatabase db(vocabulary_);
-  auto lock = MapReader(atlas_).Lock();
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   for (const auto* list : {&first, &revisit, &other}) {
-    for (const auto& kf : *list) db.Add(kf.get());
+    for (const auto& kf : *list) db.Add(lock, kf.get());
   }
   const KeyFrame* query = revisit[3].get();  // at x = -6.4, i.e. first-pass keyframe ~14.7
   const auto result = db.DetectLoopAndMergeCandidates(query, 3);
@@ -125,8 +125,8 @@ TEST_F(KeyFrameDatabaseTest, EraseWorksAfterRetirementAndClearIsPerMap) {
   const auto b = AddKeyFrames(&atlas_, map_b_, scene_, rig_, Strip(-24.0, 1.2, 5), vocabulary_, 7);
   KeyFrameDatabase db(vocabulary_);
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  for (const auto& kf : a) db.Add(kf.get());
-  for (const auto& kf : b) db.Add(kf.get());
+  for (const auto& kf : a) db.Add(lock, kf.get());
+  for (const auto& kf : b) db.Add(lock, kf.get());
   EXPECT_EQ(db.size(), 25u);
 
   // Retire keyframe 12: its BoW is released, erasing must still unlink it everywhere.
@@ -134,14 +134,14 @@ TEST_F(KeyFrameDatabaseTest, EraseWorksAfterRetirementAndClearIsPerMap) {
   retired->SetBad(lock);
   ASSERT_TRUE(retired->IsBad());
   ASSERT_TRUE(retired->bow().empty());
-  db.Erase(retired);
+  db.Erase(lock, retired);
   EXPECT_FALSE(db.Contains(retired));
   EXPECT_EQ(db.size(), 24u);
   const Frame query = QueryFrame(SE3d(SO3d(), Eigen::Vector3d(-24.0 + 1.2 * 12, 0, 0)).Inverse());
   for (const auto& c : db.DetectRelocalisationCandidates(query, map_a_)) {
     EXPECT_NE(c.keyframe, retired);
   }
-  db.Erase(retired);  // unknown now: no-op
+  db.Erase(lock, retired);  // unknown now: no-op
   EXPECT_EQ(db.size(), 24u);
 
   db.Clear(map_b_);
@@ -159,9 +159,9 @@ TEST_F(KeyFrameDatabaseTest, ResultsDoNotDependOnInsertionOrder) {
       AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 20), vocabulary_, 1);
   KeyFrameDatabase forward(vocabulary_);
   KeyFrameDatabase backward(vocabulary_);
-  auto lock = MapReader(atlas_).Lock();
-  for (const auto& kf : kfs) forward.Add(kf.get());
-  for (auto it = kfs.rbegin(); it != kfs.rend(); ++it) backward.Add(it->get());
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  for (const auto& kf : kfs) forward.Add(lock, kf.get());
+  for (auto it = kfs.rbegin(); it != kfs.rend(); ++it) backward.Add(lock, it->get());
   for (int place : {3, 9, 15}) {
     const Frame query =
         QueryFrame(SE3d(SO3d(), Eigen::Vector3d(-24.0 + 1.2 * place + 0.3, 0, 0)).Inverse());
@@ -182,13 +182,27 @@ TEST_F(KeyFrameDatabaseTest, ResultsDoNotDependOnInsertionOrder) {
   }
 }
 
+TEST_F(KeyFrameDatabaseTest, AddAndEraseRefuseToRunWithoutTheWriteLock) {
+  const auto kfs =
+      AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 2), vocabulary_, 1);
+  KeyFrameDatabase db(vocabulary_);
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  db.Add(lock, kfs[0].get());
+  lock.unlock();
+  EXPECT_THROW(db.Add(lock, kfs[1].get()), Error);
+  EXPECT_THROW(db.Erase(lock, kfs[0].get()), Error);
+  EXPECT_EQ(db.size(), 1u);
+  EXPECT_TRUE(db.Contains(kfs[0].get()));
+  EXPECT_FALSE(db.Contains(kfs[1].get()));
+}
+
 TEST_F(KeyFrameDatabaseTest, RejectsWordsOutsideTheVocabularyAndBadOptions) {
   Vocabulary small = testing::MakeRandomVocabulary(2, 2, 3);  // 4 words
   const auto kfs =
       AddKeyFrames(&atlas_, map_a_, scene_, rig_, Strip(-24.0, 1.2, 2), vocabulary_, 1);
   KeyFrameDatabase db(small);
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-  EXPECT_THROW(db.Add(kfs[0].get()), Error);
+  EXPECT_THROW(db.Add(lock, kfs[0].get()), Error);
   KeyFrameDatabaseOptions options;
   options.min_common_words_ratio = 1.5;
   EXPECT_THROW(KeyFrameDatabase(vocabulary_, options), OptionError);

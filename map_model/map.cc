@@ -54,10 +54,10 @@ MapImuStatus& Map::mutable_imu_status(const MapWriteLock& lock) {
 
 void Map::EraseMapPoint(const MapPoint* point) { map_points_.erase(point->id()); }
 
-void Map::RetireKeyFrame(const KeyFrame* kf) {
+void Map::RetireKeyFrame(const MapWriteLock& lock, const KeyFrame* kf) {
   auto it = keyframes_.find(kf->id());
   if (it == keyframes_.end()) return;
-  if (database_ != nullptr) database_->Erase(kf);
+  if (database_ != nullptr) database_->Erase(lock, kf);
   retired_[kf->id()] = std::move(it->second);
   keyframes_.erase(it);
 }

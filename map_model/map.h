@@ -57,7 +57,7 @@ class Map {
   // Removes the point from the live set (callers mark it bad first).
   void EraseMapPoint(const MapPoint* point);
   // Moves a keyframe from the live set to the retired set (KeyFrame::SetBad calls this).
-  void RetireKeyFrame(const KeyFrame* kf);
+  void RetireKeyFrame(const MapWriteLock& lock, const KeyFrame* kf);
   // Moves a keyframe out of this map entirely (map merging); returns the owning pointer.
   KeyFramePtr TakeKeyFrame(const KeyFrame* kf);
   MapPointPtr TakeMapPoint(const MapPoint* point);

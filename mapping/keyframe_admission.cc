@@ -28,7 +28,7 @@ std::vector<MapPointPtr> AdmitKeyFrame(const MapWriteLock& lock, Atlas* atlas, K
   }
   keyframe->UpdateConnections();
   // Findable by relocalisation and place recognition from now on.
-  if (KeyFrameDatabase* database = atlas->database()) database->Add(keyframe);
+  if (KeyFrameDatabase* database = atlas->database()) database->Add(lock, keyframe);
   return created;
 }
 

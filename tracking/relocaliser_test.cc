@@ -19,8 +19,8 @@ class RelocaliserTest : public ::testing::Test {
  protected:
   void SetUp() override {
     database_ = std::make_unique<KeyFrameDatabase>(bow_.vocabulary);
-    auto lock = MapReader(bow_.atlas).Lock();
-    for (const KeyFramePtr& kf : bow_.map.keyframes) database_->Add(kf.get());
+    auto lock = MapEditor(&bow_.atlas).Write(MapEdit::kFixture);
+    for (const KeyFramePtr& kf : bow_.map.keyframes) database_->Add(lock, kf.get());
   }
   // A frame of `scene` near keyframe 2's pose (5 cm and 1 degree off), without a pose.
   Frame Query(const testing::SyntheticScene& scene) const {

@@ -37,8 +37,8 @@ void BM_KeyFrameDatabase_Relocalisation(benchmark::State& state) {
   const auto kfs =
       testing::AddKeyFrames(&atlas, map, scene, rig, testing::Strip(-290, 2.9, 200), vocabulary, 1);
   KeyFrameDatabase db(vocabulary);
-  auto lock = MapReader(atlas).Lock();
-  for (const auto& kf : kfs) db.Add(kf.get());
+  auto lock = MapEditor(&atlas).Write(MapEdit::kFixture);
+  for (const auto& kf : kfs) db.Add(lock, kf.get());
   testing::FrameOptions fo;
   fo.descriptor_bit_flips = 2;
   std::vector<int> unused;

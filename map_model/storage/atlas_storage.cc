@@ -239,7 +239,7 @@ void AtlasStorage::Restore(const MapWriteLock& lock, const AtlasRecord& record,
       }
       InertialChain::Restore(kf, keyframe(k.imu_previous, "the inertial chain"),
                              keyframe(k.imu_next, "the inertial chain"));
-      if (database != nullptr) database->Add(kf);
+      if (database != nullptr) database->Add(lock, kf);
     }
     map->origin_ = keyframe(m.origin, "the origin");
     map->max_kf_id_ = m.max_keyframe_id;
