@@ -116,7 +116,7 @@ std::map<KeyFrameId, std::vector<KeyFrameId>> LoopClosing::FuseRegion(
       if (mine != other) mine->Replace(lock, other);
     } else if (!other->IsInKeyFrame(query)) {
       query->AddMapPoint(other, i);
-      other->AddObservation(query, i);
+      other->AddObservation(lock, query, i);
       other->ComputeDistinctiveDescriptor();
     }
   }

@@ -261,7 +261,7 @@ void KeyFrame::SetBad(const MapWriteLock& lock) {
   for (std::size_t i = 0; i < map_points_.size(); ++i) {
     if (map_points_[i]) {
       const MapPointPtr mp = map_points_[i];  // EraseObservation may clear our slot
-      mp->EraseObservation(this);
+      mp->EraseObservation(lock, this);
     }
   }
   connections_.clear();

@@ -49,7 +49,7 @@ inline std::vector<KeyFramePtr> AddKeyFrames(Atlas* atlas, Map* map, const Synth
                                                kfs[k].get(), map);
         map->AddMapPoint(lock, points[p]);
       }
-      points[p]->AddObservation(kfs[k].get(), static_cast<int>(i));
+      points[p]->AddObservation(lock, kfs[k].get(), static_cast<int>(i));
       kfs[k]->AddMapPoint(points[p], static_cast<int>(i));
     }
   }

@@ -33,7 +33,7 @@ MapPointPtr Map::CreateMapPoint(const MapWriteLock& lock, MapPointId id,
   RequireWriteLock(lock, "Map::CreateMapPoint");
   auto point = std::make_shared<MapPoint>(id, position_world, reference, this);
   for (const MapPoint::Observation& o : observations) {
-    point->AddObservation(o.keyframe, o.index);
+    point->AddObservation(lock, o.keyframe, o.index);
     o.keyframe->AddMapPoint(point, o.index);
   }
   point->ComputeDistinctiveDescriptor();

@@ -112,10 +112,10 @@ TEST_F(MapModelTest, ErasingObservationsMakesAPointBadAtTwoUnits) {
   }
   ASSERT_TRUE(target);
   EXPECT_EQ(target->NumObservations(), 6);
-  auto erase_first = [&target]() {
+  auto erase_first = [&target, &lock]() {
     KeyFrame* kf = target->observations().begin()->second.keyframe;
     kf->EraseMapPointMatch(target->IndexInKeyFrame(kf));
-    return std::make_pair(kf, target->EraseObservation(kf));
+    return std::make_pair(kf, target->EraseObservation(lock, kf));
   };
   EXPECT_FALSE(erase_first().second);  // 4 units left
   EXPECT_EQ(target->NumObservations(), 4);
@@ -152,6 +152,36 @@ TEST_F(MapModelTest, RetiringAndFusingRefuseToRunWithoutTheWriteLock) {
   a->SetBad(lock);
   EXPECT_TRUE(a->IsBad());
   EXPECT_EQ(atlas_.current_map()->NumMapPoints(), points - 1);
+}
+
+TEST_F(MapModelTest, ObservationEditsRefuseToRunWithoutTheWriteLock) {
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  MapPointPtr point;
+  for (const auto& mp : map_.point_of_scene_index) {
+    // Seen by three keyframes with stereo depth (6 units), not by every keyframe.
+    if (mp && mp->observations().size() == 3 && map_.keyframes.size() > 3) {
+      point = mp;
+      break;
+    }
+  }
+  ASSERT_TRUE(point);
+  KeyFrame* observer = point->observations().begin()->second.keyframe;
+  KeyFrame* other = nullptr;
+  for (const auto& kf : map_.keyframes) {
+    if (!point->IsInKeyFrame(kf.get())) other = kf.get();
+  }
+  ASSERT_NE(other, nullptr);
+  const int units = point->NumObservations();
+  lock.unlock();
+  EXPECT_THROW(point->AddObservation(lock, other, 0), Error);
+  EXPECT_THROW(point->EraseObservation(lock, observer), Error);
+  lock.lock();
+  EXPECT_EQ(point->NumObservations(), units);
+  EXPECT_TRUE(point->IsInKeyFrame(observer));
+  EXPECT_FALSE(point->IsInKeyFrame(other));
+  EXPECT_FALSE(point->EraseObservation(lock, observer));  // 4 units left
+  EXPECT_FALSE(point->IsInKeyFrame(observer));
+  EXPECT_EQ(point->NumObservations(), units - 2);
 }
 
 TEST_F(MapModelTest, ReplaceMovesObservationsToTheSurvivor) {

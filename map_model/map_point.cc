@@ -25,13 +25,19 @@ MapPointPtr MapPoint::Temporary(const Eigen::Vector3d& position_world,
   return point;
 }
 
-void MapPoint::AddObservation(KeyFrame* kf, int index) {
+void MapPoint::AddObservation(const MapWriteLock& lock, KeyFrame* kf, int index) {
+  RequireWriteLock(lock, "MapPoint::AddObservation");
+  Observe(kf, index);
+}
+
+void MapPoint::Observe(KeyFrame* kf, int index) {
   auto [it, inserted] = observations_.try_emplace(kf->id(), Observation{kf, index});
   if (!inserted) return;
   num_obs_ += kf->HasDepth(index) ? 2 : 1;
 }
 
-bool MapPoint::EraseObservation(KeyFrame* kf) {
+bool MapPoint::EraseObservation(const MapWriteLock& lock, KeyFrame* kf) {
+  RequireWriteLock(lock, "MapPoint::EraseObservation");
   auto it = observations_.find(kf->id());
   if (it == observations_.end()) return false;
   num_obs_ -= kf->HasDepth(it->second.index) ? 2 : 1;
@@ -82,7 +88,7 @@ void MapPoint::Replace(const MapWriteLock& lock, const MapPointPtr& other) {
   for (const auto& [id, obs] : observations) {
     if (!other->IsInKeyFrame(obs.keyframe)) {
       obs.keyframe->ReplaceMapPointMatch(obs.index, other);
-      other->AddObservation(obs.keyframe, obs.index);
+      other->Observe(obs.keyframe, obs.index);
     } else {
       obs.keyframe->EraseMapPointMatch(obs.index);
     }

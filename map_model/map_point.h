@@ -52,9 +52,12 @@ class MapPoint : public std::enable_shared_from_this<MapPoint> {
   const std::map<KeyFrameId, Observation>& observations() const { return observations_; }
   // Stereo/RGB-D observations count twice (as in ORB-SLAM).
   int NumObservations() const { return num_obs_; }
-  void AddObservation(KeyFrame* kf, int index);
-  // Returns true if the point has become bad (fewer than 3 observation units left).
-  bool EraseObservation(KeyFrame* kf);
+  // Observation edits take the write lock and throw without it (the point's observations are
+  // read by tracking and loop closing under the shared lock).
+  void AddObservation(const MapWriteLock& lock, KeyFrame* kf, int index);
+  // Returns true if the point has become bad (fewer than 3 observation units left); the point
+  // is then retired from its keyframes and its map under the same lock.
+  bool EraseObservation(const MapWriteLock& lock, KeyFrame* kf);
   bool IsInKeyFrame(const KeyFrame* kf) const;
   int IndexInKeyFrame(const KeyFrame* kf) const;  // -1 if not observed there
 
@@ -87,8 +90,10 @@ class MapPoint : public std::enable_shared_from_this<MapPoint> {
 
  private:
   friend class AtlasStorage;  // map files: map_model/storage/atlas_storage.h
-  // SetBad's work; EraseObservation retires a point left with too few observations under its
-  // caller's lock.
+  // AddObservation's work once the lock is checked (Replace moves observations under the lock
+  // it checked).
+  void Observe(KeyFrame* kf, int index);
+  // SetBad's work; EraseObservation retires a point left with too few observations.
   void Retire();
 
   MapPointId id_;

@@ -19,7 +19,7 @@ std::vector<MapPointPtr> AdmitKeyFrame(const MapWriteLock& lock, Atlas* atlas, K
     if (!mp || mp->IsBad()) continue;
     if (!mp->IsInKeyFrame(keyframe)) {
       // A point tracked by the frame: the keyframe becomes one of its observers.
-      mp->AddObservation(keyframe, i);
+      mp->AddObservation(lock, keyframe, i);
       mp->UpdateNormalAndDepth();
       mp->ComputeDistinctiveDescriptor();
     } else {

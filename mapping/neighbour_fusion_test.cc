@@ -32,11 +32,11 @@ class NeighbourFusionTest : public ::testing::Test {
     for (int i = 0; i < static_cast<int>(kf->map_points().size()); ++i) {
       const MapPointPtr original = kf->map_point(i);
       if (!original || original->IsBad() || n++ % 5 != 0) continue;
-      original->EraseObservation(kf);
+      original->EraseObservation(lock, kf);
       kf->EraseMapPointMatch(i);
       auto copy =
           std::make_shared<MapPoint>(atlas_.NextMapPointId(), original->position(), kf, map);
-      copy->AddObservation(kf, i);
+      copy->AddObservation(lock, kf, i);
       kf->AddMapPoint(copy, i);
       copy->ComputeDistinctiveDescriptor();
       copy->UpdateNormalAndDepth();

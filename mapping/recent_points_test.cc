@@ -37,7 +37,7 @@ class RecentPointsTest : public ::testing::Test {
       KeyFrame* kf = map_.keyframes[k].get();
       for (int i = 0; i < static_cast<int>(kf->map_points().size()); ++i) {
         if (kf->map_point(i) || kf->right_u()[i] < 0) continue;
-        mp->AddObservation(kf, i);
+        mp->AddObservation(lock, kf, i);
         kf->AddMapPoint(mp, i);
         break;
       }

@@ -95,7 +95,7 @@ TEST_F(KeyFramePointsTest, MatchedPointsStayAndTemporaryOnesAreReplaced) {
   const Eigen::Vector3d somewhere(0, 0, 5);
   auto matched = std::make_shared<MapPoint>(atlas_.NextMapPointId(), somewhere, older.get(),
                                             atlas_.current_map());
-  matched->AddObservation(older.get(), order[0]);
+  matched->AddObservation(lock, older.get(), order[0]);
   frame_.map_points[order[0]] = matched;
   const MapPointPtr temporary = MapPoint::Temporary(somewhere, frame_.descriptors()[order[1]]);
   frame_.map_points[order[1]] = temporary;

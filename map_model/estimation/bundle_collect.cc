@@ -171,7 +171,7 @@ void ApplyBundle(const MapWriteLock& lock, Map* map, const BundleProblem& proble
     if (kf->map_point(obs.keypoint_index).get() == point) {
       kf->EraseMapPointMatch(obs.keypoint_index);
     }
-    point->EraseObservation(kf);  // may retire the point (too few observations left)
+    point->EraseObservation(lock, kf);  // may retire the point (too few observations left)
   }
   for (std::size_t i = 0; i < problem.keyframes.size(); ++i) {
     KeyFrame* kf = keyframes[i].get();

@@ -144,7 +144,7 @@ inline SyntheticMap MakeBowMap(Atlas* atlas, const SyntheticScene& scene,
         mp = std::make_shared<MapPoint>(atlas->NextMapPointId(), scene.points_world[p], kf, map);
         map->AddMapPoint(lock, mp);
       }
-      mp->AddObservation(kf, static_cast<int>(i));
+      mp->AddObservation(lock, kf, static_cast<int>(i));
       kf->AddMapPoint(mp, static_cast<int>(i));
     }
   }

@@ -101,7 +101,7 @@ int OrbMatcher::Fuse(const MapWriteLock& lock, KeyFrame* keyframe,
         }
       }
     } else {
-      point->AddObservation(keyframe, c.index);
+      point->AddObservation(lock, keyframe, c.index);
       keyframe->AddMapPoint(point, c.index);
     }
     ++fused;
@@ -134,7 +134,7 @@ int OrbMatcher::Fuse(const MapWriteLock& lock, KeyFrame* keyframe, const Sim3d& 
     if (in_keyframe) {
       if (!in_keyframe->IsBad()) (*replace_with)[i] = in_keyframe;
     } else {
-      point->AddObservation(keyframe, c.index);
+      point->AddObservation(lock, keyframe, c.index);
       keyframe->AddMapPoint(point, c.index);
     }
     ++fused;

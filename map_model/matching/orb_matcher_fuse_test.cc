@@ -83,12 +83,12 @@ TEST_F(MatcherFuseTest, FuseMergesDuplicatesKeepingTheBetterObservedPoint) {
   for (const auto& p : map_.point_of_scene_index) {
     if (!p || p->observations().size() < 4 || originals.size() == 60) continue;
     const int i3 = p->IndexInKeyFrame(kf3);
-    ASSERT_FALSE(p->EraseObservation(kf3));
+    ASSERT_FALSE(p->EraseObservation(lock, kf3));
     kf3->EraseMapPointMatch(i3);
     auto d = std::make_shared<MapPoint>(
         atlas_.NextMapPointId(), p->position() + Eigen::Vector3d(0.005, -0.003, 0.004), kf3, map);
     map->AddMapPoint(lock, d);
-    d->AddObservation(kf3, i3);
+    d->AddObservation(lock, kf3, i3);
     kf3->AddMapPoint(d, i3);
     d->ComputeDistinctiveDescriptor();
     d->UpdateNormalAndDepth();
@@ -127,7 +127,7 @@ TEST_F(MatcherFuseTest, FuseAddsMissingObservationsWithinTheReprojectionGate) {
       continue;
     }
     const int i0 = p->IndexInKeyFrame(kf0);
-    ASSERT_FALSE(p->EraseObservation(kf0));
+    ASSERT_FALSE(p->EraseObservation(lock, kf0));
     kf0->EraseMapPointMatch(i0);
     dropped.push_back(p);
     slots.push_back(i0);
@@ -169,7 +169,7 @@ TEST_F(MatcherFuseTest, FuseIgnoresPointsWhoseDescriptorDiffers) {
     if (!host || !host->IsInKeyFrame(kf0)) continue;
     const int other = (i + 1) % kf3->size();
     auto q = std::make_shared<MapPoint>(atlas_.NextMapPointId(), host->position(), kf3, map);
-    q->AddObservation(kf3, other);
+    q->AddObservation(lock, kf3, other);
     q->ComputeDistinctiveDescriptor();
     q->UpdateNormalAndDepth();
     impostors.push_back(q);
@@ -223,7 +223,7 @@ TEST_F(MatcherFuseTest, LoopFuseWithSim3ReportsReplacementsAndFillsEmptySlots) {
   for (int i = 0; i < kf->size() && emptied.size() < 30; i += 5) {
     const MapPointPtr p = kf->map_point(i);
     if (!p || p->observations().size() < 3) continue;
-    ASSERT_FALSE(p->EraseObservation(kf));
+    ASSERT_FALSE(p->EraseObservation(lock, kf));
     kf->EraseMapPointMatch(i);
     emptied.insert(i);
   }

@@ -211,7 +211,7 @@ void AtlasStorage::Restore(const MapWriteLock& lock, const AtlasRecord& record,
         KeyFrame* kf = keyframe(kf_id, "an observation");
         PKSLAM_CHECK(index >= 0 && index < kf->size(),
                      "point {}: observation index {} outside keyframe {}", p.id, index, kf_id);
-        point->AddObservation(kf, index);
+        point->AddObservation(lock, kf, index);
       }
       map->map_points_[p.id] = std::move(point);
     }
