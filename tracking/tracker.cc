@@ -30,6 +30,13 @@ struct StepTimer {
   }
 };
 
+// The inertial side for an inertial rig, none otherwise.
+std::unique_ptr<InertialTracking> MakeInertialTracking(const CameraRig& rig) {
+  if (!IsInertial(rig.sensor)) return nullptr;
+  PKSLAM_CHECK(rig.imu.has_value(), "inertial sensor without IMU noise model");
+  return std::make_unique<InertialTracking>(*rig.imu);
+}
+
 }  // namespace
 
 Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<const CameraRig> rig,
@@ -43,19 +50,14 @@ Tracker::Tracker(Atlas* atlas, const Vocabulary* vocabulary, std::shared_ptr<con
       options_(options),
       builder_(rig_, orb_options),
       starter_(atlas_, vocabulary_, IsMonocular(rig_->sensor), options_),
-      relocalisation_(options_.relocalisation_widen_after, options_.relocalisation_wide_candidates,
-                      options_.pose),
-      local_map_(options_.max_local_keyframes),
-      decision_(IsMonocular(rig_->sensor),
-                StarvingRule{options_.starving_inliers, options_.starving_ratio}) {
+      inserter_(atlas_, vocabulary_, selector_.get(), mapping_, options_,
+                IsMonocular(rig_->sensor)),
+      imu_(MakeInertialTracking(*rig_)),
+      map_tracker_(atlas_, vocabulary_, options_, rig_, imu_.get()) {
   options_.Check();
   PKSLAM_CHECK(
       atlas_ != nullptr && vocabulary_ != nullptr && selector_ != nullptr && mapping_ != nullptr,
       "tracker needs an atlas, a vocabulary, a selector and local mapping");
-  if (IsInertial(rig_->sensor)) {
-    PKSLAM_CHECK(rig_->imu.has_value(), "inertial sensor without IMU noise model");
-    imu_ = std::make_unique<InertialTracking>(*rig_->imu);
-  }
 }
 
 Tracker::~Tracker() = default;
@@ -91,10 +93,12 @@ void Tracker::SetRig(const RigSetup& setup, const RigSetup& old_setup) {
   const RigWarp warp(old_setup, setup);
   rig_ = setup.rig;
   builder_.SetRig(rig_);
+  map_tracker_.SetRig(rig_);
   if (imu_) imu_->samples().SetNoise(*rig_->imu);
-  if (last_.size() > 0 || last_.HasPose()) last_.Recalibrate(rig_, warp, new_from_old);
+  if (frames_.last.size() > 0 || frames_.last.HasPose())
+    frames_.last.Recalibrate(rig_, warp, new_from_old);
   if (Frame* first = starter_.pair_first()) first->Recalibrate(rig_, warp, new_from_old);
-  if (velocity_) velocity_ = new_from_old * *velocity_ * old_from_new;
+  if (frames_.velocity) frames_.velocity = new_from_old * *frames_.velocity * old_from_new;
   records_.MoveCamera(new_from_old);
 }
 
@@ -102,8 +106,8 @@ TrackResult Tracker::Track(Frame frame) {
   frame.imu.time_offset_s = time_offset_s_;
   const StepTimer timer;
   double frame_wait_ms = 0;
-  current_ = std::move(frame);
-  mapping_->NoteFrameTime(current_.t_ns());
+  frames_.current = std::move(frame);
+  mapping_->NoteFrameTime(frames_.current.t_ns());
   if (imu_) PreintegrateImu();
   TrackResult result;
   bool new_keyframe = false;
@@ -121,17 +125,17 @@ TrackResult Tracker::Track(Frame frame) {
     // the selector sees local mapping's state after the frame is tracked, as ORB-SLAM3.
     const auto wait_start = std::chrono::steady_clock::now();
     const bool emulated = mapping_->EmulatesLive();
-    const bool idle_at_frame = emulated && mapping_->AcceptsKeyFramesAt(current_.t_ns());
+    const bool idle_at_frame = emulated && mapping_->AcceptsKeyFramesAt(frames_.current.t_ns());
     frame_wait_ms = WallMsSince(wait_start);
     {
       auto lock = MapReader(*atlas_).Lock();
       if (imu_) SyncWithInertialMapLocked(/*correct_current=*/false);  // the world tracked in
       // Local mapping may have fused points of the last frame into others meanwhile.
-      FollowReplacedPoints(&last_);
+      FollowReplacedPoints(&frames_.last);
       ok = options_.localise_only ? TrackLocalisationOnly() : TrackInMap();
       if (ok) {
-        velocity_ = current_.camera_from_world() * last_.world_from_camera();
-        DropUnmappedMatches(&current_);
+        frames_.velocity = frames_.current.camera_from_world() * frames_.last.world_from_camera();
+        DropUnmappedMatches(&frames_.current);
       }
       if (ok && !options_.localise_only) {
         selector_input =
@@ -141,7 +145,7 @@ TrackResult Tracker::Track(Frame frame) {
     if (ok) {
       new_keyframe = ActOnDecision(selector_input, &result);
     } else {
-      velocity_.reset();
+      frames_.velocity.reset();
     }
   }
 
@@ -155,35 +159,34 @@ TrackResult Tracker::Track(Frame frame) {
       options_.localise_only && localisation_.visual_odometry() && state_ == TrackingState::kOk;
   result.state = state_;
   result.new_keyframe = new_keyframe;
-  result.inliers = inliers_;
-  if (current_.HasPose() && state_ == TrackingState::kOk) {
-    result.camera_from_world = current_.camera_from_world();
+  result.inliers = frames_.inliers;
+  if (frames_.current.HasPose() && state_ == TrackingState::kOk) {
+    result.camera_from_world = frames_.current.camera_from_world();
   }
   if (state_ != TrackingState::kNotInitialized) {
-    if (!current_.reference_kf) current_.reference_kf = reference_kf_;
-    last_ = std::move(current_);
+    if (!frames_.current.reference_kf) frames_.current.reference_kf = frames_.reference_kf;
+    frames_.last = std::move(frames_.current);
   }
   return result;
 }
 
 bool Tracker::TrackInMap() {
+  const bool imu_ready = ImuReady();
   bool ok = false;
-  if (state_ == TrackingState::kOk && ImuReady()) {
-    ok = TrackWithImu();
-    if (!ok) ok = TrackReferenceKeyFrame();
-  } else if (state_ == TrackingState::kRecentlyLost && ImuReady()) {
-    ok = PredictWithImu();  // IMU-only prediction; the local map search decides
+  if (state_ == TrackingState::kOk && imu_ready) {
+    ok = map_tracker_.TrackWithImu(records_.back(), &frames_) ||
+         map_tracker_.TrackReferenceKeyFrame(&frames_);
+  } else if (state_ == TrackingState::kRecentlyLost && imu_ready) {
+    // IMU-only prediction; the local map search decides.
+    ok = map_tracker_.PredictWithImu(&frames_);
   } else if (state_ == TrackingState::kOk) {
-    if (!velocity_ || current_.id() < last_reloc_frame_id_ + 2) {
-      ok = TrackReferenceKeyFrame();
-    } else {
-      ok = TrackWithMotionModel();
-      if (!ok) ok = TrackReferenceKeyFrame();
-    }
+    const bool motion_model = frames_.velocity && !frames_.JustRelocalised();
+    ok = (motion_model && map_tracker_.TrackWithMotionModel(records_.back(), &frames_)) ||
+         map_tracker_.TrackReferenceKeyFrame(&frames_);
   } else if (state_ == TrackingState::kRecentlyLost) {
-    ok = Relocalize();
+    ok = map_tracker_.Relocalise(&frames_);
   }
-  if (ok) ok = TrackLocalMap();
+  if (ok) ok = map_tracker_.TrackLocalMap(state_, imu_ready, &frames_);
 
   if (ok) {
     state_ = TrackingState::kOk;
@@ -191,34 +194,30 @@ bool Tracker::TrackInMap() {
     const bool keep = atlas_->current_map()->NumKeyFrames() >
                       options_.MinKeyFramesToKeepMap(IsMonocular(rig_->sensor));
     state_ = keep ? TrackingState::kRecentlyLost : TrackingState::kLost;
-    lost_since_t_ns_ = current_.t_ns();
+    lost_since_t_ns_ = frames_.current.t_ns();
   } else if (state_ == TrackingState::kRecentlyLost &&
-             (current_.t_ns() - lost_since_t_ns_) * 1e-9 > options_.recently_lost_timeout_s) {
+             (frames_.current.t_ns() - lost_since_t_ns_) * 1e-9 >
+                 options_.recently_lost_timeout_s) {
     state_ = TrackingState::kLost;
   }
   return ok;
 }
 
 SelectorInput Tracker::DecideKeyFrame(bool mapping_idle, TrackResult* result) {
-  SelectorInput selector_input = BuildSelectorInput(mapping_idle);
-  // Taken once per decision (a keyframe's second input, SnapshotAfterCreation, has none).
-  selector_input.slow_motion_before_refinement = mapping_->TakeSlowMotionFlag();
-  decision_.Decide(
-      *selector_, selector_input, inliers_, [this] { return mapping_->QueueFull(); },
-      &result->keyframe_declined_queue_full);
-  return selector_input;
+  return inserter_.Decide(KeyFrameContextNow(), frames_, mapping_idle,
+                          &result->keyframe_declined_queue_full);
 }
 
 bool Tracker::ActOnDecision(const SelectorInput& selector_input, TrackResult* result) {
-  const SelectorDecision& decision = decision_.last();
+  const SelectorDecision& decision = inserter_.decision();
   bool new_keyframe = false;
   if (decision.interrupt_local_ba) mapping_->InterruptBundleAdjustment();
   if (decision.insert && !options_.localise_only) {
-    CreateNewKeyFrame(selector_input);
+    inserter_.Insert(KeyFrameContextNow(), selector_input, &frames_);
     new_keyframe = true;
   }
   // Outliers went into the keyframe (BA decides on them), not into the next frame's pose.
-  DropOutlierMatches(&current_);
+  DropOutlierMatches(&frames_.current);
   result->keyframe_reason = decision.reason;
   result->selector_decided = !options_.localise_only;
   result->criteria_held = CriteriaHeld(decision);
@@ -227,27 +226,28 @@ bool Tracker::ActOnDecision(const SelectorInput& selector_input, TrackResult* re
 
 std::vector<FrameRecord::Observation> Tracker::LastFrameInliers() const {
   if (state_ != TrackingState::kOk) return {};
-  return InlierObservations(last_);
+  return InlierObservations(frames_.last);
 }
 
 void Tracker::RecordFrame(bool keyframe, double ms, double cpu_ms) {
   FrameRecord r;
-  r.t_ns = current_.t_ns();
-  r.frame_id = current_.id();
+  r.t_ns = frames_.current.t_ns();
+  r.frame_id = frames_.current.id();
   r.state = state_;
   r.keyframe = keyframe;
   r.tracking_ms = build_ms_ + ms;
   r.tracking_cpu_ms = cpu_ms;
   r.build_cpu_ms = build_cpu_ms_;
-  r.inliers = inliers_;
-  const KeyFramePtr& ref = current_.reference_kf ? current_.reference_kf : reference_kf_;
+  r.inliers = frames_.inliers;
+  const KeyFramePtr& ref =
+      frames_.current.reference_kf ? frames_.current.reference_kf : frames_.reference_kf;
   // Inertial: RECENTLY_LOST frames carry the IMU prediction and are recorded too.
   const bool posed =
       state_ == TrackingState::kOk || (imu_ != nullptr && state_ == TrackingState::kRecentlyLost);
-  if (posed && current_.HasPose() && ref) {
+  if (posed && frames_.current.HasPose() && ref) {
     auto lock = MapReader(*atlas_).Lock();
     if (imu_) SyncWithInertialMapLocked(/*correct_current=*/true);
-    records_.SetPose(ref, keyframe, &current_, &r);
+    records_.SetPose(ref, keyframe, &frames_.current, &r);
   }
   records_.Add(std::move(r));
 }
@@ -260,11 +260,11 @@ void Tracker::HandleLost() {
   }
   if (keyframes <= options_.MinKeyFramesToKeepMap(IsMonocular(rig_->sensor))) {
     PKSLAM_LOG_WARN("tracking lost at t = {:.3f} s with {} keyframes: resetting the map",
-                    current_.t_s(), keyframes);
+                    frames_.current.t_s(), keyframes);
     Reset();
     return;
   }
-  PKSLAM_LOG_WARN("tracking lost at t = {:.3f} s: starting a new map", current_.t_s());
+  PKSLAM_LOG_WARN("tracking lost at t = {:.3f} s: starting a new map", frames_.current.t_s());
   mapping_->ResetQueue();
   {
     auto lock = MapEditor(atlas_).Write(MapEdit::kReset);
@@ -280,13 +280,13 @@ void Tracker::Reset() {
     // Records of the dropped map lose their reference (those frames end up without pose).
     Map* map = atlas_->current_map();
     records_.Forget(map);
-    last_.map_points.assign(last_.map_points.size(), nullptr);
-    current_.map_points.assign(current_.map_points.size(), nullptr);
-    local_map_.Clear();
-    reference_kf_.reset();
-    last_kf_.reset();
-    current_.reference_kf.reset();
-    last_.reference_kf.reset();
+    frames_.last.map_points.assign(frames_.last.map_points.size(), nullptr);
+    frames_.current.map_points.assign(frames_.current.map_points.size(), nullptr);
+    map_tracker_.local_map().Clear();
+    frames_.reference_kf.reset();
+    frames_.last_kf.reset();
+    frames_.current.reference_kf.reset();
+    frames_.last.reference_kf.reset();
     atlas_->ResetCurrentMap(lock);
   }
   StartOver();
@@ -294,11 +294,11 @@ void Tracker::Reset() {
 
 void Tracker::StartOver() {
   state_ = TrackingState::kNotInitialized;
-  velocity_.reset();
+  frames_.velocity.reset();
   starter_.Reset();
-  reference_kf_.reset();
-  last_kf_.reset();
-  local_map_.Clear();
+  frames_.reference_kf.reset();
+  frames_.last_kf.reset();
+  map_tracker_.local_map().Clear();
   selector_->Reset();
 }
 

@@ -2,9 +2,10 @@
 // from the images, initialises a map, tracks the camera against the last frame / reference
 // keyframe and the local map, asks the KeyframeSelector for keyframes and hands them to local
 // mapping. It keeps the state machine; the work is done by its parts (tracking/README.md:
-// frame_records.h, map_starter.h, frame_tracking.h, local_map.h, relocaliser.h,
-// localisation_tracking.h, selector_snapshot.h, keyframe_decision.h, keyframe_points.h,
-// inertial_tracking.h). Owns its frames; touches the map model only under the Atlas mutex.
+// frame_records.h, map_starter.h, map_tracker.h (frame_tracking.h, local_map.h, relocaliser.h),
+// localisation_tracking.h, keyframe_inserter.h (selector_snapshot.h, keyframe_decision.h,
+// keyframe_points.h), inertial_tracking.h). Owns its frames; touches the map model only under the
+// Atlas mutex.
 #pragma once
 
 #include <cstdint>
@@ -22,11 +23,11 @@
 #include "tracking/frame_builder.h"
 #include "tracking/frame_records.h"
 #include "tracking/inertial_tracking.h"
-#include "tracking/keyframe_decision.h"
-#include "tracking/local_map.h"
+#include "tracking/keyframe_inserter.h"
 #include "tracking/localisation_tracking.h"
 #include "tracking/map_starter.h"
-#include "tracking/relocaliser.h"
+#include "tracking/map_tracker.h"
+#include "tracking/tracked_frames.h"
 #include "tracking/tracking_options.h"
 
 namespace pkslam {
@@ -70,14 +71,14 @@ class Tracker {
   const KeyframeSelector& selector() const { return *selector_; }
   // Keyframe-decision traces (one per tracked frame), for --trace.
   using TraceRow = KeyFrameTraceRow;
-  const std::vector<TraceRow>& trace() const { return decision_.trace(); }
-  void EnableTrace(bool on) { decision_.EnableTrace(on); }
+  const std::vector<TraceRow>& trace() const { return inserter_.trace(); }
+  void EnableTrace(bool on) { inserter_.EnableTrace(on); }
   // Record every frame's matched map points in its FrameRecord (for --frame-tracks).
   void EnableFrameTracks(bool on) { records_.EnableObservations(on); }
   // Localisation only (TrackingOptions::localise_only) on a map loaded into the Atlas: the
   // next frame is relocalised against the current map (tracking/tracker_localisation.cc).
   void StartLocalisation();
-  int relocalisations() const { return relocalisation_.successes(); }
+  int relocalisations() const { return map_tracker_.relocalisations(); }
   // Localisation mode switched at run time (the library's SetLocalisationMode, as ORB-SLAM3's
   // ActivateLocalizationMode): from the next frame on, tracking only against the current map,
   // no keyframes, visual tracking (ImuReady() is false while on). Tracking thread, between
@@ -122,21 +123,11 @@ class Tracker {
   void StartMap();
   // AttachImu as the callback of the map's keyframe makers.
   AttachKeyFrame ImuAttacher();
-  bool TrackReferenceKeyFrame();
-  bool TrackWithMotionModel();
-  bool TrackLocalMap();
-  // Localisation only (localisation_ chooses between the moves); sets state_ (kOk or kLost).
-  // Atlas lock held (shared).
+  // Localisation only (localisation_ chooses between map_tracker_'s moves); sets state_ (kOk
+  // or kLost). Atlas lock held (shared).
   bool TrackLocalisationOnly();
-  // The last frame's pose moves with its reference keyframe; localisation only (stereo/RGB-D),
-  // it gets visual-odometry points.
-  void UpdateLastFrame();
-  // `mapping_idle`: whether local mapping takes keyframes at this frame's time.
-  // The selector's view of the current frame (caller holds the Atlas lock, shared).
-  SelectorInput BuildSelectorInput(bool mapping_idle) const;
-  void CreateNewKeyFrame(const SelectorInput& input);
-  // Finds the frame's pose in the current map (tracking/relocaliser.h).
-  bool Relocalize();
+  // What the keyframe inserter reads of this frame's tracking.
+  KeyFrameContext KeyFrameContextNow();
   void HandleLost();
   // Back to NOT_INITIALIZED on the current (new or cleared) map.
   void StartOver();
@@ -149,10 +140,6 @@ class Tracker {
   // frame's pose and velocity across a world change (rotation / rescale) made since it was
   // tracked.
   void SyncWithInertialMapLocked(bool correct_current);
-  bool PredictWithImu();
-  bool TrackWithImu();
-  // Visual pose optimisation, or visual-inertial once the map's IMU is initialised.
-  void OptimizeCurrentPose();
   // Tracking's keyframe joins the map's inertial chain after `previous` (map write lock held).
   void AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previous, const Frame& frame);
 
@@ -166,28 +153,23 @@ class Tracker {
   MapStarter starter_;  // while NOT_INITIALIZED
 
   TrackingState state_ = TrackingState::kNotInitialized;
-  Frame current_;
-  Frame last_;
-  std::optional<SE3d> velocity_;     // camera_from_world(current) * world_from_camera(last)
-  KeyFramePtr reference_kf_;
-  KeyFramePtr last_kf_;
-  FrameId last_reloc_frame_id_ = -1000000;
+  TrackedFrames frames_;  // the current and last frames, the motion model (tracked_frames.h)
   // CPU and wall ms building the frame being tracked (for its FrameRecord).
   double build_cpu_ms_ = 0;
   double build_ms_ = 0;
-  int inliers_ = 0;
   std::int64_t lost_since_t_ns_ = 0;
-  RelocalisationAttempts relocalisation_;
-
-  LocalMap local_map_;  // rebuilt every frame
   // Localisation only: map or visual odometry (tracking/localisation_tracking.h).
   LocalisationTracking localisation_;
 
   FrameRecords records_;  // the trajectory (frame_records.h)
   double time_offset_s_ = 0.0;
-  // The selector's decision with tracking's overrides, and its trace (keyframe_decision.h).
-  KeyFrameDecision decision_;
+  // The selector's decision with tracking's overrides, its trace, and the new keyframes
+  // (keyframe_inserter.h).
+  KeyFrameInserter inserter_;
   std::unique_ptr<InertialTracking> imu_;  // inertial sensors only
+  // The moves that place a frame in the map, with the local map (map_tracker.h); after imu_,
+  // which it uses.
+  MapTracker map_tracker_;
 };
 
 }  // namespace pkslam

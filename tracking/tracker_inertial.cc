@@ -9,7 +9,6 @@
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
 #include "map_model/map_editor.h"
-#include "tracking/frame_tracking.h"
 #include "tracking/tracker.h"
 
 namespace pkslam {
@@ -35,13 +34,13 @@ void Tracker::PreintegrateImu() {
   {
     auto lock = MapReader(*atlas_).Lock();
     SyncWithInertialMapLocked(/*correct_current=*/false);
-    bias = InertialTracking::IntegrationBias(last_, last_kf_.get());
+    bias = InertialTracking::IntegrationBias(frames_.last, frames_.last_kf.get());
   }
   // Keep what the oldest anchor still needs.
-  std::int64_t anchor = current_.t_ns();
-  if (last_kf_) anchor = std::min(anchor, last_kf_->t_ns());
+  std::int64_t anchor = frames_.current.t_ns();
+  if (frames_.last_kf) anchor = std::min(anchor, frames_.last_kf->t_ns());
   if (const Frame* first = starter_.pair_first()) anchor = std::min(anchor, first->t_ns());
-  imu_->Preintegrate(bias, anchor, &current_);
+  imu_->Preintegrate(bias, anchor, &frames_.current);
 }
 
 void Tracker::SyncWithInertialMapLocked(bool correct_current) {
@@ -50,47 +49,27 @@ void Tracker::SyncWithInertialMapLocked(bool correct_current) {
   if (!seen.ForgetsLastFrame()) return;
   // Local mapping rotated / rescaled the map after the current frame was tracked: its pose is
   // in the old world (WorldChangesSeen::single_transform).
-  if (correct_current && current_.HasPose() && seen.single_transform) {
-    InertialTracking::CarryAcross(*seen.single_transform, &current_);
+  if (correct_current && frames_.current.HasPose() && seen.single_transform) {
+    InertialTracking::CarryAcross(*seen.single_transform, &frames_.current);
   }
   if (seen.scale_ratio) {
     // Monocular-inertial initialisation rescaled the map: what tracking keeps relative to its
     // keyframes scales with it.
     const double ratio = *seen.scale_ratio;
     records_.Rescale(map, ratio);
-    if (velocity_) velocity_->translation() *= ratio;
+    if (frames_.velocity) frames_.velocity->translation() *= ratio;
   }
-}
-
-bool Tracker::PredictWithImu() { return imu_->Predict(last_, last_kf_.get(), *rig_, &current_); }
-
-bool Tracker::TrackWithImu() {
-  UpdateLastFrame();
-  if (!PredictWithImu()) return false;
-  MatchLastFramePredicted(last_, options_, IsMonocular(rig_->sensor), &current_);
-  current_.outliers.assign(current_.size(), 0);
-  // The IMU prediction stands: the matches are classified by the visual-inertial optimisation
-  // after the local map search (ORB-SLAM3 runs a visual-only optimisation here first; with the
-  // IMU prediction it only costs time).
-  return true;
-}
-
-void Tracker::OptimizeCurrentPose() {
-  if (!ImuReady() || !current_.imu.state.valid) {
-    OptimizePose(&current_, options_.pose);
-    return;
-  }
-  imu_->OptimizePose(last_, last_kf_.get(), *rig_, options_.pose, &current_);
 }
 
 void Tracker::AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previous,
                         const Frame& frame) {
   if (!imu_) return;
   // A world change between tracking and keyframe creation: the keyframe takes the corrected
-  // pose (current_ is `frame` except at monocular initialisation, which precedes any change).
-  if (&frame == &current_) {
+  // pose (frames_.current is `frame` except at monocular initialisation, which precedes any
+  // change).
+  if (&frame == &frames_.current) {
     SyncWithInertialMapLocked(true);
-    kf->SetPose(current_.camera_from_world());
+    kf->SetPose(frames_.current.camera_from_world());
   }
   imu_->Attach(lock, frame, previous, kf);
 }

@@ -1,77 +1,34 @@
-// Keyframe decisions and creation, and map initialisation (tracking/map_starter.h).
-#include <algorithm>
-#include <mutex>
-#include <shared_mutex>
-
-#include "core/bow/vocabulary.h"
-#include "core/util/log.h"
+// What the keyframe inserter reads of the Tracker (tracking/keyframe_inserter.h), and map
+// initialisation (tracking/map_starter.h).
 #include "map_model/keyframe.h"
-#include "map_model/map_editor.h"
-#include "map_model/map_point.h"
-#include "map_model/matching/orb_matcher.h"
-#include "tracking/keyframe_points.h"
 #include "tracking/selector_snapshot.h"
 #include "tracking/tracker.h"
 
 namespace pkslam {
 
-SelectorInput Tracker::BuildSelectorInput(bool mapping_idle) const {
-  TrackedFrameView view;
-  view.rig = rig_.get();
-  view.map = atlas_->current_map();
-  view.frame = &current_;
-  view.inliers = inliers_;
-  view.recently_lost = state_ == TrackingState::kRecentlyLost;
-  view.reference = reference_kf_.get();
-  view.last_keyframe = last_kf_.get();
-  view.last_relocalisation_frame_id = last_reloc_frame_id_;
-  SelectorInput in = SnapshotTrackedFrame(view, *selector_);
-  if (imu_) imu_->FillSelectorInput(current_, last_, *rig_, ImuReady(), &in);
-  NoteLocalMapping(*mapping_, mapping_idle, &in);
-  in.trace_wanted = decision_.tracing();
-  return in;
-}
-
-void Tracker::CreateNewKeyFrame(const SelectorInput& input) {
-  KeyFramePtr kf;
-  {
-    auto lock = MapEditor(atlas_).Write(MapEdit::kInsertKeyFrame);
-    std::optional<ClosePointRule> close_points;
-    if (!IsMonocular(rig_->sensor)) {
-      close_points = ClosePointRule{rig_->th_depth, options_.new_keyframe_min_close_points};
-    }
-    kf = CreateKeyFrame(lock, atlas_, *vocabulary_, ImuAttacher(), last_kf_.get(), close_points,
-                        &current_);
-  }
-  reference_kf_ = kf;
-  current_.reference_kf = kf;
-  last_kf_ = kf;
-  if (!selector_->SnapshotAfterCreation()) {
-    selector_->OnKeyFrameInserted(input);
-  } else {
-    // The frame as the keyframe holds it: the new close points in, outliers still in.
-    auto lock = MapReader(*atlas_).Lock();
-    const SelectorInput created = BuildSelectorInput(input.local_mapping_idle);
-    lock.unlock();
-    selector_->OnKeyFrameInserted(created);
-  }
-  mapping_->InsertKeyFrame(kf);
-  if (options_.lockstep) mapping_->WaitUntilIdle();
+KeyFrameContext Tracker::KeyFrameContextNow() {
+  KeyFrameContext context;
+  context.rig = rig_.get();
+  context.recently_lost = state_ == TrackingState::kRecentlyLost;
+  context.imu = imu_.get();
+  context.imu_ready = [this] { return ImuReady(); };
+  context.attach = ImuAttacher();
+  return context;
 }
 
 void Tracker::StartMap() {
-  StartedMap started = starter_.Offer(&current_, ImuAttacher(), &local_map_);
+  StartedMap started = starter_.Offer(&frames_.current, ImuAttacher(), &map_tracker_.local_map());
   if (started.refused) Reset();
   if (!started.started()) return;
   for (const KeyFramePtr& kf : started.keyframes) mapping_->InsertKeyFrame(kf);
   if (options_.lockstep) mapping_->WaitUntilIdle();
-  last_kf_ = started.newest();
-  reference_kf_ = started.newest();
-  current_.reference_kf = started.newest();
-  inliers_ = started.TrackedPoints();
+  frames_.last_kf = started.newest();
+  frames_.reference_kf = started.newest();
+  frames_.current.reference_kf = started.newest();
+  frames_.inliers = started.TrackedPoints();
   // The pair's first frame is the last one until Track ends with the current frame.
-  if (started.first_of_pair) last_ = std::move(*started.first_of_pair);
-  RestartSelector(current_, selector_.get());
+  if (started.first_of_pair) frames_.last = std::move(*started.first_of_pair);
+  RestartSelector(frames_.current, selector_.get());
   state_ = TrackingState::kOk;
 }
 

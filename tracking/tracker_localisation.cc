@@ -15,13 +15,16 @@ void Tracker::StartLocalisation() {
 bool Tracker::TrackLocalisationOnly() {
   LocalisationFrame frame;
   frame.last_tracked = state_ == TrackingState::kOk;
-  frame.has_velocity = velocity_.has_value();
-  frame.after_relocalisation_gap = current_.id() >= last_reloc_frame_id_ + 2;
+  frame.has_velocity = frames_.velocity.has_value();
+  frame.after_relocalisation_gap = !frames_.JustRelocalised();
   frame.odometry_possible = !IsMonocular(rig_->sensor);
+  // The motion model runs only after a tracked frame, which has a record.
   const LocalisationMoves moves{
-      [this] { return TrackWithMotionModel(); }, [this] { return TrackReferenceKeyFrame(); },
-      [this] { return Relocalize(); }, [this] { return TrackLocalMap(); }};
-  const bool ok = localisation_.Track(frame, moves, &current_);
+      [this] { return map_tracker_.TrackWithMotionModel(records_.back(), &frames_); },
+      [this] { return map_tracker_.TrackReferenceKeyFrame(&frames_); },
+      [this] { return map_tracker_.Relocalise(&frames_); },
+      [this] { return map_tracker_.TrackLocalMap(state_, ImuReady(), &frames_); }};
+  const bool ok = localisation_.Track(frame, moves, &frames_.current);
   state_ = ok ? TrackingState::kOk : TrackingState::kLost;
   return ok;
 }
