@@ -195,13 +195,14 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
       const Sim3d world_correction = corrected.Inverse() * non_corrected;
       for (const auto& mp : kf->map_points()) {
         if (!mp || mp->IsBad() || correction.corrected_points.count(mp->id()) > 0) continue;
-        mp->SetPosition(world_correction * mp->position());
+        mp->SetPosition(lock, world_correction * mp->position());
         correction.corrected_points[mp->id()] = kf->id();
         moved.push_back(mp.get());
       }
     }
     for (KeyFrame* kf : neighbourhood) {
-      kf->SetPose(correction.corrected_camera_from_world.at(kf->id()).ToSE3ScaledTranslation());
+      kf->SetPose(lock,
+                  correction.corrected_camera_from_world.at(kf->id()).ToSE3ScaledTranslation());
     }
     for (MapPoint* mp : moved) mp->UpdateNormalAndDepth();
     event->correction_m = (query->CameraCenter() - query_centre_before).norm();
@@ -254,16 +255,18 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     }
     const Sim3d current_from_merged = merged_from_current.Inverse();
     for (const auto& [id, kf] : current->keyframes()) {
-      kf->SetPose((Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
+      kf->SetPose(lock,
+                  (Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
       kf->mutable_imu(lock).state.velocity_world =
           merged_from_current.scale() *
           (merged_from_current.so3() * kf->imu().state.velocity_world);
     }
     for (const auto& [id, kf] : current->retired_keyframes()) {
-      kf->SetPose((Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
+      kf->SetPose(lock,
+                  (Sim3d(kf->camera_from_world()) * current_from_merged).ToSE3ScaledTranslation());
     }
     for (const auto& [id, mp] : current->map_points()) {
-      mp->SetPosition(merged_from_current * mp->position());
+      mp->SetPosition(lock, merged_from_current * mp->position());
     }
     event->correction_m = (query->CameraCenter() - query_centre_before).norm();
 

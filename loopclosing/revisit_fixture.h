@@ -37,10 +37,11 @@ class RevisitTest : public ::testing::Test {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (const auto& kf : kfs) {
       for (const auto& mp : kf->map_points()) {
-        if (mp && mp->first_keyframe_id() == kf->id()) mp->SetPosition(drift_ * mp->position());
+        if (mp && mp->first_keyframe_id() == kf->id())
+          mp->SetPosition(lock, drift_ * mp->position());
       }
     }
-    for (const auto& kf : kfs) kf->SetPose(kf->camera_from_world() * drift_.Inverse());
+    for (const auto& kf : kfs) kf->SetPose(lock, kf->camera_from_world() * drift_.Inverse());
     return kfs;
   }
 

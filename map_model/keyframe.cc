@@ -40,7 +40,7 @@ KeyFrame::KeyFrame(KeyFrameId id, const Frame& frame, Map* map)
       bow_(frame.bow()),
       feature_vector_(frame.feature_vector()),
       map_points_(frame.map_points) {
-  if (frame.HasPose()) SetPose(frame.camera_from_world());
+  if (frame.HasPose()) Place(frame.camera_from_world());
   imu_.time_offset_s = frame.imu.time_offset_s;
 }
 
@@ -48,12 +48,13 @@ KeyFrame::KeyFrame(KeyFrameId id, FrameId frame_id, std::int64_t t_ns,
                    std::shared_ptr<const CameraRig> rig, Map* map)
     : id_(id), frame_id_(frame_id), t_ns_(t_ns), rig_(std::move(rig)), map_(map) {}
 
-void KeyFrame::Recalibrate(std::shared_ptr<const CameraRig> rig, const RigWarp& warp,
-                           const SE3d& new_from_old) {
+void KeyFrame::Recalibrate(const MapWriteLock& lock, std::shared_ptr<const CameraRig> rig,
+                           const RigWarp& warp, const SE3d& new_from_old) {
+  RequireWriteLock(lock, "KeyFrame::Recalibrate");
   if (bad_) {
     camera_from_parent_ = new_from_old * camera_from_parent_ * new_from_old.Inverse();
   }
-  SetPose(new_from_old * camera_from_world_);
+  Place(new_from_old * camera_from_world_);
   rig_ = std::move(rig);
   if (bad_ || keypoints_un_.empty()) return;
   RecalibrateFeatures(*rig_, warp, &keypoints_, &keypoints_un_, &right_u_, &depth_);
@@ -74,7 +75,12 @@ std::optional<Eigen::Vector3d> KeyFrame::UnprojectStereo(int i) const {
   return world_from_camera_ * p_camera;
 }
 
-void KeyFrame::SetPose(const SE3d& camera_from_world) {
+void KeyFrame::SetPose(const MapWriteLock& lock, const SE3d& camera_from_world) {
+  RequireWriteLock(lock, "KeyFrame::SetPose");
+  Place(camera_from_world);
+}
+
+void KeyFrame::Place(const SE3d& camera_from_world) {
   camera_from_world_ = camera_from_world;
   world_from_camera_ = camera_from_world.Inverse();
 }

@@ -73,7 +73,9 @@ class KeyFrame {
   Eigen::Vector3d CameraCenter() const { return world_from_camera_.translation(); }
   // The IMU (body) pose: world_from_camera * camera_from_body.
   SE3d world_from_body() const { return world_from_camera_ * rig_->body_from_camera.Inverse(); }
-  void SetPose(const SE3d& camera_from_world);
+  // Moves the keyframe (adjustments, loop correction, a rescaled or reloaded map); throws without
+  // the write lock.
+  void SetPose(const MapWriteLock& lock, const SE3d& camera_from_world);
   // Median depth of the observed map points (q = 0.5), or the q-quantile.
   double SceneDepthQuantile(double q = 0.5) const;
 
@@ -125,15 +127,16 @@ class KeyFrame {
   // For a retired keyframe: camera_from_parent at retirement.
   const SE3d& camera_from_parent() const { return camera_from_parent_; }
 
-  // --- online calibration (map_model/estimation/calibration_apply.h; Atlas mutex exclusive) ---
+  // --- online calibration (map_model/estimation/calibration_apply.h) ---
   // Moves the keyframe to a new calibration of its rig: `rig` becomes its rig; a live keyframe's
   // keypoints move through `warp` (stereo: re-rectified; monocular: re-undistorted from the raw
   // keypoint) and its stereo depths are recomputed with the new bf; its pose and, if retired,
   // its pose relative to its parent are expressed in the new tracking camera,
   // new_from_old = (new camera_from_body) * (old camera_from_body)^-1, so the body keeps its
   // place. A keypoint the warp cannot map keeps its coordinates and loses its stereo match.
-  void Recalibrate(std::shared_ptr<const CameraRig> rig, const RigWarp& warp,
-                   const SE3d& new_from_old);
+  // Throws without the write lock.
+  void Recalibrate(const MapWriteLock& lock, std::shared_ptr<const CameraRig> rig,
+                   const RigWarp& warp, const SE3d& new_from_old);
 
   // --- inertial sensors (map_model/keyframe_inertial.h) ---
   // Read under the Atlas lock (shared).
@@ -144,6 +147,8 @@ class KeyFrame {
   KeyFrameImu& mutable_imu(const MapWriteLock& lock);
 
  private:
+  // SetPose's work (the constructor and Recalibrate, under the lock it checked, use it too).
+  void Place(const SE3d& camera_from_world);
   friend class AtlasStorage;   // map files: map_model/storage/atlas_storage.h
   friend class InertialChain;  // the temporal links (map_model/inertial_chain.h)
   // An empty keyframe that AtlasStorage fills from a map file.

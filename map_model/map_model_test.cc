@@ -2,6 +2,7 @@
 
 #include <mutex>
 
+#include "core/sensor/rig_calibration.h"
 #include "core/util/error.h"
 #include "map_model/keyframe.h"
 #include "map_model/map_editor.h"
@@ -182,6 +183,33 @@ TEST_F(MapModelTest, ObservationEditsRefuseToRunWithoutTheWriteLock) {
   EXPECT_FALSE(point->EraseObservation(lock, observer));  // 4 units left
   EXPECT_FALSE(point->IsInKeyFrame(observer));
   EXPECT_EQ(point->NumObservations(), units - 2);
+}
+
+TEST_F(MapModelTest, MovingKeyFramesAndPointsRefusesToRunWithoutTheWriteLock) {
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  KeyFrame* kf = map_.keyframes[2].get();
+  MapPointPtr point;
+  for (const auto& mp : map_.point_of_scene_index) {
+    if (mp) {
+      point = mp;
+      break;
+    }
+  }
+  ASSERT_TRUE(point);
+  const SE3d pose = kf->camera_from_world();
+  const Eigen::Vector3d position = point->position();
+  const SE3d moved = SE3d(SO3d(), Eigen::Vector3d(0.1, 0, 0)) * pose;
+  lock.unlock();
+  EXPECT_THROW(kf->SetPose(lock, moved), Error);
+  EXPECT_THROW(point->SetPosition(lock, position + Eigen::Vector3d::UnitX()), Error);
+  const RigSetup setup{kf->rig_ptr(), std::nullopt, std::nullopt};
+  EXPECT_THROW(kf->Recalibrate(lock, kf->rig_ptr(), RigWarp(setup, setup), SE3d()), Error);
+  lock.lock();
+  EXPECT_EQ(kf->camera_from_world().Matrix(), pose.Matrix());
+  EXPECT_EQ(point->position(), position);
+  kf->SetPose(lock, moved);
+  EXPECT_EQ(kf->camera_from_world().Matrix(), moved.Matrix());
+  EXPECT_TRUE(kf->world_from_camera().translation().isApprox(moved.Inverse().translation()));
 }
 
 TEST_F(MapModelTest, ReplaceMovesObservationsToTheSurvivor) {

@@ -25,6 +25,11 @@ MapPointPtr MapPoint::Temporary(const Eigen::Vector3d& position_world,
   return point;
 }
 
+void MapPoint::SetPosition(const MapWriteLock& lock, const Eigen::Vector3d& p) {
+  RequireWriteLock(lock, "MapPoint::SetPosition");
+  position_ = p;
+}
+
 void MapPoint::AddObservation(const MapWriteLock& lock, KeyFrame* kf, int index) {
   RequireWriteLock(lock, "MapPoint::AddObservation");
   Observe(kf, index);

@@ -36,7 +36,9 @@ class MapPoint : public std::enable_shared_from_this<MapPoint> {
   KeyFrameId first_keyframe_id() const { return first_kf_id_; }
 
   const Eigen::Vector3d& position() const { return position_; }
-  void SetPosition(const Eigen::Vector3d& p) { position_ = p; }
+  // Moves the point (adjustments, loop correction, a rescaled map); throws without the write
+  // lock.
+  void SetPosition(const MapWriteLock& lock, const Eigen::Vector3d& p);
   // Mean unit direction from the observing cameras to the point.
   const Eigen::Vector3d& normal() const { return normal_; }
   const Descriptor& descriptor() const { return descriptor_; }

@@ -30,7 +30,7 @@ class KeyFrameStepsTest : public ::testing::Test {
       ++dropped_;
     }
     for (const KeyFramePtr& kf : fixture_.map.keyframes) kf->UpdateConnections();
-    last().SetPose(SE3d(SO3d(), Eigen::Vector3d(kPoseErrorM, 0, 0)) * fixture_.poses.back());
+    last().SetPose(lock, SE3d(SO3d(), Eigen::Vector3d(kPoseErrorM, 0, 0)) * fixture_.poses.back());
   }
 
   KeyFrame& last() { return *fixture_.map.keyframes.back(); }

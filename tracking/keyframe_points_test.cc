@@ -125,10 +125,10 @@ TEST_F(KeyFramePointsTest, ANewKeyframeJoinsTheMapTheChainAndBringsItsClosePoint
   KeyFramePtr previous = MakeKeyFrame(lock);
   std::vector<std::pair<KeyFrame*, KeyFrame*>> attached;
   const SE3d corrected = CorrectedPose(0.01, 0.02, 0.03);
-  const AttachKeyFrame attach = [&](const MapWriteLock&, KeyFrame* kf, KeyFrame* prev,
+  const AttachKeyFrame attach = [&](const MapWriteLock& held, KeyFrame* kf, KeyFrame* prev,
                                     const Frame&) {
     attached.emplace_back(kf, prev);
-    kf->SetPose(corrected);  // as the inertial attach does after a world change
+    kf->SetPose(held, corrected);  // as the inertial attach does after a world change
   };
   Frame monocular = frame_;
   const KeyFramePtr plain =

@@ -126,10 +126,10 @@ TwoViewScaling NormaliseTwoViewScale(const MapWriteLock& lock, const TwoViewKeyF
   const double scale = 1.0 / scaling.median_depth;
   SE3d tcw = map.second->camera_from_world();
   tcw.translation() *= scale;
-  map.second->SetPose(tcw);
+  map.second->SetPose(lock, tcw);
   for (const auto& mp : map.first->map_points()) {
     if (mp && !mp->IsBad()) {
-      mp->SetPosition(mp->position() * scale);
+      mp->SetPosition(lock, mp->position() * scale);
       mp->UpdateNormalAndDepth();
     }
   }

@@ -167,7 +167,9 @@ TEST(PoseOptimizer, PointsBehindTheCameraAreOutliers) {
   const SE3d world_from_camera = s.truth.Inverse();
   for (int i : {5, 17, 42}) {
     const Eigen::Vector3d p_camera = s.truth * frame.map_points[i]->position();
-    frame.map_points[i]->SetPosition(world_from_camera * (-p_camera));
+    // A point of no map (the scene's points have none), so no map lock to move it: a new one.
+    frame.map_points[i] =
+        std::make_shared<MapPoint>(i, world_from_camera * (-p_camera), nullptr, nullptr);
   }
   const int inliers = OptimizePose(&frame);
   EXPECT_EQ(inliers, frame.size() - 3);

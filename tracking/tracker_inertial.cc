@@ -69,7 +69,7 @@ void Tracker::AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previo
   // change).
   if (&frame == &frames_.current) {
     SyncWithInertialMapLocked(true);
-    kf->SetPose(frames_.current.camera_from_world());
+    kf->SetPose(lock, frames_.current.camera_from_world());
   }
   imu_->Attach(lock, frame, previous, kf);
 }

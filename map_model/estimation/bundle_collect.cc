@@ -176,13 +176,13 @@ void ApplyBundle(const MapWriteLock& lock, Map* map, const BundleProblem& proble
   for (std::size_t i = 0; i < problem.keyframes.size(); ++i) {
     KeyFrame* kf = keyframes[i].get();
     if (!problem.keyframes[i].fixed && kf != nullptr && !kf->IsBad()) {
-      kf->SetPose(result.camera_from_world[i]);
+      kf->SetPose(lock, result.camera_from_world[i]);
     }
   }
   for (std::size_t i = 0; i < problem.points.size(); ++i) {
     MapPoint* point = points[i].get();
     if (point == nullptr || point->IsBad()) continue;
-    point->SetPosition(result.points_world[i]);
+    point->SetPosition(lock, result.points_world[i]);
     point->UpdateNormalAndDepth();
   }
 }

@@ -52,9 +52,10 @@ void MoveToCalibration(const MapWriteLock& lock, Atlas* atlas, const RigCalibrat
     const SE3d new_from_old = setup.rig->body_from_camera.Inverse() * old.rig->body_from_camera;
     const RigWarp warp(old, setup);
     for (Map* map : atlas->maps()) {
-      for (const auto& [id, kf] : map->keyframes()) kf->Recalibrate(setup.rig, warp, new_from_old);
+      for (const auto& [id, kf] : map->keyframes())
+        kf->Recalibrate(lock, setup.rig, warp, new_from_old);
       for (const auto& [id, kf] : map->retired_keyframes()) {
-        kf->Recalibrate(setup.rig, warp, new_from_old);
+        kf->Recalibrate(lock, setup.rig, warp, new_from_old);
       }
     }
   }
@@ -83,7 +84,7 @@ int RefinePointsToCalibration(Atlas* atlas, MapId map_id) {
         point->position() != problem.points[i].position_world) {
       continue;
     }
-    point->SetPosition(refined[i]);
+    point->SetPosition(lock, refined[i]);
     point->UpdateNormalAndDepth();
     ++moved;
   }

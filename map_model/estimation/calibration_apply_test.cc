@@ -171,7 +171,7 @@ TEST_F(CalibrationApplyTest, PointRefinementMovesPointsOntoTheirObservations) {
   {
     auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
     for (const auto& [id, mp] : atlas_.current_map()->map_points()) {
-      mp->SetPosition(mp->position() + Eigen::Vector3d(0.02, -0.01, 0.015));
+      mp->SetPosition(lock, mp->position() + Eigen::Vector3d(0.02, -0.01, 0.015));
     }
   }
   EXPECT_GT(RefinePointsToCalibration(&atlas_, atlas_.current_map()->id()), 100);

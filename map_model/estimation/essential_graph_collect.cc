@@ -202,7 +202,7 @@ void ApplyEssentialGraph(const MapWriteLock& lock, Map* map, const EssentialGrap
     if (kf->IsBad()) continue;
     const int v = vertex_of(kf.get());
     if (v >= 0) {
-      kf->SetPose(result.camera_from_world[v].ToSE3ScaledTranslation());
+      kf->SetPose(lock, result.camera_from_world[v].ToSE3ScaledTranslation());
       move_velocity(kf.get(), result.camera_from_world[v].Inverse() *
                                   problem.vertices[v].camera_from_world_before);
       continue;
@@ -210,7 +210,7 @@ void ApplyEssentialGraph(const MapWriteLock& lock, Map* map, const EssentialGrap
     const int a = ancestor_vertex(kf->parent());
     if (a < 0) continue;
     const Sim3d moved = Sim3d(kf->camera_from_world()) * correction[a].Inverse();
-    kf->SetPose(moved.ToSE3ScaledTranslation());
+    kf->SetPose(lock, moved.ToSE3ScaledTranslation());
     move_velocity(kf.get(), correction[a]);
   }
 
@@ -225,7 +225,7 @@ void ApplyEssentialGraph(const MapWriteLock& lock, Map* map, const EssentialGrap
       v = ancestor_vertex(mp->reference_keyframe());
     }
     if (v < 0) continue;
-    mp->SetPosition(correction[static_cast<std::size_t>(v)] * mp->position());
+    mp->SetPosition(lock, correction[static_cast<std::size_t>(v)] * mp->position());
     mp->UpdateNormalAndDepth();
   }
   map->IncreaseChangeIndex(lock);

@@ -50,7 +50,7 @@ void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& 
       const auto parent_before = before.find(parent->id());
       if (child_before == before.end() || parent_before == before.end()) continue;
       const SE3d child_from_parent = child_before->second * parent_before->second.Inverse();
-      child->SetPose(child_from_parent * parent->camera_from_world());
+      child->SetPose(lock, child_from_parent * parent->camera_from_world());
     }
   }
 
@@ -70,7 +70,7 @@ void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& 
     if (ref == nullptr) continue;
     const auto ref_before = before.find(ref->id());
     if (ref_before == before.end()) continue;
-    mp->SetPosition(ref->world_from_camera() * (ref_before->second * mp->position()));
+    mp->SetPosition(lock, ref->world_from_camera() * (ref_before->second * mp->position()));
     mp->UpdateNormalAndDepth();
   }
   map->IncreaseChangeIndex(lock);

@@ -79,13 +79,13 @@ void ApplyScaledRotation(const MapWriteLock& lock, Map* map, const SO3d& new_fro
                          double scale) {
   RequireWriteLock(lock, "ApplyScaledRotation");
   for (const auto& [id, kf] : map->keyframes()) {
-    kf->SetPose(CameraFromMovedWorld(kf->camera_from_world(), new_from_old, scale));
+    kf->SetPose(lock, CameraFromMovedWorld(kf->camera_from_world(), new_from_old, scale));
     kf->mutable_imu(lock).state.velocity_world =
         VelocityInMovedWorld(kf->imu().state.velocity_world, new_from_old, scale);
   }
   for (const auto& [id, point] : map->map_points()) {
     if (point->IsBad()) continue;
-    point->SetPosition(scale * (new_from_old * point->position()));
+    point->SetPosition(lock, scale * (new_from_old * point->position()));
     point->UpdateNormalAndDepth();
   }
 }

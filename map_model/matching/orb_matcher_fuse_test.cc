@@ -143,11 +143,11 @@ TEST_F(MatcherFuseTest, FuseAddsMissingObservationsWithinTheReprojectionGate) {
     positions.push_back(p->position());
     const double z = (kf0->camera_from_world() * p->position()).z();
     const double pixels = 4.0 * rig_->pyramid.scale[kf0->keypoints_undistorted()[slots[k]].octave];
-    p->SetPosition(p->position() +
-                   world_from_camera_rotation * Eigen::Vector3d(pixels * z / rig_->fx, 0, 0));
+    p->SetPosition(lock, p->position() + world_from_camera_rotation *
+                                             Eigen::Vector3d(pixels * z / rig_->fx, 0, 0));
   }
   EXPECT_EQ(matcher.Fuse(lock, kf0, dropped), 0);
-  for (std::size_t k = 0; k < dropped.size(); ++k) dropped[k]->SetPosition(positions[k]);
+  for (std::size_t k = 0; k < dropped.size(); ++k) dropped[k]->SetPosition(lock, positions[k]);
   EXPECT_EQ(matcher.Fuse(lock, kf0, dropped), 40);
   for (std::size_t k = 0; k < dropped.size(); ++k) {
     EXPECT_EQ(dropped[k]->IndexInKeyFrame(kf0), slots[k]);

@@ -179,7 +179,7 @@ void AtlasStorage::Restore(const MapWriteLock& lock, const AtlasRecord& record,
       kf->grid_ = FeatureGrid(kf->keypoints_un_, rig->bounds);
       kf->bow_ = BowVector::FromUnsorted(k.bow);
       kf->feature_vector_ = FeatureVector::FromPairs(k.feature_vector);
-      kf->SetPose(k.camera_from_world);
+      kf->SetPose(lock, k.camera_from_world);
       kf->map_points_.assign(k.map_points.size(), nullptr);
       kf->not_erase_ = k.not_erase;
       kf->camera_from_parent_ = k.camera_from_parent;

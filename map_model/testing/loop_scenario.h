@@ -142,11 +142,11 @@ inline void BuildLoopScenario(const LoopScenarioOptions& o, const SyntheticScene
   }
   for (const auto& [id, mp] : s->map->map_points()) {
     const KeyFrameId ref = mp->reference_keyframe()->id() - kfs[0]->id();
-    mp->SetPosition(drift[static_cast<std::size_t>(ref)] * mp->position());
+    mp->SetPosition(lock, drift[static_cast<std::size_t>(ref)] * mp->position());
   }
   for (int k = 0; k < n; ++k) {
     const Sim3d camera_from_world = Sim3d(s->true_camera_from_world[k]) * drift[k].Inverse();
-    kfs[k]->SetPose(camera_from_world.ToSE3ScaledTranslation());
+    kfs[k]->SetPose(lock, camera_from_world.ToSE3ScaledTranslation());
   }
 
   // The loop: last keyframe <-> the first-lap keyframe at the same angle. Neighbourhood: the
@@ -177,10 +177,10 @@ inline void BuildLoopScenario(const LoopScenarioOptions& o, const SyntheticScene
     for (const auto& mp : kf->map_points()) {
       if (!mp || c.corrected_points.count(mp->id()) > 0) continue;
       if (mp->reference_keyframe()->id() < late_side) continue;
-      mp->SetPosition(corrected.Inverse() * (non_corrected * mp->position()));
+      mp->SetPosition(lock, corrected.Inverse() * (non_corrected * mp->position()));
       c.corrected_points[mp->id()] = kf->id();
     }
-    kf->SetPose(corrected.ToSE3ScaledTranslation());
+    kf->SetPose(lock, corrected.ToSE3ScaledTranslation());
   }
   // Fusion restores the links across the loop with their true weights.
   std::set<KeyFrameId> in_neighbourhood;
