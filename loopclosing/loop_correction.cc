@@ -115,9 +115,9 @@ std::map<KeyFrameId, std::vector<KeyFrameId>> LoopClosing::FuseRegion(
     if (mine && !mine->IsBad()) {
       if (mine != other) mine->Replace(lock, other);
     } else if (!other->IsInKeyFrame(query)) {
-      query->AddMapPoint(other, i);
+      query->AddMapPoint(lock, other, i);
       other->AddObservation(lock, query, i);
-      other->ComputeDistinctiveDescriptor();
+      other->ComputeDistinctiveDescriptor(lock);
     }
   }
 
@@ -142,7 +142,7 @@ std::map<KeyFrameId, std::vector<KeyFrameId>> LoopClosing::FuseRegion(
   std::map<KeyFrameId, std::vector<KeyFrameId>> links;
   for (KeyFrame* kf : neighbourhood) {
     if (kf->IsBad()) continue;
-    kf->UpdateConnections();
+    kf->UpdateConnections(lock);
   }
   for (KeyFrame* kf : neighbourhood) {
     if (kf->IsBad()) continue;
@@ -168,7 +168,7 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
       ReleaseMapping();
       return nullptr;
     }
-    query->UpdateConnections();
+    query->UpdateConnections(lock);
     const std::vector<KeyFrame*> neighbourhood = Neighbourhood(query);
 
     // Corrected poses: every neighbour keeps its pose relative to the query, i.e. the whole
@@ -204,7 +204,7 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
       kf->SetPose(lock,
                   correction.corrected_camera_from_world.at(kf->id()).ToSE3ScaledTranslation());
     }
-    for (MapPoint* mp : moved) mp->UpdateNormalAndDepth();
+    for (MapPoint* mp : moved) mp->UpdateNormalAndDepth(lock);
     event->correction_m = (query->CameraCenter() - query_centre_before).norm();
 
     correction.loop_connections =
@@ -215,8 +215,8 @@ Map* LoopClosing::CorrectLoop(const CommonRegion& region, LoopEvent* event) {
     graph.num_threads = options_.num_threads;
     const EssentialGraphProblem problem = CollectEssentialGraph(map, correction, graph);
     ApplyEssentialGraph(lock, map, problem, SolveEssentialGraph(problem, graph));
-    query->AddLoopEdge(region.matched.get());
-    region.matched->AddLoopEdge(query);
+    query->AddLoopEdge(lock, region.matched.get());
+    region.matched->AddLoopEdge(lock, query);
     // Tracking predicts from its last keyframe (corrected pose and velocity) next time.
     if (four_dof) map->RecordWorldChange(lock, {});
     PKSLAM_LOG_INFO(
@@ -292,20 +292,20 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
       mp->set_map(merged);
       merged->AddMapPoint(lock, mp);
     }
-    for (const auto& mp : points) mp->UpdateNormalAndDepth();
+    for (const auto& mp : points) mp->UpdateNormalAndDepth(lock);
 
     // Re-root the moved spanning tree at the query and hang it from the matched keyframe.
     KeyFrame* new_parent = region.matched.get();
     for (KeyFrame* kf = query; kf != nullptr;) {
       KeyFrame* old_parent = kf->parent();
-      if (old_parent != nullptr) old_parent->EraseChild(kf);
-      kf->ChangeParent(new_parent);
+      if (old_parent != nullptr) old_parent->EraseChild(lock, kf);
+      kf->ChangeParent(lock, new_parent);
       new_parent = kf;
       kf = old_parent;
     }
 
     // Weld: fuse the two sides around the query and optimise the merged essential graph.
-    query->UpdateConnections();
+    query->UpdateConnections(lock);
     const std::vector<KeyFrame*> neighbourhood = Neighbourhood(query);
     LoopCorrection correction;
     correction.current_keyframe = query->id();
@@ -323,8 +323,8 @@ Map* LoopClosing::MergeMaps(const CommonRegion& region, LoopEvent* event) {
     graph.num_threads = options_.num_threads;
     const EssentialGraphProblem problem = CollectEssentialGraph(merged, correction, graph);
     ApplyEssentialGraph(lock, merged, problem, SolveEssentialGraph(problem, graph));
-    query->AddLoopEdge(region.matched.get());
-    region.matched->AddLoopEdge(query);
+    query->AddLoopEdge(lock, region.matched.get());
+    region.matched->AddLoopEdge(lock, query);
 
     merged->mutable_imu_status(lock).imu_initialized =
         merged->imu_status().imu_initialized && current->imu_status().imu_initialized;

@@ -51,8 +51,8 @@ class RevisitTest : public ::testing::Test {
       atlas_.database()->Add(lock, kf.get());
       for (const auto& mp : kf->map_points()) {
         if (!mp) continue;
-        mp->ComputeDistinctiveDescriptor();
-        mp->UpdateNormalAndDepth();
+        mp->ComputeDistinctiveDescriptor(lock);
+        mp->UpdateNormalAndDepth(lock);
       }
     }
   }

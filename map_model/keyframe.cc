@@ -99,16 +99,24 @@ double KeyFrame::SceneDepthQuantile(double q) const {
   return depths[k];
 }
 
-void KeyFrame::AddMapPoint(const MapPointPtr& point, int index) { map_points_[index] = point; }
+void KeyFrame::AddMapPoint(const MapWriteLock& lock, const MapPointPtr& point, int index) {
+  RequireWriteLock(lock, "KeyFrame::AddMapPoint");
+  map_points_[index] = point;
+}
 
-void KeyFrame::EraseMapPointMatch(int index) { map_points_[index].reset(); }
+void KeyFrame::EraseMapPointMatch(const MapWriteLock& lock, int index) {
+  RequireWriteLock(lock, "KeyFrame::EraseMapPointMatch");
+  map_points_[index].reset();
+}
 
-void KeyFrame::EraseMapPointMatch(const MapPoint* point) {
+void KeyFrame::EraseMapPointMatch(const MapWriteLock& lock, const MapPoint* point) {
+  RequireWriteLock(lock, "KeyFrame::EraseMapPointMatch");
   const int index = point->IndexInKeyFrame(this);
   if (index >= 0 && map_points_[index].get() == point) map_points_[index].reset();
 }
 
-void KeyFrame::ReplaceMapPointMatch(int index, const MapPointPtr& point) {
+void KeyFrame::ReplaceMapPointMatch(const MapWriteLock& lock, int index, const MapPointPtr& point) {
+  RequireWriteLock(lock, "KeyFrame::ReplaceMapPointMatch");
   map_points_[index] = point;
 }
 
@@ -129,7 +137,8 @@ int KeyFrame::TrackedMapPoints(int min_observations) const {
   return n;
 }
 
-void KeyFrame::UpdateConnections() {
+void KeyFrame::UpdateConnections(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "KeyFrame::UpdateConnections");
   std::map<KeyFrameId, std::pair<KeyFrame*, int>> counter;
   for (const auto& mp : map_points_) {
     if (!mp || mp->IsBad()) continue;
@@ -149,13 +158,13 @@ void KeyFrame::UpdateConnections() {
     if (weight > best.first) best = {weight, kf};
     if (weight >= kCovisibilityThreshold) {
       edges.emplace_back(weight, kf);
-      kf->AddConnection(this, weight);
+      kf->AddConnection(lock, this, weight);
     }
   }
   // Always keep at least the strongest link so no keyframe floats free.
   if (edges.empty()) {
     edges.push_back(best);
-    best.second->AddConnection(this, best.first);
+    best.second->AddConnection(lock, this, best.first);
   }
   std::sort(edges.begin(), edges.end(), HeavierFirst);
 
@@ -168,19 +177,21 @@ void KeyFrame::UpdateConnections() {
   }
   if (first_connection_ && map_ != nullptr && map_->origin() != this) {
     parent_ = ordered_connected_.front();
-    parent_->AddChild(this);
+    parent_->AddChild(lock, this);
     first_connection_ = false;
   }
 }
 
-void KeyFrame::AddConnection(KeyFrame* kf, int weight) {
+void KeyFrame::AddConnection(const MapWriteLock& lock, KeyFrame* kf, int weight) {
+  RequireWriteLock(lock, "KeyFrame::AddConnection");
   auto& entry = connections_[kf->id()];
   if (entry.first == kf && entry.second == weight) return;
   entry = {kf, weight};
   UpdateBestCovisibles();
 }
 
-void KeyFrame::EraseConnection(KeyFrame* kf) {
+void KeyFrame::EraseConnection(const MapWriteLock& lock, KeyFrame* kf) {
+  RequireWriteLock(lock, "KeyFrame::EraseConnection");
   if (connections_.erase(kf->id()) > 0) UpdateBestCovisibles();
 }
 
@@ -223,20 +234,31 @@ std::vector<KeyFrame*> KeyFrame::ConnectedKeyFrames() const {
   return out;
 }
 
-void KeyFrame::ChangeParent(KeyFrame* parent) {
+void KeyFrame::ChangeParent(const MapWriteLock& lock, KeyFrame* parent) {
+  RequireWriteLock(lock, "KeyFrame::ChangeParent");
   if (parent == this) return;  // never make a keyframe its own parent
   parent_ = parent;
-  parent->AddChild(this);
+  parent->AddChild(lock, this);
 }
 
-void KeyFrame::AddChild(KeyFrame* kf) { children_[kf->id()] = kf; }
-void KeyFrame::EraseChild(KeyFrame* kf) { children_.erase(kf->id()); }
-void KeyFrame::AddLoopEdge(KeyFrame* kf) {
+void KeyFrame::AddChild(const MapWriteLock& lock, KeyFrame* kf) {
+  RequireWriteLock(lock, "KeyFrame::AddChild");
+  children_[kf->id()] = kf;
+}
+void KeyFrame::EraseChild(const MapWriteLock& lock, KeyFrame* kf) {
+  RequireWriteLock(lock, "KeyFrame::EraseChild");
+  children_.erase(kf->id());
+}
+void KeyFrame::AddLoopEdge(const MapWriteLock& lock, KeyFrame* kf) {
+  RequireWriteLock(lock, "KeyFrame::AddLoopEdge");
   not_erase_ = true;
   loop_edges_[kf->id()] = kf;
 }
 
-void KeyFrame::SetNotErase() { not_erase_ = true; }
+void KeyFrame::SetNotErase(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "KeyFrame::SetNotErase");
+  not_erase_ = true;
+}
 
 bool KeyFrame::SetErase(const MapWriteLock& lock) {
   RequireWriteLock(lock, "KeyFrame::SetErase");
@@ -263,7 +285,7 @@ void KeyFrame::SetBad(const MapWriteLock& lock) {
     to_be_erased_ = true;
     return;
   }
-  for (const auto& [id, entry] : connections_) entry.first->EraseConnection(this);
+  for (const auto& [id, entry] : connections_) entry.first->EraseConnection(lock, this);
   for (std::size_t i = 0; i < map_points_.size(); ++i) {
     if (map_points_[i]) {
       const MapPointPtr mp = map_points_[i];  // EraseObservation may clear our slot
@@ -296,17 +318,17 @@ void KeyFrame::SetBad(const MapWriteLock& lock) {
       }
     }
     if (best_child == nullptr) break;
-    best_child->ChangeParent(best_parent);
+    best_child->ChangeParent(lock, best_parent);
     candidates[best_child->id()] = best_child;
     orphans.erase(best_child->id());
   }
   // Children without a covisible candidate hang from our parent.
   for (const auto& [child_id, child] : orphans) {
-    if (parent_ != nullptr) child->ChangeParent(parent_);
+    if (parent_ != nullptr) child->ChangeParent(lock, parent_);
   }
   children_.clear();
   if (parent_ != nullptr) {
-    parent_->EraseChild(this);
+    parent_->EraseChild(lock, this);
     camera_from_parent_ = camera_from_world_ * parent_->world_from_camera();
   }
   bad_ = true;

@@ -2,8 +2,10 @@
 // place in the covisibility graph and spanning tree.
 //
 // Threading (docs/architecture.md): all mutable state is guarded by the Atlas mutex (shared
-// lock to read, exclusive to write). The feature data copied from the frame is immutable
-// until the keyframe is retired.
+// lock to read, exclusive to write). Every change takes the write lock (MapWriteLock) as a
+// parameter and throws without it, except set_map (a map being cleared or merged moves its
+// objects under its caller's lock). The feature data copied from the frame is immutable until
+// the keyframe is retired.
 #pragma once
 
 #include <Eigen/Core>
@@ -82,10 +84,10 @@ class KeyFrame {
   // --- map points (one slot per keypoint) ---
   const std::vector<MapPointPtr>& map_points() const { return map_points_; }
   const MapPointPtr& map_point(int index) const { return map_points_[index]; }
-  void AddMapPoint(const MapPointPtr& point, int index);
-  void EraseMapPointMatch(int index);
-  void EraseMapPointMatch(const MapPoint* point);
-  void ReplaceMapPointMatch(int index, const MapPointPtr& point);
+  void AddMapPoint(const MapWriteLock& lock, const MapPointPtr& point, int index);
+  void EraseMapPointMatch(const MapWriteLock& lock, int index);
+  void EraseMapPointMatch(const MapWriteLock& lock, const MapPoint* point);
+  void ReplaceMapPointMatch(const MapWriteLock& lock, int index, const MapPointPtr& point);
   // Points in slots that are non-null and not bad.
   std::vector<MapPointPtr> GoodMapPoints() const;
   // Number of good points with at least min_observations observations.
@@ -94,9 +96,9 @@ class KeyFrame {
   // --- covisibility graph ---
   // Recounts shared points with every other keyframe, keeps edges with weight >= 15 (or the
   // best one), and on the first call links this keyframe into the spanning tree.
-  void UpdateConnections();
-  void AddConnection(KeyFrame* kf, int weight);
-  void EraseConnection(KeyFrame* kf);
+  void UpdateConnections(const MapWriteLock& lock);
+  void AddConnection(const MapWriteLock& lock, KeyFrame* kf, int weight);
+  void EraseConnection(const MapWriteLock& lock, KeyFrame* kf);
   int Weight(const KeyFrame* kf) const;
   // Covisible keyframes by decreasing weight (ties: increasing id).
   const std::vector<KeyFrame*>& CovisiblesByWeight() const { return ordered_connected_; }
@@ -106,16 +108,16 @@ class KeyFrame {
 
   // --- spanning tree and loop edges ---
   KeyFrame* parent() const { return parent_; }
-  void ChangeParent(KeyFrame* parent);
+  void ChangeParent(const MapWriteLock& lock, KeyFrame* parent);
   const std::map<KeyFrameId, KeyFrame*>& children() const { return children_; }
-  void AddChild(KeyFrame* kf);
-  void EraseChild(KeyFrame* kf);
-  void AddLoopEdge(KeyFrame* kf);
+  void AddChild(const MapWriteLock& lock, KeyFrame* kf);
+  void EraseChild(const MapWriteLock& lock, KeyFrame* kf);
+  void AddLoopEdge(const MapWriteLock& lock, KeyFrame* kf);
   const std::map<KeyFrameId, KeyFrame*>& loop_edges() const { return loop_edges_; }
 
   // --- life cycle ---
   // Loop closing protects keyframes it is working on; a retire request is then deferred.
-  void SetNotErase();
+  void SetNotErase(const MapWriteLock& lock);
   // Lifts the protection; retires the keyframe if a retire request was deferred (returns true).
   // Throws without the write lock.
   bool SetErase(const MapWriteLock& lock);

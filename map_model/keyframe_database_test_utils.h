@@ -50,10 +50,10 @@ inline std::vector<KeyFramePtr> AddKeyFrames(Atlas* atlas, Map* map, const Synth
         map->AddMapPoint(lock, points[p]);
       }
       points[p]->AddObservation(lock, kfs[k].get(), static_cast<int>(i));
-      kfs[k]->AddMapPoint(points[p], static_cast<int>(i));
+      kfs[k]->AddMapPoint(lock, points[p], static_cast<int>(i));
     }
   }
-  for (const auto& kf : kfs) kf->UpdateConnections();
+  for (const auto& kf : kfs) kf->UpdateConnections(lock);
   return kfs;
 }
 

@@ -34,10 +34,10 @@ MapPointPtr Map::CreateMapPoint(const MapWriteLock& lock, MapPointId id,
   auto point = std::make_shared<MapPoint>(id, position_world, reference, this);
   for (const MapPoint::Observation& o : observations) {
     point->AddObservation(lock, o.keyframe, o.index);
-    o.keyframe->AddMapPoint(point, o.index);
+    o.keyframe->AddMapPoint(lock, point, o.index);
   }
-  point->ComputeDistinctiveDescriptor();
-  point->UpdateNormalAndDepth();
+  point->ComputeDistinctiveDescriptor(lock);
+  point->UpdateNormalAndDepth(lock);
   map_points_[id] = point;
   return point;
 }

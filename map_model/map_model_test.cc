@@ -93,7 +93,7 @@ TEST_F(MapModelTest, OriginIsNeverRetired) {
 TEST_F(MapModelTest, NotEraseDefersRetirement) {
   auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
   KeyFrame* kf = map_.keyframes[3].get();
-  kf->SetNotErase();
+  kf->SetNotErase(lock);
   kf->SetBad(lock);
   EXPECT_FALSE(kf->IsBad());
   EXPECT_TRUE(kf->SetErase(lock));
@@ -115,7 +115,7 @@ TEST_F(MapModelTest, ErasingObservationsMakesAPointBadAtTwoUnits) {
   EXPECT_EQ(target->NumObservations(), 6);
   auto erase_first = [&target, &lock]() {
     KeyFrame* kf = target->observations().begin()->second.keyframe;
-    kf->EraseMapPointMatch(target->IndexInKeyFrame(kf));
+    kf->EraseMapPointMatch(lock, target->IndexInKeyFrame(kf));
     return std::make_pair(kf, target->EraseObservation(lock, kf));
   };
   EXPECT_FALSE(erase_first().second);  // 4 units left
@@ -210,6 +210,48 @@ TEST_F(MapModelTest, MovingKeyFramesAndPointsRefusesToRunWithoutTheWriteLock) {
   kf->SetPose(lock, moved);
   EXPECT_EQ(kf->camera_from_world().Matrix(), moved.Matrix());
   EXPECT_TRUE(kf->world_from_camera().translation().isApprox(moved.Inverse().translation()));
+}
+
+TEST_F(MapModelTest, SlotGraphAndPointEditsRefuseToRunWithoutTheWriteLock) {
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  KeyFrame* kf = map_.keyframes[2].get();
+  KeyFrame* other = map_.keyframes[0].get();
+  int slot = -1;
+  for (int i = 0; i < kf->size() && slot < 0; ++i) {
+    if (kf->map_point(i)) slot = i;
+  }
+  ASSERT_GE(slot, 0);
+  const MapPointPtr point = kf->map_point(slot);
+  const auto covisibles = kf->CovisiblesByWeight();
+  const int weight = kf->Weight(other);
+  KeyFrame* parent = kf->parent();
+  const auto children = kf->children();
+  const Eigen::Vector3d normal = point->normal();
+  lock.unlock();
+  EXPECT_THROW(kf->AddMapPoint(lock, nullptr, slot), Error);
+  EXPECT_THROW(kf->EraseMapPointMatch(lock, slot), Error);
+  EXPECT_THROW(kf->EraseMapPointMatch(lock, point.get()), Error);
+  EXPECT_THROW(kf->ReplaceMapPointMatch(lock, slot, nullptr), Error);
+  EXPECT_THROW(kf->UpdateConnections(lock), Error);
+  EXPECT_THROW(kf->AddConnection(lock, other, weight + 100), Error);
+  EXPECT_THROW(kf->EraseConnection(lock, other), Error);
+  EXPECT_THROW(kf->ChangeParent(lock, other), Error);
+  EXPECT_THROW(kf->AddChild(lock, other), Error);
+  EXPECT_THROW(kf->EraseChild(lock, other), Error);
+  EXPECT_THROW(kf->AddLoopEdge(lock, other), Error);
+  EXPECT_THROW(kf->SetNotErase(lock), Error);
+  EXPECT_THROW(point->ComputeDistinctiveDescriptor(lock), Error);
+  EXPECT_THROW(point->UpdateNormalAndDepth(lock), Error);
+  lock.lock();
+  EXPECT_EQ(kf->map_point(slot), point);
+  EXPECT_EQ(kf->CovisiblesByWeight(), covisibles);
+  EXPECT_EQ(kf->Weight(other), weight);
+  EXPECT_EQ(kf->parent(), parent);
+  EXPECT_EQ(kf->children(), children);
+  EXPECT_TRUE(kf->loop_edges().empty());
+  EXPECT_EQ(point->normal(), normal);
+  kf->EraseMapPointMatch(lock, slot);
+  EXPECT_EQ(kf->map_point(slot), nullptr);
 }
 
 TEST_F(MapModelTest, ReplaceMovesObservationsToTheSurvivor) {

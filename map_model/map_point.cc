@@ -52,7 +52,7 @@ bool MapPoint::EraseObservation(const MapWriteLock& lock, KeyFrame* kf) {
   }
   // Fewer than three observation units cannot constrain the point any more.
   if (num_obs_ <= 2) {
-    Retire();
+    Retire(lock);
     return true;
   }
   return false;
@@ -67,17 +67,17 @@ int MapPoint::IndexInKeyFrame(const KeyFrame* kf) const {
 
 void MapPoint::SetBad(const MapWriteLock& lock) {
   RequireWriteLock(lock, "MapPoint::SetBad");
-  Retire();
+  Retire(lock);
 }
 
-void MapPoint::Retire() {
+void MapPoint::Retire(const MapWriteLock& lock) {
   if (bad_) return;
   const MapPointPtr keep_alive = shared_from_this();
   bad_ = true;
   const auto observations = std::move(observations_);
   observations_.clear();
   num_obs_ = 0;
-  for (const auto& [id, obs] : observations) obs.keyframe->EraseMapPointMatch(obs.index);
+  for (const auto& [id, obs] : observations) obs.keyframe->EraseMapPointMatch(lock, obs.index);
   if (map_ != nullptr) map_->EraseMapPoint(this);
 }
 
@@ -92,19 +92,20 @@ void MapPoint::Replace(const MapWriteLock& lock, const MapPointPtr& other) {
   replaced_by_ = other;
   for (const auto& [id, obs] : observations) {
     if (!other->IsInKeyFrame(obs.keyframe)) {
-      obs.keyframe->ReplaceMapPointMatch(obs.index, other);
+      obs.keyframe->ReplaceMapPointMatch(lock, obs.index, other);
       other->Observe(obs.keyframe, obs.index);
     } else {
-      obs.keyframe->EraseMapPointMatch(obs.index);
+      obs.keyframe->EraseMapPointMatch(lock, obs.index);
     }
   }
   other->IncreaseFound(found());
   other->IncreaseVisible(visible());
-  other->ComputeDistinctiveDescriptor();
+  other->ComputeDistinctiveDescriptor(lock);
   if (map_ != nullptr) map_->EraseMapPoint(this);
 }
 
-void MapPoint::ComputeDistinctiveDescriptor() {
+void MapPoint::ComputeDistinctiveDescriptor(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "MapPoint::ComputeDistinctiveDescriptor");
   if (bad_ || observations_.empty()) return;
   std::vector<const Descriptor*> descriptors;
   descriptors.reserve(observations_.size());
@@ -137,7 +138,8 @@ void MapPoint::ComputeDistinctiveDescriptor() {
   descriptor_ = *descriptors[best];
 }
 
-void MapPoint::UpdateNormalAndDepth() {
+void MapPoint::UpdateNormalAndDepth(const MapWriteLock& lock) {
+  RequireWriteLock(lock, "MapPoint::UpdateNormalAndDepth");
   if (bad_ || observations_.empty() || reference_kf_ == nullptr) return;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   int n = 0;

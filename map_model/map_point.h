@@ -2,8 +2,10 @@
 // and which keyframes observe it.
 //
 // Threading (docs/architecture.md): everything except the visible/found counters is guarded by
-// the Atlas mutex — read under a shared lock, written under an exclusive lock. The counters are
-// atomics because tracking bumps them while holding only a shared lock.
+// the Atlas mutex — read under a shared lock, written under an exclusive lock: every change
+// takes the write lock (MapWriteLock) as a parameter and throws without it, except set_map (as
+// KeyFrame's). The counters are atomics because tracking bumps them while holding only a
+// shared lock.
 #pragma once
 
 #include <Eigen/Core>
@@ -77,9 +79,9 @@ class MapPoint : public std::enable_shared_from_this<MapPoint> {
   MapPointPtr replaced_by() const { return replaced_by_; }
 
   // Median-distance descriptor among all observations.
-  void ComputeDistinctiveDescriptor();
+  void ComputeDistinctiveDescriptor(const MapWriteLock& lock);
   // Recomputes the normal and the distance range from the observations.
-  void UpdateNormalAndDepth();
+  void UpdateNormalAndDepth(const MapWriteLock& lock);
   // Pyramid level at which the point is expected when seen from `distance` metres.
   int PredictScale(double distance, const ScalePyramid& pyramid) const;
 
@@ -96,7 +98,7 @@ class MapPoint : public std::enable_shared_from_this<MapPoint> {
   // it checked).
   void Observe(KeyFrame* kf, int index);
   // SetBad's work; EraseObservation retires a point left with too few observations.
-  void Retire();
+  void Retire(const MapWriteLock& lock);
 
   MapPointId id_;
   KeyFrameId first_kf_id_;

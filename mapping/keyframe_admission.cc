@@ -20,13 +20,13 @@ std::vector<MapPointPtr> AdmitKeyFrame(const MapWriteLock& lock, Atlas* atlas, K
     if (!mp->IsInKeyFrame(keyframe)) {
       // A point tracked by the frame: the keyframe becomes one of its observers.
       mp->AddObservation(lock, keyframe, i);
-      mp->UpdateNormalAndDepth();
-      mp->ComputeDistinctiveDescriptor();
+      mp->UpdateNormalAndDepth(lock);
+      mp->ComputeDistinctiveDescriptor(lock);
     } else {
       created.push_back(mp);
     }
   }
-  keyframe->UpdateConnections();
+  keyframe->UpdateConnections(lock);
   // Findable by relocalisation and place recognition from now on.
   if (KeyFrameDatabase* database = atlas->database()) database->Add(lock, keyframe);
   return created;

@@ -45,7 +45,7 @@ class KeyFrameAdmissionTest : public ::testing::Test {
     keyframe_ = std::make_shared<KeyFrame>(atlas_.NextKeyFrameId(), frame, map);
     map->AddKeyFrame(lock, keyframe_);
     own_->AddObservation(lock, keyframe_.get(), own_index_);
-    keyframe_->AddMapPoint(own_, own_index_);
+    keyframe_->AddMapPoint(lock, own_, own_index_);
     map->AddMapPoint(lock, own_);
   }
 

@@ -29,7 +29,7 @@ class KeyFrameStepsTest : public ::testing::Test {
       fixture_.map.point_of_scene_index[s]->SetBad(lock);
       ++dropped_;
     }
-    for (const KeyFramePtr& kf : fixture_.map.keyframes) kf->UpdateConnections();
+    for (const KeyFramePtr& kf : fixture_.map.keyframes) kf->UpdateConnections(lock);
     last().SetPose(lock, SE3d(SO3d(), Eigen::Vector3d(kPoseErrorM, 0, 0)) * fixture_.poses.back());
   }
 

@@ -49,10 +49,10 @@ int FuseWithNeighbours(const MapWriteLock& lock, KeyFrame* keyframe,
                       static_cast<std::int64_t>(ours.size() * targets.size() + candidates.size()));
   }
   for (const auto& mp : keyframe->GoodMapPoints()) {
-    mp->ComputeDistinctiveDescriptor();
-    mp->UpdateNormalAndDepth();
+    mp->ComputeDistinctiveDescriptor(lock);
+    mp->UpdateNormalAndDepth(lock);
   }
-  keyframe->UpdateConnections();
+  keyframe->UpdateConnections(lock);
   return static_cast<int>(targets.size());
 }
 

@@ -33,17 +33,17 @@ class NeighbourFusionTest : public ::testing::Test {
       const MapPointPtr original = kf->map_point(i);
       if (!original || original->IsBad() || n++ % 5 != 0) continue;
       original->EraseObservation(lock, kf);
-      kf->EraseMapPointMatch(i);
+      kf->EraseMapPointMatch(lock, i);
       auto copy =
           std::make_shared<MapPoint>(atlas_.NextMapPointId(), original->position(), kf, map);
       copy->AddObservation(lock, kf, i);
-      kf->AddMapPoint(copy, i);
-      copy->ComputeDistinctiveDescriptor();
-      copy->UpdateNormalAndDepth();
+      kf->AddMapPoint(lock, copy, i);
+      copy->ComputeDistinctiveDescriptor(lock);
+      copy->UpdateNormalAndDepth(lock);
       map->AddMapPoint(lock, copy);
       pairs_.push_back({original, copy, i});
     }
-    for (const KeyFramePtr& k : map_.keyframes) k->UpdateConnections();
+    for (const KeyFramePtr& k : map_.keyframes) k->UpdateConnections(lock);
   }
 
   struct Duplicate {

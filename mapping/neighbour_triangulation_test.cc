@@ -34,7 +34,7 @@ class NeighbourTriangulationTest : public ::testing::Test {
       map_.point_of_scene_index[s]->SetBad(lock);
       ++dropped_;
     }
-    for (const KeyFramePtr& kf : map_.keyframes) kf->UpdateConnections();
+    for (const KeyFramePtr& kf : map_.keyframes) kf->UpdateConnections(lock);
   }
   KeyFrame& last() { return *map_.keyframes.back(); }
   int SceneIndex(const KeyFrame* kf, int keypoint) const {

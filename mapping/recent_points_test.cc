@@ -38,7 +38,7 @@ class RecentPointsTest : public ::testing::Test {
       for (int i = 0; i < static_cast<int>(kf->map_points().size()); ++i) {
         if (kf->map_point(i) || kf->right_u()[i] < 0) continue;
         mp->AddObservation(lock, kf, i);
-        kf->AddMapPoint(mp, i);
+        kf->AddMapPoint(lock, mp, i);
         break;
       }
     }

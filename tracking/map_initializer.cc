@@ -98,8 +98,8 @@ TwoViewKeyFrames CreateTwoViewMap(const MapWriteLock& lock, Atlas* atlas,
         {{out.first.get(), static_cast<int>(i)}, {out.second.get(), j}});
     second->outliers[j] = 0;
   }
-  out.first->UpdateConnections();
-  out.second->UpdateConnections();
+  out.first->UpdateConnections(lock);
+  out.second->UpdateConnections(lock);
   return out;
 }
 
@@ -130,7 +130,7 @@ TwoViewScaling NormaliseTwoViewScale(const MapWriteLock& lock, const TwoViewKeyF
   for (const auto& mp : map.first->map_points()) {
     if (mp && !mp->IsBad()) {
       mp->SetPosition(lock, mp->position() * scale);
-      mp->UpdateNormalAndDepth();
+      mp->UpdateNormalAndDepth(lock);
     }
   }
   second->SetPose(tcw);

@@ -169,7 +169,7 @@ void ApplyBundle(const MapWriteLock& lock, Map* map, const BundleProblem& proble
     if (kf == nullptr || point == nullptr || kf->IsBad() || point->IsBad()) continue;
     if (point->IndexInKeyFrame(kf) != obs.keypoint_index) continue;
     if (kf->map_point(obs.keypoint_index).get() == point) {
-      kf->EraseMapPointMatch(obs.keypoint_index);
+      kf->EraseMapPointMatch(lock, obs.keypoint_index);
     }
     point->EraseObservation(lock, kf);  // may retire the point (too few observations left)
   }
@@ -183,7 +183,7 @@ void ApplyBundle(const MapWriteLock& lock, Map* map, const BundleProblem& proble
     MapPoint* point = points[i].get();
     if (point == nullptr || point->IsBad()) continue;
     point->SetPosition(lock, result.points_world[i]);
-    point->UpdateNormalAndDepth();
+    point->UpdateNormalAndDepth(lock);
   }
 }
 

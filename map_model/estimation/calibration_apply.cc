@@ -85,7 +85,7 @@ int RefinePointsToCalibration(Atlas* atlas, MapId map_id) {
       continue;
     }
     point->SetPosition(lock, refined[i]);
-    point->UpdateNormalAndDepth();
+    point->UpdateNormalAndDepth(lock);
     ++moved;
   }
   return moved;

@@ -226,7 +226,7 @@ void ApplyEssentialGraph(const MapWriteLock& lock, Map* map, const EssentialGrap
     }
     if (v < 0) continue;
     mp->SetPosition(lock, correction[static_cast<std::size_t>(v)] * mp->position());
-    mp->UpdateNormalAndDepth();
+    mp->UpdateNormalAndDepth(lock);
   }
   map->IncreaseChangeIndex(lock);
 }

@@ -115,7 +115,7 @@ TEST(EssentialGraphTest, KeyFramesAndPointsAddedAfterCollectFollowTheirAncestor)
     f.SetPose(late_from_anchor * anchor->camera_from_world());
     late = std::make_shared<KeyFrame>(s.atlas.NextKeyFrameId(), f, s.map);
     s.map->AddKeyFrame(lock, late);
-    late->ChangeParent(anchor);
+    late->ChangeParent(lock, anchor);
     late_point = std::make_shared<MapPoint>(s.atlas.NextMapPointId(),
                                             late->world_from_camera() * Eigen::Vector3d(0, 0, 5),
                                             late.get(), s.map);

@@ -115,8 +115,8 @@ void BuildInertialLoop(double loop_tilt, const testing::SyntheticScene& scene, I
     kf->mutable_imu(lock).state.velocity_world =
         Eigen::Vector3d(0.5, -0.2, 0.1 * static_cast<double>(k % 3));
     if (k >= 2) {
-      kf->parent()->EraseChild(kf);
-      kf->ChangeParent(kfs[k - 2].get());
+      kf->parent()->EraseChild(lock, kf);
+      kf->ChangeParent(lock, kfs[k - 2].get());
     }
   }
   LoopCorrection& c = l->s.correction;

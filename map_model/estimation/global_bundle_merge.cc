@@ -71,7 +71,7 @@ void MergeGlobalBundle(const MapWriteLock& lock, Map* map, const BundleProblem& 
     const auto ref_before = before.find(ref->id());
     if (ref_before == before.end()) continue;
     mp->SetPosition(lock, ref->world_from_camera() * (ref_before->second * mp->position()));
-    mp->UpdateNormalAndDepth();
+    mp->UpdateNormalAndDepth(lock);
   }
   map->IncreaseChangeIndex(lock);
 }

@@ -52,7 +52,7 @@ class MergeGlobalBundleTest : public ::testing::Test {
     frame.SetPose(pose);
     auto kf = std::make_shared<KeyFrame>(atlas_.NextKeyFrameId(), frame, map);
     map->AddKeyFrame(lock, kf);
-    kf->ChangeParent(parent);
+    kf->ChangeParent(lock, parent);
     return kf;
   }
 

@@ -86,7 +86,7 @@ void ApplyScaledRotation(const MapWriteLock& lock, Map* map, const SO3d& new_fro
   for (const auto& [id, point] : map->map_points()) {
     if (point->IsBad()) continue;
     point->SetPosition(lock, scale * (new_from_old * point->position()));
-    point->UpdateNormalAndDepth();
+    point->UpdateNormalAndDepth(lock);
   }
 }
 

@@ -145,15 +145,15 @@ inline SyntheticMap MakeBowMap(Atlas* atlas, const SyntheticScene& scene,
         map->AddMapPoint(lock, mp);
       }
       mp->AddObservation(lock, kf, static_cast<int>(i));
-      kf->AddMapPoint(mp, static_cast<int>(i));
+      kf->AddMapPoint(lock, mp, static_cast<int>(i));
     }
   }
   for (const auto& mp : out.point_of_scene_index) {
     if (!mp) continue;
-    mp->ComputeDistinctiveDescriptor();
-    mp->UpdateNormalAndDepth();
+    mp->ComputeDistinctiveDescriptor(lock);
+    mp->UpdateNormalAndDepth(lock);
   }
-  for (const auto& kf : out.keyframes) kf->UpdateConnections();
+  for (const auto& kf : out.keyframes) kf->UpdateConnections(lock);
   return out;
 }
 

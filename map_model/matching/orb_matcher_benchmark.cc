@@ -159,7 +159,7 @@ struct BowFixture {
     kf2 = std::make_shared<KeyFrame>(1002, f2, fx.atlas.current_map());
     // kf1 observes the map points of its keypoints (for keyframe-frame BoW search).
     for (int i = 0; i < kf1->size(); ++i) {
-      kf1->AddMapPoint(fx.map.point_of_scene_index[pok1[i]], i);
+      kf1->AddMapPoint(lock, fx.map.point_of_scene_index[pok1[i]], i);
     }
     frame = fx.frame;
     frame.ComputeBoW(vocabulary);

@@ -102,7 +102,7 @@ int OrbMatcher::Fuse(const MapWriteLock& lock, KeyFrame* keyframe,
       }
     } else {
       point->AddObservation(lock, keyframe, c.index);
-      keyframe->AddMapPoint(point, c.index);
+      keyframe->AddMapPoint(lock, point, c.index);
     }
     ++fused;
   }
@@ -135,7 +135,7 @@ int OrbMatcher::Fuse(const MapWriteLock& lock, KeyFrame* keyframe, const Sim3d& 
       if (!in_keyframe->IsBad()) (*replace_with)[i] = in_keyframe;
     } else {
       point->AddObservation(lock, keyframe, c.index);
-      keyframe->AddMapPoint(point, c.index);
+      keyframe->AddMapPoint(lock, point, c.index);
     }
     ++fused;
   }

@@ -84,14 +84,14 @@ TEST_F(MatcherFuseTest, FuseMergesDuplicatesKeepingTheBetterObservedPoint) {
     if (!p || p->observations().size() < 4 || originals.size() == 60) continue;
     const int i3 = p->IndexInKeyFrame(kf3);
     ASSERT_FALSE(p->EraseObservation(lock, kf3));
-    kf3->EraseMapPointMatch(i3);
+    kf3->EraseMapPointMatch(lock, i3);
     auto d = std::make_shared<MapPoint>(
         atlas_.NextMapPointId(), p->position() + Eigen::Vector3d(0.005, -0.003, 0.004), kf3, map);
     map->AddMapPoint(lock, d);
     d->AddObservation(lock, kf3, i3);
-    kf3->AddMapPoint(d, i3);
-    d->ComputeDistinctiveDescriptor();
-    d->UpdateNormalAndDepth();
+    kf3->AddMapPoint(lock, d, i3);
+    d->ComputeDistinctiveDescriptor(lock);
+    d->UpdateNormalAndDepth(lock);
     originals.push_back(p);
     duplicates.push_back(d);
   }
@@ -128,7 +128,7 @@ TEST_F(MatcherFuseTest, FuseAddsMissingObservationsWithinTheReprojectionGate) {
     }
     const int i0 = p->IndexInKeyFrame(kf0);
     ASSERT_FALSE(p->EraseObservation(lock, kf0));
-    kf0->EraseMapPointMatch(i0);
+    kf0->EraseMapPointMatch(lock, i0);
     dropped.push_back(p);
     slots.push_back(i0);
   }
@@ -170,8 +170,8 @@ TEST_F(MatcherFuseTest, FuseIgnoresPointsWhoseDescriptorDiffers) {
     const int other = (i + 1) % kf3->size();
     auto q = std::make_shared<MapPoint>(atlas_.NextMapPointId(), host->position(), kf3, map);
     q->AddObservation(lock, kf3, other);
-    q->ComputeDistinctiveDescriptor();
-    q->UpdateNormalAndDepth();
+    q->ComputeDistinctiveDescriptor(lock);
+    q->UpdateNormalAndDepth(lock);
     impostors.push_back(q);
   }
   ASSERT_EQ(impostors.size(), 40u);
@@ -224,7 +224,7 @@ TEST_F(MatcherFuseTest, LoopFuseWithSim3ReportsReplacementsAndFillsEmptySlots) {
     const MapPointPtr p = kf->map_point(i);
     if (!p || p->observations().size() < 3) continue;
     ASSERT_FALSE(p->EraseObservation(lock, kf));
-    kf->EraseMapPointMatch(i);
+    kf->EraseMapPointMatch(lock, i);
     emptied.insert(i);
   }
   const std::vector<MapPointPtr>& points_b = points_b_;

@@ -87,7 +87,8 @@ TEST_F(MatcherTriangulationTest, PairsAreCorrectAndOneToOne) {
     lock.unlock();
     write.lock();
     for (int i = 0; i < kf1->size(); i += 2) {
-      kf1->AddMapPoint(std::make_shared<MapPoint>(atlas_.NextMapPointId(), Eigen::Vector3d(0, 0, 5),
+      kf1->AddMapPoint(write,
+                       std::make_shared<MapPoint>(atlas_.NextMapPointId(), Eigen::Vector3d(0, 0, 5),
                                                   kf1.get(), nullptr),
                        i);
     }

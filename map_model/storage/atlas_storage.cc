@@ -231,7 +231,7 @@ void AtlasStorage::Restore(const MapWriteLock& lock, const AtlasRecord& record,
       kf->UpdateBestCovisibles();
       if (KeyFrame* parent = keyframe(k.parent, "a spanning-tree parent")) {
         kf->parent_ = parent;
-        parent->AddChild(kf);
+        parent->AddChild(lock, kf);
         kf->first_connection_ = false;
       }
       for (KeyFrameId other : k.loop_edges) {

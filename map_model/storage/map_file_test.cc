@@ -63,8 +63,8 @@ class MapFileTest : public ::testing::Test {
     map()->mutable_imu_status(lock).imu_initialized = true;
     map()->RecordWorldChange(
         lock, {WorldChange::Kind::kTransform, SO3d::Exp(Eigen::Vector3d(0, 0, 1)), 1.5});
-    map_.keyframes[6]->AddLoopEdge(map_.keyframes[1].get());
-    map_.keyframes[1]->AddLoopEdge(map_.keyframes[6].get());
+    map_.keyframes[6]->AddLoopEdge(lock, map_.keyframes[1].get());
+    map_.keyframes[1]->AddLoopEdge(lock, map_.keyframes[6].get());
   }
   Map* map() { return map_.keyframes[0]->map(); }
 

@@ -114,8 +114,8 @@ inline void BuildLoopScenario(const LoopScenarioOptions& o, const SyntheticScene
   auto& kfs = s->synthetic.keyframes;
   // A chain spanning tree (the fixture picks parents by covisibility, which can form cycles).
   for (int k = 1; k < n; ++k) {
-    if (KeyFrame* old = kfs[k]->parent()) old->EraseChild(kfs[k].get());
-    kfs[k]->ChangeParent(kfs[k - 1].get());
+    if (KeyFrame* old = kfs[k]->parent()) old->EraseChild(lock, kfs[k].get());
+    kfs[k]->ChangeParent(lock, kfs[k - 1].get());
   }
   // Cut the covisibility across the loop; remember what fusion will bring back.
   const int lap = o.keyframes_per_lap;
@@ -124,8 +124,8 @@ inline void BuildLoopScenario(const LoopScenarioOptions& o, const SyntheticScene
     for (int j = i + 1; j < n; ++j) {
       if (j - i <= lap / 2) continue;
       if (kfs[i]->Weight(kfs[j].get()) > 0) across.emplace_back(i, j);
-      kfs[i]->EraseConnection(kfs[j].get());
-      kfs[j]->EraseConnection(kfs[i].get());
+      kfs[i]->EraseConnection(lock, kfs[j].get());
+      kfs[j]->EraseConnection(lock, kfs[i].get());
     }
   }
   // Odometry-like drift: every step's relative motion is off by `delta` in the camera frame,
@@ -191,8 +191,8 @@ inline void BuildLoopScenario(const LoopScenarioOptions& o, const SyntheticScene
     for (const auto& mp : kfs[i]->map_points()) {
       if (mp && mp->IsInKeyFrame(kfs[j].get())) ++weight;
     }
-    kfs[i]->AddConnection(kfs[j].get(), weight);
-    kfs[j]->AddConnection(kfs[i].get(), weight);
+    kfs[i]->AddConnection(lock, kfs[j].get(), weight);
+    kfs[j]->AddConnection(lock, kfs[i].get(), weight);
     c.loop_connections[kfs[j]->id()].push_back(kfs[i]->id());
   }
 }
