@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "core/util/log.h"
 #include "imu/preintegration.h"
 #include "map_model/keyframe.h"
@@ -43,6 +45,32 @@ WorldChangesSeen InertialTracking::Follow(const Map& map) {
     last_frame_information_.reset();
   }
   return seen;
+}
+
+void InertialTracking::FollowMap(const Map& map, bool correct_current, TrackedFrames* frames,
+                                 FrameRecords* records) {
+  const WorldChangesSeen seen = Follow(map);
+  if (!seen.ForgetsLastFrame()) return;
+  // Local mapping rotated / rescaled the map after the current frame was tracked: its pose is
+  // in the old world (WorldChangesSeen::single_transform).
+  if (correct_current && frames->current.HasPose() && seen.single_transform) {
+    CarryAcross(*seen.single_transform, &frames->current);
+  }
+  if (seen.scale_ratio) {
+    // Monocular-inertial initialisation rescaled the map: what tracking keeps relative to its
+    // keyframes scales with it.
+    const double ratio = *seen.scale_ratio;
+    records->Rescale(&map, ratio);
+    if (frames->velocity) frames->velocity->translation() *= ratio;
+  }
+}
+
+void InertialTracking::PreintegrateCurrent(const ImuBias& bias, const Frame* pair_first,
+                                           TrackedFrames* frames) {
+  std::int64_t anchor = frames->current.t_ns();
+  if (frames->last_kf) anchor = std::min(anchor, frames->last_kf->t_ns());
+  if (pair_first != nullptr) anchor = std::min(anchor, pair_first->t_ns());
+  Preintegrate(bias, anchor, &frames->current);
 }
 
 bool InertialTracking::Predict(const Frame& last, const KeyFrame* last_keyframe,

@@ -18,9 +18,11 @@
 #include "keyframe/keyframe_selector.h"
 #include "map_model/frame.h"
 #include "map_model/map_ids.h"
+#include "tracking/frame_records.h"
 #include "tracking/imu_buffer.h"
 #include "tracking/inertial_pose_optimizer.h"
 #include "tracking/pose_optimizer.h"
+#include "tracking/tracked_frames.h"
 #include "tracking/world_change_cursor.h"
 
 namespace pkslam {
@@ -45,6 +47,15 @@ class InertialTracking {
   // prediction and optimisation start from the last keyframe; the Tracker carries its own
   // frames and records across what is returned.
   WorldChangesSeen Follow(const Map& map);
+  // Follow, and what tracking keeps moves with what it passed (Atlas lock held): with
+  // `correct_current`, a current frame tracked before a single rotation / rescale of the world
+  // is carried across it; a rescaled map (monocular-inertial initialisation) rescales the
+  // records' poses relative to its keyframes and the motion model.
+  void FollowMap(const Map& map, bool correct_current, TrackedFrames* frames,
+                 FrameRecords* records);
+  // Preintegrate for frames->current at `bias`, keeping the samples the oldest anchor still
+  // needs: the last keyframe, or `pair_first` (a monocular map's first frame, while starting).
+  void PreintegrateCurrent(const ImuBias& bias, const Frame* pair_first, TrackedFrames* frames);
 
   // Predicts `current`'s pose, velocity and bias: from `last` along current's preintegration,
   // or from `last_keyframe` (after a map change, or when the last frame has no state). False

@@ -209,5 +209,65 @@ TEST_F(InertialTrackingTest, AFrameIsCarriedIntoARotatedAndRescaledWorld) {
       1.5 * (change.rotation * Eigen::Vector3d(0.3, -0.2, 0.1)), 1e-12));
 }
 
+TEST_F(InertialTrackingTest, AWorldChangeMovesTheCurrentFrameTheRecordsAndTheMotionModel) {
+  TrackedFrames frames;
+  frames.current = FrameAt(2);
+  frames.current.SetPose(CameraFromWorld(2));
+  frames.velocity = SE3d(SO3d(), Eigen::Vector3d(0.1, 0.2, 0.3));
+  FrameRecords records;
+  FrameRecord record;
+  record.reference = map_.keyframes[1];
+  record.camera_from_reference = SE3d(SO3d(), Eigen::Vector3d(0.04, 0, 0));
+  records.Add(record);
+  const Eigen::Vector3d centre = frames.current.camera_from_world().Inverse().translation();
+  // A second tracker that does not carry its current frame across.
+  InertialTracking other{ImuNoise()};
+  TrackedFrames kept = frames;
+  FrameRecords kept_records = records;
+
+  auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+  Map& map = *atlas_.current_map();
+  tracking_.FollowMap(map, true, &frames, &records);  // the first look: nothing to move
+  other.FollowMap(map, false, &kept, &kept_records);
+  EXPECT_TRUE(frames.current.camera_from_world().Inverse().translation().isApprox(centre));
+  EXPECT_EQ(frames.velocity->translation(), Eigen::Vector3d(0.1, 0.2, 0.3));
+  EXPECT_EQ(records.back().camera_from_reference.translation(), Eigen::Vector3d(0.04, 0, 0));
+
+  WorldChange change;
+  change.kind = WorldChange::Kind::kTransform;
+  change.rotation = SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.3));
+  change.scale = 2.0;
+  map.RecordWorldChange(lock, change);
+  tracking_.FollowMap(map, true, &frames, &records);
+  other.FollowMap(map, false, &kept, &kept_records);
+  EXPECT_TRUE(frames.current.camera_from_world().Inverse().translation().isApprox(
+      2.0 * (change.rotation * centre), 1e-12));
+  EXPECT_TRUE(frames.velocity->translation().isApprox(Eigen::Vector3d(0.2, 0.4, 0.6), 1e-12));
+  EXPECT_TRUE(records.back().camera_from_reference.translation().isApprox(
+      Eigen::Vector3d(0.08, 0, 0), 1e-12));
+  EXPECT_TRUE(kept.current.camera_from_world().Inverse().translation().isApprox(centre))
+      << "without correct_current the frame stays in the world it was tracked in";
+  EXPECT_TRUE(kept.velocity->translation().isApprox(Eigen::Vector3d(0.2, 0.4, 0.6), 1e-12));
+}
+
+TEST_F(InertialTrackingTest, ThePreintegrationKeepsTheSamplesTheOldestAnchorNeeds) {
+  // The last keyframe (50 ms) is the oldest anchor: samples from it on stay, older ones go.
+  TrackedFrames frames;
+  frames.current = FrameAt(4);
+  frames.last_kf = map_.keyframes[1];
+  tracking_.PreintegrateCurrent(ImuBias(), nullptr, &frames);
+  const std::int64_t now = frames.current.t_ns();
+  EXPECT_TRUE(tracking_.samples().Between(frames.last_kf->t_ns(), now, ImuBias()).has_value());
+  EXPECT_FALSE(tracking_.samples().Between(0, now, ImuBias()).has_value());
+  // A monocular map's first frame at 0 s, older than the keyframe, keeps the samples from it.
+  InertialTracking starting{ImuNoise()};
+  starting.samples().Add(testing::SampleImu(motion_, 0, 6 * kKeyFrameStepNs, 5'000'000, ImuBias(),
+                                            *rig_->imu, nullptr));
+  const Frame first = FrameAt(0);
+  TrackedFrames pair = frames;
+  starting.PreintegrateCurrent(ImuBias(), &first, &pair);
+  EXPECT_TRUE(starting.samples().Between(0, now, ImuBias()).has_value());
+}
+
 }  // namespace
 }  // namespace pkslam

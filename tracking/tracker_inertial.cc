@@ -36,29 +36,11 @@ void Tracker::PreintegrateImu() {
     SyncWithInertialMapLocked(/*correct_current=*/false);
     bias = InertialTracking::IntegrationBias(frames_.last, frames_.last_kf.get());
   }
-  // Keep what the oldest anchor still needs.
-  std::int64_t anchor = frames_.current.t_ns();
-  if (frames_.last_kf) anchor = std::min(anchor, frames_.last_kf->t_ns());
-  if (const Frame* first = starter_.pair_first()) anchor = std::min(anchor, first->t_ns());
-  imu_->Preintegrate(bias, anchor, &frames_.current);
+  imu_->PreintegrateCurrent(bias, starter_.pair_first(), &frames_);
 }
 
 void Tracker::SyncWithInertialMapLocked(bool correct_current) {
-  const Map* map = atlas_->current_map();
-  const WorldChangesSeen seen = imu_->Follow(*map);
-  if (!seen.ForgetsLastFrame()) return;
-  // Local mapping rotated / rescaled the map after the current frame was tracked: its pose is
-  // in the old world (WorldChangesSeen::single_transform).
-  if (correct_current && frames_.current.HasPose() && seen.single_transform) {
-    InertialTracking::CarryAcross(*seen.single_transform, &frames_.current);
-  }
-  if (seen.scale_ratio) {
-    // Monocular-inertial initialisation rescaled the map: what tracking keeps relative to its
-    // keyframes scales with it.
-    const double ratio = *seen.scale_ratio;
-    records_.Rescale(map, ratio);
-    if (frames_.velocity) frames_.velocity->translation() *= ratio;
-  }
+  imu_->FollowMap(*atlas_->current_map(), correct_current, &frames_, &records_);
 }
 
 void Tracker::AttachImu(const MapWriteLock& lock, KeyFrame* kf, KeyFrame* previous,
