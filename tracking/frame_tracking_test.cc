@@ -20,13 +20,7 @@ class FrameTrackingTest : public ::testing::Test {
   // A frame of the scene at `camera_from_world` (no pose set), 0.5 px noise.
   Frame At(const SE3d& camera_from_world, FrameId id,
            std::vector<int>* point_of_keypoint = nullptr) const {
-    std::vector<int> unused;
-    if (point_of_keypoint == nullptr) point_of_keypoint = &unused;
-    testing::FrameOptions options;
-    options.pixel_noise = 0.5;
-    options.seed = 40 + id;
-    return testing::MakeFrame(bow_.scene, bow_.rig, camera_from_world, id, id * 50'000'000, options,
-                              point_of_keypoint);
+    return bow_.NoisyFrame(camera_from_world, id, 40 + id, point_of_keypoint);
   }
   // The last frame: at the fourth pose, posed, matched to the map's points.
   Frame LastFrame() const {

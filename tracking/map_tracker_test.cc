@@ -22,13 +22,7 @@ class MapTrackerTest : public ::testing::Test {
   // A frame of the scene at `camera_from_world` (no pose set), 0.5 px noise.
   Frame At(const SE3d& camera_from_world, FrameId id,
            std::vector<int>* point_of_keypoint = nullptr) const {
-    std::vector<int> unused;
-    if (point_of_keypoint == nullptr) point_of_keypoint = &unused;
-    testing::FrameOptions options;
-    options.pixel_noise = 0.5;
-    options.seed = 70 + id;
-    return testing::MakeFrame(bow_.scene, bow_.rig, camera_from_world, id, id * 50'000'000, options,
-                              point_of_keypoint);
+    return bow_.NoisyFrame(camera_from_world, id, 70 + id, point_of_keypoint);
   }
   // The last frame at the fourth keyframe's pose, matched to the map's points, with its record
   // (reference: that keyframe) and the tracked frames around it.

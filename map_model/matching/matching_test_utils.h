@@ -197,6 +197,18 @@ struct StereoBowMap {
         poses(MakeForwardPath(keyframes, 0.15, path_seed)),
         map(MakeBowMap(&atlas, scene, rig, poses, {}, vocabulary, true)) {}
 
+  // A frame of the scene at `camera_from_world` (no pose set), id `id` at id * 50 ms, 0.5 px
+  // noise drawn with `seed`; `point_of_keypoint` (optional) gets each keypoint's scene index.
+  Frame NoisyFrame(const SE3d& camera_from_world, FrameId id, std::uint64_t seed,
+                   std::vector<int>* point_of_keypoint = nullptr) const {
+    std::vector<int> unused;
+    FrameOptions options;
+    options.pixel_noise = 0.5;
+    options.seed = seed;
+    return MakeFrame(scene, rig, camera_from_world, id, id * 50'000'000, options,
+                     point_of_keypoint != nullptr ? point_of_keypoint : &unused);
+  }
+
   SyntheticScene scene;
   Vocabulary vocabulary;
   std::shared_ptr<CameraRig> rig;
