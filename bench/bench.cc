@@ -113,17 +113,14 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
   c.skipped = c.total - static_cast<int>(pending.size());
   if (c.skipped > 0) PKSLAM_LOG_INFO("{} of {} runs already finished: skipped", c.skipped, c.total);
 
-  // With prune_cache the runs of one recipe run together (matrix order within) and each
-  // rendering is made by its first run and deleted after its last.
+  // With prune_cache the runs of one recipe run together (matrix order within), run 1 of every
+  // dataset before run 2 of any (RenderingOrder), and each rendering is made by its first run
+  // and deleted after its last.
   std::map<std::string, int> runs_per_render;
   if (options.prune_cache) {
-    std::map<std::string, std::size_t> first;
-    for (const RunSpec* r : pending) {
-      if (r->sim) first.emplace(SimKey(options, *r), first.size());
-    }
-    auto rank = [&](const RunSpec* r) { return r->sim ? first[SimKey(options, *r)] : 0; };
-    std::stable_sort(pending.begin(), pending.end(),
-                     [&](const RunSpec* a, const RunSpec* b) { return rank(a) < rank(b); });
+    pending = RenderingOrder(std::move(pending), [&](const RunSpec& r) {
+      return r.sim ? std::optional<std::string>(SimKey(options, r)) : std::nullopt;
+    });
     for (const RunSpec* r : pending) {
       if (r->sim) ++runs_per_render[SimKey(options, *r)];
     }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <charconv>
+#include <map>
+#include <utility>
 
 #include "core/util/error.h"
 
@@ -139,6 +141,37 @@ std::vector<RunSpec> SelectSensors(const std::vector<RunSpec>& runs,
   for (const auto& r : runs) {
     if (std::find(sensors.begin(), sensors.end(), r.sensor) != sensors.end()) out.push_back(r);
   }
+  return out;
+}
+
+std::vector<const RunSpec*> RenderingOrder(
+    std::vector<const RunSpec*> runs,
+    const std::function<std::optional<std::string>(const RunSpec&)>& rendering_of) {
+  struct Rank {
+    int lowest_run;
+    std::size_t first;
+  };
+  std::map<std::string, Rank> ranks;
+  std::vector<std::optional<std::string>> keys;
+  keys.reserve(runs.size());
+  for (const RunSpec* r : runs) {
+    keys.push_back(rendering_of(*r));
+    if (!keys.back()) continue;
+    const auto [it, added] = ranks.try_emplace(*keys.back(), Rank{r->run, ranks.size()});
+    if (!added) it->second.lowest_run = std::min(it->second.lowest_run, r->run);
+  }
+  std::vector<std::size_t> order(runs.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  auto rank = [&](std::size_t i) {
+    if (!keys[i]) return std::pair<int, std::size_t>(-1, 0);
+    const Rank& k = ranks.at(*keys[i]);
+    return std::pair<int, std::size_t>(k.lowest_run, k.first);
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return rank(a) < rank(b); });
+  std::vector<const RunSpec*> out;
+  out.reserve(runs.size());
+  for (const std::size_t i : order) out.push_back(runs[i]);
   return out;
 }
 

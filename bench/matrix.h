@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -47,6 +48,15 @@ std::vector<RunSpec> ExpandSuite(const Suite& suite);
 // suite does not run.
 std::vector<RunSpec> SelectSensors(const std::vector<RunSpec>& runs,
                                    const std::vector<std::string>& sensors);
+
+// The runs grouped by rendering (`rendering_of` names a run's rendering; a run without one ranks
+// first), the renderings ordered by the lowest run number among their runs, then by where their
+// first run stands; matrix order within a group. A study pruned as it goes (`--prune-cache`)
+// and stopped after a sitting thus holds run 1 of every dataset before run 2 of any: a balanced
+// partial design, where the plain matrix order would finish all runs of the first datasets.
+std::vector<const RunSpec*> RenderingOrder(
+    std::vector<const RunSpec*> runs,
+    const std::function<std::optional<std::string>(const RunSpec&)>& rendering_of);
 
 // The dataset spec of a run (throws Error when absent).
 const DatasetSpec& DatasetOf(const Suite& suite, const RunSpec& run);
