@@ -20,6 +20,10 @@ made within each pair, on log ATE (a ratio, as the paper's per-cent changes are)
   (Holm p < 0.05) or "not distinguishable"; and "the paper's effect lies outside the interval"
   when the paper's change (-18.1% stereo-inertial, -20.4% mono-inertial) is outside the 95%
   interval. Each verdict is scoped to what ran: realistic renders of the EuRoC trajectories.
+- Power, per analysis: the probability that a t-test at 0.05 (unadjusted; the fixed analysis's
+  sign flip is approximated by its t-interval) with the spread measured here finds the paper's
+  change, and the smallest reduction it finds with 80% probability. A "not distinguishable"
+  with low power says little; with high power it says the paper's effect is not there.
 """
 
 import itertools
@@ -28,7 +32,7 @@ import re
 from collections import OrderedDict
 
 import numpy as np
-from scipy import stats
+from scipy import optimize, stats
 
 ALPHA = 0.05
 PAPER_RATIO = {"stereo-inertial": 1 - 0.181, "mono-inertial": 1 - 0.204}
@@ -36,6 +40,7 @@ FAILED_PENALTY = math.log(2.0)
 EXACT_LIMIT = 16  # pairs: exact sign-flip enumeration up to 2^16 arrangements
 PERMUTATIONS = 20000
 PERMUTATION_SEED = 39
+MAX_NONCENTRALITY = 60.0
 
 # The paper's per-sequence mean ATE (m), ORB-SLAM3 / PKS (../shared/docs/PKS.md).
 PAPER_SEQUENCES = {
@@ -108,14 +113,29 @@ def sign_flip_p(diffs, seed=PERMUTATION_SEED):
     return (extreme + 1) / (PERMUTATIONS + 1), False
 
 
-def fixed_interval(diffs):
-    """95% t-interval of the statistic with the sequences fixed (pooled within-sequence
-    spread of the differences)."""
+def fixed_spread(diffs):
+    """(standard error, degrees of freedom) of the statistic with the sequences fixed: the
+    pooled within-sequence spread of the differences."""
     dof = sum(d.size - 1 for d in diffs)
     if dof <= 0:
-        return math.nan, math.nan
+        return math.nan, 0
     ss = sum(float(((d - d.mean()) ** 2).sum()) for d in diffs)
-    se = math.sqrt(ss / dof * sum(1.0 / d.size for d in diffs)) / len(diffs)
+    return math.sqrt(ss / dof * sum(1.0 / d.size for d in diffs)) / len(diffs), dof
+
+
+def random_spread(diffs):
+    """(standard error, degrees of freedom) of the mean of the per-sequence mean differences."""
+    means = np.array([d.mean() for d in diffs])
+    if means.size < 2:
+        return math.nan, 0
+    return float(means.std(ddof=1)) / math.sqrt(means.size), means.size - 1
+
+
+def fixed_interval(diffs):
+    """95% t-interval of the statistic with the sequences fixed."""
+    se, dof = fixed_spread(diffs)
+    if dof <= 0:
+        return math.nan, math.nan
     half = stats.t.ppf(1 - ALPHA / 2, dof) * se
     m = statistic(diffs)
     return m - half, m + half
@@ -123,18 +143,42 @@ def fixed_interval(diffs):
 
 def random_sequences(diffs):
     """(p, low, high) of a one-sample t-test over the per-sequence mean differences."""
-    means = np.array([d.mean() for d in diffs])
-    if means.size < 2:
+    se, dof = random_spread(diffs)
+    if dof <= 0:
         return math.nan, math.nan, math.nan
-    sd = float(means.std(ddof=1))
-    m = float(means.mean())
-    if sd == 0:
+    m = float(np.mean([d.mean() for d in diffs]))
+    if se == 0:
         return (1.0 if m == 0 else 0.0), m, m
-    se = sd / math.sqrt(means.size)
-    t = m / se
-    p = 2 * float(stats.t.sf(abs(t), means.size - 1))
-    half = stats.t.ppf(1 - ALPHA / 2, means.size - 1) * se
+    p = 2 * float(stats.t.sf(abs(m / se), dof))
+    half = stats.t.ppf(1 - ALPHA / 2, dof) * se
     return p, m - half, m + half
+
+
+def power(effect, se, dof):
+    """Probability that a two-sided t-test at ALPHA with this standard error and these degrees
+    of freedom finds a true log-ratio `effect` (noncentral t). The spread is the one measured,
+    the effect a hypothesis (the paper's), so this is the design's power for that effect, not
+    the "observed power" of the measured change."""
+    if dof <= 0 or not math.isfinite(se):
+        return math.nan
+    if se == 0:
+        return 1.0 if effect != 0 else ALPHA
+    crit = stats.t.ppf(1 - ALPHA / 2, dof)
+    # Beyond 60 standard errors the power is 1 to many digits; scipy's noncentral t fails there.
+    nc = max(-MAX_NONCENTRALITY, min(MAX_NONCENTRALITY, effect / se))
+    with np.errstate(divide="ignore"):  # a tail far beyond the critical value is 0
+        return float(stats.nct.sf(crit, dof, nc) + stats.nct.cdf(-crit, dof, nc))
+
+
+def detectable_pct(se, dof, target=0.8):
+    """The smallest reduction (per cent, negative) found with probability `target`."""
+    if dof <= 0 or not math.isfinite(se):
+        return math.nan
+    if se == 0:
+        return 0.0
+    # Solved in standard errors, where the bracket does not depend on the spread.
+    nc = optimize.brentq(lambda n: power(-n, 1.0, dof) - target, 0.0, MAX_NONCENTRALITY)
+    return pct(-nc * se)
 
 
 def pct(log_value):
@@ -209,14 +253,20 @@ def analyse(rows, pairs=None, seed=PERMUTATION_SEED):
             p_fixed, exact = sign_flip_p(values, seed)
             f_low, f_high = fixed_interval(values)
             p_random, r_low, r_high = random_sequences(values)
+            f_se, f_dof = fixed_spread(values)
+            r_se, r_dof = random_spread(values)
             pooled.append({
                 "sensor": sensor, "config": config, "baseline": baseline,
                 "sequences": len(values), "pairs": int(sum(d.size for d in values)),
                 "change_pct": pct(m), "paper_change_pct": pct(paper),
                 "fixed": {"p": p_fixed, "exact": exact, "low": f_low, "high": f_high,
-                          "ci_low_pct": pct(f_low), "ci_high_pct": pct(f_high)},
+                          "ci_low_pct": pct(f_low), "ci_high_pct": pct(f_high),
+                          "power_paper": power(paper, f_se, f_dof),
+                          "detectable_pct": detectable_pct(f_se, f_dof)},
                 "random": {"p": p_random, "low": r_low, "high": r_high,
-                           "ci_low_pct": pct(r_low), "ci_high_pct": pct(r_high)}})
+                           "ci_low_pct": pct(r_low), "ci_high_pct": pct(r_high),
+                           "power_paper": power(paper, r_se, r_dof),
+                           "detectable_pct": detectable_pct(r_se, r_dof)}})
         for kind in ("fixed", "random"):
             for entry, adjusted in zip(pooled, holm([e[kind]["p"] for e in pooled])):
                 a = entry[kind]
@@ -229,6 +279,10 @@ def analyse(rows, pairs=None, seed=PERMUTATION_SEED):
 
 def fmt_pct(v):
     return f"{v:+.1f}%" if math.isfinite(v) else "n/a"
+
+
+def fmt_share(v):
+    return f"{100 * v:.0f}%" if math.isfinite(v) else "n/a"
 
 
 def fmt_p(v):
@@ -246,7 +300,9 @@ def sentence(e):
             f"{fmt_p(f['p_holm'])} ({'; '.join(f['verdict'])}); flights as a sample: "
             f"[{fmt_pct(r['ci_low_pct'])}, {fmt_pct(r['ci_high_pct'])}], Holm p "
             f"{fmt_p(r['p_holm'])} ({'; '.join(r['verdict'])}). The paper: "
-            f"{fmt_pct(e['paper_change_pct'])} on real EuRoC.")
+            f"{fmt_pct(e['paper_change_pct'])} on real EuRoC; the power to find it here: "
+            f"{fmt_share(f['power_paper'])} with these sequences fixed, "
+            f"{fmt_share(r['power_paper'])} with flights as a sample.")
 
 
 def markdown(result):
@@ -266,6 +322,17 @@ def markdown(result):
             f"{fmt_pct(f['ci_high_pct'])}], {fmt_p(f['p_holm'])} | {'; '.join(f['verdict'])} | "
             f"[{fmt_pct(r['ci_low_pct'])}, {fmt_pct(r['ci_high_pct'])}], {fmt_p(r['p_holm'])} | "
             f"{'; '.join(r['verdict'])} | {fmt_pct(e['paper_change_pct'])} |")
+    lines += ["", "Power: the probability that each analysis finds the paper's change, given the "
+              "spread measured here; and the smallest reduction it finds with 80% probability.",
+              "", "| sensor | comparison | the paper's change | fixed sequences: power, "
+              "detectable | flights as a sample: power, detectable |", "|---|---|---|---|---|"]
+    for e in result["pooled"]:
+        f, r = e["fixed"], e["random"]
+        lines.append(
+            f"| {e['sensor']} | {e['config']} vs {e['baseline']} | "
+            f"{fmt_pct(e['paper_change_pct'])} | {fmt_share(f['power_paper'])}, "
+            f"{fmt_pct(f['detectable_pct'])} | {fmt_share(r['power_paper'])}, "
+            f"{fmt_pct(r['detectable_pct'])} |")
     lines += ["", "| sensor | sequence | comparison | pairs | ATE change [95% interval] | p "
               "(sign flip) | the paper's change |", "|---|---|---|---|---|---|---|"]
     for e in result["per_sequence"]:

@@ -123,6 +123,29 @@ class PairedStatisticsTest(unittest.TestCase):
         self.assertEqual(ps.holm([0.01, math.nan, 0.04])[0], 0.02)
         self.assertTrue(math.isnan(ps.holm([0.01, math.nan, 0.04])[1]))
 
+    def test_power_grows_with_precision_and_is_alpha_without_an_effect(self):
+        paper = math.log(0.819)
+        self.assertAlmostEqual(ps.power(0.0, 0.05, 20), ps.ALPHA, places=9)
+        self.assertGreater(ps.power(paper, 0.01, 20), 0.999)
+        self.assertLess(ps.power(paper, 0.5, 4), 0.1)
+        # Many degrees of freedom: 80% power at (1.96 + 0.84) standard errors.
+        se = 0.02
+        self.assertAlmostEqual(ps.detectable_pct(se, 10000),
+                               100 * (math.exp(-(1.96 + 0.8416) * se) - 1), delta=0.05)
+        # Few sequences need a larger effect than many pairs with the same standard error.
+        self.assertLess(ps.detectable_pct(se, 4), ps.detectable_pct(se, 50))
+        self.assertTrue(math.isnan(ps.power(paper, math.nan, 0)))
+
+    def test_a_study_this_precise_would_find_the_papers_effect(self):
+        noise = lambda d, k: 1.0 + 0.01 * (((5 * k + d) % 3) - 1)  # noqa: E731
+        rows = paired_rows({"orbslam3": render,
+                            "pks": lambda d, k: 0.97 * render(d, k) * noise(d, k)})
+        _, e = self.pooled(rows)
+        self.assertGreater(e["fixed"]["power_paper"], 0.99)
+        self.assertGreater(e["fixed"]["detectable_pct"], -5.0)  # finds a few per cent
+        md = ps.markdown(ps.analyse(rows))
+        self.assertIn("| stereo-inertial | pks vs orbslam3 | -18.1% | 100%, ", md)
+
     def test_markdown_scopes_every_sentence(self):
         rows = paired_rows({"orbslam3": render, "pks": lambda d, k: 0.9 * render(d, k)})
         md = ps.markdown(ps.analyse(rows))
