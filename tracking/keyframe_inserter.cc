@@ -55,6 +55,7 @@ SelectorInput KeyFrameInserter::Decide(const KeyFrameContext& context, const Tra
   decision_.Decide(
       *selector_, in, frames.inliers, [this] { return mapping_->QueueFull(); },
       declined_queue_full);
+  decided_frame_ = in.frame_id;
   return in;
 }
 

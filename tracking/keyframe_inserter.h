@@ -6,6 +6,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 
 #include "core/sensor/camera_rig.h"
 #include "keyframe/keyframe_selector.h"
@@ -53,7 +54,11 @@ class KeyFrameInserter {
   KeyFramePtr Insert(const KeyFrameContext& context, const SelectorInput& input,
                      TrackedFrames* frames);
 
-  const SelectorDecision& decision() const { return decision_.last(); }
+  // The decision made for frame `frame_id`, or null when the last decision was another frame's
+  // (a frame tracked in localisation mode, switched on at run time, has none).
+  const SelectorDecision* DecisionFor(FrameId frame_id) const {
+    return decided_frame_ == frame_id ? &decision_.last() : nullptr;
+  }
   const std::vector<KeyFrameTraceRow>& trace() const { return decision_.trace(); }
   void EnableTrace(bool on) { decision_.EnableTrace(on); }
 
@@ -64,6 +69,7 @@ class KeyFrameInserter {
   MappingBackend* mapping_;
   const TrackingOptions& options_;
   KeyFrameDecision decision_;
+  std::optional<FrameId> decided_frame_;  // the frame decision_.last() was made for
 };
 
 }  // namespace pkslam

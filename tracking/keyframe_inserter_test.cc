@@ -108,7 +108,8 @@ TEST_F(KeyFrameInserterTest, AnInsertedKeyFrameJoinsTheMapLocalMappingAndTheSele
   KeyFrameInserter inserter = MakeInserter();
   bool declined = false;
   const SelectorInput input = Decide(&inserter, &declined);
-  ASSERT_TRUE(inserter.decision().insert);
+  ASSERT_NE(inserter.DecisionFor(frames_.current.id()), nullptr);
+  ASSERT_TRUE(inserter.DecisionFor(frames_.current.id())->insert);
   EXPECT_FALSE(declined);
   EXPECT_EQ(input.frame_id, frames_.current.id());
   EXPECT_EQ(input.inliers, frames_.inliers);
@@ -159,11 +160,23 @@ TEST_F(KeyFrameInserterTest, AFullQueueTurnsTheKeyFrameDownAndSaysSo) {
   bool declined = false;
   Decide(&inserter, &declined);
   ASSERT_EQ(selector_.decided.size(), 1u) << "the selector still decides";
-  EXPECT_FALSE(inserter.decision().insert);
+  ASSERT_NE(inserter.DecisionFor(frames_.current.id()), nullptr);
+  EXPECT_FALSE(inserter.DecisionFor(frames_.current.id())->insert);
   EXPECT_TRUE(declined);
   ASSERT_EQ(inserter.trace().size(), 1u);
   EXPECT_EQ(inserter.trace()[0].frame_id, frames_.current.id());
   EXPECT_FALSE(inserter.trace()[0].decision.insert);
+}
+
+TEST_F(KeyFrameInserterTest, ADecisionBelongsToTheFrameItWasMadeFor) {
+  KeyFrameInserter inserter = MakeInserter();
+  EXPECT_EQ(inserter.DecisionFor(frames_.current.id()), nullptr) << "nothing decided yet";
+  bool declined = false;
+  Decide(&inserter, &declined);
+  EXPECT_NE(inserter.DecisionFor(frames_.current.id()), nullptr);
+  // The next frame, tracked without a decision (localisation mode switched on at run time),
+  // must not act on this one's: it would insert, interrupt local BA and count its reasons again.
+  EXPECT_EQ(inserter.DecisionFor(frames_.current.id() + 1), nullptr);
 }
 
 }  // namespace

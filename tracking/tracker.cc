@@ -209,18 +209,21 @@ SelectorInput Tracker::DecideKeyFrame(bool mapping_idle, TrackResult* result) {
 }
 
 bool Tracker::ActOnDecision(const SelectorInput& selector_input, TrackResult* result) {
-  const SelectorDecision& decision = inserter_.decision();
+  // Localisation decides nothing; the last decision is an earlier frame's.
+  const SelectorDecision* decision = inserter_.DecisionFor(frames_.current.id());
   bool new_keyframe = false;
-  if (decision.interrupt_local_ba) mapping_->InterruptBundleAdjustment();
-  if (decision.insert && !options_.localise_only) {
+  if (decision != nullptr && decision->interrupt_local_ba) mapping_->InterruptBundleAdjustment();
+  if (decision != nullptr && decision->insert) {
     inserter_.Insert(KeyFrameContextNow(), selector_input, &frames_);
     new_keyframe = true;
   }
   // Outliers went into the keyframe (BA decides on them), not into the next frame's pose.
   DropOutlierMatches(&frames_.current);
-  result->keyframe_reason = decision.reason;
-  result->selector_decided = !options_.localise_only;
-  result->criteria_held = CriteriaHeld(decision);
+  if (decision != nullptr) {
+    result->keyframe_reason = decision->reason;
+    result->selector_decided = true;
+    result->criteria_held = CriteriaHeld(*decision);
+  }
   return new_keyframe;
 }
 
