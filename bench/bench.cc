@@ -110,6 +110,11 @@ std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& 
         static_cast<int>(finished.size()), options.jobs, cancel,
         [&](int i) { ReevaluateRun(suite, *finished[i], options); }, [&](int) { progress.Add(); });
   }
+  std::set<std::string> pending_peers;
+  for (const RunSpec* r : pending) {
+    if (!r->peer_command.empty()) pending_peers.insert(r->config);
+  }
+  CheckPeerCommands(suite, pending_peers);
   c.skipped = c.total - static_cast<int>(pending.size());
   if (c.skipped > 0) PKSLAM_LOG_INFO("{} of {} runs already finished: skipped", c.skipped, c.total);
 

@@ -341,7 +341,14 @@ std::optional<RunResult> ExecuteRun(const Suite& suite, const RunSpec& run,
   }
   const fs::path log = run_dir / (peer ? "peer.log" : "pkslam.log");
   std::ofstream(run_dir / "command.txt") << ShellCommand(argv) << '\n';
-  const ProcessResult p = RunProcess(argv, log, suite.timeout_s, cancel);
+  ProcessResult p;
+  try {
+    p = RunProcess(argv, log, suite.timeout_s, cancel);
+  } catch (const Error& e) {  // it could not be started: this run failed, not the bench
+    result.error = e.what();
+    WriteResult(run_dir, result);
+    return result;
+  }
   if (cancel != nullptr && cancel->load()) return std::nullopt;
   result.provenance = ProvenanceOf(options, run_dir, peer);
   if (!p.ok()) {

@@ -26,7 +26,8 @@ struct HarnessOptions {
   bool retry_failed = false;     // re-execute runs whose result.csv says failed
   bool reevaluate = false;       // measure finished runs again (new evaluation code or truth)
   // Render each simulator recipe just before its first pending run, execute the runs of one
-  // recipe together, and delete the rendering when its last pending run finished: disk holds
+  // recipe together (run 1 of every dataset before run 2 of any: RenderingOrder), and delete
+  // the rendering when its last pending run finished: disk holds
   // about `jobs` renderings at a time (a study with per-run render seeds of full EuRoC replays
   // would otherwise need ~2 GB per run).
   bool prune_cache = false;

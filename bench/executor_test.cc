@@ -4,6 +4,8 @@
 
 #include <fstream>
 
+#include "bench/matrix.h"
+#include "bench/suite.h"
 #include "core/util/error.h"
 #include "tests/support/test_data.h"
 
@@ -51,6 +53,29 @@ TEST(ExecutableId, HashesTheContentAndNamesAnUnreadableFile) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("missing"), std::string::npos) << e.what();
   }
+}
+
+// A peer that cannot be started fails its own run (with the reason), not the whole bench.
+TEST(ExecuteRun, APeerThatCannotStartIsAFailedRun) {
+  const fs::path dir = testing::MakeTempDir("peer_cannot_start");
+  fs::create_directories(dir / "data");
+  const Suite suite = ParseSuite(
+      "runs: 1\nsensors: [stereo]\nselectors: []\npeers:\n"
+      "  - {label: p, command: [" +
+          (dir / "no_such_peer").string() +
+          ", '{dataset}']}\ndatasets:\n  - {name: a, path: " + (dir / "data").string() + "}\n",
+      dir / "suite.yaml");
+  const auto runs = ExpandSuite(suite);
+  ASSERT_EQ(runs.size(), 1u);
+  HarnessOptions options;
+  options.pkslam = "/bin/true";
+  options.out = dir / "out";
+  options.cache = dir / "cache";
+  const auto result = ExecuteRun(suite, runs[0], options, nullptr);
+  ASSERT_TRUE(result.has_value());
+  EXPECT_FALSE(result->ok);
+  EXPECT_NE(result->error.find("no_such_peer"), std::string::npos) << result->error;
+  EXPECT_TRUE(fs::exists(RunDir(options.out, runs[0]) / "result.csv"));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "bench/suite.h"
 
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -203,6 +204,7 @@ PeerSpec ParsePeer(const Context& c, const YAML::Node& node) {
   if (p.label.empty() || p.label.find_first_of("/\\ \t@") != std::string::npos) {
     c.Fail(node, "peer label '" + p.label + "' must be non-empty without '/', '@' or spaces");
   }
+  p.line = c.Line(node);
   p.command = StringList(c, node["command"], "command");
   if (p.command.empty() || p.command.front().empty()) c.Fail(node, "peer command is empty");
   if (node["sensors"]) p.sensors = StringList(c, node["sensors"], "sensors");
@@ -355,6 +357,47 @@ Suite ParseSuite(const std::string& text, const fs::path& file) {
   }
   Validate(c, root, s);
   return s;
+}
+
+namespace {
+
+bool Executable(const fs::path& file) {
+  return fs::is_regular_file(file) && access(file.c_str(), X_OK) == 0;
+}
+
+// A bare program name as posix_spawnp finds it: the first executable of that name on PATH.
+bool OnPath(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path != nullptr ? path : "/usr/bin:/bin");
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    if (Executable(fs::path(dir.empty() ? "." : dir) / name)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+void CheckPeerCommands(const Suite& suite, const std::set<std::string>& peers) {
+  const std::string suite_dir = fs::absolute(suite.file).parent_path().string();
+  for (const PeerSpec& p : suite.peers) {
+    if (peers.count(p.label) == 0) continue;
+    auto fail = [&](const std::string& what) {
+      throw InputError(suite.file, p.line, "peer '" + p.label + "': " + what);
+    };
+    for (std::size_t i = 0; i < p.command.size(); ++i) {
+      const std::string& word = p.command[i];
+      const auto at = word.find("{suite_dir}");
+      const std::string file =
+          at == std::string::npos ? word : word.substr(0, at) + suite_dir + word.substr(at + 11);
+      if (i == 0) {
+        const bool found = file.find('/') == std::string::npos ? OnPath(file) : Executable(file);
+        if (!found) fail("cannot run '" + file + "' (no such executable file)");
+      } else if (at != std::string::npos && !fs::exists(file)) {
+        fail("'" + file + "' does not exist");
+      }
+    }
+  }
 }
 
 Suite ReadSuite(const fs::path& file) {

@@ -33,6 +33,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,7 @@ struct PeerSpec {
   // The sensors it runs (empty: every sensor of the suite); others are skipped, not failed
   // (the ORB-SLAM3 peer has no RGB-D mode).
   std::vector<std::string> sensors;
+  std::size_t line = 0;  // in the suite file (messages)
 };
 
 struct Suite {
@@ -135,5 +137,12 @@ Suite ReadSuite(const std::filesystem::path& file);
 // The same from text (file only names the source in messages; relative paths resolve
 // against its directory).
 Suite ParseSuite(const std::string& text, const std::filesystem::path& file);
+
+// Before a bench starts its runs: every peer's program can be started (a path exists and is
+// executable; a bare name is on PATH) and every file it names beside the suite
+// ("{suite_dir}/...") exists. Throws InputError naming the suite file and the peer's line, so
+// a mistyped path stops a study at once, not as failed runs hours in. `peers`: the labels
+// checked (those with runs to do).
+void CheckPeerCommands(const Suite& suite, const std::set<std::string>& peers);
 
 }  // namespace pkslam::bench

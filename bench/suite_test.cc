@@ -4,10 +4,13 @@
 #include <stdlib.h>
 
 #include <algorithm>
+#include <fstream>
+#include <set>
 
 #include "bench/executor.h"
 #include "bench/matrix.h"
 #include "core/util/error.h"
+#include "tests/support/test_data.h"
 
 namespace pkslam::bench {
 namespace {
@@ -287,6 +290,62 @@ datasets:
             "/cache/a-seed1-0abc/settings.yaml");
   EXPECT_EQ(settings_of(RunArguments(s, runs[1], "/data/b", "out")),
             fs::absolute("dir/conf/b.yaml").string());
+}
+
+// A peer's program and the files beside the suite it names are checked before a bench starts.
+TEST(Suite, APeerWhosePathsAreMissingStopsTheBenchAtOnce) {
+  const fs::path dir = testing::MakeTempDir("peer_paths");
+  const fs::path script = dir / "run_peer";
+  std::ofstream(script) << "#!/bin/sh\n";
+  fs::permissions(script, fs::perms::owner_all);
+  const std::string head =
+      "sensors: [stereo]\nselectors: [orbslam3]\ndatasets: [{name: a, path: /a}]\n";
+  const auto suite = [&](const std::string& peers) {
+    return ParseSuite(head + "peers:\n" + peers, dir / "suite.yaml");
+  };
+  const Suite good = suite(
+      "  - {label: p, command: [bash, '{suite_dir}/run_peer', '{dataset}']}\n"
+      "  - {label: q, command: ['{suite_dir}/run_peer']}\n");
+  EXPECT_NO_THROW(CheckPeerCommands(good, {"p", "q"}));
+  const Suite bad = suite(
+      "  - {label: p, command: [bash, '{suite_dir}/run_peer']}\n"
+      "  - {label: q, command: ['{suite_dir}/../studies/run_peer', '{dataset}']}\n"
+      "  - {label: r, command: [bash, '{suite_dir}/missing_script']}\n"
+      "  - {label: s, command: [no-such-program-pkslam]}\n");
+  EXPECT_NO_THROW(CheckPeerCommands(bad, {"p"}));
+  EXPECT_NO_THROW(CheckPeerCommands(bad, {})) << "peers with nothing to run are not checked";
+  const auto expect = [&](const std::string& label, std::size_t line, const std::string& what) {
+    try {
+      CheckPeerCommands(bad, {label});
+      FAIL() << "no error for peer " << label;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.line(), line) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("suite.yaml"), std::string::npos) << e.what();
+    }
+  };
+  expect("q", 6, "studies/run_peer");
+  expect("r", 7, "missing_script' does not exist");
+  expect("s", 8, "cannot run 'no-such-program-pkslam'");
+}
+
+// The suites the repository ships read, and their peers' scripts are where they say.
+TEST(Suite, EveryShippedSuiteReadsAndItsPeersCanStart) {
+  setenv("EUROC_ROOT", "/euroc", 0);  // suites of recorded data name their folder by these
+  setenv("PKSLAM_CALIBRATION_RENDERS", "/renders", 0);
+  int suites = 0, peers = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(PKSLAM_SOURCE_DIR) / "bench/suites")) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Suite s = ReadSuite(entry.path());
+    std::set<std::string> labels;
+    for (const PeerSpec& p : s.peers) labels.insert(p.label);
+    EXPECT_NO_THROW(CheckPeerCommands(s, labels));
+    ++suites;
+    peers += static_cast<int>(labels.size());
+  }
+  EXPECT_GT(suites, 10);
+  EXPECT_GT(peers, 4);
 }
 
 TEST(Suite, BadPeersAreErrors) {
