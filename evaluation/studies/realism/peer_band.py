@@ -5,6 +5,11 @@ coverage and failures, the peer's ratio to
 its published real-EuRoC ATE (the preset's bar: 0.5x to 2x) and pkslam's ratio to the peer.
 
   /usr/bin/python3 evaluation/studies/realism/peer_band.py bench-realism/results.csv [--md OUT.md]
+      [--configs orbslam3-peer,orbslam3,pks]
+
+Any bench with the peer reads: the PKS study's (bench/suites/pks-study-eleven.yaml, euroc preset,
+5 runs, Sim(3) as its own alignment) too, since the table uses each run's SE(3) ATE column;
+--configs keeps the columns named.
 """
 import argparse
 import csv
@@ -32,15 +37,11 @@ def sequence_key(dataset):
     return None
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument('results')
-    ap.add_argument('--md', help='also write the table as markdown here')
-    args = ap.parse_args()
+def band_table(rows, configs=None):
+    """(markdown lines, in band, checked) for results.csv rows; `configs` limits the columns."""
     runs = defaultdict(list)
-    with open(args.results) as f:
-        for row in csv.DictReader(f):
+    for row in rows:
+        if configs is None or row['config'] in configs:
             runs[(row['dataset'], row['sensor'], row['config'])].append(row)
     configs = sorted({k[2] for k in runs}, key=lambda c: (c != PEER, c))
     lines = ['| sequence | sensor | published | ' +
@@ -86,6 +87,23 @@ def main():
                      ' | '.join(cells) + f' | {ratio_cell} | {band_cell} | ' + ' | '.join(rel) +
                      ' |')
     lines.append(f'\npeer within 0.5x-2x of its published value: {in_band} of {checked}')
+    return lines, in_band, checked
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('results')
+    ap.add_argument('--md', help='also write the table as markdown here')
+    ap.add_argument('--configs', help='comma-separated columns to keep (default: every one)')
+    args = ap.parse_args()
+    try:
+        with open(args.results, newline='') as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        sys.exit(f'peer_band: {args.results}: {e.strerror}')
+    configs = set(args.configs.split(',')) if args.configs else None
+    lines, _, _ = band_table(rows, configs)
     text = '\n'.join(lines)
     print(text)
     if args.md:
