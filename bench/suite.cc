@@ -8,6 +8,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include "core/util/error.h"
 
@@ -387,9 +388,11 @@ void CheckPeerCommands(const Suite& suite, const std::set<std::string>& peers) {
     };
     for (std::size_t i = 0; i < p.command.size(); ++i) {
       const std::string& word = p.command[i];
-      const auto at = word.find("{suite_dir}");
-      const std::string file =
-          at == std::string::npos ? word : word.substr(0, at) + suite_dir + word.substr(at + 11);
+      constexpr std::string_view kSuiteDir = "{suite_dir}";  // as PeerArguments fills it in
+      const auto at = word.find(kSuiteDir);
+      const std::string file = at == std::string::npos ? word
+                                                       : word.substr(0, at) + suite_dir +
+                                                             word.substr(at + kSuiteDir.size());
       if (i == 0) {
         const bool found = file.find('/') == std::string::npos ? OnPath(file) : Executable(file);
         if (!found) fail("cannot run '" + file + "' (no such executable file)");
