@@ -8,8 +8,8 @@
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <string_view>
 
+#include "bench/peer_import.h"
 #include "core/util/error.h"
 
 namespace pkslam::bench {
@@ -380,25 +380,22 @@ bool OnPath(const std::string& name) {
 }  // namespace
 
 void CheckPeerCommands(const Suite& suite, const std::set<std::string>& peers) {
-  const std::string suite_dir = fs::absolute(suite.file).parent_path().string();
+  const fs::path suite_dir = fs::absolute(suite.file).parent_path();
   for (const PeerSpec& p : suite.peers) {
     if (peers.count(p.label) == 0) continue;
     auto fail = [&](const std::string& what) {
       throw InputError(suite.file, p.line, "peer '" + p.label + "': " + what);
     };
-    for (std::size_t i = 0; i < p.command.size(); ++i) {
-      const std::string& word = p.command[i];
-      constexpr std::string_view kSuiteDir = "{suite_dir}";  // as PeerArguments fills it in
-      const auto at = word.find(kSuiteDir);
-      const std::string file = at == std::string::npos ? word
-                                                       : word.substr(0, at) + suite_dir +
-                                                             word.substr(at + kSuiteDir.size());
-      if (i == 0) {
-        const bool found = file.find('/') == std::string::npos ? OnPath(file) : Executable(file);
-        if (!found) fail("cannot run '" + file + "' (no such executable file)");
-      } else if (at != std::string::npos && !fs::exists(file)) {
-        fail("'" + file + "' does not exist");
-      }
+    // The command as the executor will fill it in, the run's own placeholders left as they are.
+    const std::vector<std::string> argv =
+        PeerArguments(p.command, "{dataset}", "{sensor}", "{out}", 0, suite_dir);
+    const std::string& program = argv.front();
+    const bool found =
+        program.find('/') == std::string::npos ? OnPath(program) : Executable(program);
+    if (!found) fail("cannot run '" + program + "' (no such executable file)");
+    for (std::size_t i = 1; i < argv.size(); ++i) {
+      const bool beside_suite = p.command[i].find("{suite_dir}") != std::string::npos;
+      if (beside_suite && !fs::exists(argv[i])) fail("'" + argv[i] + "' does not exist");
     }
   }
 }
