@@ -18,6 +18,25 @@ std::string FormatDuration(double seconds) {
 
 }  // namespace
 
+namespace progress_detail {
+
+bool PlainLineDue(int percent, int last_percent_printed, double seconds_since_last_line) {
+  if (percent < 0) return false;  // unknown total: only forced lines
+  if (percent / 5 != last_percent_printed / 5) return true;
+  // Slow items: a line per item after a quiet minute (an ETA an hour out is worth updating).
+  constexpr double kQuietSeconds = 60.0;
+  return seconds_since_last_line >= kQuietSeconds;
+}
+
+std::string FormatRate(double items_per_second) {
+  if (items_per_second > 0 && items_per_second < 0.1) {
+    return FormatDuration(1.0 / items_per_second) + " each";
+  }
+  return fmt::format("{:.1f}/s", items_per_second);
+}
+
+}  // namespace progress_detail
+
 Progress::Progress(std::string label, std::size_t total, bool quiet)
     : label_(std::move(label)),
       total_(total),
@@ -53,8 +72,9 @@ void Progress::Draw(bool force) {
   if (tty_) {
     if (!force && now - last_draw_ < std::chrono::milliseconds(100)) return;
   } else {
-    // Plain logs: one line per 5% step (or per call when the total is unknown and forced).
-    if (!force && (total_ == 0 || percent / 5 == last_percent_printed_ / 5)) return;
+    // Plain logs: see progress_detail::PlainLineDue (and forced lines, e.g. the last one).
+    const double quiet_s = std::chrono::duration<double>(now - last_draw_).count();
+    if (!force && !progress_detail::PlainLineDue(percent, last_percent_printed_, quiet_s)) return;
   }
   last_draw_ = now;
   last_percent_printed_ = percent;
@@ -63,11 +83,11 @@ void Progress::Draw(bool force) {
     constexpr int kWidth = 30;
     const int filled = std::min(kWidth, percent * kWidth / 100);
     const double eta = rate > 0 ? static_cast<double>(total_ - std::min(done_, total_)) / rate : -1;
-    line = fmt::format("{} [{}{}] {:3}% {}/{} {:.1f}/s ETA {}", label_, std::string(filled, '#'),
-                       std::string(kWidth - filled, '.'), percent, done_, total_, rate,
-                       FormatDuration(eta));
+    line = fmt::format("{} [{}{}] {:3}% {}/{} {} ETA {}", label_, std::string(filled, '#'),
+                       std::string(kWidth - filled, '.'), percent, done_, total_,
+                       progress_detail::FormatRate(rate), FormatDuration(eta));
   } else {
-    line = fmt::format("{} {} done {:.1f}/s elapsed {}", label_, done_, rate,
+    line = fmt::format("{} {} done {} elapsed {}", label_, done_, progress_detail::FormatRate(rate),
                        FormatDuration(elapsed));
   }
   if (!suffix_.empty()) line += "  " + suffix_;

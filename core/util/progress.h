@@ -1,6 +1,8 @@
 // Progress line for long work (simulation, runs, sweeps, training, fusion).
 // Prints "label  [#####.....]  42% 123/290  12.3/s  ETA 0:14" to stderr, redrawn in place
-// when stderr is a terminal and every ~5% as plain lines otherwise (logs stay readable).
+// when stderr is a terminal and as plain lines otherwise (logs stay readable): one per 5% step,
+// and for slow work (a bench's runs take minutes) also one per finished item once a minute has
+// passed since the last line, so a log of a study never goes quiet for long.
 #pragma once
 
 #include <chrono>
@@ -8,6 +10,13 @@
 #include <string>
 
 namespace pkslam {
+
+namespace progress_detail {
+// Plain (non-terminal) output: is a line due for an item finished now?
+bool PlainLineDue(int percent, int last_percent_printed, double seconds_since_last_line);
+// "12.3/s" for fast work, "2:05 each" when an item takes more than ten seconds.
+std::string FormatRate(double items_per_second);
+}  // namespace progress_detail
 
 class Progress {
  public:
