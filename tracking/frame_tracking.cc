@@ -50,7 +50,7 @@ int MatchLastFramePredicted(const Frame& last, const TrackingOptions& options, b
   return MatchLastFrame(last, radius, monocular, options.min_matches_motion_model, frame);
 }
 
-int CountLocalMapInliers(bool stereo, Frame* frame) {
+int CountLocalMapInliers(bool drop_outliers, Frame* frame) {
   int inliers = 0;
   for (int i = 0; i < frame->size(); ++i) {
     const auto& mp = frame->map_points[i];
@@ -58,7 +58,7 @@ int CountLocalMapInliers(bool stereo, Frame* frame) {
     if (!frame->outliers[i]) {
       mp->IncreaseFound();
       if (mp->NumObservations() > 0) ++inliers;
-    } else if (stereo) {
+    } else if (drop_outliers) {
       frame->map_points[i].reset();
     }
   }

@@ -33,10 +33,11 @@ int MatchLastFrame(const Frame& last, double radius, bool monocular, int min_mat
 int MatchLastFramePredicted(const Frame& last, const TrackingOptions& options, bool monocular,
                             Frame* frame);
 
-// After the local map's pose optimisation: every inlier's point was found once more, a stereo
-// frame forgets its outliers' matches (a monocular one keeps them for its keyframe's BA).
+// After the local map's pose optimisation: every inlier's point was found once more; with
+// `drop_outliers` (ORB-SLAM3: plain stereo only) the outliers' matches are forgotten now, else
+// they stay for a new keyframe's BA and go after the keyframe decision (Tracker::ActOnDecision).
 // Returns the inliers to points in the map.
-int CountLocalMapInliers(bool stereo, Frame* frame);
+int CountLocalMapInliers(bool drop_outliers, Frame* frame);
 
 // Matches of the last frame to points local mapping fused into others follow them.
 void FollowReplacedPoints(Frame* frame);

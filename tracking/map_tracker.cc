@@ -106,7 +106,9 @@ bool MapTracker::TrackLocalMap(TrackingState state, bool imu_ready, TrackedFrame
   local_map_.Search(&current, *rig_, radius);
   current.outliers.assign(current.size(), 0);
   OptimizePose(imu_ready, frames);
-  const int inliers = CountLocalMapInliers(IsStereo(rig_->sensor), &current);
+  // Stereo-inertial keeps its outliers' matches until the keyframe decision, as ORB-SLAM3 does
+  // (it drops them here for plain stereo only): a new keyframe then carries them to its BA.
+  const int inliers = CountLocalMapInliers(rig_->sensor == Sensor::kStereo, &current);
   frames->inliers = inliers;
   const int confirming_frames = static_cast<int>(rig_->fps + 0.5);
   if (frames->WithinFramesOfRelocalisation(confirming_frames) &&

@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <utility>
 #include <vector>
 
+#include "core/sensor/camera_rig.h"
 #include "map_model/keyframe.h"
 #include "map_model/keyframe_database.h"
 #include "map_model/map_editor.h"
@@ -151,6 +153,42 @@ TEST_F(MapTrackerTest, ARecentlyLostFrameNeedsOnlyAFewInliers) {
   EXPECT_FALSE(tracker.TrackLocalMap(TrackingState::kOk, false, &frames));
   EXPECT_GT(frames.inliers, 10);
   EXPECT_TRUE(tracker.TrackLocalMap(TrackingState::kRecentlyLost, false, &lost));
+}
+
+TEST_F(MapTrackerTest, StereoInertialKeepsOutlierMatchesForItsKeyFrameAndStereoDropsThem) {
+  // ORB-SLAM3's TrackLocalMap forgets an outlier's match at once only for plain stereo; with an
+  // IMU the match stays until the keyframe decision, so a new keyframe carries it (its BA
+  // decides) and only the next frame's pose goes without it.
+  for (const Sensor sensor : {Sensor::kStereo, Sensor::kStereoInertial}) {
+    auto rig = std::make_shared<CameraRig>(*bow_.rig);
+    rig->sensor = sensor;
+    TrackedFrames frames = AfterLastFrame();
+    frames.current = At(Moved(bow_.poses[3], 0.02), 54);
+    frames.velocity = Moved(SE3d(), 0.02);
+    MapTracker tracker(&bow_.atlas, &bow_.vocabulary, options_, rig, nullptr);
+    auto lock = MapReader(bow_.atlas).Lock();
+    ASSERT_TRUE(tracker.TrackWithMotionModel(record_, &frames));
+    // 20 pairs of matched keypoints swap their points: wrong matches, outliers of the pose.
+    std::vector<int> matched;
+    for (int i = 0; i < frames.current.size(); ++i) {
+      if (frames.current.map_points[i]) matched.push_back(i);
+    }
+    ASSERT_GT(matched.size(), 100u);
+    for (std::size_t k = 0; k < 20; ++k) {
+      std::swap(frames.current.map_points[matched[k]],
+                frames.current.map_points[matched[matched.size() - 1 - k]]);
+    }
+    ASSERT_TRUE(tracker.TrackLocalMap(TrackingState::kOk, false, &frames));
+    int matched_outliers = 0;
+    for (int i = 0; i < frames.current.size(); ++i) {
+      if (frames.current.map_points[i] && frames.current.outliers[i]) ++matched_outliers;
+    }
+    if (sensor == Sensor::kStereo) {
+      EXPECT_EQ(matched_outliers, 0);
+    } else {
+      EXPECT_GE(matched_outliers, 20) << "of the 40 swapped matches";
+    }
+  }
 }
 
 }  // namespace
