@@ -130,6 +130,11 @@ def created_per_minute(rows):
     return sum(rates) / len(rates) if rates else math.nan
 
 
+def number(x, digits):
+    """x with `digits` decimals, or a dash when there is none (a configuration without runs)."""
+    return f"{x:.{digits}f}" if math.isfinite(x) else "—"
+
+
 def rate_table(rows, datasets, sensors, pairs):
     lines = ["| sequence | sensor | configuration | keyframes created / min | beside | ratio | "
              "within 10% |", "|---|---|---|---|---|---|---|"]
@@ -145,8 +150,8 @@ def rate_table(rows, datasets, sensors, pairs):
                 ratio = ra / rb if math.isfinite(ra) and math.isfinite(rb) and rb > 0 else math.nan
                 within = ("yes" if abs(ratio - 1) <= RATE_TOLERANCE + 1e-9 else "**no**") \
                     if math.isfinite(ratio) else "—"
-                lines.append(f"| {short(dataset)} | {sensor} | {a} | {ra:.1f} | {b} {rb:.1f} | "
-                             f"{ratio:.2f} | {within} |")
+                lines.append(f"| {short(dataset)} | {sensor} | {a} | {number(ra, 1)} | "
+                             f"{b} {number(rb, 1)} | {number(ratio, 2)} | {within} |")
     return lines
 
 

@@ -70,6 +70,11 @@ class StudyTablesTest(unittest.TestCase):
         self.assertIn("| stereo-inertial | pks vs orbslam3 | 2 | 8 |", text)
         self.assertIn("| MH_01 | stereo-inertial | pks | 33.0 | orbslam3 30.0 | 1.10 | yes |",
                       text)
+        # A partner without runs (a study stopped part-way): dashes, not "nan".
+        out = self.run_tables("--rate-pairs", "pks:pks-authors")
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertIn("| MH_01 | stereo-inertial | pks | 33.0 | pks-authors — | — | — |", out.stdout)
+        self.assertNotIn("nan", out.stdout)
         bad = self.run_tables("--rate-pairs", "pks")
         self.assertNotEqual(bad.returncode, 0)
 
