@@ -94,8 +94,8 @@ def summary_table(rows, sensors, configs):
                 f"{mean([r['ate'] for r in ok]):.4f} | "
                 f"{mean([num(r['raw']['ate_se3_rmse_m']) for r in ok]):.4f} | "
                 f"{mean([num(r['raw']['keyframes']) for r in g]):.0f} | "
-                f"{mean([num(r['raw']['cpu_s']) for r in g]):.0f} | "
-                f"{mean([num(r['raw']['mapping_cpu_s']) for r in g]):.0f} |")
+                f"{number(mean([num(r['raw']['cpu_s']) for r in g]), 0)} | "
+                f"{number(mean([num(r['raw']['mapping_cpu_s']) for r in g]), 0)} |")
     return lines
 
 
