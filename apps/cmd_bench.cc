@@ -41,6 +41,7 @@ struct BenchArgs {
   std::vector<std::string> collect;
   std::vector<std::string> run_ids;
   std::vector<std::string> sensors;
+  std::vector<std::string> configs;
   std::string pkslam;
   std::string python = "/usr/bin/python3";
   int jobs = 1;
@@ -111,7 +112,8 @@ void Run(const BenchArgs& a) {
   if (a.suite.empty()) throw OptionError("a SUITE file is required (or --collect DIR)");
   const bench::Suite suite = bench::ReadSuite(a.suite);
   const auto all = bench::ExpandSuite(suite);
-  const auto runs = bench::SelectRuns(bench::SelectSensors(all, a.sensors), a.run_ids);
+  const auto runs = bench::SelectRuns(
+      bench::SelectConfigs(bench::SelectSensors(all, a.sensors), a.configs), a.run_ids);
   if (a.list) {
     for (const auto& r : runs) std::cout << r.id << '\n';
     return;
@@ -200,6 +202,10 @@ void RegisterBenchCommand(CLI::App& app) {
   cmd->add_option("--sensor", args->sensors,
                   "Only the runs of these sensors (a study split over sittings, one sensor "
                   "first; the report covers the runs selected)");
+  cmd->add_option("--config", args->configs,
+                  "Only the runs of these configurations: labels, or `peers` / `pkslam` for "
+                  "every peer / every pkslam configuration (a study in passes: the peers alone "
+                  "at --jobs 1, then pkslam's runs at --jobs 2)");
   cmd->add_flag("--retry-failed", args->retry_failed, "Run failed runs again");
   cmd->add_flag("--prune-cache", args->prune_cache,
                 "Render each simulated dataset just before its runs and delete it after them "

@@ -144,6 +144,39 @@ std::vector<RunSpec> SelectSensors(const std::vector<RunSpec>& runs,
   return out;
 }
 
+std::vector<RunSpec> SelectConfigs(const std::vector<RunSpec>& runs,
+                                   const std::vector<std::string>& configs) {
+  if (configs.empty()) return runs;
+  const auto has_label = [&](const std::string& name) {
+    return std::any_of(runs.begin(), runs.end(),
+                       [&](const RunSpec& r) { return r.config == name; });
+  };
+  const auto selects = [&](const std::string& name, const RunSpec& r) {
+    if (r.config == name) return true;
+    if (has_label(name)) return false;  // a configuration's own label wins over the groups
+    if (name == "peers") return !r.peer_command.empty();
+    if (name == "pkslam") return r.peer_command.empty();
+    return false;
+  };
+  for (const auto& name : configs) {
+    const bool any =
+        std::any_of(runs.begin(), runs.end(), [&](const RunSpec& r) { return selects(name, r); });
+    if (!any) {
+      throw OptionError("--config '" + name +
+                        "': no run of the suite has this configuration (a label, 'peers' or "
+                        "'pkslam')");
+    }
+  }
+  std::vector<RunSpec> out;
+  for (const auto& r : runs) {
+    if (std::any_of(configs.begin(), configs.end(),
+                    [&](const std::string& name) { return selects(name, r); })) {
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
 std::vector<const RunSpec*> RenderingOrder(
     std::vector<const RunSpec*> runs,
     const std::function<std::optional<std::string>(const RunSpec&)>& rendering_of) {

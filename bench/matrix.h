@@ -49,6 +49,14 @@ std::vector<RunSpec> ExpandSuite(const Suite& suite);
 std::vector<RunSpec> SelectSensors(const std::vector<RunSpec>& runs,
                                    const std::vector<std::string>& sensors);
 
+// The runs of these configurations (all when `configs` is empty), in their order: a study in
+// passes, e.g. its peers alone on the machine, then pkslam's runs two at a time (`pkslam bench
+// --config`). A name is a configuration's label, or `peers` (every peer) or `pkslam` (every
+// selector configuration) unless a configuration has that label. Throws OptionError for a name
+// that selects nothing.
+std::vector<RunSpec> SelectConfigs(const std::vector<RunSpec>& runs,
+                                   const std::vector<std::string>& configs);
+
 // The runs grouped by rendering (`rendering_of` names a run's rendering; a run without one ranks
 // first), the renderings ordered by the lowest run number among their runs, then by where their
 // first run stands; matrix order within a group. A study pruned as it goes (`--prune-cache`)

@@ -229,6 +229,40 @@ datasets:
   EXPECT_EQ(runs[3].id, "a/stereo-inertial/orbslam3-peer/seed2");
 }
 
+// A study in passes: its peers alone, then pkslam's configurations (`pkslam bench --config`).
+TEST(Suite, ConfigSelectionByLabelOrGroup) {
+  const std::string text = R"(runs: 2
+sensors: [stereo-inertial]
+selectors: [orbslam3, pks]
+peers:
+  - {label: orbslam3-peer, command: [x]}
+  - {label: pks-authors, command: [y]}
+datasets:
+  - {name: a, path: /data/a}
+)";
+  const auto runs = ExpandSuite(ParseSuite(text, "suite.yaml"));
+  ASSERT_EQ(runs.size(), 8u);
+  const auto peers = SelectConfigs(runs, {"peers"});
+  ASSERT_EQ(peers.size(), 4u);
+  for (const auto& r : peers) EXPECT_FALSE(r.peer_command.empty()) << r.id;
+  const auto mine = SelectConfigs(runs, {"pkslam"});
+  ASSERT_EQ(mine.size(), 4u);
+  for (const auto& r : mine) EXPECT_TRUE(r.peer_command.empty()) << r.id;
+  const auto two = SelectConfigs(runs, {"pks-authors", "orbslam3"});
+  ASSERT_EQ(two.size(), 4u);
+  EXPECT_EQ(two[0].config, "orbslam3");  // the matrix's order, not the arguments'
+  EXPECT_EQ(SelectConfigs(runs, {}).size(), runs.size());
+  EXPECT_THROW(SelectConfigs(runs, {"vins"}), OptionError);
+  // A configuration labelled like a group is selected by its label only.
+  const auto own = ExpandSuite(
+      ParseSuite("runs: 1\nsensors: [stereo]\nselectors: [{name: pks, label: peers}]\npeers:\n"
+                 "  - {label: p, command: [x]}\ndatasets:\n  - {name: a, path: /data/a}\n",
+                 "suite.yaml"));
+  const auto labelled = SelectConfigs(own, {"peers"});
+  ASSERT_EQ(labelled.size(), 1u);
+  EXPECT_EQ(labelled[0].config, "peers");
+}
+
 // A peer's `sensors` limits it to those sensors; the suite's selectors still run every sensor.
 TEST(Suite, PeerSensorsLimitItsRuns) {
   const Suite s = ParseSuite(R"(runs: 1
