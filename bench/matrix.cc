@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <map>
+#include <set>
 #include <utility>
 
 #include "core/util/error.h"
@@ -147,13 +148,11 @@ std::vector<RunSpec> SelectSensors(const std::vector<RunSpec>& runs,
 std::vector<RunSpec> SelectConfigs(const std::vector<RunSpec>& runs,
                                    const std::vector<std::string>& configs) {
   if (configs.empty()) return runs;
-  const auto has_label = [&](const std::string& name) {
-    return std::any_of(runs.begin(), runs.end(),
-                       [&](const RunSpec& r) { return r.config == name; });
-  };
+  std::set<std::string> labels;
+  for (const auto& r : runs) labels.insert(r.config);
   const auto selects = [&](const std::string& name, const RunSpec& r) {
     if (r.config == name) return true;
-    if (has_label(name)) return false;  // a configuration's own label wins over the groups
+    if (labels.count(name) > 0) return false;  // a configuration's own label wins over the groups
     if (name == "peers") return !r.peer_command.empty();
     if (name == "pkslam") return r.peer_command.empty();
     return false;
