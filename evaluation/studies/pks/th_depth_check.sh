@@ -7,7 +7,7 @@
 # pkslam's default) 60. On one stereo-inertial rendering (a study's sim_cache entry or any
 # `pkslam simulate` output), one run each:
 #   pkslam orbslam3-v03     $PKSLAM run (live emulation on the work clock: load does not move it)
-#   v0.3 binary             $PKS_PEER/base (run_pks_peer's settings, ThDepth edited)
+#   v0.3 binary             $PKS_PEER/base (run_pks_peer with V03_THDEPTH)
 #   v1.0 binary             $PEER_COUNT (build_v10_counter.sh: the v1.0 peer that counts), at
 #                           60 only (the study's v1.0 peer; its rule is v0.3's without the exit)
 # and prints keyframes created (culled ones too) and kept. The two binaries pace themselves to
@@ -30,16 +30,13 @@ export NICE=${NICE:-0}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 
-with_depth() {  # FILE KEY DEPTH > stdout: FILE with KEY's value replaced
-  sed "s/^$2:.*/$2: $3/" "$1"
-}
-
 for depth in 60 35; do
   run=$out/pkslam_th$depth
   if [ ! -f "$run/stats.json" ]; then
     args=()
     if [ "$depth" != 60 ]; then
-      with_depth "$out/pkslam_th60/calibration/settings.yaml" Stereo.ThDepth "$depth.0" > "$out/pkslam_th$depth.yaml"
+      sed "s/^Stereo.ThDepth:.*/Stereo.ThDepth: $depth.0/" \
+          "$out/pkslam_th60/calibration/settings.yaml" > "$out/pkslam_th$depth.yaml"
       args=(--settings "$out/pkslam_th$depth.yaml")
     fi
     echo "[th-depth] pkslam orbslam3-v03, ThDepth $depth"
@@ -48,16 +45,14 @@ for depth in 60 35; do
   fi
 done
 
-template=$pks_peer/base/src/ORB_SLAM3/Examples/Stereo-Inertial/EuRoC.yaml
-if [ -f "$template" ]; then
-  /usr/bin/python3 "$here/peers/v03_settings.py" "$seq" "$template" "$out/v03.yaml" --stereo
+if [ -d "$pks_peer/base" ]; then
   for depth in 35 60; do
     run=$out/v03_th$depth
     [ -f "$run/keyframes_created.txt" ] && continue
-    with_depth "$out/v03.yaml" ThDepth "$depth.0" > "$out/v03_th$depth.yaml"
     echo "[th-depth] v0.3 binary, ThDepth $depth"
-    SETTINGS="$out/v03_th$depth.yaml" PEER="$pks_peer/base" bash "$tools/run_orbslam3.sh" \
-        "$seq" stereo-inertial "$run" > "$run.log" 2>&1 || echo "[th-depth] v0.3 binary failed: $run.log"
+    V03_THDEPTH="$depth.0" PKS_PEER="$pks_peer" PKSLAM_PEER_TOOLS="$tools" \
+        "$here/peers/run_pks_peer" base "$seq" stereo-inertial "$run" > "$run.log" 2>&1 ||
+      echo "[th-depth] v0.3 binary failed: $run.log"
   done
 else
   echo "[th-depth] no v0.3 peer in $pks_peer (build_pks_peers.sh): skipped"
