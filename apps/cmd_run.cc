@@ -248,6 +248,19 @@ void AddSystemOptions(CLI::App* cmd, const std::shared_ptr<RunArgs>& args) {
       "Inertial sensors: keep gravity fixed after the 15 s visual-inertial BA, as ORB-SLAM3 "
       "(for experiments)");
   cmd->add_option_function<std::string>(
+         "--inertial-search",
+         [args](const std::string& mode) {
+           args->options.system.tracking.inertial_search =
+               mode == "orbslam3" ? TrackingOptions::InertialSearch::kOrbSlam3
+                                  : TrackingOptions::InertialSearch::kLastFrame;
+         },
+         "Inertial sensors, how a tracked frame finds its matches: last-frame (match the "
+         "IMU-predicted frame against the last frame, then the local map narrowly) | orbslam3 "
+         "(ORB-SLAM3's: the prediction alone, then the local map searched wider; for studies of "
+         "keyframe rules, docs/pks_study.md)")
+      ->check(OneOf({"last-frame", "orbslam3"}))
+      ->default_str("last-frame");
+  cmd->add_option_function<std::string>(
          "--calibrate",
          [args](const std::string& mode) {
            args->options.system.mapping.calibration.enabled = mode == "online";

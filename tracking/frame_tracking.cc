@@ -44,10 +44,9 @@ int MatchLastFrame(const Frame& last, double radius, bool monocular, int min_mat
 }
 
 int MatchLastFramePredicted(const Frame& last, const TrackingOptions& options, bool monocular,
-                            Frame* frame) {
-  const double radius =
-      monocular ? options.motion_model_radius_mono : options.motion_model_radius_stereo;
-  return MatchLastFrame(last, radius, monocular, options.min_matches_motion_model, frame);
+                            bool inertial, Frame* frame) {
+  return MatchLastFrame(last, options.MotionModelRadius(monocular, inertial), monocular,
+                        options.min_matches_motion_model, frame);
 }
 
 int CountLocalMapInliers(bool drop_outliers, Frame* frame) {

@@ -29,9 +29,9 @@ int OptimizeAndDiscard(const PoseOptimizerOptions& options, Frame* frame);
 int MatchLastFrame(const Frame& last, double radius, bool monocular, int min_matches, Frame* frame);
 
 // The threshold MatchLastFrame searches within for a frame predicted by the motion model or the
-// IMU: `options`' monocular or stereo radius.
+// IMU: TrackingOptions::MotionModelRadius.
 int MatchLastFramePredicted(const Frame& last, const TrackingOptions& options, bool monocular,
-                            Frame* frame);
+                            bool inertial, Frame* frame);
 
 // After the local map's pose optimisation: every inlier's point was found once more; with
 // `drop_outliers` (ORB-SLAM3: plain stereo only) the outliers' matches are forgotten now, else

@@ -10,8 +10,11 @@
 
 namespace pkslam {
 
-KeyFrame* LocalMap::Update(Frame* frame) {
-  KeyFrame* best = UpdateKeyFrames(frame);
+KeyFrame* LocalMap::Update(Frame* frame, const Frame* voters) {
+  for (MapPointPtr& mp : frame->map_points) {
+    if (mp && mp->IsBad()) mp.reset();
+  }
+  KeyFrame* best = UpdateKeyFrames(voters != nullptr ? *voters : *frame);
   UpdatePoints();
   return best;
 }
@@ -26,16 +29,11 @@ void LocalMap::Clear() {
   points_.clear();
 }
 
-KeyFrame* LocalMap::UpdateKeyFrames(Frame* frame) {
-  // Keyframes observing the frame's points, by how many they share.
+KeyFrame* LocalMap::UpdateKeyFrames(const Frame& voters) {
+  // Keyframes observing the voters' points, by how many they share.
   std::map<KeyFrameId, std::pair<KeyFrame*, int>> counter;
-  for (int i = 0; i < frame->size(); ++i) {
-    const auto& mp = frame->map_points[i];
-    if (!mp) continue;
-    if (mp->IsBad()) {
-      frame->map_points[i].reset();
-      continue;
-    }
+  for (const MapPointPtr& mp : voters.map_points) {
+    if (!mp || mp->IsBad()) continue;
     for (const auto& [id, obs] : mp->observations()) {
       auto& entry = counter[id];
       entry.first = obs.keyframe;

@@ -23,8 +23,10 @@ class LocalMap {
   // Rebuilds the local keyframes from `frame`'s matches (dropping its matches to retired
   // points), then the local points from the keyframes. Returns the keyframe sharing the most
   // points with the frame, or nullptr when the frame has no match: then the keyframes of the
-  // last update stay (as in ORB-SLAM3).
-  KeyFrame* Update(Frame* frame);
+  // last update stay (as in ORB-SLAM3). With `voters`, the keyframes come from its matches
+  // instead: ORB-SLAM3's front end leaves an IMU-predicted frame without matches, and votes with
+  // the last frame's (TrackingOptions::InertialSearch::kOrbSlam3).
+  KeyFrame* Update(Frame* frame, const Frame* voters = nullptr);
 
   // Starts from these keyframes and points (a map just initialised).
   void Reset(std::vector<KeyFrame*> keyframes, std::vector<MapPointPtr> points);
@@ -40,7 +42,7 @@ class LocalMap {
   const std::vector<MapPointPtr>& points() const { return points_; }
 
  private:
-  KeyFrame* UpdateKeyFrames(Frame* frame);
+  KeyFrame* UpdateKeyFrames(const Frame& voters);
   void UpdatePoints();
 
   int max_keyframes_;

@@ -1,5 +1,7 @@
 #include "tracking/map_tracker.h"
 
+#include <algorithm>
+
 #include "core/bow/vocabulary.h"
 #include "core/util/error.h"
 #include "map_model/atlas.h"
@@ -53,7 +55,8 @@ bool MapTracker::TrackWithMotionModel(const FrameRecord& last_record, TrackedFra
   Frame& current = frames->current;
   current.SetPose(*frames->velocity * frames->last.camera_from_world());
   const bool mono = IsMonocular(rig_->sensor);
-  const int n = MatchLastFramePredicted(frames->last, options_, mono, &current);
+  const int n =
+      MatchLastFramePredicted(frames->last, options_, mono, IsInertial(rig_->sensor), &current);
   if (n < options_.min_matches_motion_model) return false;
   const int in_map = OptimizeAndDiscard(options_.pose, &current);
   if (options_.localise_only && !mono) {
@@ -73,7 +76,16 @@ bool MapTracker::TrackWithImu(const FrameRecord& last_record, TrackedFrames* fra
   UpdateLastFrame(last_record, frames);
   if (!PredictWithImu(frames)) return false;
   Frame& current = frames->current;
-  MatchLastFramePredicted(frames->last, options_, IsMonocular(rig_->sensor), &current);
+  // ORB-SLAM3's front end trusts the prediction alone once the IMU is initialised, except in
+  // the second after a relocalisation; the local map search is then wider (TrackLocalMap).
+  const int confirming_frames = static_cast<int>(rig_->fps + 0.5);
+  if (options_.inertial_search == TrackingOptions::InertialSearch::kLastFrame ||
+      frames->WithinFramesOfRelocalisation(confirming_frames)) {
+    MatchLastFramePredicted(frames->last, options_, IsMonocular(rig_->sensor), /*inertial=*/true,
+                            &current);
+  } else {
+    std::fill(current.map_points.begin(), current.map_points.end(), nullptr);
+  }
   current.outliers.assign(current.size(), 0);
   // The IMU prediction stands: the matches are classified by the visual-inertial optimisation
   // after the local map search (ORB-SLAM3 runs a visual-only optimisation here first; with the
@@ -94,15 +106,27 @@ bool MapTracker::Relocalise(TrackedFrames* frames) {
 
 bool MapTracker::TrackLocalMap(TrackingState state, bool imu_ready, TrackedFrames* frames) {
   Frame& current = frames->current;
-  if (KeyFrame* best = local_map_.Update(&current)) {
+  // ORB-SLAM3's front end left an IMU-predicted frame without matches: the last frame's choose
+  // its local map (as ORB-SLAM3's UpdateLocalKeyFrames once the IMU is initialised).
+  const bool unmatched = std::none_of(current.map_points.begin(), current.map_points.end(),
+                                      [](const MapPointPtr& mp) { return mp != nullptr; });
+  const Frame* voters =
+      options_.inertial_search == TrackingOptions::InertialSearch::kOrbSlam3 && unmatched
+          ? &frames->last
+          : nullptr;
+  if (KeyFrame* best = local_map_.Update(&current, voters)) {
     KeyFramePtr reference = atlas_->current_map()->Share(best);
     if (!reference && best->map() != nullptr) reference = best->map()->Share(best);
     frames->reference_kf = reference;
     current.reference_kf = reference;
   }
   const bool lost = state == TrackingState::kRecentlyLost || state == TrackingState::kLost;
-  const double radius =
-      options_.LocalSearchRadius(IsRgbd(rig_->sensor), frames->JustRelocalised(), lost);
+  double radius = options_.LocalSearchRadius(IsRgbd(rig_->sensor), frames->JustRelocalised(), lost);
+  if (options_.inertial_search == TrackingOptions::InertialSearch::kOrbSlam3 &&
+      IsInertial(rig_->sensor) && !frames->JustRelocalised() && !lost) {
+    const MapImuStatus& imu = atlas_->current_map()->imu_status();
+    radius = TrackingOptions::InertialLocalSearchRadius(imu.imu_initialized, imu.inertial_ba2_done);
+  }
   local_map_.Search(&current, *rig_, radius);
   current.outliers.assign(current.size(), 0);
   OptimizePose(imu_ready, frames);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -189,6 +190,43 @@ TEST_F(MapTrackerTest, StereoInertialKeepsOutlierMatchesForItsKeyFrameAndStereoD
       EXPECT_GE(matched_outliers, 20) << "of the 40 swapped matches";
     }
   }
+}
+
+TEST_F(MapTrackerTest, OrbSlam3sInertialSearchFindsAnUnmatchedFrameThroughTheLastFramesMatches) {
+  // ORB-SLAM3's front end leaves an IMU-predicted frame unmatched: its local map comes from the
+  // last frame's matches and is searched wider (10x the octave scale before IMU initialisation,
+  // 2x after the second inertial BA). pkslam's own has matched the last frame by then: an
+  // unmatched frame finds no local map.
+  auto rig = std::make_shared<CameraRig>(*bow_.rig);
+  rig->sensor = Sensor::kStereoInertial;
+  const SE3d truth = Moved(bow_.poses[3], 0.02);
+  // The prediction is 1.1 degrees off: several pixels at every level.
+  const SE3d predicted =
+      SE3d(SO3d::Exp(Eigen::Vector3d(0.02, 0, 0)), Eigen::Vector3d::Zero()) * truth;
+  auto track = [&](TrackingOptions::InertialSearch search, bool ba2_done) {
+    if (ba2_done) {
+      auto lock = MapEditor(&bow_.atlas).Write(MapEdit::kFixture);
+      bow_.atlas.current_map()->mutable_imu_status(lock).imu_initialized = true;
+      bow_.atlas.current_map()->mutable_imu_status(lock).inertial_ba2_done = true;
+    }
+    options_.inertial_search = search;
+    TrackedFrames frames = AfterLastFrame();
+    frames.current = At(truth, 55);
+    frames.current.SetPose(predicted);
+    MapTracker tracker(&bow_.atlas, &bow_.vocabulary, options_, rig, nullptr);
+    auto lock = MapReader(bow_.atlas).Lock();
+    const bool ok = tracker.TrackLocalMap(TrackingState::kOk, false, &frames);
+    return std::make_tuple(ok, Metres(frames.current.camera_from_world(), truth), frames.inliers);
+  };
+  EXPECT_FALSE(std::get<0>(track(TrackingOptions::InertialSearch::kLastFrame, false)));
+  const auto [wide_ok, wide_error, wide_inliers] =
+      track(TrackingOptions::InertialSearch::kOrbSlam3, false);
+  EXPECT_TRUE(wide_ok);
+  EXPECT_LT(wide_error, 0.01);
+  const int narrow_inliers =
+      std::get<2>(track(TrackingOptions::InertialSearch::kOrbSlam3, /*ba2_done=*/true));
+  EXPECT_LT(narrow_inliers, wide_inliers / 2)
+      << "2x the octave scale misses the matches at the lower levels";
 }
 
 }  // namespace

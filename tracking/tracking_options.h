@@ -24,6 +24,18 @@ struct TrackingOptions {
   // Motion-model search radius (pixels at level 0), stereo/RGB-D and monocular.
   double motion_model_radius_stereo = 7.0;
   double motion_model_radius_mono = 15.0;
+  // Inertial sensors: how a tracked frame finds its matches.
+  //  kLastFrame (pkslam): the IMU-predicted frame is matched against the last frame within the
+  //    motion-model radius, then against the local map at local_map_radius.
+  //  kOrbSlam3 (ORB-SLAM3 v1.0's TrackWithMotionModel and SearchLocalPoints): once the IMU is
+  //    initialised the prediction stands alone (no last-frame matching, except within a second of
+  //    a relocalisation), so the local map is searched wider: 10x the octave scale before the IMU
+  //    is initialised, 6x until the second inertial BA, 2x after; stereo-inertial's motion model
+  //    (before IMU initialisation) searches at the monocular radius (ORB-SLAM3 narrows it to 7 px
+  //    for plain stereo only). For studies of keyframe rules that read tracking's match counts:
+  //    with it, the `orbslam3-v03` reading makes the v0.3 binary's keyframes (docs/pks_study.md).
+  enum class InertialSearch { kLastFrame, kOrbSlam3 };
+  InertialSearch inertial_search = InertialSearch::kLastFrame;
   // Minimum matches for motion-model / reference-keyframe tracking to succeed.
   int min_matches_motion_model = 20;
   int min_matches_reference_kf = 15;
@@ -93,6 +105,16 @@ struct TrackingOptions {
     if (just_relocalised) radius = local_map_radius_after_reloc;
     if (lost) radius = 15.0;
     return radius;
+  }
+  // kOrbSlam3's local-map radius for a tracked inertial frame (not just relocalised, not lost).
+  static double InertialLocalSearchRadius(bool imu_initialised, bool inertial_ba2_done) {
+    if (!imu_initialised) return 10.0;
+    return inertial_ba2_done ? 2.0 : 6.0;
+  }
+  // The motion model's radius (pixels at level 0).
+  double MotionModelRadius(bool monocular, bool inertial) const {
+    const bool wide = monocular || (inertial && inertial_search == InertialSearch::kOrbSlam3);
+    return wide ? motion_model_radius_mono : motion_model_radius_stereo;
   }
 };
 

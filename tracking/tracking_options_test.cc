@@ -49,5 +49,17 @@ TEST(TrackingOptions, TheLocalMapSearchWidensAfterRelocalisationAndWhileLost) {
   EXPECT_EQ(options.LocalSearchRadius(false, true, true), 15.0) << "lost wins";
 }
 
+TEST(TrackingOptions, OrbSlam3sInertialSearchWidensTheLocalMapAndTheStereoMotionModel) {
+  EXPECT_EQ(TrackingOptions::InertialLocalSearchRadius(false, false), 10.0) << "IMU uninitialised";
+  EXPECT_EQ(TrackingOptions::InertialLocalSearchRadius(true, false), 6.0) << "before BA2";
+  EXPECT_EQ(TrackingOptions::InertialLocalSearchRadius(true, true), 2.0) << "after BA2";
+  TrackingOptions options;
+  EXPECT_EQ(options.MotionModelRadius(/*monocular=*/false, /*inertial=*/true), 7.0);
+  EXPECT_EQ(options.MotionModelRadius(true, true), 15.0);
+  options.inertial_search = TrackingOptions::InertialSearch::kOrbSlam3;
+  EXPECT_EQ(options.MotionModelRadius(false, true), 15.0) << "ORB-SLAM3: 7 px for STEREO only";
+  EXPECT_EQ(options.MotionModelRadius(false, false), 7.0);
+}
+
 }  // namespace
 }  // namespace pkslam
