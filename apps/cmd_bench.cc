@@ -43,6 +43,7 @@ struct BenchArgs {
   std::vector<std::string> sensors;
   std::vector<std::string> configs;
   std::string pkslam;
+  std::string simulator;
   std::string python = "/usr/bin/python3";
   int jobs = 1;
   bool retry_failed = false;
@@ -134,7 +135,10 @@ void Run(const BenchArgs& a) {
   h.retry_failed = a.retry_failed;
   h.reevaluate = a.reevaluate;
   h.prune_cache = a.prune_cache;
-  h.simulator_id = bench::ExecutableId(h.pkslam);
+  h.simulator = a.simulator;
+  h.Check();
+  h.simulator_id = bench::ExecutableId(h.Simulator());
+  h.executable_id = bench::ExecutableId(h.pkslam);
   h.pkslam_commit = CommitOf(h.pkslam);
   if (!a.emit_jobs.empty()) {
     const auto e = bench::EmitJobs(suite, runs, h);
@@ -217,6 +221,10 @@ void RegisterBenchCommand(CLI::App& app) {
   cmd->add_option("--python", args->python, "Python with matplotlib and numpy for the plots")
       ->capture_default_str();
   cmd->add_option("--pkslam", args->pkslam, "pkslam executable for the runs (default: this one)");
+  cmd->add_option("--simulator", args->simulator,
+                  "pkslam executable that renders the simulated datasets and keys their cache "
+                  "(default: --pkslam): a study run in passes by different builds replays the "
+                  "same renderings");
   cmd->add_flag("--quiet", args->quiet, "No progress bars");
   cmd->callback([args] { Run(*args); });
 }

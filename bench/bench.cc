@@ -244,6 +244,9 @@ EmittedJobs EmitJobs(const Suite& suite, const std::vector<RunSpec>& runs,
           fs::absolute(suite.file).string(),     "--out",       out.string(), "--cache",
           fs::absolute(options.cache).string(),  "--run-id",    r.id,         "--quiet"};
       if (options.retry_failed) argv.push_back("--retry-failed");
+      if (!options.simulator.empty()) {
+        argv.insert(argv.end(), {"--simulator", fs::absolute(options.simulator).string()});
+      }
       jobs << ShellCommand(argv) << '\n';
       ++e.jobs;
     }

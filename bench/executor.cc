@@ -106,6 +106,9 @@ void HarnessOptions::Check() const {
   PKSLAM_CHECK_OPTION(!out.empty(), "--out", "empty");
   PKSLAM_CHECK_OPTION(!cache.empty(), "--cache", "empty");
   if (!fs::exists(pkslam)) throw OptionError("pkslam executable not found: " + pkslam.string());
+  if (!simulator.empty() && !fs::exists(simulator)) {
+    throw OptionError("--simulator: pkslam executable not found: " + simulator.string());
+  }
 }
 
 fs::path RunDir(const fs::path& out, const RunSpec& run) { return out / "runs" / run.id; }
@@ -153,7 +156,7 @@ fs::path EnsureSimulated(const HarnessOptions& options, const std::string& datas
   const fs::path log = dir.string() + ".log";
   fs::remove_all(tmp);
   fs::remove(log);
-  std::vector<std::string> argv = {options.pkslam.string()};
+  std::vector<std::string> argv = {options.Simulator().string()};
   const auto args = SimulateArguments(recipe, tmp);
   argv.insert(argv.end(), args.begin(), args.end());
   { std::ofstream(log) << "# " << ShellCommand(argv) << '\n'; }
@@ -256,7 +259,7 @@ fs::path KeepGroundTruth(const fs::path& run_dir, const fs::path& dataset,
 RunProvenance ProvenanceOf(const HarnessOptions& options, const fs::path& run_dir, bool peer) {
   RunProvenance p;
   p.pkslam_commit = options.pkslam_commit;
-  p.executable = options.simulator_id;
+  p.executable = options.executable_id;
   p.cores = static_cast<int>(std::thread::hardware_concurrency());
   p.jobs = options.jobs;
   p.finished_utc = fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::time(nullptr)));

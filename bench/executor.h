@@ -19,6 +19,10 @@ namespace pkslam::bench {
 
 struct HarnessOptions {
   std::filesystem::path pkslam;  // the pkslam executable the child processes run
+  // The pkslam executable that renders the simulated datasets (empty: `pkslam`). A study run in
+  // passes by different builds of pkslam renders with one build throughout, so its renderings
+  // keep their cache keys and every pass replays the same images.
+  std::filesystem::path simulator;
   std::filesystem::path out;     // OUT: runs/, results.csv, summary, report
   std::filesystem::path cache;   // simulator renderings (shared between suites)
   int jobs = 1;                  // runs executed at once
@@ -31,13 +35,15 @@ struct HarnessOptions {
   // about `jobs` renderings at a time (a study with per-run render seeds of full EuRoC replays
   // would otherwise need ~2 GB per run).
   bool prune_cache = false;
-  // Part of every cache key (ExecutableId of `pkslam`): a rebuilt simulator may render the same
-  // command line differently, so its renders are never mistaken for an older build's.
+  // Part of every cache key (ExecutableId of Simulator()): a rebuilt simulator may render the
+  // same command line differently, so its renders are never mistaken for an older build's.
   std::string simulator_id;
-  // The commit of `pkslam` (BuildCommit of that build), recorded in every result with the
-  // executable's id, the machine's cores, `jobs` and the time (results.h RunProvenance).
+  // The commit of `pkslam` (BuildCommit of that build) and its ExecutableId, recorded in every
+  // result with the machine's cores, `jobs` and the time (results.h RunProvenance).
   std::string pkslam_commit;
+  std::string executable_id;
 
+  const std::filesystem::path& Simulator() const { return simulator.empty() ? pkslam : simulator; }
   void Check() const;
 };
 

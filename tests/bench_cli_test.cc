@@ -214,6 +214,63 @@ TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
   EXPECT_EQ(SummaryWithoutTimes(jobs / "summary.csv"), SummaryWithoutTimes(out / "summary.csv"));
 }
 
+// A study run in passes by different builds of pkslam renders with one build throughout
+// (--simulator): the renderings are keyed by the simulator, the results record the build that ran.
+TEST(BenchCli, TheSimulatorKeysTheRenderingsAndTheRunsRecordPkslam) {
+  const fs::path dir = testing::MakeTempDir("bench_simulator");
+  const fs::path cache = dir / "cache";
+  // Another build of the simulator: the same program with a different hash.
+  const fs::path simulator = dir / "pkslam-simulator";
+  std::ofstream(simulator, std::ios::binary)
+      << testing::ReadFileBytes(testing::PkslamExecutable()) << '\n';
+  fs::permissions(simulator, fs::perms::owner_exec, fs::perm_options::add);
+  const std::string run_id = "sim_medium_5s/stereo/orbslam3/seed1";
+  auto bench = [&](const std::string& out, const std::string& extra) {
+    return RunPkslam(
+        fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --run-id {} "
+                    "--quiet {}",
+                    kSmoke.string(), (dir / out).string(), cache.string(), run_id, extra));
+  };
+  auto renderings = [&] {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(cache)) {
+      if (fs::exists(e.path() / ".complete")) names.push_back(e.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  auto executable_of = [&](const std::string& out) {
+    const auto lines = Lines(dir / out / "runs" / run_id / "result.csv");
+    if (lines.size() < 2) return std::string();
+    const auto header = Fields(lines[0]);
+    const auto row = Fields(lines[1]);
+    const auto at = std::find(header.begin(), header.end(), "executable") - header.begin();
+    return static_cast<std::size_t>(at) < row.size() ? row[at] : std::string();
+  };
+
+  auto r = bench("a", "");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto first = renderings();
+  ASSERT_EQ(first.size(), 1u);
+  r = bench("b", fmt::format("--simulator '{}'", simulator.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto second = renderings();
+  ASSERT_EQ(second.size(), 2u) << "the other simulator renders anew";
+  const std::string added = second[0] == first[0] ? second[1] : second[0];
+  EXPECT_THAT(testing::ReadFileBytes(cache / added / "recipe.txt"),
+              StartsWith(simulator.string() + " simulate"));
+  EXPECT_FALSE(executable_of("a").empty());
+  EXPECT_EQ(executable_of("b"), executable_of("a")) << "both runs were made by pkslam";
+  // The same simulator again: its rendering is found, nothing is rendered.
+  r = bench("c", fmt::format("--simulator '{}'", simulator.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(renderings(), second);
+
+  r = bench("d", fmt::format("--simulator '{}'", (dir / "missing").string()));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr((dir / "missing").string()));
+}
+
 TEST(BenchCli, BadSuitesAreOneErrorLineWithFileAndLine) {
   const fs::path dir = testing::MakeTempDir("bench_bad");
   std::ofstream(dir / "bad.yaml") << "runs: 2\nselectors: [orbslam3]\nsensors: [stereo]\n"
