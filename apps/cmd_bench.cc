@@ -18,6 +18,7 @@
 #include "bench/report.h"
 #include "core/util/build_info.h"
 #include "core/util/error.h"
+#include "core/util/log.h"
 #include "core/util/output_guard.h"
 
 namespace pkslam::apps {
@@ -140,6 +141,13 @@ void Run(const BenchArgs& a) {
   h.simulator_id = bench::ExecutableId(h.Simulator());
   h.executable_id = bench::ExecutableId(h.pkslam);
   h.pkslam_commit = CommitOf(h.pkslam);
+  if (h.pkslam_commit.ends_with("-dirty")) {
+    // Every row records this commit: a study's runs would name a tree that no commit holds.
+    PKSLAM_LOG_WARN(
+        "{}: built from a modified tree (commit {}): the results cannot be traced "
+        "to a commit; build a clean checkout for a study",
+        h.pkslam.string(), h.pkslam_commit);
+  }
   if (!a.emit_jobs.empty()) {
     const auto e = bench::EmitJobs(suite, runs, h);
     std::cout << fmt::format(

@@ -271,6 +271,26 @@ TEST(BenchCli, TheSimulatorKeysTheRenderingsAndTheRunsRecordPkslam) {
   EXPECT_THAT(r.output, HasSubstr((dir / "missing").string()));
 }
 
+// Every row records the commit of the pkslam that ran it: one built from a modified tree is
+// named as such when the bench starts, not discovered in results.csv afterwards.
+TEST(BenchCli, APkslamBuiltFromAModifiedTreeIsNamed) {
+  const fs::path dir = testing::MakeTempDir("bench_dirty");
+  const fs::path fake = dir / "pkslam-dirty";
+  std::ofstream(fake) << "#!/bin/sh\necho 'pkslam 0.1.0 (commit 0123abc-dirty, Release)'\n";
+  fs::permissions(fake, fs::perms::owner_exec, fs::perm_options::add);
+  auto r = RunPkslam(fmt::format("bench '{}' --emit-jobs '{}' --pkslam '{}'", kSmoke.string(),
+                                 (dir / "jobs").string(), fake.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("modified tree (commit 0123abc-dirty)"));
+  // This test's own build, when it comes from a clean tree (CI's clone), is not named.
+  if (RunPkslam("--version").output.find("-dirty") == std::string::npos) {
+    r = RunPkslam(
+        fmt::format("bench '{}' --emit-jobs '{}'", kSmoke.string(), (dir / "jobs2").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, Not(HasSubstr("modified tree")));
+  }
+}
+
 TEST(BenchCli, BadSuitesAreOneErrorLineWithFileAndLine) {
   const fs::path dir = testing::MakeTempDir("bench_bad");
   std::ofstream(dir / "bad.yaml") << "runs: 2\nselectors: [orbslam3]\nsensors: [stereo]\n"
