@@ -138,8 +138,9 @@ void Run(const BenchArgs& a) {
   h.prune_cache = a.prune_cache;
   h.simulator = a.simulator;
   h.Check();
-  h.simulator_id = bench::ExecutableId(h.Simulator());
+  // Hashing reads the whole executable: once when the runs' pkslam also renders.
   h.executable_id = bench::ExecutableId(h.pkslam);
+  h.simulator_id = h.simulator.empty() ? h.executable_id : bench::ExecutableId(h.simulator);
   h.pkslam_commit = CommitOf(h.pkslam);
   if (h.pkslam_commit.ends_with("-dirty")) {
     // Every row records this commit: a study's runs would name a tree that no commit holds.

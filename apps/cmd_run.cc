@@ -247,19 +247,21 @@ void AddSystemOptions(CLI::App* cmd, const std::shared_ptr<RunArgs>& args) {
       [args](std::int64_t) { args->options.system.mapping.inertial.gravity_refinement = false; },
       "Inertial sensors: keep gravity fixed after the 15 s visual-inertial BA, as ORB-SLAM3 "
       "(for experiments)");
+  using Search = TrackingOptions::InertialSearch;
+  const std::string last_frame = TrackingOptions::InertialSearchName(Search::kLastFrame);
+  const std::string orbslam3 = TrackingOptions::InertialSearchName(Search::kOrbSlam3);
   cmd->add_option_function<std::string>(
          "--inertial-search",
-         [args](const std::string& mode) {
+         [args, orbslam3](const std::string& mode) {
            args->options.system.tracking.inertial_search =
-               mode == "orbslam3" ? TrackingOptions::InertialSearch::kOrbSlam3
-                                  : TrackingOptions::InertialSearch::kLastFrame;
+               mode == orbslam3 ? Search::kOrbSlam3 : Search::kLastFrame;
          },
          "Inertial sensors, how a tracked frame finds its matches: last-frame (match the "
          "IMU-predicted frame against the last frame, then the local map narrowly) | orbslam3 "
          "(ORB-SLAM3's: the prediction alone, then the local map searched wider; for studies of "
          "keyframe rules, docs/pks_study.md)")
-      ->check(OneOf({"last-frame", "orbslam3"}))
-      ->default_str("last-frame");
+      ->check(OneOf({last_frame, orbslam3}))
+      ->default_str(last_frame);
   cmd->add_option_function<std::string>(
          "--calibrate",
          [args](const std::string& mode) {

@@ -439,9 +439,7 @@ void WriteTimingJson(const RunOptions& options, const RunSummary& summary, const
   json->Member("inertial_ba_fixed_anchor", mapping.inertial_ba_fixed_anchor);
   json->Member("gravity_refinement_enabled", options.system.mapping.inertial.gravity_refinement);
   json->Member("inertial_search",
-               options.system.tracking.inertial_search == TrackingOptions::InertialSearch::kOrbSlam3
-                   ? "orbslam3"
-                   : "last-frame");
+               TrackingOptions::InertialSearchName(options.system.tracking.inertial_search));
   json->Key("gravity_refinements").BeginArray();
   for (const GravityRefinementStat& g : mapping.gravity_refinements) {
     json->BeginObject();

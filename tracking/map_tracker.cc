@@ -78,9 +78,8 @@ bool MapTracker::TrackWithImu(const FrameRecord& last_record, TrackedFrames* fra
   Frame& current = frames->current;
   // ORB-SLAM3's front end trusts the prediction alone once the IMU is initialised, except in
   // the second after a relocalisation; the local map search is then wider (TrackLocalMap).
-  const int confirming_frames = static_cast<int>(rig_->fps + 0.5);
   if (options_.inertial_search == TrackingOptions::InertialSearch::kLastFrame ||
-      frames->WithinFramesOfRelocalisation(confirming_frames)) {
+      WithinASecondOfRelocalisation(*frames)) {
     MatchLastFramePredicted(frames->last, options_, IsMonocular(rig_->sensor), /*inertial=*/true,
                             &current);
   } else {
@@ -108,12 +107,10 @@ bool MapTracker::TrackLocalMap(TrackingState state, bool imu_ready, TrackedFrame
   Frame& current = frames->current;
   // ORB-SLAM3's front end left an IMU-predicted frame without matches: the last frame's choose
   // its local map (as ORB-SLAM3's UpdateLocalKeyFrames once the IMU is initialised).
-  const bool unmatched = std::none_of(current.map_points.begin(), current.map_points.end(),
+  const bool unmatched = options_.inertial_search == TrackingOptions::InertialSearch::kOrbSlam3 &&
+                         std::none_of(current.map_points.begin(), current.map_points.end(),
                                       [](const MapPointPtr& mp) { return mp != nullptr; });
-  const Frame* voters =
-      options_.inertial_search == TrackingOptions::InertialSearch::kOrbSlam3 && unmatched
-          ? &frames->last
-          : nullptr;
+  const Frame* voters = unmatched ? &frames->last : nullptr;
   if (KeyFrame* best = local_map_.Update(&current, voters)) {
     KeyFramePtr reference = atlas_->current_map()->Share(best);
     if (!reference && best->map() != nullptr) reference = best->map()->Share(best);
@@ -134,13 +131,15 @@ bool MapTracker::TrackLocalMap(TrackingState state, bool imu_ready, TrackedFrame
   // (it drops them here for plain stereo only): a new keyframe then carries them to its BA.
   const int inliers = CountLocalMapInliers(rig_->sensor == Sensor::kStereo, &current);
   frames->inliers = inliers;
-  const int confirming_frames = static_cast<int>(rig_->fps + 0.5);
-  if (frames->WithinFramesOfRelocalisation(confirming_frames) &&
-      inliers < options_.min_inliers_after_reloc) {
+  if (WithinASecondOfRelocalisation(*frames) && inliers < options_.min_inliers_after_reloc) {
     return false;
   }
   if (state == TrackingState::kRecentlyLost && inliers > 10) return true;
   return inliers >= options_.min_inliers;
+}
+
+bool MapTracker::WithinASecondOfRelocalisation(const TrackedFrames& frames) const {
+  return frames.WithinFramesOfRelocalisation(static_cast<int>(rig_->fps + 0.5));
 }
 
 void MapTracker::OptimizePose(bool imu_ready, TrackedFrames* frames) const {

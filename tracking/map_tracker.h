@@ -63,6 +63,10 @@ class MapTracker {
  private:
   // Visual pose optimisation, or visual-inertial once the map's IMU is initialised.
   void OptimizePose(bool imu_ready, TrackedFrames* frames) const;
+  // A second of frames after a relocalisation (ORB-SLAM3's mnFramesToResetIMU / mMaxFrames):
+  // the new pose must be confirmed by more inliers, and ORB-SLAM3's front end matches the last
+  // frame again meanwhile.
+  bool WithinASecondOfRelocalisation(const TrackedFrames& frames) const;
 
   const Atlas* atlas_;
   const Vocabulary* vocabulary_;

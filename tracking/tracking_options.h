@@ -36,6 +36,10 @@ struct TrackingOptions {
   //    with it, the `orbslam3-v03` reading makes the v0.3 binary's keyframes (docs/pks_study.md).
   enum class InertialSearch { kLastFrame, kOrbSlam3 };
   InertialSearch inertial_search = InertialSearch::kLastFrame;
+  // Its names on the command line and in stats.json: "last-frame", "orbslam3".
+  static const char* InertialSearchName(InertialSearch search) {
+    return search == InertialSearch::kOrbSlam3 ? "orbslam3" : "last-frame";
+  }
   // Minimum matches for motion-model / reference-keyframe tracking to succeed.
   int min_matches_motion_model = 20;
   int min_matches_reference_kf = 15;
