@@ -45,6 +45,7 @@ struct BenchArgs {
   std::vector<std::string> configs;
   std::string pkslam;
   std::string simulator;
+  std::vector<std::string> resume_from;
   std::string python = "/usr/bin/python3";
   int jobs = 1;
   bool retry_failed = false;
@@ -102,12 +103,15 @@ void Run(const BenchArgs& a) {
   if (!a.collect.empty()) {
     if (!a.suite.empty()) throw OptionError("--collect takes no SUITE");
     std::vector<fs::path> dirs(a.collect.begin(), a.collect.end());
+    if (a.out.empty() && fs::is_regular_file(dirs.front())) {
+      throw OptionError("--out DIR is required when the first --collect is a results.csv");
+    }
     report.out = a.out.empty() ? dirs.front() : fs::path(a.out);
     for (const auto& d : dirs) report.run_roots.push_back(d / "runs");
     report.title = bench::ReadBenchTitle(dirs.front(), "pkslam bench");
     const auto results = bench::CollectResults(dirs);
     if (results.empty()) throw InputError(dirs.front(), "no finished runs to collect");
-    std::cout << fmt::format("collected {} runs from {} folder(s)\n", results.size(), dirs.size());
+    std::cout << fmt::format("collected {} runs from {} source(s)\n", results.size(), dirs.size());
     PrintReport(results, bench::WriteReport(results, report), report.out);
     return;
   }
@@ -137,6 +141,7 @@ void Run(const BenchArgs& a) {
   h.reevaluate = a.reevaluate;
   h.prune_cache = a.prune_cache;
   h.simulator = a.simulator;
+  h.resume_from.assign(a.resume_from.begin(), a.resume_from.end());
   h.Check();
   // Hashing reads the whole executable: once when the runs' pkslam also renders.
   h.executable_id = bench::ExecutableId(h.pkslam);
@@ -208,7 +213,8 @@ void RegisterBenchCommand(CLI::App& app) {
                   "DIR/run_parallel.sh and DIR/slurm.sh instead of running");
   cmd->add_option("--collect", args->collect,
                   "Merge the finished runs of these folders into one report (in --out, default "
-                  "the first folder)");
+                  "the first folder); a results.csv among them adds its recorded rows (a later "
+                  "source wins for a run id found twice)");
   cmd->add_option("--run-id", args->run_ids,
                   "Execute only these runs (ids as --list prints); no report is written: `pkslam "
                   "bench --collect OUT` makes it");
@@ -234,6 +240,9 @@ void RegisterBenchCommand(CLI::App& app) {
                   "pkslam executable that renders the simulated datasets and keys their cache "
                   "(default: --pkslam): a study run in passes by different builds replays the "
                   "same renderings");
+  cmd->add_option("--resume-from", args->resume_from,
+                  "results.csv of an earlier collection: its runs count as finished (a study "
+                  "resumes where its recorded results end, without the old run folders)");
   cmd->add_flag("--quiet", args->quiet, "No progress bars");
   cmd->callback([args] { Run(*args); });
 }

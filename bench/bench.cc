@@ -11,6 +11,7 @@
 #include <set>
 #include <thread>
 
+#include "bench/import_finished.h"
 #include "bench/process.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -92,11 +93,25 @@ std::vector<RunSpec> SelectRuns(const std::vector<RunSpec>& runs,
   return out;
 }
 
+namespace {
+
+// --resume-from: the recorded runs become finished runs of OUT before anything is scheduled.
+void ImportRecorded(const HarnessOptions& options, const std::vector<RunSpec>& runs) {
+  for (const auto& file : options.resume_from) {
+    const ImportCounts i = ImportFinished(file, runs, options.out);
+    PKSLAM_LOG_INFO("{}: {} finished runs imported, {} already here, {} not in this selection",
+                    file.string(), i.imported, i.present, i.other);
+  }
+}
+
+}  // namespace
+
 std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& runs,
                                 const HarnessOptions& options, BenchCounts* counts,
                                 const std::atomic<bool>* cancel) {
   options.Check();
   fs::create_directories(options.out);
+  ImportRecorded(options, runs);
   BenchCounts c;
   c.total = static_cast<int>(runs.size());
   std::vector<const RunSpec*> pending;
@@ -231,6 +246,7 @@ EmittedJobs EmitJobs(const Suite& suite, const std::vector<RunSpec>& runs,
   options.Check();
   const fs::path out = fs::absolute(options.out);
   WriteBenchInfo(out, suite);
+  ImportRecorded(options, runs);
   EmittedJobs e;
   e.jobs_file = out / "jobs.txt";
   e.parallel_script = out / "run_parallel.sh";

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <thread>
 
+#include "bench/import_finished.h"
 #include "bench/peer_import.h"
 #include "bench/process.h"
 #include "bench/run_evaluation.h"
@@ -278,6 +279,7 @@ std::optional<RunResult> ReevaluateRun(const Suite& suite, const RunSpec& run,
   const fs::path run_dir = RunDir(options.out, run);
   const auto done = ReadFinished(run_dir);
   if (!done || !done->ok) return std::nullopt;
+  if (IsImported(run_dir)) return done;  // no trajectory here: the recorded numbers stand
   RunResult result = ResultSkeleton(run, suite);
   result.dense_points = done->dense_points;
   result.provenance = done->provenance;  // what ran it, not this harness

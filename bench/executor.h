@@ -35,6 +35,9 @@ struct HarnessOptions {
   // about `jobs` renderings at a time (a study with per-run render seeds of full EuRoC replays
   // would otherwise need ~2 GB per run).
   bool prune_cache = false;
+  // Recorded results (results.csv of an earlier collection) whose runs count as finished
+  // (ImportFinished): a study resumes on a machine that no longer has its run folders.
+  std::vector<std::filesystem::path> resume_from;
   // Part of every cache key (ExecutableId of Simulator()): a rebuilt simulator may render the
   // same command line differently, so its renders are never mistaken for an older build's.
   std::string simulator_id;

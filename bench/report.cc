@@ -332,6 +332,10 @@ ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& opt
 std::vector<RunResult> CollectResults(const std::vector<fs::path>& dirs) {
   std::map<std::string, RunResult> by_id;
   for (const auto& dir : dirs) {
+    if (fs::is_regular_file(dir)) {  // a recorded collection (its results.csv)
+      for (auto& r : ReadResultsCsv(dir)) by_id[r.run_id] = std::move(r);
+      continue;
+    }
     const fs::path runs = dir / "runs";
     if (!fs::is_directory(runs)) throw InputError(dir, "no runs/ folder to collect");
     for (const auto& entry : fs::recursive_directory_iterator(runs)) {

@@ -34,7 +34,8 @@ struct ReportFiles {
 ReportFiles WriteReport(std::vector<RunResult> results, const ReportOptions& options);
 
 // Results of every finished run folder below DIR/runs (result.csv files), sorted by index;
-// several folders are merged (a run id found twice keeps the later folder's row).
+// several folders are merged (a run id found twice keeps the later folder's row). An entry that
+// is a file is a recorded collection (a results.csv): its rows join in the same way.
 std::vector<RunResult> CollectResults(const std::vector<std::filesystem::path>& dirs);
 
 // Renders tables as HTML (exposed for tests).

@@ -214,6 +214,64 @@ TEST(BenchCli, SmokeSuiteRunsResumesAndScalesOut) {
   EXPECT_EQ(SummaryWithoutTimes(jobs / "summary.csv"), SummaryWithoutTimes(out / "summary.csv"));
 }
 
+// A study resumes from its recorded results.csv on a machine without its run folders: the
+// recorded runs are not run again, the others are, and the collection holds both.
+TEST(BenchCli, ResumesFromRecordedResultsWithoutTheRunFolders) {
+  const fs::path dir = testing::MakeTempDir("bench_resume_from");
+  const fs::path cache = dir / "cache";
+  const std::string first = "sim_medium_5s/stereo/orbslam3/seed1";
+  const std::string second = "sim_medium_5s/stereo/pks/seed1";
+  auto r =
+      RunPkslam(fmt::format("--log-level warn bench '{}' --out '{}' --cache '{}' --run-id {} "
+                            "--quiet --no-plots",
+                            kSmoke.string(), (dir / "a").string(), cache.string(), first));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = RunPkslam(fmt::format("--log-level warn bench --collect '{}' --no-plots --quiet",
+                            (dir / "a").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const fs::path recorded = dir / "recorded.csv";  // what a study keeps in its repository
+  const auto row_of = [](const fs::path& csv) {    // the row without its index
+    const std::string line = Lines(csv).at(1);
+    return line.substr(line.find(','));
+  };
+  fs::copy_file(dir / "a" / "results.csv", recorded);
+  fs::remove_all(dir / "a");
+
+  const std::string resume = fmt::format(
+      "bench '{}' --out '{}' --cache '{}' --run-id {} --run-id {} --quiet --no-plots "
+      "--resume-from '{}'",
+      kSmoke.string(), (dir / "b").string(), cache.string(), first, second, recorded.string());
+  r = RunPkslam(resume);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("1 finished runs imported"));
+  EXPECT_THAT(r.output, HasSubstr("1 of 2 runs already finished: skipped"));
+  EXPECT_EQ(row_of(dir / "b" / "runs" / first / "result.csv"), row_of(recorded))
+      << "the recorded row, provenance included (only the index may differ)";
+  // Measuring again keeps the imported numbers (there is no trajectory to measure).
+  r = RunPkslam(resume + " --reevaluate");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("0 finished runs imported, 1 already here"));
+  EXPECT_THAT(r.output, HasSubstr("2 of 2 runs already finished: skipped"));
+  EXPECT_EQ(row_of(dir / "b" / "runs" / first / "result.csv"), row_of(recorded));
+  r = RunPkslam(fmt::format("--log-level warn bench --collect '{}' --no-plots --quiet",
+                            (dir / "b").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("collected 2 runs"));
+  // The recorded collection merges with a folder's runs: here the first run only in the record,
+  // the second only in the folder.
+  fs::remove_all(dir / "b" / "runs" / first);
+  r = RunPkslam(fmt::format("--log-level warn bench --collect '{}' '{}' --out '{}' --no-plots",
+                            recorded.string(), (dir / "b").string(), (dir / "merged").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("collected 2 runs from 2 source(s)"));
+  EXPECT_EQ(Lines(dir / "merged" / "results.csv").size(), 3u);
+
+  r = RunPkslam(fmt::format("bench '{}' --out '{}' --run-id {} --resume-from '{}'", kSmoke.string(),
+                            (dir / "c").string(), first, (dir / "missing.csv").string()));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr((dir / "missing.csv").string()));
+}
+
 // A study run in passes by different builds of pkslam renders with one build throughout
 // (--simulator): the renderings are keyed by the simulator, the results record the build that ran.
 TEST(BenchCli, TheSimulatorKeysTheRenderingsAndTheRunsRecordPkslam) {
