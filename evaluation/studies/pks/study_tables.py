@@ -13,11 +13,13 @@ Reads REPORT/results.csv (one row per run) and the analysis of bench/bench_stati
   5. when run k of every configuration replays the same rendering (round 2, issue 39): the
      paired analysis of bench/paired_statistics.py (--compare CONFIG:BASELINE, repeatable);
   6. --rate-pairs A:B,...: keyframes created per minute of A beside B's per sequence (e.g.
-     pkslam's pks-released beside the authors' binary), and whether A is within 10% of B.
+     pkslam's pks-released beside the authors' binary), and whether A is within 10% of B;
+  7. the builds that made the runs (per configuration). Runs of several pkslam builds, or of
+     several builds of one peer, are refused (exit 3) unless --pool-builds says to pool them.
 
   /usr/bin/python3 evaluation/studies/pks/study_tables.py REPORT/results.csv \
       [--datasets real_MH_01_easy,real_V1_01_easy] [--compare pks-authors:orbslam3-v03-peer] \
-      [--rate-pairs pks-released:pks-authors] > tables.md
+      [--rate-pairs pks-released:pks-authors] [--pool-builds] > tables.md
 """
 
 import argparse
@@ -164,6 +166,16 @@ def pairs_argument(texts, parser):
         parser.error(str(e))
 
 
+def builds_table(rows, configs):
+    """Which build made how many of each configuration's runs."""
+    lines = ["| configuration | build | runs |", "|---|---|---|"]
+    for config in configs:
+        counts = collections.Counter(r["build"] or "not recorded" for r in rows
+                                     if r["config"] == config)
+        lines += [f"| {config} | {b} | {n} |" for b, n in counts.items()]
+    return lines
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("results", help="REPORT/results.csv of pkslam bench --collect")
@@ -174,6 +186,8 @@ def main():
                              "against the suite's baseline)")
     parser.add_argument("--rate-pairs", default="", metavar="A:B,...",
                         help="keyframe rates of A beside B per sequence")
+    parser.add_argument("--pool-builds", action="store_true",
+                        help="analyse runs of different builds together (refused by default)")
     args = parser.parse_args()
     compare = pairs_argument(args.compare, parser)
     rate_pairs = pairs_argument([args.rate_pairs] if args.rate_pairs else [], parser)
@@ -190,6 +204,11 @@ def main():
         rows = [r for r in rows if r["dataset"] in keep]
     if not rows:
         sys.exit(f"study_tables: {args.results}: no runs left")
+    mixed = bench_statistics.pooled_builds(rows)
+    if mixed and not args.pool_builds:
+        print(f"study_tables: {args.results}: {mixed}; pass --pool-builds to analyse them "
+              "together", file=sys.stderr)
+        sys.exit(3)
     result = bench_statistics.analyse(rows, pairs=compare or None)
     datasets = bench_statistics.unique(r["dataset"] for r in rows)
     sensors = bench_statistics.unique(r["sensor"] for r in rows)
@@ -211,6 +230,8 @@ def main():
         out += ["", "**Keyframe rates** (keyframes created, culled ones too, per minute of "
                 "sequence; mean over runs)", ""]
         out += rate_table(rows, datasets, sensors, rate_pairs)
+    out += ["", "**Builds** (what made the runs)", ""]
+    out += builds_table(rows, configs)
     print("\n".join(out))
 
 

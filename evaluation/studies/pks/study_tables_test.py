@@ -13,10 +13,12 @@ import unittest
 HERE = os.path.dirname(os.path.abspath(__file__))
 FIELDS = ["index", "dataset", "sensor", "config", "baseline", "status", "ate_m",
           "ate_se3_rmse_m", "coverage", "keyframes", "cpu_s", "mapping_cpu_s",
-          "keyframe_reasons", "sweep_param", "seed", "keyframes_created", "sequence_s"]
+          "keyframe_reasons", "sweep_param", "seed", "keyframes_created", "sequence_s",
+          "pkslam_commit", "executable"]
 
 
-def write_results(path):
+def write_results(path, rebuilt_runs=0):
+    """The last `rebuilt_runs` pkslam runs come from a second build of the same commit."""
     rows, index = [], 0
     for dataset in ("real_MH_01_easy", "real_V1_01_easy"):
         for config in ("orbslam3", "pks"):
@@ -31,8 +33,11 @@ def write_results(path):
                     "keyframes": 100 if config == "pks" else 50, "cpu_s": 10, "mapping_cpu_s": 4,
                     "keyframe_reasons": ("imu=6 time=2" if config == "pks" else "c1b+c2=3"),
                     "sweep_param": "", "seed": run + 1,
-                    "keyframes_created": 33 if config == "pks" else 30, "sequence_s": 60})
+                    "keyframes_created": 33 if config == "pks" else 30, "sequence_s": 60,
+                    "pkslam_commit": "abc123", "executable": "build-a"})
                 index += 1
+    for r in rows[len(rows) - rebuilt_runs:]:
+        r["executable"] = "build-b"
     # A sweep row: left out of every table.
     rows.append(dict(rows[0], index=index, config="orbslam3-sweep", sweep_param="min_frames"))
     with open(path, "w", newline="") as f:
@@ -42,10 +47,10 @@ def write_results(path):
 
 
 class StudyTablesTest(unittest.TestCase):
-    def run_tables(self, *extra):
+    def run_tables(self, *extra, rebuilt_runs=0):
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "results.csv")
-            write_results(path)
+            write_results(path, rebuilt_runs)
             return subprocess.run([sys.executable, os.path.join(HERE, "study_tables.py"), path,
                                    *extra], capture_output=True, text=True)
 
@@ -77,6 +82,18 @@ class StudyTablesTest(unittest.TestCase):
         self.assertNotIn("nan", out.stdout)
         bad = self.run_tables("--rate-pairs", "pks")
         self.assertNotEqual(bad.returncode, 0)
+
+    def test_runs_of_two_builds_are_pooled_only_when_asked(self):
+        out = self.run_tables()
+        self.assertIn("| pks | pkslam abc123 (executable build-a) | 8 |", out.stdout)
+        out = self.run_tables(rebuilt_runs=2)
+        self.assertEqual(out.returncode, 3)
+        self.assertIn("pkslam runs come from 2 builds", out.stderr)
+        self.assertIn("build-b): 2 runs", out.stderr)
+        out = self.run_tables("--pool-builds", rebuilt_runs=2)
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertIn("| pks | pkslam abc123 (executable build-a) | 6 |", out.stdout)
+        self.assertIn("| pks | pkslam abc123 (executable build-b) | 2 |", out.stdout)
 
     def test_dataset_filter_and_empty_selection(self):
         out = self.run_tables("--datasets", "real_MH_01_easy")
