@@ -74,6 +74,15 @@ std::string SimKey(const HarnessOptions& options, const RunSpec& run) {
   return SimCacheDir(options, run.dataset, *run.sim).string();
 }
 
+// --resume-from: the recorded runs become finished runs of OUT before anything is scheduled.
+void ImportRecorded(const HarnessOptions& options, const std::vector<RunSpec>& runs) {
+  for (const auto& file : options.resume_from) {
+    const ImportCounts i = ImportFinished(file, runs, options.out);
+    PKSLAM_LOG_INFO("{}: {} finished runs imported, {} already here, {} not in this selection",
+                    file.string(), i.imported, i.present, i.other);
+  }
+}
+
 }  // namespace
 
 std::vector<RunSpec> SelectRuns(const std::vector<RunSpec>& runs,
@@ -92,19 +101,6 @@ std::vector<RunSpec> SelectRuns(const std::vector<RunSpec>& runs,
   }
   return out;
 }
-
-namespace {
-
-// --resume-from: the recorded runs become finished runs of OUT before anything is scheduled.
-void ImportRecorded(const HarnessOptions& options, const std::vector<RunSpec>& runs) {
-  for (const auto& file : options.resume_from) {
-    const ImportCounts i = ImportFinished(file, runs, options.out);
-    PKSLAM_LOG_INFO("{}: {} finished runs imported, {} already here, {} not in this selection",
-                    file.string(), i.imported, i.present, i.other);
-  }
-}
-
-}  // namespace
 
 std::vector<RunResult> RunSuite(const Suite& suite, const std::vector<RunSpec>& runs,
                                 const HarnessOptions& options, BenchCounts* counts,
