@@ -143,6 +143,48 @@ void RenderOptions::Check() const {
   PKSLAM_CHECK_OPTION(max_distance > 0.0f, "render.max_distance", "{}", max_distance);
 }
 
+std::vector<BoundSphere> SegmentSpheres(const Shape& shape) {
+  if (shape.type == ShapeType::kRoom) return {};
+  const Eigen::Vector3f& h = shape.half;
+  if (shape.type == ShapeType::kCylinder) {
+    // Along its axis (local z), in pieces about as long as the radius.
+    const float r = h.x();
+    const int n = std::clamp(static_cast<int>(std::ceil(h.z() / std::max(r, 1e-3f))), 1, 8);
+    if (n == 1) return {{Eigen::Vector3f::Zero(), shape.bound_radius()}};
+    std::vector<BoundSphere> spheres;
+    const float piece = h.z() / static_cast<float>(n);  // half length of a piece
+    for (int k = 0; k < n; ++k) {
+      spheres.push_back(
+          {Eigen::Vector3f(0.0f, 0.0f, -h.z() + (2.0f * k + 1.0f) * piece), std::hypot(r, piece)});
+    }
+    return spheres;
+  }
+  // Box or quad: a grid of at most 4 x 4 cells over its two largest axes, cells about as
+  // wide as the box is thick (or a quarter of its length, for thin slabs and quads).
+  int order[3] = {0, 1, 2};
+  std::sort(order, order + 3, [&](int i, int j) { return h[i] > h[j]; });
+  const float cell = std::max(h[order[2]], 0.25f * h[order[0]]);
+  int n[3] = {1, 1, 1};
+  for (int i = 0; i < 2; ++i) {
+    n[order[i]] =
+        std::clamp(static_cast<int>(std::ceil(h[order[i]] / std::max(cell, 1e-3f))), 1, 4);
+  }
+  if (n[0] * n[1] * n[2] == 1) return {{Eigen::Vector3f::Zero(), shape.bound_radius()}};
+  const Eigen::Vector3f piece(h.x() / n[0], h.y() / n[1], h.z() / n[2]);  // half cell
+  std::vector<BoundSphere> spheres;
+  for (int i = 0; i < n[0]; ++i) {
+    for (int j = 0; j < n[1]; ++j) {
+      for (int k = 0; k < n[2]; ++k) {
+        const Eigen::Vector3f centre =
+            -h +
+            Eigen::Vector3f(2.0f * i + 1.0f, 2.0f * j + 1.0f, 2.0f * k + 1.0f).cwiseProduct(piece);
+        spheres.push_back({centre, piece.norm()});
+      }
+    }
+  }
+  return spheres;
+}
+
 Renderer::Renderer(const Scene& scene, const RenderOptions& options)
     : scene_(scene), options_(options) {
   options_.Check();
@@ -157,23 +199,62 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options)
       PKSLAM_CHECK(s.material[f] >= 0 && s.material[f] < static_cast<int>(scene_.materials.size()),
                    "shape {} face {} material {} out of range", s.name, f, s.material[f]);
     }
+    bounds_.push_back(SegmentSpheres(s));
   }
 }
 
 namespace {
 
-// Per-frame data of one shape: the camera ray -> shape-local transform and the bounding
-// sphere as seen from the camera (direction + angular radius) for tile culling.
+// A bounding sphere as seen from the camera: direction and angular radius, for the tile test.
+struct ViewSphere {
+  Eigen::Vector3f dir_camera = Eigen::Vector3f::UnitZ();  // unit
+  float cos_rho = 0.0f;
+  float sin_rho = 0.0f;
+  bool contains_camera = false;
+  // No point of the sphere is nearer the camera than this (its near side; 0 when the camera is
+  // inside it). Rays are unit vectors, so hit distances compare with it.
+  float near = 0.0f;
+};
+
+ViewSphere SeeSphere(const Eigen::Vector3f& centre_camera, float radius) {
+  ViewSphere v;
+  const float dist = centre_camera.norm();
+  if (dist <= radius * 1.001f) {
+    v.contains_camera = true;
+    return v;
+  }
+  v.near = std::max(dist - radius * 1.001f, 0.0f);
+  v.dir_camera = centre_camera / dist;
+  v.sin_rho = radius / dist;
+  v.cos_rho = std::sqrt(1.0f - v.sin_rho * v.sin_rho);
+  return v;
+}
+
+// Whether some ray of the tile can meet the sphere: cone (axis a, half-angle alpha) meets
+// sphere (direction c, angular radius rho) iff angle(a, c) < alpha + rho.
+bool TileSees(const CameraRays::Tile& tile, const ViewSphere& s) {
+  if (s.contains_camera) return true;
+  const float cos_sum = tile.cos_half * s.cos_rho - tile.sin_half * s.sin_rho;
+  const bool wide =
+      tile.sin_half * s.cos_rho + tile.cos_half * s.sin_rho < 0.0f || cos_sum < -0.999f;
+  return wide || tile.axis.dot(s.dir_camera) >= cos_sum;
+}
+
+// Per-frame data of one shape: the camera ray -> shape-local transform, its bounding sphere
+// and its part spheres (SegmentSpheres) as seen from the camera.
 struct FrameShape {
   int index = 0;
   Eigen::Matrix3f local_from_camera;
   Eigen::Vector3f origin_local;
-  Eigen::Vector3f sphere_dir_camera;  // unit
-  float cos_rho = 0.0f;
-  float sin_rho = 0.0f;
-  bool contains_camera = false;
-  // No point of the shape is nearer the camera than this (the bounding sphere's near side; 0
-  // when the camera is inside it). Rays are unit vectors, so hit distances compare with it.
+  ViewSphere bound;
+  int first_part = 0;  // into the frame's part list
+  int num_parts = 0;
+};
+
+// A shape some ray of a tile may hit, and the nearest such a hit can be (the nearest part
+// sphere the tile sees, no nearer than the whole shape's bound).
+struct TileCandidate {
+  const FrameShape* shape = nullptr;
   float near = 0.0f;
 };
 
@@ -196,6 +277,7 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
   const Shape* room = nullptr;
   FrameShape room_frame;
   std::vector<FrameShape> shapes;
+  std::vector<ViewSphere> parts;
   for (int i = 0; i < static_cast<int>(scene_.shapes.size()); ++i) {
     const Shape& s = scene_.shapes[i];
     FrameShape f;
@@ -208,25 +290,22 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
       room_frame = f;
       continue;
     }
-    const Eigen::Vector3f to_centre = r_wc.transpose() * (s.center - o_w);
-    const float dist = to_centre.norm();
-    const float radius = s.bound_radius();
-    if (dist <= radius * 1.001f) {
-      f.contains_camera = true;
-    } else {
-      f.near = std::max(dist - radius * 1.001f, 0.0f);
-      f.sphere_dir_camera = to_centre / dist;
-      f.sin_rho = radius / dist;
-      f.cos_rho = std::sqrt(1.0f - f.sin_rho * f.sin_rho);
+    f.bound = SeeSphere(r_wc.transpose() * (s.center - o_w), s.bound_radius());
+    f.first_part = static_cast<int>(parts.size());
+    for (const BoundSphere& b : bounds_[i]) {
+      const Eigen::Vector3f centre_world = s.center + s.world_from_local * b.centre_local;
+      parts.push_back(SeeSphere(r_wc.transpose() * (centre_world - o_w), b.radius));
     }
+    f.num_parts = static_cast<int>(parts.size()) - f.first_part;
     shapes.push_back(f);
   }
   // Nearest first, so a ray stops testing once its hit is nearer than the next shape can be
   // (dense scenes: most rays hit something close). Ties in `near` keep the scene order, and a
   // shape is only skipped when it cannot be hit before the current hit, so the image is the
   // same as testing every shape.
-  std::stable_sort(shapes.begin(), shapes.end(),
-                   [](const FrameShape& a, const FrameShape& b) { return a.near < b.near; });
+  std::stable_sort(shapes.begin(), shapes.end(), [](const FrameShape& a, const FrameShape& b) {
+    return a.bound.near < b.bound.near;
+  });
 
   const auto& tiles = rays.tiles();
   const int samples = rays.supersample() * rays.supersample();
@@ -234,23 +313,23 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
   tbb::parallel_for(
       tbb::blocked_range<int>(0, static_cast<int>(tiles.size())),
       [&](const tbb::blocked_range<int>& range) {
-        std::vector<const FrameShape*> candidates;
+        std::vector<TileCandidate> candidates;
         candidates.reserve(shapes.size() + 1);
         for (int ti = range.begin(); ti != range.end(); ++ti) {
           const CameraRays::Tile& tile = tiles[ti];
           candidates.clear();
-          if (room) candidates.push_back(&room_frame);
+          if (room) candidates.push_back({&room_frame, 0.0f});
+          // The order stays the frame's (by the whole shape's bound): culling by the parts
+          // only drops shapes no ray of the tile can hit and raises the bound a ray skips by,
+          // so the image is the same as without the parts.
           for (const FrameShape& f : shapes) {
-            if (f.contains_camera) {
-              candidates.push_back(&f);
-              continue;
+            if (!TileSees(tile, f.bound)) continue;
+            float near = std::numeric_limits<float>::infinity();
+            for (int p = f.first_part; p < f.first_part + f.num_parts; ++p) {
+              if (TileSees(tile, parts[p])) near = std::min(near, parts[p].near);
             }
-            // Cone (axis a, half-angle alpha) meets sphere (direction c, angular radius rho)
-            // iff angle(a, c) < alpha + rho.
-            const float cos_sum = tile.cos_half * f.cos_rho - tile.sin_half * f.sin_rho;
-            const bool wide =
-                tile.sin_half * f.cos_rho + tile.cos_half * f.sin_rho < 0.0f || cos_sum < -0.999f;
-            if (wide || tile.axis.dot(f.sphere_dir_camera) >= cos_sum) candidates.push_back(&f);
+            if (near == std::numeric_limits<float>::infinity()) continue;
+            candidates.push_back({&f, std::max(near, f.bound.near)});
           }
           for (int y = tile.y0; y < tile.y1; ++y) {
             float* rad = out->radiance.ptr<float>(y);
@@ -267,8 +346,10 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
                 Eigen::Vector2f uv;
                 Eigen::Vector3f n_local;
                 Eigen::Vector3f d_best;
-                for (const FrameShape* f : candidates) {
-                  if (f->near >= t) break;  // sorted: no later shape can be hit sooner
+                for (const TileCandidate& c : candidates) {
+                  const FrameShape* f = c.shape;
+                  if (f->bound.near >= t) break;  // sorted: no later shape can be hit sooner
+                  if (c.near >= t) continue;
                   const Eigen::Vector3f d = f->local_from_camera * rc;
                   if (HitLocal(scene_.shapes[f->index], f->origin_local, d, 1e-4f, &t, &face)) {
                     best = f;

@@ -1,5 +1,7 @@
 // Ray-casting renderer. Per-pixel bearing vectors come from CameraModel::Unproject (so lens
-// distortion is exact); shapes are culled per 16x16 tile against the tile's cone of rays;
+// distortion is exact); shapes are culled per 16x16 tile against the tile's cone of rays, by
+// their bounding sphere and then by spheres around their parts (SegmentSpheres), which also
+// bound how near a hit can be, so a ray skips shapes it cannot reach before its current hit;
 // shading = albedo (mip-mapped texture, footprint from distance, incidence and the pixel's
 // angular size) x (ambient + soft point lights). Output is linear radiance (sensor effects
 // are in sensor_model.h) and optionally depth along the optical axis.
@@ -98,6 +100,17 @@ struct RenderBuffers {
   cv::Mat depth;     // CV_32F metres along the camera z axis (only with options.depth)
 };
 
+// A sphere bounding part of a shape (centre in the shape's frame). Long and flat shapes get a
+// row or grid of them, so tile culling and the nearest-possible-hit bound follow the shape
+// rather than one sphere around all of it (a pipe, a rail, a floor mat).
+struct BoundSphere {
+  Eigen::Vector3f centre_local = Eigen::Vector3f::Zero();
+  float radius = 0.0f;
+};
+// Spheres whose union contains every point of `shape` (none for the room, which is never
+// culled): at most 16.
+std::vector<BoundSphere> SegmentSpheres(const Shape& shape);
+
 class Renderer {
  public:
   Renderer(const Scene& scene, const RenderOptions& options);
@@ -112,6 +125,7 @@ class Renderer {
  private:
   const Scene& scene_;
   RenderOptions options_;
+  std::vector<std::vector<BoundSphere>> bounds_;  // SegmentSpheres of each shape
 };
 
 }  // namespace pkslam::sim
