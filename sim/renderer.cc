@@ -274,6 +274,10 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
   const Eigen::Matrix3f r_wc = world_from_camera.RotationMatrix().cast<float>();
   const Eigen::Vector3f o_w = world_from_camera.translation().cast<float>();
 
+  // The part spheres were taken from the scene when the Renderer was made.
+  PKSLAM_CHECK(bounds_.size() == scene_.shapes.size(),
+               "the scene changed after its Renderer was made ({} shapes, {} then)",
+               scene_.shapes.size(), bounds_.size());
   const Shape* room = nullptr;
   FrameShape room_frame;
   std::vector<FrameShape> shapes;

@@ -113,6 +113,8 @@ std::vector<BoundSphere> SegmentSpheres(const Shape& shape);
 
 class Renderer {
  public:
+  // Keeps a reference to `scene` and its shapes' part spheres: the scene must outlive the
+  // Renderer and keep its shapes (Render checks their count).
   Renderer(const Scene& scene, const RenderOptions& options);
 
   // Renders the view of a camera at world_from_camera (optical frame: z forward, y down).
