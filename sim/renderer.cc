@@ -199,7 +199,10 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options)
       PKSLAM_CHECK(s.material[f] >= 0 && s.material[f] < static_cast<int>(scene_.materials.size()),
                    "shape {} face {} material {} out of range", s.name, f, s.material[f]);
     }
-    bounds_.push_back(SegmentSpheres(s));
+    // A shape one sphere fits is culled by its bounding sphere alone (the same sphere).
+    std::vector<BoundSphere> parts = SegmentSpheres(s);
+    if (parts.size() == 1) parts.clear();
+    bounds_.push_back(std::move(parts));
   }
 }
 
@@ -241,7 +244,7 @@ bool TileSees(const CameraRays::Tile& tile, const ViewSphere& s) {
 }
 
 // Per-frame data of one shape: the camera ray -> shape-local transform, its bounding sphere
-// and its part spheres (SegmentSpheres) as seen from the camera.
+// and its part spheres (SegmentSpheres; none when one sphere fits it) as seen from the camera.
 struct FrameShape {
   int index = 0;
   Eigen::Matrix3f local_from_camera;
@@ -328,6 +331,10 @@ void Renderer::Render(const CameraRays& rays, const SE3d& world_from_camera, Ren
           // so the image is the same as without the parts.
           for (const FrameShape& f : shapes) {
             if (!TileSees(tile, f.bound)) continue;
+            if (f.num_parts == 0) {
+              candidates.push_back({&f, f.bound.near});
+              continue;
+            }
             float near = std::numeric_limits<float>::infinity();
             for (int p = f.first_part; p < f.first_part + f.num_parts; ++p) {
               if (TileSees(tile, parts[p])) near = std::min(near, parts[p].near);

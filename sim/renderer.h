@@ -127,7 +127,8 @@ class Renderer {
  private:
   const Scene& scene_;
   RenderOptions options_;
-  std::vector<std::vector<BoundSphere>> bounds_;  // SegmentSpheres of each shape
+  // SegmentSpheres of each shape split into parts (empty where one sphere fits it).
+  std::vector<std::vector<BoundSphere>> bounds_;
 };
 
 }  // namespace pkslam::sim

@@ -5,11 +5,8 @@
 
 #include <cmath>
 
-#include "sim/euroc_writer.h"
-#include "sim/motion_generator.h"
 #include "sim/renderer.h"
-#include "sim/scene_builder.h"
-#include "sim/scene_description.h"
+#include "sim/sim_testing.h"
 
 namespace pkslam::sim {
 namespace {
@@ -74,9 +71,7 @@ TEST(RendererCulling, DepthEqualsTheNearestHitOverEveryShape) {
   build.texture_size = 64;
   const Scene scene = BuildScene(LoadSceneDescription("euroc_machine_hall"), build, {});
   const CameraRig cam = EurocCam0();
-  MotionOptions motion;
-  motion.duration_s = 20;
-  const SplineTrajectory flight = GenerateMotion(scene, motion, cam.body_from_camera, 3, 0);
+  const SplineTrajectory flight = RandomTestFlight(scene, MotionLevel::kMedium, 20, 3);
   // A quarter-resolution EuRoC camera keeps the brute-force test short.
   const CameraRays rays(CameraModel::Pinhole(188, 120, 114.0, 114.0, 93.5, 59.5));
   RenderOptions options;
