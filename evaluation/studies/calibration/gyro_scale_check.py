@@ -3,7 +3,7 @@
 
     python3 evaluation/studies/calibration/gyro_scale_check.py SEQ OUT [--pkslam BIN]
         [--sensor stereo-inertial] [--seed 1]
-        [--variants none,gyro,gyro-diagonal,gyro+accel,accel,accel-diagonal]
+        [--variants none,gyro,gyro-diagonal,gyro+accel,accel,accel-diagonal] [--true-baseline]
         [-- extra pkslam run arguments]
 
 SEQ is a `pkslam simulate --realism euroc` folder (SEQ/truth/realism_draw.yaml holds the drawn
@@ -17,14 +17,19 @@ symbolic links, SEQ is not modified):
   accel           accelerometer samples by M_a^-1 only
   accel-diagonal  accelerometer samples divided by diag(M_a) (its per-axis scale factor only)
 then `pkslam run --calibrate online` on it, and prints the ATE (SE(3) alignment), the scale a
-Sim(3) alignment finds (the map's scale error) and the calibration estimates against the truth
-(calibration_truth.py). The biases, g-sensitivity and noise stay. With
+Sim(3) alignment finds (the map's scale error), the calibration estimates against the truth
+(calibration_truth.py) and the stereo depth error the estimate leaves (stereo_depth_error.py:
+the disparity offset and scale fitted over 1-8 m). The biases, g-sensitivity and noise stay.
+--true-baseline also puts the stereo translation of the copies' files at the truth (cam1's
+T_BS moved so that cam0_from_cam1 has the true translation and the file's rotation): online
+calibration holds the baseline at the file's value, so this shows what its error costs. With
 --calibrate-hold-gyro-scale among the extra arguments this is the experiment that found the gyro
 scale behind cam0's fy bias (docs/calibration.md, "The gyro's scale factor").
 """
 import argparse
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -36,6 +41,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 sys.path.insert(0, HERE)
 import calibration_truth  # noqa: E402
+import stereo_depth_error  # noqa: E402
 
 VARIANTS = ("none", "gyro", "gyro-diagonal", "gyro+accel", "accel", "accel-diagonal")
 
@@ -71,6 +77,37 @@ def corrected_copy(seq, out, variant, draw):
         f.write("\n".join(rows) + "\n")
 
 
+def true_baseline_files(seq, out):
+    """OUT/mav0/cam1: SEQ's cam1 with the images linked and sensor.yaml's T_BS moved so that
+    cam0_from_cam1 keeps the file's rotation and takes the truth's translation."""
+    cam1 = os.path.join(out, "mav0", "cam1")
+    if os.path.islink(cam1):
+        os.unlink(cam1)
+    os.makedirs(cam1, exist_ok=True)
+    for name in os.listdir(os.path.join(seq, "mav0", "cam1")):
+        if name != "sensor.yaml" and not os.path.exists(os.path.join(cam1, name)):
+            os.symlink(os.path.abspath(os.path.join(seq, "mav0", "cam1", name)),
+                       os.path.join(cam1, name))
+    body_from = {}
+    for source, folder in (("file", os.path.join(seq, "mav0")), ("truth", os.path.join(seq, "truth"))):
+        for cam in ("cam0", "cam1"):
+            path = (os.path.join(folder, cam, "sensor.yaml") if source == "file"
+                    else os.path.join(folder, f"{cam}_sensor.yaml"))
+            body_from[source, cam] = calibration_truth.t_bs(calibration_truth.load_yaml(path))
+    cam0_from_cam1 = np.linalg.inv(body_from["file", "cam0"]) @ body_from["file", "cam1"]
+    true_cam0_from_cam1 = np.linalg.inv(body_from["truth", "cam0"]) @ body_from["truth", "cam1"]
+    cam0_from_cam1[:3, 3] = true_cam0_from_cam1[:3, 3]
+    body_from_cam1 = body_from["file", "cam0"] @ cam0_from_cam1
+    with open(os.path.join(seq, "mav0", "cam1", "sensor.yaml")) as f:
+        text = f.read()
+    rows = ",\n         ".join(", ".join(repr(float(v)) for v in body_from_cam1[i]) for i in range(4))
+    new_text, count = re.subn(r"data: \[[^\]]*\]", f"data: [{rows}]", text, count=1)
+    if count != 1:
+        sys.exit(f"{seq}/mav0/cam1/sensor.yaml: no T_BS data list")
+    with open(os.path.join(cam1, "sensor.yaml"), "w") as f:
+        f.write(new_text)
+
+
 def ate(pkslam, seq, run, align="se3"):
     """ATE rmse (m) and the alignment's scale."""
     out = os.path.join(run, f"ate_{align}.json")
@@ -96,6 +133,8 @@ def main():
     ap.add_argument("--sensor", default="stereo-inertial")
     ap.add_argument("--seed", default="1")
     ap.add_argument("--variants", default=",".join(VARIANTS))
+    ap.add_argument("--true-baseline", action="store_true",
+                    help="the copies' files hold the true stereo translation")
     args = ap.parse_args(argv)
     variants = args.variants.split(",")
     for v in variants:
@@ -107,10 +146,15 @@ def main():
         sys.exit(f"{args.seq}/truth/realism_draw.yaml: no imu_gyro_matrix (not a euroc-preset render)")
     truth = calibration_truth.truth_parameters(args.seq)
     print(f"{'variant':15s} {'ATE [mm]':>9s} {'Sim3 scale-1 %':>14s} {'fx-truth':>9s} "
-          f"{'fy-truth':>9s} {'td-truth ms':>11s} {'gyro sy-truth %':>15s}")
+          f"{'fy-truth':>9s} {'td-truth ms':>11s} {'gyro sy-truth %':>15s} "
+          f"{'stereo offset px':>16s} {'stereo scale %':>14s}")
+    truth_rig = stereo_depth_error.load_rig(os.path.join(args.seq, "truth", "cam0_sensor.yaml"),
+                                            os.path.join(args.seq, "truth", "cam1_sensor.yaml"))
     for v in variants:
         folder = os.path.join(args.out, v)
         corrected_copy(args.seq, os.path.join(folder, "seq"), v, draw)
+        if args.true_baseline:
+            true_baseline_files(args.seq, os.path.join(folder, "seq"))
         run = os.path.join(folder, "run")
         with open(os.path.join(folder, "run.log"), "w") as log:
             subprocess.run([args.pkslam, "run", "--dataset", os.path.join(folder, "seq"),
@@ -125,8 +169,13 @@ def main():
         gyro = est["gyro.sy"]["estimate"] - gyro_truth if "gyro.sy" in est else float("nan")
         se3, _ = ate(args.pkslam, args.seq, run)
         _, scale = ate(args.pkslam, args.seq, run, "sim3")
+        offset, depth_scale = stereo_depth_error.rig_offset_scale(
+            truth_rig, stereo_depth_error.load_rig(
+                os.path.join(run, "calibration", "cam0", "sensor.yaml"),
+                os.path.join(run, "calibration", "cam1", "sensor.yaml")))
         print(f"{v:15s} {se3 * 1e3:9.2f} {(scale - 1) * 100:14.3f} {err('cam0.fx'):9.3f} "
-              f"{err('cam0.fy'):9.3f} {err('time_offset'):11.3f} {gyro:15.3f}", flush=True)
+              f"{err('cam0.fy'):9.3f} {err('time_offset'):11.3f} {gyro:15.3f} "
+              f"{offset:16.4f} {depth_scale * 100:14.3f}", flush=True)
 
 
 if __name__ == "__main__":
