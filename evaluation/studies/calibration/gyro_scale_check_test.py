@@ -7,7 +7,9 @@ import unittest
 import numpy as np
 
 import gyro_scale_check as gsc
+import residual_sources_test as rs_test
 from calibration_truth import exp_se3, load_yaml, t_bs
+from residual_sources_test import write
 
 TRUE_BODY_FROM_CAM0 = exp_se3([-0.02, 0.07, 0.0, 0.01, -0.02, 1.56])
 TRUE_CAM0_FROM_CAM1 = exp_se3([0.11, 0.0, 0.0, 0.0, 0.0, 0.0])
@@ -16,18 +18,12 @@ FILE_BODY_FROM_CAM0 = exp_se3([0.003, 0.001, -0.0026, 0.0018, 0.0026, 0.003]) @ 
 FILE_CAM0_FROM_CAM1 = TRUE_CAM0_FROM_CAM1 @ exp_se3([0.0002, -0.0001, 0.0001, 0.0002, -0.0001, -0.0002])
 
 
+INTRINSICS = [458.6, 457.3, 367.2, 248.4]
+DISTORTION = [-0.28, 0.07, 0.0002, 0.00002]
+
+
 def camera_yaml(body_from_cam):
-    rows = ',\n         '.join(', '.join(repr(float(v)) for v in body_from_cam[i]) for i in range(4))
-    return (f'%YAML:1.0\nsensor_type: camera\nT_BS:\n  cols: 4\n  rows: 4\n  data: [{rows}]\n'
-            f'rate_hz: 20\nresolution: [752, 480]\ncamera_model: pinhole\n'
-            f'intrinsics: [458.6, 457.3, 367.2, 248.4]\ndistortion_model: radial-tangential\n'
-            f'distortion_coefficients: [-0.28, 0.07, 0.0002, 0.00002]\n')
-
-
-def write(path, text):
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(path, 'w') as f:
-        f.write(text)
+    return rs_test.camera_yaml(body_from_cam, INTRINSICS, DISTORTION)
 
 
 class TrueBaselineTest(unittest.TestCase):
