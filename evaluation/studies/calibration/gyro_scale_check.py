@@ -29,7 +29,6 @@ scale behind cam0's fy bias (docs/calibration.md, "The gyro's scale factor").
 import argparse
 import json
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -41,6 +40,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 sys.path.insert(0, HERE)
 import calibration_truth  # noqa: E402
+import residual_sources  # noqa: E402
 import stereo_depth_error  # noqa: E402
 
 VARIANTS = ("none", "gyro", "gyro-diagonal", "gyro+accel", "accel", "accel-diagonal")
@@ -88,24 +88,18 @@ def true_baseline_files(seq, out):
         if name != "sensor.yaml" and not os.path.exists(os.path.join(cam1, name)):
             os.symlink(os.path.abspath(os.path.join(seq, "mav0", "cam1", name)),
                        os.path.join(cam1, name))
-    body_from = {}
-    for source, folder in (("file", os.path.join(seq, "mav0")), ("truth", os.path.join(seq, "truth"))):
-        for cam in ("cam0", "cam1"):
-            path = (os.path.join(folder, cam, "sensor.yaml") if source == "file"
-                    else os.path.join(folder, f"{cam}_sensor.yaml"))
-            body_from[source, cam] = calibration_truth.t_bs(calibration_truth.load_yaml(path))
-    cam0_from_cam1 = np.linalg.inv(body_from["file", "cam0"]) @ body_from["file", "cam1"]
-    true_cam0_from_cam1 = np.linalg.inv(body_from["truth", "cam0"]) @ body_from["truth", "cam1"]
+
+    def body_from(path):
+        return calibration_truth.t_bs(calibration_truth.load_yaml(os.path.join(seq, path)))
+    file0 = body_from("mav0/cam0/sensor.yaml")
+    cam0_from_cam1 = np.linalg.inv(file0) @ body_from("mav0/cam1/sensor.yaml")
+    true_cam0_from_cam1 = (np.linalg.inv(body_from("truth/cam0_sensor.yaml"))
+                           @ body_from("truth/cam1_sensor.yaml"))
     cam0_from_cam1[:3, 3] = true_cam0_from_cam1[:3, 3]
-    body_from_cam1 = body_from["file", "cam0"] @ cam0_from_cam1
     with open(os.path.join(seq, "mav0", "cam1", "sensor.yaml")) as f:
-        text = f.read()
-    rows = ",\n         ".join(", ".join(repr(float(v)) for v in body_from_cam1[i]) for i in range(4))
-    new_text, count = re.subn(r"data: \[[^\]]*\]", f"data: [{rows}]", text, count=1)
-    if count != 1:
-        sys.exit(f"{seq}/mav0/cam1/sensor.yaml: no T_BS data list")
+        text = residual_sources.with_tbs(f.read(), file0 @ cam0_from_cam1)
     with open(os.path.join(cam1, "sensor.yaml"), "w") as f:
-        f.write(new_text)
+        f.write(text)
 
 
 def ate(pkslam, seq, run, align="se3"):

@@ -23,7 +23,8 @@ import sys
 
 import cv2
 import numpy as np
-import yaml
+
+from calibration_truth import load_yaml, t_bs
 
 DEPTHS_M = [1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0]
 GRID = (9, 7)  # points across and down the image, inside a 10% margin
@@ -31,15 +32,11 @@ UNDISTORT_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 200, 1e-1
 
 
 def load_sensor(path):
-    with open(path) as f:
-        text = "".join(l for l in f if not l.startswith("%"))
-    s = yaml.safe_load(text)
+    s = load_yaml(path)
     fx, fy, cx, cy = (float(v) for v in s["intrinsics"])
-    k = np.array(s["distortion_coefficients"], float)
     w, h = (int(v) for v in s["resolution"])
-    t_bs = np.array(s["T_BS"]["data"], float).reshape(4, 4)
-    return {"K": np.array([[fx, 0, cx], [0, fy, cy], [0, 0, 1.0]]), "D": k, "size": (w, h),
-            "T_BS": t_bs}
+    return {"K": np.array([[fx, 0, cx], [0, fy, cy], [0, 0, 1.0]]),
+            "D": np.array(s["distortion_coefficients"], float), "size": (w, h), "T_BS": t_bs(s)}
 
 
 def load_rig(cam0_path, cam1_path):
@@ -128,7 +125,7 @@ def report(name, truth_rig, rig):
         err = np.median(est_range[m] / true_range[m] - 1.0) * 100.0
         off = np.median(disparity[m] - needed[m])
         cells.append(f"{err:+.3f}% ({off:+.3f})")
-    offset, scale = rig_offset_scale(truth_rig, rig)
+    offset, scale = fit_offset_scale(depth, true_range, est_range, f, b)
     print(f"| {name} | " + " | ".join(cells) + f" | {offset:+.4f} px, {scale * 100:+.3f}% |")
 
 

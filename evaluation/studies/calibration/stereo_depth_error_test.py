@@ -7,6 +7,7 @@ import unittest
 
 import numpy as np
 
+import residual_sources_test as rs_test
 import stereo_depth_error as sde
 
 INTRINSICS = [458.6, 457.3, 367.2, 248.4]
@@ -16,11 +17,7 @@ DISTORTION = [-0.28, 0.07, 0.0002, 0.00002]
 def camera_yaml(x_m, intrinsics):
     body_from_cam = np.eye(4)
     body_from_cam[0, 3] = x_m
-    rows = ', '.join(repr(float(v)) for v in body_from_cam.reshape(-1))
-    return (f'%YAML:1.0\nsensor_type: camera\nT_BS:\n  cols: 4\n  rows: 4\n  data: [{rows}]\n'
-            f'rate_hz: 20\nresolution: [752, 480]\ncamera_model: pinhole\n'
-            f'intrinsics: {intrinsics}\ndistortion_model: radial-tangential\n'
-            f'distortion_coefficients: {DISTORTION}\n')
+    return rs_test.camera_yaml(body_from_cam, intrinsics, DISTORTION)
 
 
 def write_rig(folder, cam0_intrinsics, cam1_intrinsics):
