@@ -38,6 +38,7 @@ struct CalibrateArgs {
   bool lever_arm = false;
   bool mono_intrinsics = false;
   bool gyro_scale = true;
+  bool accel_axes = true;
   bool quiet = false;
   std::string python = "/usr/bin/python3";
 };
@@ -145,6 +146,7 @@ void RunCalibrate(const CalibrateArgs& args) {
   c.imu_translation = args.lever_arm;
   c.monocular_intrinsics = args.mono_intrinsics;
   c.gyro_scale = args.gyro_scale;
+  c.accel_axes = args.accel_axes;
   c.final_max_observations_per_keyframe = 0;
   c.final_iterations_first = 30;
   c.final_iterations_second = 15;
@@ -228,6 +230,9 @@ void RegisterCalibrateCommand(CLI::App& app) {
   cmd->add_flag("--calibrate-hold-gyro-scale{false}", args->gyro_scale,
                 "inertial: hold the gyroscope's scale factors at the file's values (estimated by "
                 "default)");
+  cmd->add_flag("--calibrate-hold-accel-axes{false}", args->accel_axes,
+                "inertial: hold the accelerometer's scale factors and misalignment at the file's "
+                "values (estimated by default)");
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
   cmd->add_option("--python", args->python, "Python with matplotlib, for the plot")
       ->capture_default_str();

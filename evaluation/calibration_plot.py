@@ -3,9 +3,10 @@
 
     python3 evaluation/calibration_plot.py RUN/stats.json OUT.png [--title TEXT]
 
-Five panels against the data time of each adjustment: intrinsics (estimate - file, px), the
+Six panels against the data time of each adjustment: intrinsics (estimate - file, px), the
 rotation of the stereo and camera-IMU extrinsics (deg), their translation (mm), the camera-IMU
-time offset (ms) and the gyro's per-axis scale-factor error (%). The final estimate is drawn at the end with its 1-sigma bar when
+time offset (ms), the gyro's and the accelerometer's per-axis scale-factor errors (%) and the
+accelerometer's axis misalignment (deg). The final estimate is drawn at the end with its 1-sigma bar when
 the run computed sigmas. Used by `pkslam calibrate` (DIR/calibration_history.png), the bench
 report and docs/calibration.md.
 """
@@ -23,14 +24,17 @@ def groups(name):
         return 2
     if name == "time_offset":
         return 3
-    if name.startswith("gyro.s"):
+    if name.startswith(("gyro.s", "accel.s")):
         return 4
+    if name.startswith("accel.m"):
+        return 5
     return None  # distortion: too small to share an axis with pixels
 
 
 TITLES = ["intrinsics: estimate - file [px]", "extrinsic rotation change [deg]",
           "extrinsic translation change [mm]", "camera-IMU time offset [ms]",
-          "gyro scale-factor error [%]"]
+          "IMU scale-factor error: estimate - file [%]",
+          "accelerometer misalignment: estimate - file [deg]"]
 
 
 def main(argv):
@@ -51,9 +55,7 @@ def main(argv):
     final = {p["name"]: p for p in calibration["parameters"]}
     history = [h for h in calibration["history"] if h.get("applied")]
     fig, grid = plt.subplots(2, 3, figsize=(15, 7), sharex=True)
-    grid = grid.ravel()
-    grid[5].axis("off")
-    axes = grid[:5]
+    axes = grid.ravel()
     t_end = max([h["span_s"] for h in history] + [1.0]) * 1.08
     for name, p in final.items():
         g = groups(name)
@@ -61,7 +63,7 @@ def main(argv):
             continue
         ax = axes[g]
         ts = [h["span_s"] for h in history if name in h["estimate"]]
-        base = p["file"] if g in (0, 4) else 0.0
+        base = p["file"] if g in (0, 4, 5) else 0.0
         ys = [h["estimate"][name] - base for h in history if name in h["estimate"]]
         line, = ax.plot(ts, ys, marker="o", ms=3, label=name)
         ax.errorbar([t_end], [p["estimate"] - base], yerr=[p.get("sigma", 0.0)], fmt="s",
@@ -72,7 +74,7 @@ def main(argv):
         ax.grid(alpha=0.3)
         if any(not line.get_label().startswith("_") for line in ax.lines):
             ax.legend(fontsize=7, ncol=2)
-    for ax in axes[2:]:  # the bottom row
+    for ax in axes[3:]:  # the bottom row
         ax.set_xlabel("data time of the map at the adjustment [s] (square: final, 1 sigma)")
     fig.suptitle(args.title or "calibration estimates while mapping", fontsize=11)
     fig.tight_layout()

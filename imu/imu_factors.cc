@@ -77,7 +77,7 @@ Eigen::Matrix<double, N, N> SqrtOfInformation(const Eigen::Matrix<double, N, N>&
 }
 
 // The inertial edge's residual and Jacobians for a preintegration `pim` (InertialError and, with
-// deltas shifted by the gyro scale, GyroScaledInertialError).
+// deltas shifted by the IMU's axis errors, ImuAxesInertialError).
 bool EvaluateInertialEdge(const PreintegratedImu& pim_, const Vec3& gravity_world_,
                           const Mat9& sqrt_info_, double const* const* parameters,
                           double* residuals, double** jacobians) {
@@ -174,53 +174,80 @@ bool InertialError::Evaluate(double const* const* parameters, double* residuals,
   return EvaluateInertialEdge(pim_, gravity_world_, sqrt_info_, parameters, residuals, jacobians);
 }
 
-GyroScaledInertialError::GyroScaledInertialError(const PreintegratedImu& pim,
-                                                 const Vec3& gravity_world,
-                                                 const GyroScaleJacobians& scale,
-                                                 const Vec3& integrated_scale)
+ImuAxesInertialError::ImuAxesInertialError(const PreintegratedImu& pim, const Vec3& gravity_world,
+                                           const GyroScaleJacobians& gyro,
+                                           const AccelAxesJacobians& accel,
+                                           const Vec3& integrated_gyro_scale,
+                                           const Mat3& integrated_accel_axes)
     : pim_(WithoutSteps(pim)),
       gravity_world_(gravity_world),
       sqrt_info_(PreintegrationSqrtInformation(pim)),
-      scale_(scale),
-      inv_integrated_(Vec3::Ones().cwiseQuotient(Vec3::Ones() + integrated_scale)),
-      integrated_scale_(integrated_scale) {
+      gyro_(gyro),
+      accel_(accel),
+      inv_integrated_(Vec3::Ones().cwiseQuotient(Vec3::Ones() + integrated_gyro_scale)),
+      integrated_scale_(integrated_gyro_scale),
+      integrated_axes_(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(
+          Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(integrated_accel_axes).data())) {
   PKSLAM_CHECK(pim.dt > 0, "inertial edge over an empty preintegration");
-  PKSLAM_CHECK(integrated_scale.allFinite() && integrated_scale.cwiseAbs().maxCoeff() < 0.5,
-               "gyro scale error ({}, {}, {}) out of range", integrated_scale.x(),
-               integrated_scale.y(), integrated_scale.z());
+  PKSLAM_CHECK(
+      integrated_gyro_scale.allFinite() && integrated_gyro_scale.cwiseAbs().maxCoeff() < 0.5,
+      "gyro scale error ({}, {}, {}) out of range", integrated_gyro_scale.x(),
+      integrated_gyro_scale.y(), integrated_gyro_scale.z());
+  PKSLAM_CHECK(
+      integrated_accel_axes.allFinite() && integrated_accel_axes.cwiseAbs().maxCoeff() < 0.5,
+      "accelerometer axis errors out of range (largest {})",
+      integrated_accel_axes.cwiseAbs().maxCoeff());
+  const Mat3 inv = (Mat3::Identity() + integrated_accel_axes).inverse();
+  axes_to_corrected_.setZero();
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) {
+      axes_to_corrected_.block<3, 3>(3 * r, 3 * k) = inv(r, k) * Mat3::Identity();
+    }
+  }
 }
 
-bool GyroScaledInertialError::Evaluate(double const* const* parameters, double* residuals,
-                                       double** jacobians) const {
+bool ImuAxesInertialError::Evaluate(double const* const* parameters, double* residuals,
+                                    double** jacobians) const {
   // The steps were corrected with integrated_scale_: the change to 1 / (1 + k) is, to first
   // order, a scale change dk = (k - k_integrated) / (1 + k_integrated) of the corrected rates.
+  // Likewise the accelerometer's: dE' = (I + E_integrated)^-1 (E - E_integrated).
   const Eigen::Map<const Vec3> k(parameters[6]);
+  const Eigen::Map<const Eigen::Matrix<double, 9, 1>> e(parameters[7]);
   const Vec3 dk = (k - integrated_scale_).cwiseProduct(inv_integrated_);
-  const Vec3 psi = scale_.rotation * dk;
+  const Eigen::Matrix<double, 9, 1> de = axes_to_corrected_ * (e - integrated_axes_);
+  const Vec3 psi = gyro_.rotation * dk;
   PreintegratedImu shifted = pim_;
   shifted.delta_R = pim_.delta_R * SO3d::Exp(psi);
-  shifted.delta_v = pim_.delta_v + scale_.velocity * dk;
-  shifted.delta_p = pim_.delta_p + scale_.position * dk;
+  shifted.delta_v = pim_.delta_v + gyro_.velocity * dk + accel_.velocity * de;
+  shifted.delta_p = pim_.delta_p + gyro_.position * dk + accel_.position * de;
   if (!EvaluateInertialEdge(shifted, gravity_world_, sqrt_info_, parameters, residuals,
                             jacobians)) {
     return false;
   }
-  if (jacobians == nullptr || jacobians[6] == nullptr) return true;
-  const Eigen::Map<const Vec3> bg(parameters[2]);
-  const SO3d r_i = BodyPoseFromBlock(parameters[0]).so3();
-  const SO3d r_j = BodyPoseFromBlock(parameters[4]).so3();
-  const RotationResidual rot = EvaluateRotation(shifted, bg, r_i, r_j, true);
-  // r_R = Log(B^T Exp(-psi) dR^T R_i^T R_j) with B the bias correction: a change of psi enters
-  // as Exp(-B^T Jr(psi) d psi) on the left of the error rotation.
-  const Mat3 b = SO3d::Exp(shifted.J_R_bg * (bg - shifted.bias.gyro)).Matrix();
-  const Mat3 d_psi = -rot.jr_inv * SO3d::Exp(rot.r).Matrix().transpose() * b.transpose() *
-                     SO3d::RightJacobian(psi);
-  RowMajorJacobian<3> j;
-  j.block<3, 3>(0, 0) = d_psi * scale_.rotation;
-  j.block<3, 3>(3, 0) = -scale_.velocity;
-  j.block<3, 3>(6, 0) = -scale_.position;
-  j = j * inv_integrated_.asDiagonal();
-  Write<RowMajorJacobian<3>>(jacobians[6], sqrt_info_ * j);
+  if (jacobians == nullptr) return true;
+  if (jacobians[6] != nullptr) {
+    const Eigen::Map<const Vec3> bg(parameters[2]);
+    const SO3d r_i = BodyPoseFromBlock(parameters[0]).so3();
+    const SO3d r_j = BodyPoseFromBlock(parameters[4]).so3();
+    const RotationResidual rot = EvaluateRotation(shifted, bg, r_i, r_j, true);
+    // r_R = Log(B^T Exp(-psi) dR^T R_i^T R_j) with B the bias correction: a change of psi
+    // enters as Exp(-B^T Jr(psi) d psi) on the left of the error rotation.
+    const Mat3 b = SO3d::Exp(shifted.J_R_bg * (bg - shifted.bias.gyro)).Matrix();
+    const Mat3 d_psi = -rot.jr_inv * SO3d::Exp(rot.r).Matrix().transpose() * b.transpose() *
+                       SO3d::RightJacobian(psi);
+    RowMajorJacobian<3> j;
+    j.block<3, 3>(0, 0) = d_psi * gyro_.rotation;
+    j.block<3, 3>(3, 0) = -gyro_.velocity;
+    j.block<3, 3>(6, 0) = -gyro_.position;
+    j = j * inv_integrated_.asDiagonal();
+    Write<RowMajorJacobian<3>>(jacobians[6], sqrt_info_ * j);
+  }
+  if (jacobians[7] != nullptr) {
+    RowMajorJacobian<9> j = RowMajorJacobian<9>::Zero();
+    j.block<3, 9>(3, 0) = -accel_.velocity * axes_to_corrected_;
+    j.block<3, 9>(6, 0) = -accel_.position * axes_to_corrected_;
+    Write<RowMajorJacobian<9>>(jacobians[7], sqrt_info_ * j);
+  }
   return true;
 }
 

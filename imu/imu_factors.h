@@ -44,17 +44,23 @@ class InertialError final : public ceres::SizedCostFunction<9, 7, 3, 3, 3, 7, 3>
   Eigen::Matrix<double, 9, 9> sqrt_info_;
 };
 
-// The inertial edge with the gyroscope's per-axis scale-factor error k as a parameter (online
-// calibration, docs/calibration.md: the gyro reads (1 + k) times the true rate). pim's steps were
-// corrected with `integrated_scale` (divided by 1 + k_integrated); the deltas follow k to first
-// order through GyroScaleJacobiansOf (imu/preintegration.h), then the residual is InertialError's.
-// Parameters {pose_i[7], v_i[3], bias_gyro_i[3], bias_accel_i[3], pose_j[7], v_j[3], k[3]};
-// residual 9.
-class GyroScaledInertialError final : public ceres::SizedCostFunction<9, 7, 3, 3, 3, 7, 3, 3> {
+// The inertial edge with the IMU's axis errors as parameters (online calibration,
+// docs/calibration.md): the gyroscope's per-axis scale-factor error k (it reads (1 + k) times the
+// true rate) and the accelerometer's axis errors E (it reads (I + E) times the true specific
+// force; row-major 9-vector). pim's steps were corrected with `integrated_gyro_scale` (divided by
+// 1 + k_integrated) and `integrated_accel_axes` (multiplied by (I + E_integrated)^-1); the deltas
+// follow k and E to first order through GyroScaleJacobiansOf and AccelAxesJacobiansOf
+// (imu/preintegration.h), then the residual is InertialError's. A block the solve holds is set
+// constant: at its integrated value its shift is exactly zero.
+// Parameters {pose_i[7], v_i[3], bias_gyro_i[3], bias_accel_i[3], pose_j[7], v_j[3], k[3],
+// E[9]}; residual 9.
+class ImuAxesInertialError final : public ceres::SizedCostFunction<9, 7, 3, 3, 3, 7, 3, 3, 9> {
  public:
-  // `scale` = GyroScaleJacobiansOf(pim), computed where pim still has its steps.
-  GyroScaledInertialError(const PreintegratedImu& pim, const Eigen::Vector3d& gravity_world,
-                          const GyroScaleJacobians& scale, const Eigen::Vector3d& integrated_scale);
+  // The Jacobians of pim, computed where pim still has its steps.
+  ImuAxesInertialError(const PreintegratedImu& pim, const Eigen::Vector3d& gravity_world,
+                       const GyroScaleJacobians& gyro, const AccelAxesJacobians& accel,
+                       const Eigen::Vector3d& integrated_gyro_scale,
+                       const Eigen::Matrix3d& integrated_accel_axes);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
@@ -62,9 +68,13 @@ class GyroScaledInertialError final : public ceres::SizedCostFunction<9, 7, 3, 3
   PreintegratedImu pim_;  // without its steps
   Eigen::Vector3d gravity_world_;
   Eigen::Matrix<double, 9, 9> sqrt_info_;
-  GyroScaleJacobians scale_;
-  Eigen::Vector3d inv_integrated_;  // 1 / (1 + integrated_scale), per axis
+  GyroScaleJacobians gyro_;
+  AccelAxesJacobians accel_;
+  Eigen::Vector3d inv_integrated_;  // 1 / (1 + integrated_gyro_scale), per axis
   Eigen::Vector3d integrated_scale_;
+  Eigen::Matrix<double, 9, 1> integrated_axes_;  // row-major, as the parameter block
+  // d vec(dE') / d vec(E) = (I + E_integrated)^-1 kron I3 (row-major vectors).
+  Eigen::Matrix<double, 9, 9> axes_to_corrected_;
 };
 
 // Bias random walk between consecutive bias blocks: r = W (b_j - b_i), W^T W = covariance^-1.

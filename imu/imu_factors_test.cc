@@ -133,11 +133,22 @@ TEST(InertialError, SolvesForTheSecondStateInCeres) {
   EXPECT_LT((Eigen::Map<const Vec3>(v_j.data()) - b.velocity_world).norm(), 1e-3);
 }
 
-TEST(GyroScaledInertialError, EqualsInertialErrorAtTheIntegratedScaleAndJacobiansMatch) {
+// Row-major 9-vector of a 3x3 matrix (the accelerometer axes' parameter block).
+Block AxesBlock(const Eigen::Matrix3d& m) {
+  Block b(9);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) b[3 * r + c] = m(r, c);
+  }
+  return b;
+}
+
+TEST(ImuAxesInertialError, EqualsInertialErrorAtTheIntegratedAxesAndJacobiansMatch) {
   const Scenario s;
   const Vec3 integrated(0.002, -0.004, 0.001);
-  const GyroScaledInertialError scaled(s.pim, kTestGravity, GyroScaleJacobiansOf(s.pim),
-                                       integrated);
+  Eigen::Matrix3d axes;
+  axes << 0.003, 0.0005, -0.0004, 0.0002, -0.002, 0.0007, -0.0006, 0.0003, 0.001;
+  const ImuAxesInertialError scaled(s.pim, kTestGravity, GyroScaleJacobiansOf(s.pim),
+                                    AccelAxesJacobiansOf(s.pim), integrated, axes);
   const InertialError plain(s.pim, kTestGravity);
   const BodyPoseManifold pose_manifold;
   std::mt19937 rng(7);
@@ -150,7 +161,8 @@ TEST(GyroScaledInertialError, EqualsInertialErrorAtTheIntegratedScaleAndJacobian
       VecBlock(s.true_bias.accel + RandomTangent<3>(rng, 0.1)),
       PoseBlock(b.world_from_body * SE3d::Exp(RandomTangent<6>(rng, 0.05))),
       VecBlock(b.velocity_world + RandomTangent<3>(rng, 0.1)),
-      VecBlock(integrated)};
+      VecBlock(integrated),
+      AxesBlock(axes)};
   std::vector<const double*> p;
   for (const Block& block : blocks) p.push_back(block.data());
   Eigen::Matrix<double, 9, 1> r_scaled, r_plain;
@@ -159,23 +171,40 @@ TEST(GyroScaledInertialError, EqualsInertialErrorAtTheIntegratedScaleAndJacobian
   EXPECT_LT((r_scaled - r_plain).norm(), 1e-12);
   for (int trial = 0; trial < 3; ++trial) {
     blocks[6] = VecBlock(integrated + RandomTangent<3>(rng, 0.01));
+    blocks[7] = AxesBlock(axes + Eigen::Matrix3d::Random() * 0.01);
     ExpectJacobiansMatch(CompareJacobians(scaled, blocks,
                                           {&pose_manifold, nullptr, nullptr, nullptr,
-                                           &pose_manifold, nullptr, nullptr}),
-                         7, 1e-5);
+                                           &pose_manifold, nullptr, nullptr, nullptr}),
+                         8, 1e-5);
   }
 }
 
-TEST(GyroScaledInertialError, RecoversAScaleErrorOfTheGyro) {
-  // The samples come from a gyro reading 0.8% fast about x and 0.5% slow about z, integrated
-  // as if exact; with both states and the bias held at the truth, the edges of three
-  // consecutive seconds are explained by k = (0.008, 0, -0.005), and the plain edge is not.
+// Three consecutive seconds of the helix, sampled by an IMU with axis errors and integrated as
+// if exact; with both states and the biases held at the truth, the edges are explained by the
+// true errors, and the plain edges are not.
+struct AxisErrorCase {
+  Vec3 gyro_scale = Vec3::Zero();
+  Eigen::Matrix3d accel_axes = Eigen::Matrix3d::Zero();
+  bool free_gyro = true;
+  bool free_accel = true;
+};
+
+struct AxisErrorFit {
+  Vec3 gyro_scale;
+  Eigen::Matrix3d accel_axes;
+  double plain_cost = 0;
+  double final_cost = 0;
+};
+
+AxisErrorFit FitAxisErrors(const AxisErrorCase& c) {
   const HelixMotion motion;
-  const Vec3 k_true(0.008, 0.0, -0.005);
   constexpr std::int64_t kSecondNs = 1'000'000'000;
   std::vector<ImuMeasurement> samples =
       SampleImu(motion, 0, 3 * kSecondNs + 5'000'000, 2'500'000, ImuBias(), {}, nullptr);
-  for (ImuMeasurement& m : samples) m.gyro = m.gyro.cwiseProduct(Vec3::Ones() + k_true);
+  for (ImuMeasurement& m : samples) {
+    m.gyro = m.gyro.cwiseProduct(Vec3::Ones() + c.gyro_scale);
+    m.accel = (Eigen::Matrix3d::Identity() + c.accel_axes) * m.accel;
+  }
   std::vector<PreintegratedImu> pims;
   for (int i = 0; i < 3; ++i) {
     pims.push_back(StartPreintegration(ImuBias(), ImuNoise{}));
@@ -188,19 +217,23 @@ TEST(GyroScaledInertialError, RecoversAScaleErrorOfTheGyro) {
     velocities.push_back(VecBlock(x.velocity_world));
   }
   Block bg = VecBlock(Vec3::Zero()), ba = VecBlock(Vec3::Zero()), k = VecBlock(Vec3::Zero());
+  Block e = AxesBlock(Eigen::Matrix3d::Zero());
   ceres::Problem problem;
-  double plain_cost = 0;
+  AxisErrorFit fit;
   for (int i = 0; i < 3; ++i) {
-    problem.AddResidualBlock(new GyroScaledInertialError(pims[i], kTestGravity,
-                                                         GyroScaleJacobiansOf(pims[i]), Vec3::Zero()),
-                             nullptr, poses[i].data(), velocities[i].data(), bg.data(), ba.data(),
-                             poses[i + 1].data(), velocities[i + 1].data(), k.data());
+    problem.AddResidualBlock(
+        new ImuAxesInertialError(pims[i], kTestGravity, GyroScaleJacobiansOf(pims[i]),
+                                 AccelAxesJacobiansOf(pims[i]), Vec3::Zero(),
+                                 Eigen::Matrix3d::Zero()),
+        nullptr,
+        {poses[i].data(), velocities[i].data(), bg.data(), ba.data(), poses[i + 1].data(),
+         velocities[i + 1].data(), k.data(), e.data()});
     const InertialError plain(pims[i], kTestGravity);
     const std::vector<const double*> p = {poses[i].data(), velocities[i].data(), bg.data(),
                                           ba.data(), poses[i + 1].data(), velocities[i + 1].data()};
     Eigen::Matrix<double, 9, 1> r;
     plain.Evaluate(p.data(), r.data(), nullptr);
-    plain_cost += r.squaredNorm();
+    fit.plain_cost += r.squaredNorm();
   }
   for (int i = 0; i <= 3; ++i) {
     problem.SetParameterBlockConstant(poses[i].data());
@@ -208,13 +241,43 @@ TEST(GyroScaledInertialError, RecoversAScaleErrorOfTheGyro) {
   }
   problem.SetParameterBlockConstant(bg.data());
   problem.SetParameterBlockConstant(ba.data());
+  if (!c.free_gyro) problem.SetParameterBlockConstant(k.data());
+  if (!c.free_accel) problem.SetParameterBlockConstant(e.data());
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
-  const Vec3 solved(k[0], k[1], k[2]);
-  EXPECT_LT((solved - k_true).cwiseAbs().maxCoeff(), 2e-4) << solved.transpose();
-  EXPECT_GT(plain_cost, 1e3 * summary.final_cost);
+  fit.final_cost = summary.final_cost;
+  fit.gyro_scale = Vec3(k[0], k[1], k[2]);
+  for (int r = 0; r < 3; ++r) {
+    for (int col = 0; col < 3; ++col) fit.accel_axes(r, col) = e[3 * r + col];
+  }
+  return fit;
+}
+
+TEST(ImuAxesInertialError, RecoversAScaleErrorOfTheGyro) {
+  // A gyro reading 0.8% fast about x and 0.5% slow about z; the accelerometer's block held.
+  AxisErrorCase c;
+  c.gyro_scale = Vec3(0.008, 0.0, -0.005);
+  c.free_accel = false;
+  const AxisErrorFit fit = FitAxisErrors(c);
+  EXPECT_LT((fit.gyro_scale - c.gyro_scale).cwiseAbs().maxCoeff(), 2e-4)
+      << fit.gyro_scale.transpose();
+  EXPECT_EQ(fit.accel_axes, Eigen::Matrix3d::Zero());
+  EXPECT_GT(fit.plain_cost, 1e3 * fit.final_cost);
+}
+
+TEST(ImuAxesInertialError, RecoversTheAccelerometersScaleAndMisalignment) {
+  // An accelerometer 0.4% long on x, 0.3% short on z, with 0.05-0.1 deg cross-axis terms, and
+  // the gyro's 0.5% on y: over the helix's turning and gravity both are seen.
+  AxisErrorCase c;
+  c.gyro_scale = Vec3(0.0, 0.005, 0.0);
+  c.accel_axes << 0.004, 0.0012, -0.0009, 0.0015, 0.0, 0.0017, -0.0010, 0.0009, -0.003;
+  const AxisErrorFit fit = FitAxisErrors(c);
+  EXPECT_LT((fit.accel_axes - c.accel_axes).cwiseAbs().maxCoeff(), 2e-4) << fit.accel_axes;
+  EXPECT_LT((fit.gyro_scale - c.gyro_scale).cwiseAbs().maxCoeff(), 2e-4)
+      << fit.gyro_scale.transpose();
+  EXPECT_GT(fit.plain_cost, 1e3 * fit.final_cost);
 }
 
 TEST(InertialGravityScaleError, ResidualVanishesAtTruthAndJacobiansMatch) {

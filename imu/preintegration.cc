@@ -164,6 +164,37 @@ GyroScaleJacobians GyroScaleJacobiansOf(const PreintegratedImu& pim) {
   return j;
 }
 
+AccelAxesJacobians AccelAxesJacobiansOf(const PreintegratedImu& pim) {
+  // A change dE' moves each step's corrected sample by -dE' a = -(I3 kron a^T) vec(dE'): the
+  // accelerometer bias's recursion (J_v_ba, J_p_ba) with that input matrix in place of -I.
+  AccelAxesJacobians j;
+  SO3d delta_R;
+  for (const PreintegratedImu::Step& s : pim.steps) {
+    const Vec3 w_dt = (s.gyro - pim.bias.gyro) * s.dt;
+    const SO3d step_R = SO3d::Exp(w_dt);
+    const Mat3 half_R = pim.scheme == ImuIntegrationScheme::kMidpoint
+                            ? SO3d::Exp(0.5 * w_dt).Matrix()
+                            : Mat3::Identity();
+    const Mat3 r_s = delta_R.Matrix() * half_R;
+    Eigen::Matrix<double, 3, 9> d = Eigen::Matrix<double, 3, 9>::Zero();
+    for (int r = 0; r < 3; ++r) d.block<1, 3>(r, 3 * r) = -s.accel.transpose();
+    const Eigen::Matrix<double, 3, 9> d_acc = r_s * d;
+    j.position += j.velocity * s.dt + 0.5 * d_acc * s.dt * s.dt;
+    j.velocity += d_acc * s.dt;
+    delta_R = delta_R * step_R;
+  }
+  return j;
+}
+
+void TransformAccel(const Mat3& m, PreintegratedImu* pim) {
+  PKSLAM_CHECK(m.allFinite() && std::abs(m.determinant()) > 0.5, "accelerometer axis transform");
+  if (m == Mat3::Identity()) return;
+  for (PreintegratedImu::Step& s : pim->steps) s.accel = m * s.accel;
+  ImuBias bias = pim->bias;
+  bias.accel = m * bias.accel;
+  Reintegrate(bias, pim);
+}
+
 void RescaleGyro(const Vec3& factor, PreintegratedImu* pim) {
   PKSLAM_CHECK(factor.allFinite() && factor.minCoeff() > 0, "gyro rescale factor ({}, {}, {})",
                factor.x(), factor.y(), factor.z());

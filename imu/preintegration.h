@@ -86,6 +86,24 @@ struct GyroScaleJacobians {
 };
 GyroScaleJacobians GyroScaleJacobiansOf(const PreintegratedImu& pim);
 
+// First-order Jacobians of the deltas with respect to a change dE' of the accelerometer's axis
+// errors, expressed in the corrected axes (online calibration, docs/calibration.md: the
+// accelerometer reads (I + E) times the true specific force and its samples are corrected with
+// (I + E)^-1; moving E to E + dE changes a corrected sample a by -dE' a to first order, with
+// dE' = (I + E)^-1 dE). With dE' as a row-major 9-vector, around dE' = 0:
+//   delta_v + velocity dE',  delta_p + position dE'  (delta_R does not change)
+// (replayed from pim.steps at pim.bias, so a pim without steps gives 0).
+struct AccelAxesJacobians {
+  Eigen::Matrix<double, 3, 9> velocity = Eigen::Matrix<double, 3, 9>::Zero();
+  Eigen::Matrix<double, 3, 9> position = Eigen::Matrix<double, 3, 9>::Zero();
+};
+AccelAxesJacobians AccelAxesJacobiansOf(const PreintegratedImu& pim);
+
+// Multiplies every step's accelerometer sample and the linearisation bias's accelerometer part
+// by `m`, then re-integrates: moves a preintegration from one accelerometer axis correction to
+// another (m = (I + E_new)^-1 (I + E_old)). An identity m leaves pim untouched.
+void TransformAccel(const Eigen::Matrix3d& m, PreintegratedImu* pim);
+
 // Multiplies every step's gyro sample and the linearisation bias's gyro part by `factor` per
 // axis, then re-integrates: moves a preintegration from one gyro scale correction to another
 // (factor = (1 + k_old) / (1 + k_new)). A factor of exactly one leaves pim untouched.

@@ -167,6 +167,49 @@ TEST_P(PreintegrationSchemes, GyroScaleJacobiansMatchRescaledReintegration) {
   EXPECT_GT(j.velocity.norm(), 0.1);
 }
 
+TEST_P(PreintegrationSchemes, AccelAxesJacobiansMatchTransformedReintegration) {
+  // A change dE' of the corrected samples' axis errors multiplies them by (I + dE')^-1, which
+  // TransformAccel integrates exactly; the bias is held (compared at b0).
+  const HelixMotion motion;
+  const std::int64_t t0 = 0, t1 = kSecond;
+  const ImuBias b0(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));
+  const PreintegratedImu pim =
+      Integrate(SampleImu(motion, t0, t1, 5'000'000, b0, {}, nullptr), t0, t1, b0, GetParam());
+  const AccelAxesJacobians j = AccelAxesJacobiansOf(pim);
+  const double h = 1e-6;
+  Eigen::Matrix<double, 3, 9> n_v, n_p;
+  for (int i = 0; i < 9; ++i) {
+    Eigen::Matrix3d e = Eigen::Matrix3d::Zero();
+    e(i / 3, i % 3) = h;
+    PreintegratedImu plus = pim, minus = pim;
+    TransformAccel((Eigen::Matrix3d::Identity() + e).inverse(), &plus);
+    TransformAccel((Eigen::Matrix3d::Identity() - e).inverse(), &minus);
+    EXPECT_LT((DeltaRotation(minus, b0).Inverse() * DeltaRotation(plus, b0)).Log().norm(), 1e-12);
+    n_v.col(i) = (DeltaVelocity(plus, b0) - DeltaVelocity(minus, b0)) / (2 * h);
+    n_p.col(i) = (DeltaPosition(plus, b0) - DeltaPosition(minus, b0)) / (2 * h);
+  }
+  EXPECT_LT((n_v - j.velocity).norm(), 1e-5 * (1 + j.velocity.norm())) << j.velocity;
+  EXPECT_LT((n_p - j.position).norm(), 1e-5 * (1 + j.position.norm())) << j.position;
+  // Gravity alone is ~9.8 m/s^2 on one axis: a 1% error of it is ~0.1 m/s over the second.
+  EXPECT_GT(j.velocity.norm(), 5.0);
+}
+
+TEST(Preintegration, TransformAccelByIdentityChangesNothingAndRejectsSingularMatrices) {
+  const HelixMotion motion;
+  const ImuBias b0(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));
+  const PreintegratedImu pim = Integrate(SampleImu(motion, 0, kSecond, 5'000'000, b0, {}, nullptr),
+                                         0, kSecond, b0, ImuIntegrationScheme::kMidpoint);
+  PreintegratedImu same = pim;
+  TransformAccel(Eigen::Matrix3d::Identity(), &same);
+  EXPECT_EQ(same.delta_v, pim.delta_v);
+  EXPECT_EQ(same.covariance, pim.covariance);
+  PreintegratedImu scaled = pim;
+  TransformAccel(Eigen::Vector3d(1.01, 1.0, 1.0).asDiagonal(), &scaled);
+  EXPECT_NEAR(scaled.bias.accel.x(), 1.01 * b0.accel.x(), 1e-15);
+  EXPECT_GT((scaled.delta_v - pim.delta_v).norm(), 1e-3);
+  EXPECT_THROW(TransformAccel(Eigen::Matrix3d::Zero(), &scaled), Error);
+}
+
 TEST(Preintegration, RescaleGyroByOneChangesNothingAndRejectsBadFactors) {
   const HelixMotion motion;
   const ImuBias b0(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));

@@ -118,7 +118,8 @@ EurocCameraSensor EurocCameraSensorOf(const CameraModel& camera, const SE3d& bod
   return s;
 }
 
-EurocImuSensor EurocImuSensorOf(const ImuNoise& noise, const Eigen::Vector3d& gyroscope_scale_error) {
+EurocImuSensor EurocImuSensorOf(const ImuNoise& noise, const Eigen::Vector3d& gyroscope_scale_error,
+                                const Eigen::Matrix3d& accelerometer_axis_errors) {
   EurocImuSensor imu;
   imu.rate_hz = noise.rate_hz;
   imu.gyroscope_noise_density = noise.gyro_noise_density;
@@ -126,6 +127,7 @@ EurocImuSensor EurocImuSensorOf(const ImuNoise& noise, const Eigen::Vector3d& gy
   imu.accelerometer_noise_density = noise.accel_noise_density;
   imu.accelerometer_random_walk = noise.accel_random_walk;
   imu.gyroscope_scale_error = gyroscope_scale_error;
+  imu.accelerometer_axis_errors = accelerometer_axis_errors;
   return imu;
 }
 
@@ -147,6 +149,16 @@ std::string EurocImuSensorYaml(const EurocImuSensor& imu, const std::string& com
         "gyroscope_scale_error: [{}, {}, {}]\n",
         Real(imu.gyroscope_scale_error.x()), Real(imu.gyroscope_scale_error.y()),
         Real(imu.gyroscope_scale_error.z()));
+  }
+  if (!imu.accelerometer_axis_errors.isZero()) {
+    const Eigen::Matrix3d& e = imu.accelerometer_axis_errors;
+    text += fmt::format(
+        "# pkslam: the accelerometer reads (I + E) times the true specific force (E row-major)\n"
+        "accelerometer_axis_errors: [{}, {}, {},\n"
+        "                            {}, {}, {},\n"
+        "                            {}, {}, {}]\n",
+        Real(e(0, 0)), Real(e(0, 1)), Real(e(0, 2)), Real(e(1, 0)), Real(e(1, 1)), Real(e(1, 2)),
+        Real(e(2, 0)), Real(e(2, 1)), Real(e(2, 2)));
   }
   return text + "\n";
 }
@@ -191,6 +203,18 @@ EurocImuSensor ReadEurocImuSensor(const std::filesystem::path& sensor_yaml) {
                               k[i]));
       }
       imu.gyroscope_scale_error[i] = k[i];
+    }
+  }
+  if (yaml.Has("accelerometer_axis_errors")) {
+    const std::vector<double> e = yaml.DoubleSequence("accelerometer_axis_errors", 9);
+    for (int i = 0; i < 9; ++i) {
+      if (!(std::abs(e[i]) <= 0.2)) {
+        yaml.Fail("accelerometer_axis_errors",
+                  fmt::format("{} is not an axis error (a scale fraction or a misalignment "
+                              "angle in rad, within [-0.2, 0.2])",
+                              e[i]));
+      }
+      imu.accelerometer_axis_errors(i / 3, i % 3) = e[i];
     }
   }
   return imu;

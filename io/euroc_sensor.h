@@ -37,6 +37,10 @@ struct EurocImuSensor {
   // pkslam's key gyroscope_scale_error (optional, not in EuRoC's files): the gyro reads
   // (1 + k) times the true rate per axis (written by pkslam's calibration estimates).
   Eigen::Vector3d gyroscope_scale_error = Eigen::Vector3d::Zero();
+  // pkslam's key accelerometer_axis_errors (optional, not in EuRoC's files; 9 numbers,
+  // row-major): the accelerometer reads (I + E) times the true specific force (scale factors on
+  // the diagonal, misalignment angles in rad off it; written by pkslam's calibration estimates).
+  Eigen::Matrix3d accelerometer_axis_errors = Eigen::Matrix3d::Zero();
 };
 
 // A camera's description from a camera model: pinhole, its intrinsics, "equidistant" for a
@@ -44,9 +48,9 @@ struct EurocImuSensor {
 EurocCameraSensor EurocCameraSensorOf(const CameraModel& camera, const SE3d& body_from_camera,
                                       double rate_hz, double timeshift_cam_imu = 0.0);
 // An IMU at the body frame (T_BS identity, as EuRoC's) with `noise`'s densities and rate.
-EurocImuSensor EurocImuSensorOf(const ImuNoise& noise,
-                                const Eigen::Vector3d& gyroscope_scale_error =
-                                    Eigen::Vector3d::Zero());
+EurocImuSensor EurocImuSensorOf(
+    const ImuNoise& noise, const Eigen::Vector3d& gyroscope_scale_error = Eigen::Vector3d::Zero(),
+    const Eigen::Matrix3d& accelerometer_axis_errors = Eigen::Matrix3d::Zero());
 
 // Parse and validate (positive rate and size, known models, coefficient counts, rigid T_BS).
 // Throws InputError naming the file and key.
@@ -56,7 +60,8 @@ EurocImuSensor ReadEurocImuSensor(const std::filesystem::path& sensor_yaml);
 // A camera's sensor.yaml in EuRoC's layout (%YAML:1.0 header, T_BS rows under the bracket);
 // timeshift_cam_imu only when not 0. Doubles are written with every digit.
 std::string EurocCameraSensorYaml(const EurocCameraSensor& camera, const std::string& comment);
-// An IMU's sensor.yaml in EuRoC's layout; gyroscope_scale_error only when not 0.
+// An IMU's sensor.yaml in EuRoC's layout; gyroscope_scale_error and accelerometer_axis_errors
+// only when not 0.
 std::string EurocImuSensorYaml(const EurocImuSensor& imu, const std::string& comment);
 
 }  // namespace pkslam

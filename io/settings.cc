@@ -207,6 +207,19 @@ Settings ReadOrbSlam3Settings(const std::filesystem::path& file) {
         s.gyro_scale[i] = *k;
       }
     }
+    if (yaml.Has("IMU.AccelAxes")) {
+      const Eigen::MatrixXd e = yaml.Matrix("IMU.AccelAxes", 3, 3);
+      for (int i = 0; i < 9; ++i) {
+        const double v = e(i / 3, i % 3);
+        if (!(std::abs(v) <= 0.2)) {
+          yaml.Fail("IMU.AccelAxes",
+                    fmt::format("entries must be within [-0.2, 0.2] (scale fractions, "
+                                "misalignment in rad), found {} at row {}, col {}",
+                                v, i / 3, i % 3));
+        }
+      }
+      s.accel_axes = e;
+    }
   }
   if (yaml.Has("RGBD.DepthMapFactor")) s.depth_map_factor = Positive(yaml, "RGBD.DepthMapFactor");
   if (yaml.Has("RGBD.DepthNoise")) s.depth_noise_k = Positive(yaml, "RGBD.DepthNoise");

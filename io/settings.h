@@ -72,6 +72,10 @@ struct Settings {
   // IMU.GyroScaleX/Y/Z (pkslam; optional, default 0): the gyroscope's per-axis scale-factor error
   // (fraction: it reads 1 + k times the true rate). ORB-SLAM3 has no such keys and ignores them.
   Eigen::Vector3d gyro_scale = Eigen::Vector3d::Zero();
+  // IMU.AccelAxes (pkslam; optional, default 0): a 3x3 !!opencv-matrix E, the accelerometer's
+  // axis errors (scale factors on the diagonal, misalignment in rad off it: it reads (I + E) times
+  // the true specific force). ORB-SLAM3 has no such key and ignores it.
+  Eigen::Matrix3d accel_axes = Eigen::Matrix3d::Zero();
   // RGBD.DepthMapFactor: depth image value per metre (TUM: 5000). Optional.
   std::optional<double> depth_map_factor;
   // RGBD.DepthNoise (pkslam): k of the depth noise sigma_z = k z^2 [1/m]; optional, default
@@ -102,8 +106,9 @@ struct Settings {
 Settings ReadOrbSlam3Settings(const std::filesystem::path& file);
 
 // Writes `settings` (after Check()) in the same format. Matrices are written with dt: f, as
-// ORB-SLAM3 reads them as float, but with every double digit, so reading the file back here
-// gives the same values. Throws Error if the file cannot be written.
+// ORB-SLAM3 reads them as float (pkslam's IMU.AccelAxes with dt: d), but with every double
+// digit, so reading the file back here gives the same values. Throws Error if the file cannot
+// be written.
 void WriteOrbSlam3Settings(const Settings& settings, const std::filesystem::path& file);
 
 }  // namespace pkslam

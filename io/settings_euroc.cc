@@ -77,6 +77,7 @@ Settings SettingsFromEuroc(const EurocDataset& dataset) {
     // Kalibr's timeshift_cam_imu when cam0's file has it (pkslam's calibration estimates).
     s.time_offset_s = cam0.timeshift_cam_imu;
     s.gyro_scale = imu.gyroscope_scale_error;
+    s.accel_axes = imu.accelerometer_axis_errors;
   }
   s.th_depth = 60;
   s.orb = OrbExtractorSettings{};  // 1200 features, 1.2, 8 levels, FAST 20 / 7

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/util/error.h"
+#include "io/euroc_sensor.h"
 #include "io/settings_euroc.h"
 #include "io/test_fixtures.h"
 #include "tests/support/test_data.h"
@@ -83,6 +84,8 @@ TEST(Settings, ReadsEurocStereoInertialFile) {
   EXPECT_EQ(s.imu->gyro_noise_density, 1.6968e-04);
   EXPECT_EQ(s.imu->accel_random_walk, 3.0e-3);
   EXPECT_EQ(s.imu->rate_hz, 200);
+  EXPECT_TRUE(s.gyro_scale.isZero());  // pkslam's keys, absent
+  EXPECT_TRUE(s.accel_axes.isZero());
   EXPECT_FALSE(s.depth_map_factor.has_value());
   EXPECT_EQ(s.orb, OrbExtractorSettings{});
   EXPECT_TRUE(s.keyframe.empty());
@@ -117,6 +120,50 @@ TEST(Settings, FromRealEurocSliceEqualsAuthoredFile) {
       SettingsFromEuroc(EurocDataset::Open(shared / "euroc" / "V1_01_easy_static"));
   ExpectSettingsNear(from_dataset, ReadOrbSlam3Settings(kTestData / "euroc_stereo_inertial.yaml"),
                      1e-12);
+}
+
+// pkslam's keys in imu0/sensor.yaml (written by a run's calibration estimates) reach the
+// settings; out-of-range or misshapen values name the key.
+TEST(Settings, FromEurocReadsTheImuScaleAndAxisErrors) {
+  const fs::path root = testing::MakeTempDir("settings_euroc_imu");
+  testing::EurocFixture().Write(root);
+  const fs::path yaml = root / "mav0" / "imu0" / "sensor.yaml";
+  const Eigen::Vector3d gyro_scale(0.001, -0.0048, 0.0);
+  Eigen::Matrix3d accel_axes;
+  accel_axes << 0.0021, 1.3e-3, -0.4e-3,  //
+      -0.9e-3, -0.0017, 2.2e-3,           //
+      0.0, 1.0 / 3.0 * 1e-3, 0.0005;
+  const ImuNoise noise{1.6968e-04, 2.0e-3, 1.9393e-05, 3.0e-3, 200};
+  const std::string text =
+      EurocImuSensorYaml(EurocImuSensorOf(noise, gyro_scale, accel_axes), "imu0");
+  EXPECT_THAT(text, HasSubstr("# pkslam: the accelerometer reads (I + E) times the true specific "
+                              "force (E row-major)\naccelerometer_axis_errors: [0.0021, 0.0013, "));
+  testing::WriteText(yaml, text);
+  const Settings s = SettingsFromEuroc(EurocDataset::Open(root));
+  EXPECT_EQ(s.gyro_scale, gyro_scale);
+  EXPECT_EQ(s.accel_axes, accel_axes);
+  // Zero errors are not written, and absent keys read as zero.
+  const std::string plain = EurocImuSensorYaml(EurocImuSensorOf(noise), "imu0");
+  EXPECT_THAT(plain, ::testing::Not(HasSubstr("accelerometer_axis_errors")));
+  testing::WriteText(yaml, plain);
+  EXPECT_TRUE(SettingsFromEuroc(EurocDataset::Open(root)).accel_axes.isZero());
+
+  const auto error = [&](const std::string& value) -> std::string {
+    testing::WriteText(yaml, plain + "accelerometer_axis_errors: " + value + "\n");
+    try {
+      ReadEurocImuSensor(yaml);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no InputError";
+  };
+  EXPECT_THAT(error("[0, 0, 0, 0, 0, 0, 0, 0]"),
+              HasSubstr("key 'accelerometer_axis_errors': expected 9 numbers, found 8"));
+  EXPECT_THAT(error("[0, 0, 0, 0, 0, -0.3, 0, 0, 0]"),
+              HasSubstr("key 'accelerometer_axis_errors': -0.3 is not an axis error"));
+  EXPECT_THAT(error("[0, 0, 0, 0, 0, x, 0, 0, 0]"),
+              HasSubstr("key 'accelerometer_axis_errors': sequence element: expected a number"));
+  fs::remove_all(root);
 }
 
 class SettingsFiles : public ::testing::Test {
@@ -189,10 +236,22 @@ TEST_F(SettingsFiles, RoundTripKannalaBrandtAndRectified) {
   kb.imu = ImuNoise{0.004, 0.05, 4.4e-5, 0.00172, 200};
   kb.orb = {1500, 1.25, 9, 19, 6};
   kb.gyro_scale = Eigen::Vector3d(0.001, -0.0048, 0.0);
+  kb.accel_axes << 0.0021, 1.3e-3, -0.4e-3,  //
+      -0.9e-3, -0.0017, 2.2e-3,              //
+      0.0, 1.0 / 3.0 * 1e-3, 0.0005;
   WriteOrbSlam3Settings(kb, dir_ / "kb.yaml");
   const Settings kb_back = ReadOrbSlam3Settings(dir_ / "kb.yaml");
   ExpectSettingsNear(kb_back, kb, 1e-15);
   EXPECT_EQ(kb_back.gyro_scale, kb.gyro_scale);
+  EXPECT_EQ(kb_back.accel_axes, kb.accel_axes);  // every digit, row-major
+  // A 3x3 double matrix to OpenCV too (ORB-SLAM3 ignores the key).
+  cv::FileStorage fs((dir_ / "kb.yaml").string(), cv::FileStorage::READ);
+  cv::Mat accel_axes;
+  fs["IMU.AccelAxes"] >> accel_axes;
+  ASSERT_EQ(accel_axes.type(), CV_64F);
+  ASSERT_EQ(accel_axes.rows, 3);
+  ASSERT_EQ(accel_axes.cols, 3);
+  EXPECT_EQ(accel_axes.at<double>(1, 2), 2.2e-3);
 
   Settings rectified;
   rectified.rectified_stereo = true;
@@ -227,6 +286,24 @@ TEST_F(SettingsFiles, MissingOrMalformedKeysNameKeyFileAndLine) {
               HasSubstr("key 'IMU.NoiseAcc': missing (required)"));
   EXPECT_THAT(ReadError(Edited("IMU.Frequency: 200.0", "IMU.Frequency: 200.0\nIMU.GyroScaleY: 0.5")),
               HasSubstr("key 'IMU.GyroScaleY': must be within [-0.1, 0.1] (a fraction"));
+  const auto with_accel_axes = [&](const std::string& matrix) {
+    return Edited("IMU.Frequency: 200.0", "IMU.Frequency: 200.0\nIMU.AccelAxes: " + matrix);
+  };
+  EXPECT_THAT(ReadError(with_accel_axes("!!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n"
+                                        "  data: [0.001, 0, 0, 0, 0.5, 0, 0, 0, 0]")),
+              HasSubstr("key 'IMU.AccelAxes': entries must be within [-0.2, 0.2] (scale fractions, "
+                        "misalignment in rad), found 0.5 at row 1, col 1"));
+  EXPECT_THAT(ReadError(with_accel_axes("!!opencv-matrix\n  rows: 3\n  cols: 2\n  dt: d\n"
+                                        "  data: [0, 0, 0, 0, 0, 0]")),
+              HasSubstr("key 'IMU.AccelAxes': expected a 3x3 matrix, found 3x2"));
+  EXPECT_THAT(ReadError(with_accel_axes("!!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n"
+                                        "  data: [0, 0, 0, 0, 0, 0, 0, 0]")),
+              HasSubstr("key 'IMU.AccelAxes': matrix data has 8 numbers, expected 9"));
+  EXPECT_THAT(ReadError(with_accel_axes("!!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n"
+                                        "  data: [0, 0, 0, 0, .nan, 0, 0, 0, 0]")),
+              HasSubstr("key 'IMU.AccelAxes': matrix data: is not finite"));
+  EXPECT_THAT(ReadError(with_accel_axes("[0, 0, 0, 0, 0, 0, 0, 0, 0]")),
+              HasSubstr("key 'IMU.AccelAxes': expected a matrix (rows, cols, data)"));
   EXPECT_THAT(ReadError(Edited("Stereo.T_c1_c2", "Stereo.T_c1_c2_typo")),
               HasSubstr("key 'Stereo.T_c1_c2': missing (required with Camera2.*)"));
   EXPECT_THAT(ReadError(Edited("0.9999972564774497,", "1.5,")),

@@ -32,14 +32,18 @@ class Writer {
   }
   // dt: f because ORB-SLAM3 reads these matrices as CV_32F; the digits are full double ones.
   void Transform(const std::string& key, const SE3d& transform) {
-    const Eigen::Matrix4d m = transform.Matrix();
-    out_ += key + ": !!opencv-matrix\n  rows: 4\n  cols: 4\n  dt: f\n  data: [";
-    for (int r = 0; r < 4; ++r) {
-      for (int c = 0; c < 4; ++c) {
+    MatrixKey(key, transform.Matrix(), "f");
+  }
+  // Rows continued under the opening bracket; `dt` is OpenCV's type letter.
+  void MatrixKey(const std::string& key, const Eigen::MatrixXd& m, const char* dt) {
+    out_ += fmt::format("{}: !!opencv-matrix\n  rows: {}\n  cols: {}\n  dt: {}\n  data: [", key,
+                        m.rows(), m.cols(), dt);
+    for (Eigen::Index r = 0; r < m.rows(); ++r) {
+      for (Eigen::Index c = 0; c < m.cols(); ++c) {
         out_ += Real(m(r, c));
-        if (r == 3 && c == 3) break;
-        out_ += c == 3 ? ",\n         " : ", ";
+        if (c + 1 < m.cols()) out_ += ", ";
       }
+      if (r + 1 < m.rows()) out_ += ",\n         ";
     }
     out_ += "]\n";
   }
@@ -123,6 +127,10 @@ void WriteOrbSlam3Settings(const Settings& s, const std::filesystem::path& file)
       w.RealKey("IMU.GyroScaleX", s.gyro_scale.x());
       w.RealKey("IMU.GyroScaleY", s.gyro_scale.y());
       w.RealKey("IMU.GyroScaleZ", s.gyro_scale.z());
+    }
+    if (!s.accel_axes.isZero()) {
+      w.Comment("pkslam: the accelerometer reads (I + AccelAxes) times the true specific force");
+      w.MatrixKey("IMU.AccelAxes", s.accel_axes, "d");  // pkslam's: ORB-SLAM3 does not read it
     }
     w.Blank();
   }

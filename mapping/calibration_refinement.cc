@@ -55,7 +55,7 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
   CalibrationGates g;
   const auto freeze_all = [&](const std::string& reason) {
     for (const char* group : {"intrinsics", "stereo", "imu_rotation", "imu_translation",
-                              "time_offset", "gyro_scale"}) {
+                              "time_offset", "gyro_scale", "accel_axes"}) {
       g.frozen[group] = reason;
     }
     g.free = {};
@@ -108,7 +108,8 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
 
   if (!IsInertial(sensor) || !problem.inertial) {
     if (IsInertial(sensor)) {
-      for (const char* group : {"imu_rotation", "imu_translation", "time_offset", "gyro_scale"}) {
+      for (const char* group :
+           {"imu_rotation", "imu_translation", "time_offset", "gyro_scale", "accel_axes"}) {
         g.frozen[group] = "the map's IMU is not initialised";
       }
     }
@@ -149,6 +150,15 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
     g.free.gyro_scale = true;
   } else {
     g.frozen["gyro_scale"] = g.frozen["imu_rotation"];
+  }
+  // The accelerometer's axes: gravity must be seen along more than one axis, which the same
+  // turning gives (a body that never tilts sees gravity along one axis only).
+  if (!options.accel_axes) {
+    g.frozen["accel_axes"] = "held at the file's value (--calibrate-hold-accel-axes)";
+  } else if (g.second_axis_rate >= options.min_rotation_rate) {
+    g.free.accel_axes = true;
+  } else {
+    g.frozen["accel_axes"] = g.frozen["imu_rotation"];
   }
   if (!options.imu_translation) {
     g.frozen["imu_translation"] = "held at the file's value (--calibrate-lever-arm estimates it)";

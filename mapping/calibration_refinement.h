@@ -60,6 +60,10 @@ struct OnlineCalibrationOptions {
   // Estimate the gyroscope's per-axis scale factor (inertial rigs). On by default: an
   // unmodelled scale error of the gyro is absorbed by the focal length (calibration_bundle.h).
   bool gyro_scale = true;
+  // Estimate the accelerometer's axis errors (scale factors and misalignment; inertial rigs).
+  // On by default: an unmodelled misalignment tilts the gravity the accelerometer sees, and the
+  // camera-IMU rotation takes the tilt (calibration_bundle.h).
+  bool accel_axes = true;
   // Observability gates (DecideFreedom). Camera-IMU rotation: the angular rate about the
   // keyframes' second-most-excited axis (rms, rad/s): rotation about a single axis leaves the
   // rotation about it unobservable. Camera-IMU translation (a lever arm seen only through
@@ -96,7 +100,7 @@ struct OnlineCalibrationOptions {
 struct CalibrationGates {
   CalibrationFreedom free;
   // group ("intrinsics", "stereo", "imu_rotation", "imu_translation", "time_offset",
-  // "gyro_scale") -> reason
+  // "gyro_scale", "accel_axes") -> reason
   std::map<std::string, std::string> frozen;
   // The measured motion and coverage the gates compared.
   double second_axis_rate = 0;  // rad/s

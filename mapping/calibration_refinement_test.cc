@@ -55,6 +55,15 @@ TEST(DecideFreedomTest, ATurningStereoInertialFlightFreesAllButTheLeverArm) {
   const CalibrationGates h = DecideFreedom(p, Sensor::kStereoInertial, held);
   EXPECT_FALSE(h.free.gyro_scale);
   EXPECT_NE(h.frozen.at("gyro_scale").find("--calibrate-hold-gyro-scale"), std::string::npos);
+  // So are the accelerometer's axis errors.
+  EXPECT_TRUE(g.free.accel_axes);
+  EXPECT_TRUE(h.free.accel_axes);
+  OnlineCalibrationOptions held_accel;
+  held_accel.accel_axes = false;
+  const CalibrationGates ha = DecideFreedom(p, Sensor::kStereoInertial, held_accel);
+  EXPECT_FALSE(ha.free.accel_axes);
+  EXPECT_TRUE(ha.free.gyro_scale);
+  EXPECT_NE(ha.frozen.at("accel_axes").find("--calibrate-hold-accel-axes"), std::string::npos);
 }
 
 TEST(DecideFreedomTest, RotationAboutOneAxisLeavesTheCameraImuRotationFrozen) {
@@ -66,6 +75,8 @@ TEST(DecideFreedomTest, RotationAboutOneAxisLeavesTheCameraImuRotationFrozen) {
   EXPECT_NE(g.frozen.at("imu_rotation").find("one axis"), std::string::npos);
   EXPECT_FALSE(g.free.gyro_scale);  // nor the gyro's scale about the other axes
   EXPECT_EQ(g.frozen.at("gyro_scale"), g.frozen.at("imu_rotation"));
+  EXPECT_FALSE(g.free.accel_axes);
+  EXPECT_EQ(g.frozen.at("accel_axes"), g.frozen.at("imu_rotation"));
   EXPECT_TRUE(g.free.time_offset);  // the images move
 }
 
@@ -89,7 +100,7 @@ TEST(DecideFreedomTest, SensorsWithoutScaleOrWithDepthFreezeEverything) {
   for (Sensor s : {Sensor::kMonocular, Sensor::kRgbd}) {
     const CalibrationGates g = DecideFreedom(p, s, {});
     EXPECT_FALSE(g.free.Any());
-    EXPECT_EQ(g.frozen.size(), 6u);
+    EXPECT_EQ(g.frozen.size(), 7u);
   }
 }
 

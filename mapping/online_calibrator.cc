@@ -86,7 +86,7 @@ std::optional<OnlineCalibrator::Job> OnlineCalibrator::Gather(const KeyFramePtr&
     if (IsInertial(sensor_) && !inertial) return std::nullopt;
     CalibrationCollectOptions collect;
     collect.max_observations_per_keyframe = options_.max_observations_per_keyframe;
-    collect.gyro_scale_jacobians = options_.gyro_scale;
+    collect.imu_axes_jacobians = options_.gyro_scale || options_.accel_axes;
     job.setup = atlas_->rig_setup();
     job.problem = CollectCalibrationBundle(lock, kf.get(), inertial, job.setup,
                                            atlas_->calibration(), prior_, collect);

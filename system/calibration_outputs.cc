@@ -16,7 +16,8 @@ const std::string& SourceOf(const std::string& name, const CalibrationSources& s
   if (name.rfind("cam1.", 0) == 0 || name.rfind("stereo.", 0) == 0) return s.cam1;
   if (name.rfind("imu.", 0) == 0) return s.imu;
   if (name == "time_offset") return s.time_offset;
-  if (name.rfind("gyro.", 0) == 0) return s.gyro;
+  // The IMU's intrinsics: gyro.s* (scale factors) and accel.s*, accel.m* (axis errors).
+  if (name.rfind("gyro.", 0) == 0 || name.rfind("accel.", 0) == 0) return s.gyro;
   return s.cam0;
 }
 
@@ -24,7 +25,7 @@ const std::string& SourceOf(const std::string& name, const CalibrationSources& s
 
 CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings) {
   const std::string f = settings.string();
-  return {f, f, f, f, f + " (IMU.GyroScaleX/Y/Z; absent: 0)"};
+  return {f, f, f, f, f + " (IMU.GyroScaleX/Y/Z, IMU.AccelAxes; absent: 0)"};
 }
 
 CalibrationSources SourcesFromEurocDataset(const std::filesystem::path& dataset) {
@@ -32,7 +33,7 @@ CalibrationSources SourcesFromEurocDataset(const std::filesystem::path& dataset)
   const std::string cam1 = (dataset / "mav0" / "cam1" / "sensor.yaml").string();
   const std::string imu = (dataset / "mav0" / "imu0" / "sensor.yaml").string();
   return {cam0, cam1, cam0 + " (T_BS)", cam0 + " (timeshift_cam_imu; absent: 0)",
-          imu + " (gyroscope_scale_error; absent: 0)"};
+          imu + " (gyroscope_scale_error, accelerometer_axis_errors; absent: 0)"};
 }
 
 std::vector<std::string> CalibrationWarnings(const CalibrationReport& report,
@@ -149,9 +150,10 @@ void WriteCalibrationFiles(const CalibrationReport& report, const Settings& sett
   }
   if (IsInertial(report.sensor) && settings.imu) {
     std::filesystem::create_directories(dir / "imu0");
-    WriteFileAtomically(dir / "imu0" / "sensor.yaml",
-                        EurocImuSensorYaml(EurocImuSensorOf(*settings.imu, e.gyro_scale),
-                                           comment + ", imu0"));
+    WriteFileAtomically(
+        dir / "imu0" / "sensor.yaml",
+        EurocImuSensorYaml(EurocImuSensorOf(*settings.imu, e.gyro_scale, e.accel_axes),
+                           comment + ", imu0"));
   }
   WriteOrbSlam3Settings(SettingsWithCalibration(settings, e), dir / "settings.yaml");
 }

@@ -45,6 +45,8 @@ struct CalibrationReport {
 // Where each parameter group came from, for the warnings: the settings file, or a EuRoC
 // dataset's sensor.yaml files.
 struct CalibrationSources {
+  // gyro: the IMU's own errors, the gyro's scale factors (gyro.*) and the accelerometer's axis
+  // errors (accel.*).
   std::string cam0, cam1, imu, time_offset, gyro;
 };
 CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings);
@@ -63,8 +65,8 @@ void WriteCalibrationJson(const CalibrationReport& report,
 
 // OUT/calibration/{cam0,cam1}/sensor.yaml (EuRoC; cam0's with timeshift_cam_imu for inertial
 // sensors), for inertial sensors OUT/calibration/imu0/sensor.yaml (with pkslam's
-// gyroscope_scale_error) and OUT/calibration/settings.yaml (ORB-SLAM3 v1.0, `settings` with the
-// estimate).
+// gyroscope_scale_error and accelerometer_axis_errors) and OUT/calibration/settings.yaml
+// (ORB-SLAM3 v1.0, `settings` with the estimate).
 void WriteCalibrationFiles(const CalibrationReport& report, const Settings& settings,
                            const std::filesystem::path& out_dir);
 

@@ -5,6 +5,7 @@
 
 #include "core/sensor/test_rig_calibration.h"
 #include "io/euroc_sensor.h"
+#include "system/rig_factory.h"
 #include "tests/support/test_data.h"
 
 namespace pkslam {
@@ -22,6 +23,9 @@ CalibrationReport Report() {
   r.estimate = r.file;
   r.estimate.time_offset_s = 3.0e-3;
   r.estimate.gyro_scale = Eigen::Vector3d(0.001, 0.0048, -0.0011);
+  r.estimate.accel_axes << 0.002, 1.5e-3, -0.7e-3,  //
+      -0.4e-3, -0.0013, 2.6e-3,                     //
+      0.9e-3, -1.1e-3, 0.0007;
   // cx 0.4 px off at sigma 0.2 (but at least 2/3 px, a third of the prior: no warning), the time
   // offset 3 ms at 0.15 (sigma 2/3 ms: 4.5 sigma), fx 12 px at 0.3 (a gross error: 6 prior
   // sigmas), cy 1.2 px at 0.1 (warned at the floor only: 1.8 sigma, none).
@@ -33,28 +37,36 @@ CalibrationReport Report() {
                   // The gyro's y scale 0.48% at 0.05 (sigma a third of 0.5%: 2.9 sigma, none);
                   // z 2.5% (a file written for another gyro: 15 sigma).
                   {"gyro.sy", "%", 0.0, 0.48, 0.05, 0.5, true},
-                  {"gyro.sz", "%", 0.0, 2.5, 0.05, 0.5, true}};
+                  {"gyro.sz", "%", 0.0, 2.5, 0.05, 0.5, true},
+                  // The accelerometer's x-y misalignment 1.5 deg at 0.05 (prior 0.2: 22 sigma).
+                  {"accel.mxy", "deg", 0.0, 1.5, 0.05, 0.2, true}};
   return r;
 }
 
 TEST(CalibrationWarnings, NameTheParameterTheSizeAndTheFile) {
   const CalibrationReport r = Report();
   const auto w = CalibrationWarnings(r, SourcesFromEurocDataset("seq"));
-  ASSERT_THAT(w, SizeIs(3));
+  ASSERT_THAT(w, SizeIs(4));
   EXPECT_THAT(w[0], HasSubstr("time_offset in seq/mav0/cam0/sensor.yaml (timeshift_cam_imu"));
   EXPECT_THAT(w[0], HasSubstr("-3 ms off the estimate (4.5 sigma, a third of the prior's;"));
   EXPECT_THAT(w[0], ::testing::Not(HasSubstr("wrong for this rig")));
   EXPECT_THAT(w[1], HasSubstr("cam1.fx in seq/mav0/cam1/sensor.yaml is 12 px off"));
   EXPECT_THAT(w[1], HasSubstr("6 times a calibration file's usual error"));
-  EXPECT_THAT(w[2], HasSubstr("gyro.sz in seq/mav0/imu0/sensor.yaml (gyroscope_scale_error; "
-                              "absent: 0) is -2.5 % off"));
+  EXPECT_THAT(w[2], HasSubstr("gyro.sz in seq/mav0/imu0/sensor.yaml (gyroscope_scale_error, "
+                              "accelerometer_axis_errors; absent: 0) is -2.5 % off"));
+  EXPECT_THAT(w[3], HasSubstr("accel.mxy in seq/mav0/imu0/sensor.yaml (gyroscope_scale_error, "
+                              "accelerometer_axis_errors; absent: 0) is -1.5 deg off"));
   // A settings file names itself; without the covariance the prior's third still finds gross
   // errors; with --calibrate off nothing is claimed.
-  EXPECT_THAT(CalibrationWarnings(r, SourcesFromSettingsFile("s.yaml"))[0], HasSubstr("in s.yaml"));
+  const auto sw = CalibrationWarnings(r, SourcesFromSettingsFile("s.yaml"));
+  ASSERT_THAT(sw, SizeIs(4));
+  EXPECT_THAT(sw[0], HasSubstr("in s.yaml"));
+  EXPECT_THAT(sw[3],
+              HasSubstr("accel.mxy in s.yaml (IMU.GyroScaleX/Y/Z, IMU.AccelAxes; absent: 0)"));
   CalibrationReport no_sigma = r;
   no_sigma.covariance_ok = false;
   const auto nw = CalibrationWarnings(no_sigma, SourcesFromEurocDataset("seq"));
-  ASSERT_THAT(nw, SizeIs(3));
+  ASSERT_THAT(nw, SizeIs(4));
   EXPECT_THAT(nw[0], HasSubstr("a third of the prior's: no covariance"));
   CalibrationReport off = r;
   off.online = false;
@@ -81,12 +93,24 @@ TEST(CalibrationFiles, ReadBackAsEurocSensorsAndSettings) {
   const Settings back = ReadOrbSlam3Settings(dir / "calibration/settings.yaml");
   EXPECT_DOUBLE_EQ(back.time_offset_s, 3.0e-3);
   EXPECT_EQ(back.gyro_scale, r.estimate.gyro_scale);
-  // The IMU's file carries the gyro's scale error in pkslam's key; EuRoC's keys read as before.
+  EXPECT_EQ(back.accel_axes, r.estimate.accel_axes);
+  // The IMU's file carries the gyro's scale error and the accelerometer's axis errors in
+  // pkslam's keys; EuRoC's keys read as before.
   const EurocImuSensor imu = ReadEurocImuSensor(dir / "calibration/imu0/sensor.yaml");
   EXPECT_EQ(imu.gyroscope_scale_error, r.estimate.gyro_scale);
+  EXPECT_EQ(imu.accelerometer_axis_errors, r.estimate.accel_axes);
   EXPECT_EQ(imu.gyroscope_noise_density, ImuNoise{}.gyro_noise_density);
   EXPECT_EQ(imu.rate_hz, ImuNoise{}.rate_hz);
   EXPECT_LT((*back.right_from_left * r.estimate.cam1_from_cam0.Inverse()).Log().norm(), 1e-12);
+  // The settings give the rig's calibration its IMU errors back; without an IMU there are none.
+  const RigCalibration again = CalibrationFromSettings(back, Sensor::kStereoInertial);
+  EXPECT_EQ(again.gyro_scale, r.estimate.gyro_scale);
+  EXPECT_EQ(again.accel_axes, r.estimate.accel_axes);
+  Settings no_imu = settings;
+  no_imu.imu.reset();
+  no_imu.body_from_cam0.reset();
+  EXPECT_TRUE(SettingsWithCalibration(no_imu, r.estimate).accel_axes.isZero());
+  EXPECT_TRUE(SettingsWithCalibration(no_imu, r.estimate).gyro_scale.isZero());
 }
 
 }  // namespace

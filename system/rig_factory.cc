@@ -12,6 +12,7 @@ RigCalibration CalibrationFromSettings(const Settings& settings, Sensor sensor) 
   c.body_from_cam0 = settings.body_from_cam0.value_or(SE3d());
   c.time_offset_s = settings.time_offset_s;
   c.gyro_scale = settings.gyro_scale;
+  c.accel_axes = settings.accel_axes;
   if (IsStereo(sensor) && settings.IsStereo()) {
     if (settings.rectified_stereo) {
       c.cameras.push_back(settings.camera1);
@@ -29,6 +30,7 @@ Settings SettingsWithCalibration(Settings settings, const RigCalibration& calibr
   if (settings.body_from_cam0) settings.body_from_cam0 = calibration.body_from_cam0;
   settings.time_offset_s = settings.imu ? calibration.time_offset_s : 0.0;
   settings.gyro_scale = settings.imu ? calibration.gyro_scale : Eigen::Vector3d::Zero();
+  settings.accel_axes = settings.imu ? calibration.accel_axes : Eigen::Matrix3d::Zero();
   if (calibration.stereo() && settings.IsStereo()) {
     const bool still_rectified =
         settings.rectified_stereo && !calibration.cameras[1].HasDistortion() &&

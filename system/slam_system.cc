@@ -87,8 +87,7 @@ SlamSystem::SlamSystem(const Settings& settings, std::shared_ptr<const Vocabular
   tracker_->EnableTrace(options_.trace);
   time_offset_s_ = IsInertial(options_.sensor) ? file_calibration_.time_offset_s : 0.0;
   tracker_->SetTimeOffset(time_offset_s_);
-  tracker_->SetGyroScale(IsInertial(options_.sensor) ? file_calibration_.gyro_scale
-                                                     : Eigen::Vector3d::Zero());
+  SetTrackerImuAxisErrors(file_calibration_);
   tracker_->EnableFrameTracks(options_.frame_tracks);
   if (!options_.no_loop) {
     LocalMapper* mapper = mapper_.get();
@@ -135,7 +134,7 @@ void SlamSystem::FinishCalibration() {
         IsInertial(options_.sensor) && map->imu_status().inertial_ba1_done;
     CalibrationCollectOptions collect;
     collect.max_observations_per_keyframe = o.final_max_observations_per_keyframe;
-    collect.gyro_scale_jacobians = o.gyro_scale;
+    collect.imu_axes_jacobians = o.gyro_scale || o.accel_axes;
     setup = atlas_.rig_setup();
     problem = CollectCalibrationBundle(lock, newest, inertial, setup, atlas_.calibration(),
                                        file_calibration_, collect);
@@ -310,6 +309,12 @@ std::int64_t SlamSystem::ImuClock(std::int64_t t_ns) const {
   return t_ns + static_cast<std::int64_t>(std::llround(time_offset_s_ * 1e9));
 }
 
+void SlamSystem::SetTrackerImuAxisErrors(const RigCalibration& calibration) {
+  const bool inertial = IsInertial(options_.sensor);
+  tracker_->SetImuAxisErrors(inertial ? calibration.gyro_scale : Eigen::Vector3d::Zero(),
+                             inertial ? calibration.accel_axes : Eigen::Matrix3d::Zero());
+}
+
 void SlamSystem::SyncCalibration() {
   if (atlas_.calibration_version() == calibration_version_) return;
   RigSetup setup;
@@ -324,8 +329,7 @@ void SlamSystem::SyncCalibration() {
   setup_ = std::move(setup);
   time_offset_s_ = IsInertial(options_.sensor) ? calibration.time_offset_s : 0.0;
   tracker_->SetTimeOffset(time_offset_s_);
-  tracker_->SetGyroScale(IsInertial(options_.sensor) ? calibration.gyro_scale
-                                                     : Eigen::Vector3d::Zero());
+  SetTrackerImuAxisErrors(calibration);
 }
 
 TrackResult SlamSystem::TrackStereo(const cv::Mat& left, const cv::Mat& right, std::int64_t t_ns) {
@@ -367,7 +371,7 @@ CalibrationBundleResult SlamSystem::RefineCalibration(const CalibrationFreedom& 
     KeyFrame* newest = map->keyframes().rbegin()->second.get();
     CalibrationCollectOptions collect;
     collect.max_observations_per_keyframe = max_observations_per_keyframe;
-    collect.gyro_scale_jacobians = free.gyro_scale;
+    collect.imu_axes_jacobians = free.gyro_scale || free.accel_axes;
     problem = CollectCalibrationBundle(lock, newest, IsInertial(options_.sensor), setup_,
                                        file_calibration_, file_calibration_, collect);
   }

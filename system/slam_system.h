@@ -184,6 +184,8 @@ class SlamSystem {
   // frame SyncCalibration takes a newer one (tracking thread).
   int calibration_version_ = 0;
   void SyncCalibration();
+  // The tracker's IMU samples corrected for `calibration`'s axis errors (inertial sensors).
+  void SetTrackerImuAxisErrors(const RigCalibration& calibration);
   std::shared_ptr<const Vocabulary> vocabulary_;
   Atlas atlas_;
   std::unique_ptr<LocalMapper> mapper_;

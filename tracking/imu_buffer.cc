@@ -34,9 +34,21 @@ std::optional<PreintegratedImu> ImuBuffer::Between(std::int64_t t0_ns, std::int6
         Eigen::Vector3d::Ones().cwiseQuotient(Eigen::Vector3d::Ones() + gyro_scale_);
     for (ImuMeasurement& m : samples) m.gyro = m.gyro.cwiseProduct(inverse);
   }
+  if (accel_correction_) {
+    for (ImuMeasurement& m : samples) m.accel = *accel_correction_ * m.accel;
+  }
   PreintegratedImu pim = StartPreintegration(bias, noise_);
   IntegrateSamples(samples, t0_ns, t1_ns, &pim);
   return pim;
+}
+
+void ImuBuffer::SetAxisErrors(const Eigen::Vector3d& gyro_scale,
+                              const Eigen::Matrix3d& accel_axes) {
+  gyro_scale_ = gyro_scale;
+  accel_correction_.reset();
+  if (!accel_axes.isZero(0.0)) {
+    accel_correction_ = (Eigen::Matrix3d::Identity() + accel_axes).inverse();
+  }
 }
 
 void ImuBuffer::KeepFrom(std::int64_t anchor_ns) {

@@ -25,9 +25,10 @@ class ImuBuffer {
   // times otherwise, and keeps the samples before the offending one).
   void Add(const std::vector<ImuMeasurement>& samples);
 
-  // The gyroscope's per-axis scale-factor error k (online calibration): rates are divided by
-  // 1 + k as they are integrated. Zero (the default) integrates the samples as given.
-  void SetGyroScale(const Eigen::Vector3d& k) { gyro_scale_ = k; }
+  // The IMU's axis errors (online calibration, RigCalibration::gyro_scale and accel_axes): rates
+  // are divided by 1 + k per axis and specific forces multiplied by (I + E)^-1 as they are
+  // integrated. Zero (the default) integrates the samples as given.
+  void SetAxisErrors(const Eigen::Vector3d& gyro_scale, const Eigen::Matrix3d& accel_axes);
   // A new IMU noise model (a recalibrated rig).
   void SetNoise(const ImuNoise& noise) { noise_ = noise; }
 
@@ -47,6 +48,7 @@ class ImuBuffer {
   std::deque<ImuMeasurement> samples_;
   ImuNoise noise_;
   Eigen::Vector3d gyro_scale_ = Eigen::Vector3d::Zero();
+  std::optional<Eigen::Matrix3d> accel_correction_;  // (I + E)^-1; unset for E = 0
 };
 
 }  // namespace pkslam

@@ -53,13 +53,34 @@ TEST(ImuBufferTest, GyroScaleDividesTheRates) {
   plain.Add(ConstantSamples(100'000'000, gyro, Eigen::Vector3d(0, 0, 9.81)));
   scaled.Add(ConstantSamples(100'000'000, gyro, Eigen::Vector3d(0, 0, 9.81)));
   const Eigen::Vector3d k(0.01, -0.02, 0.03);
-  scaled.SetGyroScale(k);
+  scaled.SetAxisErrors(k, Eigen::Matrix3d::Zero());
   const auto a = plain.Between(0, 100'000'000, ImuBias{});
   const auto b = scaled.Between(0, 100'000'000, ImuBias{});
   ASSERT_TRUE(a && b);
   const Eigen::Vector3d expected = gyro.cwiseQuotient(Eigen::Vector3d::Ones() + k);
   EXPECT_TRUE(b->average_gyro.isApprox(expected, 1e-12)) << b->average_gyro.transpose();
   EXPECT_FALSE(a->average_gyro.isApprox(b->average_gyro, 1e-6));
+}
+
+TEST(ImuBufferTest, AccelAxesCorrectTheSpecificForce) {
+  // An accelerometer reading (I + E) times the truth: corrected, the buffer integrates the truth.
+  const Eigen::Vector3d truth(0.3, -0.5, 9.81);
+  Eigen::Matrix3d e;
+  e << 0.004, 0.001, -0.002, 0.0015, -0.003, 0.001, -0.001, 0.002, 0.002;
+  ImuBuffer plain{ImuNoise{}};
+  ImuBuffer corrected{ImuNoise{}};
+  const Eigen::Vector3d measured = (Eigen::Matrix3d::Identity() + e) * truth;
+  plain.Add(ConstantSamples(100'000'000, Eigen::Vector3d::Zero(), measured));
+  corrected.Add(ConstantSamples(100'000'000, Eigen::Vector3d::Zero(), measured));
+  corrected.SetAxisErrors(Eigen::Vector3d::Zero(), e);
+  const auto a = plain.Between(0, 100'000'000, ImuBias{});
+  const auto b = corrected.Between(0, 100'000'000, ImuBias{});
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(b->average_accel.isApprox(truth, 1e-12)) << b->average_accel.transpose();
+  EXPECT_TRUE(a->average_accel.isApprox(measured, 1e-12));
+  // Back to zero: the samples as given again.
+  corrected.SetAxisErrors(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero());
+  EXPECT_EQ(corrected.Between(0, 100'000'000, ImuBias{})->delta_v, a->delta_v);
 }
 
 TEST(ImuBufferTest, KeepFromKeepsTheSampleBeforeTheAnchorAndRefusesOutOfOrderSamples) {

@@ -34,7 +34,7 @@ class InertialTracking {
   explicit InertialTracking(const ImuNoise& noise, double gravity_magnitude = 9.81)
       : samples_(noise), gravity_magnitude_(gravity_magnitude) {}
 
-  // The samples (Add, SetGyroScale, SetNoise).
+  // The samples (Add, SetAxisErrors, SetNoise).
   ImuBuffer& samples() { return samples_; }
   const ImuBuffer& samples() const { return samples_; }
 

@@ -97,9 +97,9 @@ class Tracker {
   // The camera-IMU time offset the caller shifted the next frames' stamps by (recorded in their
   // FrameImu / KeyFrameImu for the calibration BA).
   void SetTimeOffset(double seconds) { time_offset_s_ = seconds; }
-  // The gyroscope's per-axis scale-factor error (RigCalibration::gyro_scale): samples are
-  // divided by 1 + k as they are integrated.
-  void SetGyroScale(const Eigen::Vector3d& k);
+  // The IMU's axis errors (RigCalibration::gyro_scale, accel_axes): samples are corrected for
+  // them as they are integrated (ImuBuffer::SetAxisErrors).
+  void SetImuAxisErrors(const Eigen::Vector3d& gyro_scale, const Eigen::Matrix3d& accel_axes);
   // A new calibration estimate (online calibration) moved the map's keyframes to `setup`'s rig:
   // frames are built with it from now on, and what tracking keeps of earlier frames (the last
   // frame, the monocular initialisation frame, the motion model, the records' poses relative to

@@ -18,8 +18,9 @@ void Tracker::AddImu(const std::vector<ImuMeasurement>& samples) {
   imu_->samples().Add(samples);
 }
 
-void Tracker::SetGyroScale(const Eigen::Vector3d& k) {
-  if (imu_) imu_->samples().SetGyroScale(k);
+void Tracker::SetImuAxisErrors(const Eigen::Vector3d& gyro_scale,
+                               const Eigen::Matrix3d& accel_axes) {
+  if (imu_) imu_->samples().SetAxisErrors(gyro_scale, accel_axes);
 }
 
 bool Tracker::ImuReady() const {

@@ -226,6 +226,11 @@
       if (gyro.length) {
         parts.push(`gyro scale ${gyro.map((k) => `${k.slice(-1)} ${e[k].toFixed(2)}`).join(' ')} %`);
       }
+      const accel = ['accel.sx', 'accel.sy', 'accel.sz'].filter((k) => e[k] !== undefined);
+      if (accel.length) {
+        parts.push(`accelerometer scale ${
+            accel.map((k) => `${k.slice(-1)} ${e[k].toFixed(2)}`).join(' ')} %`);
+      }
       for (const k of ['cam0.fx', 'cam0.cx', 'cam1.cx']) {
         if (e[k] !== undefined && D.calibration_file[k] !== undefined) {
           parts.push(`${k} ${(e[k] - D.calibration_file[k]) >= 0 ? '+' : ''}${(e[k] - D.calibration_file[k]).toFixed(2)} px`);

@@ -66,6 +66,9 @@ void CheckSameRig(const RigCalibration& file, const RigCalibration& estimate) {
   PKSLAM_CHECK_OPTION((file.gyro_scale - estimate.gyro_scale).cwiseAbs().maxCoeff() <= 0.05,
                       "calibration", "gyro scale error differs by {:.2f}% (within 5%)",
                       100.0 * (file.gyro_scale - estimate.gyro_scale).cwiseAbs().maxCoeff());
+  PKSLAM_CHECK_OPTION((file.accel_axes - estimate.accel_axes).cwiseAbs().maxCoeff() <= 0.05,
+                      "calibration", "accelerometer axis errors differ by {:.2f}% (within 5%)",
+                      100.0 * (file.accel_axes - estimate.accel_axes).cwiseAbs().maxCoeff());
 }
 
 RigSetup BuildRig(const RigCalibration& calibration, const RigShape& shape) {

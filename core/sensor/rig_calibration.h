@@ -44,6 +44,12 @@ struct RigCalibration {
   // true rate about each IMU axis, so its samples are divided by 1 + gyro_scale before they are
   // integrated. Calibration files do not state it (0); online calibration estimates it.
   Eigen::Vector3d gyro_scale = Eigen::Vector3d::Zero();
+  // The accelerometer's axis errors E (scale factors on the diagonal, axis misalignment off it,
+  // small angles in rad): it reads (I + E) times the true specific force in the IMU frame, so its
+  // samples are multiplied by (I + E)^-1 before they are integrated and the accelerometer bias
+  // lives in the corrected axes. Calibration files do not state it (0); online calibration
+  // estimates it.
+  Eigen::Matrix3d accel_axes = Eigen::Matrix3d::Zero();
 
   bool stereo() const { return cameras.size() >= 2; }
   SE3d body_from_cam1() const { return body_from_cam0 * cam1_from_cam0.Inverse(); }
@@ -76,9 +82,9 @@ struct RigSetup {
 
 // Whether `estimate` can be a calibration of the rig `file` describes, not of another camera:
 // same cameras and image sizes, focal lengths within 3%, principal points within 20 px,
-// extrinsics within 3 deg and 3 cm, time offsets within 50 ms, gyro scale errors within 5%
-// (several times the error of a bad calibration, far below the difference between two rigs). Throws OptionError naming the
-// first difference.
+// extrinsics within 3 deg and 3 cm, time offsets within 50 ms, gyro scale and accelerometer axis
+// errors within 5% (several times the error of a bad calibration, far below the difference
+// between two rigs). Throws OptionError naming the first difference.
 void CheckSameRig(const RigCalibration& file, const RigCalibration& estimate);
 
 // Throws OptionError for calibrations the pipeline cannot track with (an RGB-D fisheye, stereo

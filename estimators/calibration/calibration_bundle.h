@@ -3,15 +3,19 @@
 // cy, k1, k2; the right camera's fy and cy stay, as its vertical coordinate is not measured),
 // the stereo extrinsic's rotation about the y and z axes (its translation is the map's scale
 // and its rotation about x moves only rows: both stay), the camera-IMU extrinsic cam0_from_body,
-// the camera-IMU time offset and the gyroscope's per-axis scale factor, each held to the
-// calibration file's value by a Gaussian prior.
+// the camera-IMU time offset, the gyroscope's per-axis scale factor and the accelerometer's axis
+// errors (scale factors and misalignment), each held to the calibration file's value by a
+// Gaussian prior.
 //
 // The gyro's scale factor belongs here because it is what an unmodelled one turns into
 // otherwise: the camera's rotation is seen twice, in the images (through the focal length) and
 // by the gyro (through its scale), and a scale error of the gyro pulls the focal length by the
 // same fraction (a 0.48% error about the IMU's y axis, cam0's x, held cam0's fy 1.3 px low on a
 // realistic V1_02 replay; docs/calibration.md). The inertial edges take it to first order
-// (imu/imu_factors.h GyroScaledInertialError).
+// (imu/imu_factors.h ImuAxesInertialError). The accelerometer's axis errors belong here for the
+// same reason: an unmodelled misalignment tilts the gravity the accelerometer sees, and the
+// camera-IMU rotation took the tilt (0.097 deg from the truth on a realistic V1_01 replay, 0.023
+// deg with the render's accelerometer errors removed; docs/calibration.md).
 //
 // Why a separate, whole-map adjustment rather than free calibration blocks in local BA: a
 // 10-keyframe window barely sees a camera-IMU rotation or a time offset (they need the motion of
@@ -69,6 +73,10 @@ struct CalibrationPriorOptions {
   double time_offset_ms = 2.0;
   // The gyroscope's per-axis scale-factor error (%): 0.1-0.5% for MEMS gyros (docs/realism.md).
   double gyro_scale_pct = 0.5;
+  // The accelerometer's per-axis scale-factor error (%) and axis misalignment (deg, each
+  // off-diagonal term): 0.1-0.5% and up to 0.05 deg for MEMS accelerometers (docs/realism.md).
+  double accel_scale_pct = 0.5;
+  double accel_misalignment_deg = 0.1;
 
   void Check() const;
 };
@@ -81,10 +89,11 @@ struct CalibrationFreedom {
   bool imu_translation = false;
   bool time_offset = false;
   bool gyro_scale = false;
+  bool accel_axes = false;
 
   bool Any() const {
     return intrinsics[0] || intrinsics[1] || stereo_extrinsic || imu_rotation || imu_translation ||
-           time_offset || gyro_scale;
+           time_offset || gyro_scale || accel_axes;
   }
 };
 
@@ -130,6 +139,8 @@ struct CalibrationBundleProblem {
   // Per bundle.edges entry: GyroScaleJacobiansOf its preintegration (the edges' copies carry no
   // steps). Empty: computed from the edges' own steps (hand-made problems).
   std::vector<GyroScaleJacobians> gyro_scale_jacobians;
+  // Likewise AccelAxesJacobiansOf each edge's preintegration (empty: from the edges' steps).
+  std::vector<AccelAxesJacobians> accel_axes_jacobians;
   // The calibration the keyframes' measurements were taken with (the starting point) and the
   // calibration file's (the prior's mean).
   RigCalibration initial;
@@ -145,7 +156,9 @@ struct CalibrationBundleProblem {
 // cam1's position in cam0): r* the rotation vector of R_estimate R_file^T (deg), t* the
 // translation difference (mm), both in the parent frame's axes (body, cam0).
 struct CalibrationParameter {
-  std::string name;  // cam0.fx, cam1.k1, stereo.rx, imu.tz, time_offset, gyro.sx, ...
+  // cam0.fx, cam1.k1, stereo.rx, imu.tz, time_offset, gyro.sx, accel.sx (E's diagonal, %),
+  // accel.mxy (E's row x, column y: misalignment, deg), ...
+  std::string name;
   std::string unit;  // px, "", deg, mm, ms, %
   double file = 0;   // the prior's mean
   double estimate = 0;

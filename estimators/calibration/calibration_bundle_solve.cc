@@ -107,6 +107,14 @@ void AddCalibrationBlocks(const CalibrationBundleProblem& problem,
                                 Eigen::Vector3d::Constant(sig.gyro_scale_pct * 1e-2)),
         nullptr, s->gyro_scale());
   }
+  if (problem.inertial && problem.free.accel_axes) {
+    Eigen::Matrix<double, 9, 1> mean, sigma;
+    for (int i = 0; i < 9; ++i) {
+      mean(i) = problem.prior.accel_axes(i / 3, i % 3);
+      sigma(i) = i % 4 == 0 ? sig.accel_scale_pct * 1e-2 : sig.accel_misalignment_deg / kRadToDeg;
+    }
+    ceres_problem->AddResidualBlock(new EuclideanPriorError(mean, sigma), nullptr, s->accel_axes());
+  }
 }
 
 // One solve: the state copied from the problem, the Ceres problem built over it (calibration
@@ -154,6 +162,8 @@ class CalibrationSolve {
     PoseToBlock(problem.initial.cam1_from_cam0, s_.cam1_from_cam0());
     *s_.offset() = problem.initial.time_offset_s;
     Eigen::Map<Eigen::Vector3d>(s_.gyro_scale()) = problem.initial.gyro_scale;
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(s_.accel_axes()) =
+        problem.initial.accel_axes;
     result_.estimate = problem.initial;
   }
 
@@ -224,6 +234,8 @@ class CalibrationSolve {
     result.estimate.time_offset_s = *s_.offset();
     if (problem_.inertial) {
       result.estimate.gyro_scale = Eigen::Map<const Eigen::Vector3d>(s_.gyro_scale());
+      result.estimate.accel_axes =
+          Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(s_.accel_axes());
     }
     result.parameters = CalibrationParameters(problem_.prior, result.estimate, problem_.free,
                                               options_.prior, problem_.inertial);
@@ -245,28 +257,42 @@ class CalibrationSolve {
     ceres_problem_.AddParameterBlock(s_.ba(i), 3);
   }
 
-  // Keyframes and the inertial chain, with the gyro's scale factor when it is free.
+  // Keyframes and the inertial chain, with the IMU's axis errors when either is free (the other
+  // held constant).
   void AddInertialChain() {
     if (!problem_.inertial) return;
-    const bool gyro_scale_free = problem_.free.gyro_scale;
-    PKSLAM_CHECK(problem_.gyro_scale_jacobians.empty() ||
-                     problem_.gyro_scale_jacobians.size() == problem_.bundle.edges.size(),
-                 "calibration BA: {} gyro scale Jacobians for {} inertial edges",
-                 problem_.gyro_scale_jacobians.size(), problem_.bundle.edges.size());
-    for (std::size_t edge = 0; edge < problem_.bundle.edges.size(); ++edge) {
+    const bool axes_free = problem_.free.gyro_scale || problem_.free.accel_axes;
+    const std::size_t num_edges = problem_.bundle.edges.size();
+    PKSLAM_CHECK(
+        problem_.gyro_scale_jacobians.empty() || problem_.gyro_scale_jacobians.size() == num_edges,
+        "calibration BA: {} gyro scale Jacobians for {} inertial edges",
+        problem_.gyro_scale_jacobians.size(), num_edges);
+    PKSLAM_CHECK(
+        problem_.accel_axes_jacobians.empty() || problem_.accel_axes_jacobians.size() == num_edges,
+        "calibration BA: {} accelerometer axes Jacobians for {} inertial edges",
+        problem_.accel_axes_jacobians.size(), num_edges);
+    if (axes_free) {
+      ceres_problem_.AddParameterBlock(s_.gyro_scale(), 3);
+      ceres_problem_.AddParameterBlock(s_.accel_axes(), 9);
+      if (!problem_.free.gyro_scale) ceres_problem_.SetParameterBlockConstant(s_.gyro_scale());
+      if (!problem_.free.accel_axes) ceres_problem_.SetParameterBlockConstant(s_.accel_axes());
+    }
+    for (std::size_t edge = 0; edge < num_edges; ++edge) {
       const auto& e = problem_.bundle.edges[edge];
       AddInertial(e.from);
       AddInertial(e.to);
-      if (gyro_scale_free) {
+      if (axes_free) {
         ceres_problem_.AddResidualBlock(
-            new GyroScaledInertialError(e.preintegration, problem_.bundle.gravity_world,
-                                        problem_.gyro_scale_jacobians.empty()
-                                            ? GyroScaleJacobiansOf(e.preintegration)
-                                            : problem_.gyro_scale_jacobians[edge],
-                                        problem_.initial.gyro_scale),
+            new ImuAxesInertialError(
+                e.preintegration, problem_.bundle.gravity_world,
+                problem_.gyro_scale_jacobians.empty() ? GyroScaleJacobiansOf(e.preintegration)
+                                                      : problem_.gyro_scale_jacobians[edge],
+                problem_.accel_axes_jacobians.empty() ? AccelAxesJacobiansOf(e.preintegration)
+                                                      : problem_.accel_axes_jacobians[edge],
+                problem_.initial.gyro_scale, problem_.initial.accel_axes),
             nullptr,
             {s_.pose(e.from), s_.v(e.from), s_.bg(e.from), s_.ba(e.from), s_.pose(e.to), s_.v(e.to),
-             s_.gyro_scale()});
+             s_.gyro_scale(), s_.accel_axes()});
       } else {
         ceres_problem_.AddResidualBlock(
             new InertialError(e.preintegration, problem_.bundle.gravity_world), nullptr,
@@ -380,7 +406,10 @@ class CalibrationSolve {
          {s_.cam0_from_body(), s_.cam1_from_cam0(), s_.offset(), s_.no_velocity()}) {
       schur.AddOther(block);
     }
-    if (problem_.inertial && problem_.free.gyro_scale) schur.AddOther(s_.gyro_scale());
+    if (problem_.inertial && (problem_.free.gyro_scale || problem_.free.accel_axes)) {
+      schur.AddOther(s_.gyro_scale());
+      schur.AddOther(s_.accel_axes());
+    }
     return SchurSolverOptions(schur, options_.num_threads);
   }
 

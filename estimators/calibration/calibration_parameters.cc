@@ -58,7 +58,9 @@ void CalibrationPriorOptions::Check() const {
         std::pair{"calibration.prior.imu_rotation_deg", imu_rotation_deg},
         std::pair{"calibration.prior.imu_translation_mm", imu_translation_mm},
         std::pair{"calibration.prior.time_offset_ms", time_offset_ms},
-        std::pair{"calibration.prior.gyro_scale_pct", gyro_scale_pct}}) {
+        std::pair{"calibration.prior.gyro_scale_pct", gyro_scale_pct},
+        std::pair{"calibration.prior.accel_scale_pct", accel_scale_pct},
+        std::pair{"calibration.prior.accel_misalignment_deg", accel_misalignment_deg}}) {
     PKSLAM_CHECK_OPTION(value > 0 && std::isfinite(value), name, "{} (a positive sigma)", value);
   }
 }
@@ -103,6 +105,20 @@ std::vector<CalibrationParameter> CalibrationParameters(const RigCalibration& pr
       out.push_back({fmt::format("gyro.s{}", axes[i]), "%", prior.gyro_scale[i] * 100.0,
                      estimate.gyro_scale[i] * 100.0, 0.0, sigmas.gyro_scale_pct,
                      free.gyro_scale});
+    }
+    // Row-major, as the solve's block (calibration_sigmas.cc relies on the order).
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        if (r == c) {
+          out.push_back({fmt::format("accel.s{}", axes[r]), "%", prior.accel_axes(r, c) * 100.0,
+                         estimate.accel_axes(r, c) * 100.0, 0.0, sigmas.accel_scale_pct,
+                         free.accel_axes});
+        } else {
+          out.push_back({fmt::format("accel.m{}{}", axes[r], axes[c]), "deg",
+                         prior.accel_axes(r, c) * kDeg, estimate.accel_axes(r, c) * kDeg, 0.0,
+                         sigmas.accel_misalignment_deg, free.accel_axes});
+        }
+      }
     }
   }
   return out;

@@ -93,6 +93,13 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
     if (problem.free.gyro_scale) {
       entries.push_back({s->gyro_scale(), index, Eigen::MatrixXd::Identity(3, 3) * 100.0});
     }
+    index += 3;
+    if (problem.free.accel_axes) {
+      // Row-major: the diagonal in %, the misalignment in deg (CalibrationParameters).
+      Eigen::MatrixXd j = Eigen::MatrixXd::Zero(9, 9);
+      for (int i = 0; i < 9; ++i) j(i, i) = i % 4 == 0 ? 100.0 : kRadToDeg;
+      entries.push_back({s->accel_axes(), index, j});
+    }
   }
   if (entries.empty()) return true;
   std::vector<const double*> blocks;

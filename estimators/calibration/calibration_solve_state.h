@@ -28,7 +28,7 @@ class State {
         points_(num_points),
         data_(static_cast<std::size_t>((kBodyPoseBlockSize + 9) * num_kf + 3 * num_points +
                                        2 * kCalibIntrinsicsSize + 2 * kCalibExtrinsicSize + 1 + 3 +
-                                       3),
+                                       3 + 9),
               0.0) {}
   double* pose(int i) { return data_.data() + kBodyPoseBlockSize * i; }
   double* v(int i) { return data_.data() + kBodyPoseBlockSize * kf_ + 3 * i; }
@@ -44,6 +44,8 @@ class State {
   double* no_velocity() { return offset() + 1; }
   // The gyro's per-axis scale-factor error (RigCalibration::gyro_scale).
   double* gyro_scale() { return no_velocity() + 3; }
+  // The accelerometer's axis errors (RigCalibration::accel_axes, row-major).
+  double* accel_axes() { return gyro_scale() + 3; }
 
  private:
   int kf_;

@@ -21,11 +21,26 @@ Eigen::Vector3d GyroRescale(const RigCalibration& from, const RigCalibration& to
       .cwiseQuotient(Eigen::Vector3d::Ones() + to.gyro_scale);
 }
 
-// A keyframe's preintegration and gyro bias moved to a new gyro scale correction.
-void RescaleKeyFrameGyro(const MapWriteLock& lock, const Eigen::Vector3d& factor, KeyFrame* kf) {
+// (I + E_to)^-1 (I + E_from): what moves an accelerometer sample corrected for axis errors
+// E_from to one corrected for E_to.
+Eigen::Matrix3d AccelTransform(const RigCalibration& from, const RigCalibration& to) {
+  if (from.accel_axes == to.accel_axes) return Eigen::Matrix3d::Identity();
+  return (Eigen::Matrix3d::Identity() + to.accel_axes).inverse() *
+         (Eigen::Matrix3d::Identity() + from.accel_axes);
+}
+
+// A keyframe's preintegration and biases moved to new axis error corrections.
+void MoveKeyFrameImu(const MapWriteLock& lock, const Eigen::Vector3d& gyro_factor,
+                     const Eigen::Matrix3d& accel_transform, KeyFrame* kf) {
   KeyFrameImu& imu = kf->mutable_imu(lock);
-  if (imu.from_previous) RescaleGyro(factor, &*imu.from_previous);
-  imu.state.bias.gyro = imu.state.bias.gyro.cwiseProduct(factor);
+  if (gyro_factor != Eigen::Vector3d::Ones()) {
+    if (imu.from_previous) RescaleGyro(gyro_factor, &*imu.from_previous);
+    imu.state.bias.gyro = imu.state.bias.gyro.cwiseProduct(gyro_factor);
+  }
+  if (accel_transform != Eigen::Matrix3d::Identity()) {
+    if (imu.from_previous) TransformAccel(accel_transform, &*imu.from_previous);
+    imu.state.bias.accel = accel_transform * imu.state.bias.accel;
+  }
 }
 
 }  // namespace
@@ -35,15 +50,16 @@ void MoveToCalibration(const MapWriteLock& lock, Atlas* atlas, const RigCalibrat
   RequireWriteLock(lock, "MoveToCalibration");
   const RigSetup old = atlas->rig_setup();
   const Eigen::Vector3d gyro_factor = GyroRescale(atlas->calibration(), calibration);
-  if (gyro_factor != Eigen::Vector3d::Ones()) {
-    // The chain's preintegrations were integrated with the old correction (tracking corrects
-    // each sample as it integrates it: Tracker::SetGyroScale).
+  const Eigen::Matrix3d accel_transform = AccelTransform(atlas->calibration(), calibration);
+  if (gyro_factor != Eigen::Vector3d::Ones() || accel_transform != Eigen::Matrix3d::Identity()) {
+    // The chain's preintegrations were integrated with the old corrections (tracking corrects
+    // each sample as it integrates it: Tracker::SetImuAxisErrors).
     for (Map* map : atlas->maps()) {
       for (const auto& [id, kf] : map->keyframes()) {
-        RescaleKeyFrameGyro(lock, gyro_factor, kf.get());
+        MoveKeyFrameImu(lock, gyro_factor, accel_transform, kf.get());
       }
       for (const auto& [id, kf] : map->retired_keyframes()) {
-        RescaleKeyFrameGyro(lock, gyro_factor, kf.get());
+        MoveKeyFrameImu(lock, gyro_factor, accel_transform, kf.get());
       }
     }
   }

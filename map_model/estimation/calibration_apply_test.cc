@@ -134,6 +134,45 @@ TEST_F(CalibrationApplyTest, AGyroScaleEstimateMovesTheChainsPreintegrationsAndB
               0.164 * 0.005 / 1.005, 1e-5);
 }
 
+TEST_F(CalibrationApplyTest, AnAccelAxesEstimateMovesTheChainsPreintegrationsAndBiases) {
+  // The estimate says the accelerometer reads 0.4% long on y with a 0.1 deg cross-axis term:
+  // every keyframe's preintegration is re-integrated from samples multiplied by (I + E)^-1, and
+  // its accelerometer bias with them; the gyro side stays.
+  const Eigen::Vector3d bias_accel(0.05, -0.1, 0.02);
+  PreintegratedImu pim =
+      StartPreintegration(ImuBias(Eigen::Vector3d::Zero(), bias_accel), ImuNoise{});
+  for (int i = 0; i < 40; ++i) {
+    IntegrateMeasurement(Eigen::Vector3d(0.1, 9.8, 0.2), Eigen::Vector3d(0.3, 0.8, -0.2), 0.005,
+                         &pim);
+  }
+  {
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+    for (std::size_t k = 1; k < map_.keyframes.size(); ++k) {
+      map_.keyframes[k]->mutable_imu(lock).from_previous = pim;
+      map_.keyframes[k]->mutable_imu(lock).state.bias.accel = bias_accel;
+    }
+  }
+  RigCalibration estimate = file_;
+  estimate.accel_axes(1, 1) = 0.004;
+  estimate.accel_axes(0, 1) = 0.1 * M_PI / 180.0;
+  {
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kCalibration);
+    MoveToCalibration(lock, &atlas_, estimate, setup_);
+  }
+  auto lock = MapReader(atlas_).Lock();
+  EXPECT_EQ(atlas_.calibration().accel_axes, estimate.accel_axes);
+  const Eigen::Matrix3d m = (Eigen::Matrix3d::Identity() + estimate.accel_axes).inverse();
+  const KeyFrame& kf = *map_.keyframes[4];
+  ASSERT_TRUE(kf.imu().from_previous.has_value());
+  EXPECT_TRUE(
+      kf.imu().from_previous->steps[0].accel.isApprox(m * Eigen::Vector3d(0.1, 9.8, 0.2), 1e-15));
+  EXPECT_TRUE(kf.imu().state.bias.accel.isApprox(m * bias_accel, 1e-15));
+  EXPECT_EQ(kf.imu().from_previous->delta_R.quaternion().coeffs(),
+            pim.delta_R.quaternion().coeffs());
+  // 0.2 s of ~9.8 m/s^2 along y, 0.4% shorter: ~8 mm/s less velocity.
+  EXPECT_NEAR((pim.delta_v - kf.imu().from_previous->delta_v).norm(), 0.2 * 9.9 * 0.004, 1e-3);
+}
+
 TEST_F(CalibrationApplyTest, AnAdjustmentOfAnExactMapMovesLittleAndAppliesCleanly) {
   CalibrationBundleProblem problem;
   {

@@ -143,13 +143,15 @@ CalibrationBundleProblem CollectCalibrationBundle(const MapLock& lock, KeyFrame*
                                                         : Eigen::Vector3d::Zero());
     problem.time_offset_applied.push_back(kf->imu().time_offset_s);
   }
-  // The edges' copies carry no steps: the gyro scale's Jacobians come from the keyframes'.
-  if (options.gyro_scale_jacobians) {
+  // The edges' copies carry no steps: the axis errors' Jacobians come from the keyframes'.
+  if (options.imu_axes_jacobians) {
     for (const auto& e : problem.bundle.edges) {
       const KeyFrame& to = *keyframes[static_cast<std::size_t>(e.to)];
-      problem.gyro_scale_jacobians.push_back(to.imu().from_previous
-                                                 ? GyroScaleJacobiansOf(*to.imu().from_previous)
-                                                 : GyroScaleJacobians{});
+      const bool steps = to.imu().from_previous.has_value();
+      problem.gyro_scale_jacobians.push_back(steps ? GyroScaleJacobiansOf(*to.imu().from_previous)
+                                                   : GyroScaleJacobians{});
+      problem.accel_axes_jacobians.push_back(steps ? AccelAxesJacobiansOf(*to.imu().from_previous)
+                                                   : AccelAxesJacobians{});
     }
   }
   // Physical measurements; an observation that cannot be mapped back is dropped.

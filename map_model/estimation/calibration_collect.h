@@ -16,9 +16,9 @@ struct CalibrationCollectOptions {
   // image, best-observed points first: the calibration needs the image covered more than it
   // needs every point, and the solve's cost grows with the observations.
   int max_observations_per_keyframe = 0;
-  // The gyro scale's Jacobians of every inertial edge (one replay of the chain's IMU steps);
-  // an adjustment that holds the scale never reads them.
-  bool gyro_scale_jacobians = true;
+  // The IMU axis errors' Jacobians (gyro scale, accelerometer axes) of every inertial edge (one
+  // replay of the chain's IMU steps); an adjustment that holds both never reads them.
+  bool imu_axes_jacobians = true;
 
   void Check() const;
 };

@@ -283,6 +283,7 @@ CalibrationRecord ToCalibrationRecord(const RigCalibration& calibration) {
   r.cam1_from_cam0 = calibration.cam1_from_cam0;
   r.time_offset_s = calibration.time_offset_s;
   for (int i = 0; i < 3; ++i) r.gyro_scale[i] = calibration.gyro_scale[i];
+  for (int i = 0; i < 9; ++i) r.accel_axes[i] = calibration.accel_axes(i / 3, i % 3);
   return r;
 }
 
@@ -296,6 +297,7 @@ RigCalibration FromCalibrationRecord(const CalibrationRecord& record) {
   c.cam1_from_cam0 = record.cam1_from_cam0;
   c.time_offset_s = record.time_offset_s;
   c.gyro_scale = Eigen::Vector3d(record.gyro_scale[0], record.gyro_scale[1], record.gyro_scale[2]);
+  for (int i = 0; i < 9; ++i) c.accel_axes(i / 3, i % 3) = record.accel_axes[i];
   return c;
 }
 

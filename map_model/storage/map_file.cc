@@ -186,6 +186,9 @@ void WriteMapFile(const std::filesystem::path& file, const AtlasRecord& record) 
     std::array<double, 3> gyro_scale{};
     if (record.calibration) gyro_scale = record.calibration->gyro_scale;
     archive(gyro_scale);  // version 3
+    std::array<double, 9> accel_axes{};
+    if (record.calibration) accel_axes = record.calibration->accel_axes;
+    archive(accel_axes);  // version 4
   }
   const std::string payload = payload_stream.str();
   std::string out;
@@ -238,6 +241,11 @@ AtlasRecord ReadMapFile(const std::filesystem::path& file) {
       std::array<double, 3> gyro_scale{};
       archive(gyro_scale);
       if (record.calibration) record.calibration->gyro_scale = gyro_scale;
+    }
+    if (version >= 4) {
+      std::array<double, 9> accel_axes{};
+      archive(accel_axes);
+      if (record.calibration) record.calibration->accel_axes = accel_axes;
     }
   } catch (const std::exception& e) {
     throw InputError(file, fmt::format("map file payload does not decode: {}", e.what()));

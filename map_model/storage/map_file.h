@@ -22,8 +22,9 @@
 namespace pkslam {
 
 // Version 2 appends the map's calibration (AtlasRecord::calibration) to version 1's payload,
-// version 3 the gyro's scale-factor error after it; older files still read (without them).
-inline constexpr std::uint32_t kMapFileVersion = 3;
+// version 3 the gyro's scale-factor error after it, version 4 the accelerometer's axis errors
+// after that; older files still read (without them).
+inline constexpr std::uint32_t kMapFileVersion = 4;
 inline constexpr std::uint32_t kOldestMapFileVersion = 1;
 
 // Writes atomically (a partial file never replaces a good one). Throws OutputError.

@@ -5,12 +5,14 @@
 #include "map_model/storage/map_file.h"
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
 
+#include "core/sensor/test_rig_calibration.h"
 #include "core/util/error.h"
 #include "map_model/keyframe.h"
 #include "map_model/map.h"
@@ -149,6 +151,56 @@ TEST_F(MapFileTest, RoundTripGivesTheSameMapAndTheSameBytes) {
   EXPECT_TRUE(testing::ReadFileBytes(second) == testing::ReadFileBytes(first));
   // New objects continue after the loaded ids.
   EXPECT_EQ(loaded.NextKeyFrameId(), atlas_.NextKeyFrameId());
+}
+
+// The map's calibration keeps the IMU's errors: the gyro's scale factors (version 3) and the
+// accelerometer's axis errors (version 4, row-major); a version 3 file (the same payload without
+// the axis errors) reads with them zero.
+TEST_F(MapFileTest, CalibrationKeepsTheImuErrorsAndVersion3ReadsZeroAxisErrors) {
+  RigCalibration calibration = testing::EurocRigCalibration();
+  calibration.time_offset_s = 2.5e-3;
+  calibration.gyro_scale = Eigen::Vector3d(0.001, -0.0048, 0.0007);
+  calibration.accel_axes << 0.0021, 1.3e-3, -0.4e-3,  //
+      -0.9e-3, -0.0017, 2.2e-3,                       //
+      0.0, 1.0 / 3.0 * 1e-3, 0.0005;
+  AtlasRecord record;
+  {
+    auto lock = MapReader(atlas_).Lock();
+    record = AtlasStorage::Snapshot(atlas_, *rig_, kVocabulary);
+  }
+  record.calibration = ToCalibrationRecord(calibration);
+  const std::filesystem::path file = dir_ / "calibration.pkmap";
+  WriteMapFile(file, record);
+  const AtlasRecord back = ReadMapFile(file);
+  ASSERT_TRUE(back.calibration.has_value());
+  const RigCalibration restored = FromCalibrationRecord(*back.calibration);
+  EXPECT_EQ(restored.time_offset_s, calibration.time_offset_s);
+  EXPECT_EQ(restored.gyro_scale, calibration.gyro_scale);
+  EXPECT_EQ(restored.accel_axes, calibration.accel_axes);  // exact, and not transposed
+
+  // Version 3: the header's version, size and checksum over the payload less its last nine
+  // doubles (cereal's portable binary array of 9 doubles: 72 bytes, no length).
+  const std::string bytes = testing::ReadFileBytes(file);
+  ASSERT_EQ(bytes[8], static_cast<char>(kMapFileVersion));
+  const std::string payload = bytes.substr(24, bytes.size() - 24 - 9 * sizeof(double));
+  std::string v3 = bytes.substr(0, 24) + payload;
+  const auto put = [&](std::size_t at, std::uint64_t value, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) v3[at + i] = static_cast<char>((value >> (8 * i)) & 0xff);
+  };
+  put(8, 3, 4);
+  put(12, payload.size(), 8);
+  put(20, crc32(0L, reinterpret_cast<const Bytef*>(payload.data()), payload.size()), 4);
+  WriteBytes(dir_ / "v3.pkmap", v3);
+  const AtlasRecord old = ReadMapFile(dir_ / "v3.pkmap");
+  ASSERT_TRUE(old.calibration.has_value());
+  const RigCalibration old_calibration = FromCalibrationRecord(*old.calibration);
+  EXPECT_EQ(old_calibration.gyro_scale, calibration.gyro_scale);
+  EXPECT_TRUE(old_calibration.accel_axes.isZero());
+  EXPECT_EQ(old.maps.size(), record.maps.size());
+  // The same truncated payload claimed as version 4 does not decode.
+  put(8, kMapFileVersion, 4);
+  WriteBytes(dir_ / "short_v4.pkmap", v3);
+  EXPECT_THROW(ReadMapFile(dir_ / "short_v4.pkmap"), InputError);
 }
 
 TEST_F(MapFileTest, DamagedFilesGiveOneLineErrorsNamingTheFile) {

@@ -117,6 +117,8 @@ struct CalibrationRecord {
   double time_offset_s = 0;
   // RigCalibration::gyro_scale (version 3; zero in older files).
   std::array<double, 3> gyro_scale{};
+  // RigCalibration::accel_axes, row-major (version 4; zero in older files).
+  std::array<double, 9> accel_axes{};
   // Keyframes tracked with a non-zero time offset (KeyFrameImu::time_offset_s).
   std::vector<std::pair<KeyFrameId, double>> keyframe_time_offsets;
 };

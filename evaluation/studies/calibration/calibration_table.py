@@ -39,6 +39,9 @@ PARAMETER_GROUPS = [
     ('cam1 focal (px)', ['cam1.fx'], 0.2),
     ('cam0 principal point (px)', ['cam0.cx', 'cam0.cy'], None),
     ('gyro scale factor (%, per axis)', ['gyro.sx', 'gyro.sy', 'gyro.sz'], None),
+    ('accelerometer scale factor (%, per axis)', ['accel.sx', 'accel.sy', 'accel.sz'], None),
+    ('accelerometer misalignment (deg, per term)',
+     ['accel.mxy', 'accel.mxz', 'accel.myx', 'accel.myz', 'accel.mzx', 'accel.mzy'], None),
 ]
 
 

@@ -108,6 +108,16 @@ def truth_parameters(seq):
         m = np.array(draw["imu_gyro_matrix"], float)
         for i, a in enumerate("xyz"):
             out[f"gyro.s{a}"] = (m[i, i] - 1.0) * 100.0
+    # The accelerometer reads M a: its axis errors E = M - I, the diagonal in %, the
+    # misalignment (off the diagonal, small angles) in deg, as stats.json's accel.* entries.
+    if "imu_accel_matrix" in draw:
+        e = np.array(draw["imu_accel_matrix"], float) - np.eye(3)
+        for i, a in enumerate("xyz"):
+            for j, b in enumerate("xyz"):
+                if i == j:
+                    out[f"accel.s{a}"] = e[i, i] * 100.0
+                else:
+                    out[f"accel.m{a}{b}"] = math.degrees(e[i, j])
     return out
 
 
