@@ -39,6 +39,7 @@ struct CalibrateArgs {
   bool mono_intrinsics = false;
   bool gyro_scale = true;
   bool accel_axes = true;
+  bool accel_scale = false;
   bool quiet = false;
   std::string python = "/usr/bin/python3";
 };
@@ -147,6 +148,7 @@ void RunCalibrate(const CalibrateArgs& args) {
   c.monocular_intrinsics = args.mono_intrinsics;
   c.gyro_scale = args.gyro_scale;
   c.accel_axes = args.accel_axes;
+  c.accel_scale = args.accel_scale;
   c.final_max_observations_per_keyframe = 0;
   c.final_iterations_first = 30;
   c.final_iterations_second = 15;
@@ -231,8 +233,11 @@ void RegisterCalibrateCommand(CLI::App& app) {
                 "inertial: hold the gyroscope's scale factors at the file's values (estimated by "
                 "default)");
   cmd->add_flag("--calibrate-hold-accel-axes{false}", args->accel_axes,
-                "inertial: hold the accelerometer's scale factors and misalignment at the file's "
-                "values (estimated by default)");
+                "inertial: hold the accelerometer's misalignment at the file's values (estimated "
+                "by default)");
+  cmd->add_flag("--calibrate-accel-scale", args->accel_scale,
+                "inertial: estimate the accelerometer's per-axis scale factors too (held by "
+                "default; its misalignment is estimated)");
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
   cmd->add_option("--python", args->python, "Python with matplotlib, for the plot")
       ->capture_default_str();

@@ -285,8 +285,11 @@ void AddSystemOptions(CLI::App* cmd, const std::shared_ptr<RunArgs>& args) {
                 "values (estimated by default; docs/calibration.md)");
   cmd->add_flag("--calibrate-hold-accel-axes{false}",
                 args->options.system.mapping.calibration.accel_axes,
-                "--calibrate online, inertial: hold the accelerometer's scale factors and "
-                "misalignment at the file's values (estimated by default; docs/calibration.md)");
+                "--calibrate online, inertial: hold the accelerometer's misalignment at the "
+                "file's values (estimated by default; docs/calibration.md)");
+  cmd->add_flag("--calibrate-accel-scale", args->options.system.mapping.calibration.accel_scale,
+                "--calibrate online, inertial: estimate the accelerometer's per-axis scale "
+                "factors too (held by default; docs/calibration.md)");
   cmd->add_option("--calibrate-thread", args->options.system.calibration_thread,
                   "--calibrate online: where each adjustment solves: thread (beside local "
                   "mapping, which goes on meanwhile), step (inside local mapping's keyframe step, "

@@ -46,6 +46,15 @@ PreintegratedImu Integrate(const std::vector<ImuMeasurement>& samples, std::int6
   return pim;
 }
 
+// One second of the helix, sampled every 5 ms without noise by an IMU with bias kHelixBias and
+// integrated at that bias.
+const ImuBias kHelixBias(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));
+PreintegratedImu HelixSecond(ImuIntegrationScheme scheme) {
+  const HelixMotion motion;
+  return Integrate(SampleImu(motion, 0, kSecond, 5'000'000, kHelixBias, {}, nullptr), 0, kSecond,
+                   kHelixBias, scheme);
+}
+
 constexpr ImuIntegrationScheme kSchemes[] = {ImuIntegrationScheme::kMidpoint,
                                              ImuIntegrationScheme::kOrbSlam3};
 
@@ -139,11 +148,8 @@ TEST_P(PreintegrationSchemes, BiasJacobiansMatchNumericDifferences) {
 TEST_P(PreintegrationSchemes, GyroScaleJacobiansMatchRescaledReintegration) {
   // The gyro reads (1 + k) times the rate: the Jacobians give the deltas of rates divided by
   // 1 + dk, which RescaleGyro(1 / (1 + dk)) integrates exactly.
-  const HelixMotion motion;
-  const std::int64_t t0 = 0, t1 = kSecond;
-  const ImuBias b0(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));
-  const PreintegratedImu pim =
-      Integrate(SampleImu(motion, t0, t1, 5'000'000, b0, {}, nullptr), t0, t1, b0, GetParam());
+  const ImuBias& b0 = kHelixBias;
+  const PreintegratedImu pim = HelixSecond(GetParam());
   const GyroScaleJacobians j = GyroScaleJacobiansOf(pim);
   const double h = 1e-6;
   Eigen::Matrix3d n_R, n_v, n_p;
@@ -170,11 +176,8 @@ TEST_P(PreintegrationSchemes, GyroScaleJacobiansMatchRescaledReintegration) {
 TEST_P(PreintegrationSchemes, AccelAxesJacobiansMatchTransformedReintegration) {
   // A change dE' of the corrected samples' axis errors multiplies them by (I + dE')^-1, which
   // TransformAccel integrates exactly; the bias is held (compared at b0).
-  const HelixMotion motion;
-  const std::int64_t t0 = 0, t1 = kSecond;
-  const ImuBias b0(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));
-  const PreintegratedImu pim =
-      Integrate(SampleImu(motion, t0, t1, 5'000'000, b0, {}, nullptr), t0, t1, b0, GetParam());
+  const ImuBias& b0 = kHelixBias;
+  const PreintegratedImu pim = HelixSecond(GetParam());
   const AccelAxesJacobians j = AccelAxesJacobiansOf(pim);
   const double h = 1e-6;
   Eigen::Matrix<double, 3, 9> n_v, n_p;
@@ -195,10 +198,8 @@ TEST_P(PreintegrationSchemes, AccelAxesJacobiansMatchTransformedReintegration) {
 }
 
 TEST(Preintegration, TransformAccelByIdentityChangesNothingAndRejectsSingularMatrices) {
-  const HelixMotion motion;
-  const ImuBias b0(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));
-  const PreintegratedImu pim = Integrate(SampleImu(motion, 0, kSecond, 5'000'000, b0, {}, nullptr),
-                                         0, kSecond, b0, ImuIntegrationScheme::kMidpoint);
+  const ImuBias& b0 = kHelixBias;
+  const PreintegratedImu pim = HelixSecond(ImuIntegrationScheme::kMidpoint);
   PreintegratedImu same = pim;
   TransformAccel(Eigen::Matrix3d::Identity(), &same);
   EXPECT_EQ(same.delta_v, pim.delta_v);
@@ -211,11 +212,8 @@ TEST(Preintegration, TransformAccelByIdentityChangesNothingAndRejectsSingularMat
 }
 
 TEST(Preintegration, RescaleGyroByOneChangesNothingAndRejectsBadFactors) {
-  const HelixMotion motion;
-  const ImuBias b0(Vec3(0.01, -0.02, 0.015), Vec3(0.1, 0.05, -0.2));
-  const PreintegratedImu pim =
-      Integrate(SampleImu(motion, 0, kSecond, 5'000'000, b0, {}, nullptr), 0, kSecond, b0,
-                ImuIntegrationScheme::kMidpoint);
+  const ImuBias& b0 = kHelixBias;
+  const PreintegratedImu pim = HelixSecond(ImuIntegrationScheme::kMidpoint);
   PreintegratedImu same = pim;
   RescaleGyro(Vec3::Ones(), &same);
   EXPECT_EQ(same.delta_v, pim.delta_v);

@@ -55,7 +55,7 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
   CalibrationGates g;
   const auto freeze_all = [&](const std::string& reason) {
     for (const char* group : {"intrinsics", "stereo", "imu_rotation", "imu_translation",
-                              "time_offset", "gyro_scale", "accel_axes"}) {
+                              "time_offset", "gyro_scale", "accel_axes", "accel_scale"}) {
       g.frozen[group] = reason;
     }
     g.free = {};
@@ -108,8 +108,8 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
 
   if (!IsInertial(sensor) || !problem.inertial) {
     if (IsInertial(sensor)) {
-      for (const char* group :
-           {"imu_rotation", "imu_translation", "time_offset", "gyro_scale", "accel_axes"}) {
+      for (const char* group : {"imu_rotation", "imu_translation", "time_offset", "gyro_scale",
+                                "accel_axes", "accel_scale"}) {
         g.frozen[group] = "the map's IMU is not initialised";
       }
     }
@@ -159,6 +159,13 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
     g.free.accel_axes = true;
   } else {
     g.frozen["accel_axes"] = g.frozen["imu_rotation"];
+  }
+  if (!g.free.accel_axes) {
+    g.frozen["accel_scale"] = g.frozen["accel_axes"];
+  } else if (!options.accel_scale) {
+    g.frozen["accel_scale"] = "held at the file's value (--calibrate-accel-scale estimates it)";
+  } else {
+    g.free.accel_scale = true;
   }
   if (!options.imu_translation) {
     g.frozen["imu_translation"] = "held at the file's value (--calibrate-lever-arm estimates it)";

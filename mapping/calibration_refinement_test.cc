@@ -64,6 +64,14 @@ TEST(DecideFreedomTest, ATurningStereoInertialFlightFreesAllButTheLeverArm) {
   EXPECT_FALSE(ha.free.accel_axes);
   EXPECT_TRUE(ha.free.gyro_scale);
   EXPECT_NE(ha.frozen.at("accel_axes").find("--calibrate-hold-accel-axes"), std::string::npos);
+  // The accelerometer's scale factors only when asked for.
+  EXPECT_FALSE(g.free.accel_scale);
+  EXPECT_NE(g.frozen.at("accel_scale").find("--calibrate-accel-scale"), std::string::npos);
+  OnlineCalibrationOptions scale;
+  scale.accel_scale = true;
+  EXPECT_TRUE(DecideFreedom(p, Sensor::kStereoInertial, scale).free.accel_scale);
+  held_accel.accel_scale = true;
+  EXPECT_FALSE(DecideFreedom(p, Sensor::kStereoInertial, held_accel).free.accel_scale);
 }
 
 TEST(DecideFreedomTest, RotationAboutOneAxisLeavesTheCameraImuRotationFrozen) {
@@ -100,7 +108,7 @@ TEST(DecideFreedomTest, SensorsWithoutScaleOrWithDepthFreezeEverything) {
   for (Sensor s : {Sensor::kMonocular, Sensor::kRgbd}) {
     const CalibrationGates g = DecideFreedom(p, s, {});
     EXPECT_FALSE(g.free.Any());
-    EXPECT_EQ(g.frozen.size(), 7u);
+    EXPECT_EQ(g.frozen.size(), 8u);
   }
 }
 

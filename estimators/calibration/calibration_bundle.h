@@ -89,7 +89,10 @@ struct CalibrationFreedom {
   bool imu_translation = false;
   bool time_offset = false;
   bool gyro_scale = false;
+  // The accelerometer's misalignment (E's off-diagonal terms); with `accel_scale` its per-axis
+  // scale factors (E's diagonal) too, which are otherwise held by the block's manifold.
   bool accel_axes = false;
+  bool accel_scale = false;
 
   bool Any() const {
     return intrinsics[0] || intrinsics[1] || stereo_extrinsic || imu_rotation || imu_translation ||

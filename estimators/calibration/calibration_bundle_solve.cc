@@ -101,6 +101,15 @@ void AddCalibrationBlocks(const CalibrationBundleProblem& problem,
   } else {
     ceres_problem->SetParameterBlockConstant(s->offset());
   }
+  if (problem.inertial && (problem.free.gyro_scale || problem.free.accel_axes)) {
+    // Both axis-error blocks enter the inertial edges (ImuAxesInertialError); the one not free
+    // is constant, and the accelerometer's diagonal stays unless its scale is free.
+    ceres_problem->AddParameterBlock(s->gyro_scale(), 3);
+    ceres_problem->AddParameterBlock(s->accel_axes(), 9,
+                                     problem.free.accel_scale ? nullptr : &m->accel_misalignment);
+    if (!problem.free.gyro_scale) ceres_problem->SetParameterBlockConstant(s->gyro_scale());
+    if (!problem.free.accel_axes) ceres_problem->SetParameterBlockConstant(s->accel_axes());
+  }
   if (problem.inertial && problem.free.gyro_scale) {
     ceres_problem->AddResidualBlock(
         new EuclideanPriorError(problem.prior.gyro_scale,
@@ -271,12 +280,6 @@ class CalibrationSolve {
         problem_.accel_axes_jacobians.empty() || problem_.accel_axes_jacobians.size() == num_edges,
         "calibration BA: {} accelerometer axes Jacobians for {} inertial edges",
         problem_.accel_axes_jacobians.size(), num_edges);
-    if (axes_free) {
-      ceres_problem_.AddParameterBlock(s_.gyro_scale(), 3);
-      ceres_problem_.AddParameterBlock(s_.accel_axes(), 9);
-      if (!problem_.free.gyro_scale) ceres_problem_.SetParameterBlockConstant(s_.gyro_scale());
-      if (!problem_.free.accel_axes) ceres_problem_.SetParameterBlockConstant(s_.accel_axes());
-    }
     for (std::size_t edge = 0; edge < num_edges; ++edge) {
       const auto& e = problem_.bundle.edges[edge];
       AddInertial(e.from);

@@ -112,7 +112,7 @@ std::vector<CalibrationParameter> CalibrationParameters(const RigCalibration& pr
         if (r == c) {
           out.push_back({fmt::format("accel.s{}", axes[r]), "%", prior.accel_axes(r, c) * 100.0,
                          estimate.accel_axes(r, c) * 100.0, 0.0, sigmas.accel_scale_pct,
-                         free.accel_axes});
+                         free.accel_axes && free.accel_scale});
         } else {
           out.push_back({fmt::format("accel.m{}{}", axes[r], axes[c]), "deg",
                          prior.accel_axes(r, c) * kDeg, estimate.accel_axes(r, c) * kDeg, 0.0,

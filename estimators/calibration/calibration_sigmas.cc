@@ -98,7 +98,7 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
       // Row-major: the diagonal in %, the misalignment in deg (CalibrationParameters).
       Eigen::MatrixXd j = Eigen::MatrixXd::Zero(9, 9);
       for (int i = 0; i < 9; ++i) j(i, i) = i % 4 == 0 ? 100.0 : kRadToDeg;
-      entries.push_back({s->accel_axes(), index, j});
+      entries.push_back({s->accel_axes(), index, j, /*ambient=*/!problem.free.accel_scale});
     }
   }
   if (entries.empty()) return true;

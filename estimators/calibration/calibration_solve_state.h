@@ -82,6 +82,8 @@ struct CalibrationManifolds {
         stereo(StereoExtrinsicFree(problem) ? kStereoHeldAxes : std::array<bool, 6>{}) {}
   // The right camera's fy and cy stay: the stereo matcher measures only its u coordinate.
   ceres::SubsetManifold right_intrinsics{kCalibIntrinsicsSize, {1, 3}};
+  // The accelerometer's axis errors with the diagonal (its scale factors) held.
+  ceres::SubsetManifold accel_misalignment{9, {0, 4, 8}};
   SE3LeftSubsetManifold imu;
   SE3LeftSubsetManifold stereo;
 };

@@ -43,6 +43,22 @@ class CalibrationApplyTest : public ::testing::Test {
                             testing::FrameOptions{});
   }
 
+  // Gives every keyframe after the first the same preintegration (0.2 s of a constant sample,
+  // integrated at `bias`) and that bias as its state's: a chain to move. Returns it.
+  PreintegratedImu SetChain(const ImuBias& bias) {
+    PreintegratedImu pim = StartPreintegration(bias, ImuNoise{});
+    for (int i = 0; i < 40; ++i) {
+      IntegrateMeasurement(Eigen::Vector3d(0.1, 9.8, 0.2), Eigen::Vector3d(0.3, 0.8, -0.2), 0.005,
+                           &pim);
+    }
+    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
+    for (std::size_t k = 1; k < map_.keyframes.size(); ++k) {
+      map_.keyframes[k]->mutable_imu(lock).from_previous = pim;
+      map_.keyframes[k]->mutable_imu(lock).state.bias = bias;
+    }
+    return pim;
+  }
+
   Atlas atlas_;
   RigCalibration file_;
   RigSetup setup_;
@@ -100,19 +116,8 @@ TEST_F(CalibrationApplyTest, AGyroScaleEstimateMovesTheChainsPreintegrationsAndB
   // A chain whose samples were corrected with no scale error; the estimate says the gyro reads
   // 0.5% fast about y: every keyframe's preintegration is re-integrated from samples divided by
   // 1.005 (and its gyro bias, a term of the same samples, with them).
-  PreintegratedImu pim = StartPreintegration(
-      ImuBias(Eigen::Vector3d(0.01, -0.02, 0.0), Eigen::Vector3d::Zero()), ImuNoise{});
-  for (int i = 0; i < 40; ++i) {
-    IntegrateMeasurement(Eigen::Vector3d(0.1, 9.8, 0.2), Eigen::Vector3d(0.3, 0.8, -0.2), 0.005,
-                         &pim);
-  }
-  {
-    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    for (std::size_t k = 1; k < map_.keyframes.size(); ++k) {
-      map_.keyframes[k]->mutable_imu(lock).from_previous = pim;
-      map_.keyframes[k]->mutable_imu(lock).state.bias.gyro = Eigen::Vector3d(0.01, -0.02, 0.0);
-    }
-  }
+  const PreintegratedImu pim =
+      SetChain(ImuBias(Eigen::Vector3d(0.01, -0.02, 0.0), Eigen::Vector3d::Zero()));
   RigCalibration estimate = file_;
   estimate.gyro_scale = Eigen::Vector3d(0.0, 0.005, 0.0);
   {
@@ -139,19 +144,7 @@ TEST_F(CalibrationApplyTest, AnAccelAxesEstimateMovesTheChainsPreintegrationsAnd
   // every keyframe's preintegration is re-integrated from samples multiplied by (I + E)^-1, and
   // its accelerometer bias with them; the gyro side stays.
   const Eigen::Vector3d bias_accel(0.05, -0.1, 0.02);
-  PreintegratedImu pim =
-      StartPreintegration(ImuBias(Eigen::Vector3d::Zero(), bias_accel), ImuNoise{});
-  for (int i = 0; i < 40; ++i) {
-    IntegrateMeasurement(Eigen::Vector3d(0.1, 9.8, 0.2), Eigen::Vector3d(0.3, 0.8, -0.2), 0.005,
-                         &pim);
-  }
-  {
-    auto lock = MapEditor(&atlas_).Write(MapEdit::kFixture);
-    for (std::size_t k = 1; k < map_.keyframes.size(); ++k) {
-      map_.keyframes[k]->mutable_imu(lock).from_previous = pim;
-      map_.keyframes[k]->mutable_imu(lock).state.bias.accel = bias_accel;
-    }
-  }
+  const PreintegratedImu pim = SetChain(ImuBias(Eigen::Vector3d::Zero(), bias_accel));
   RigCalibration estimate = file_;
   estimate.accel_axes(1, 1) = 0.004;
   estimate.accel_axes(0, 1) = 0.1 * M_PI / 180.0;
