@@ -114,15 +114,17 @@ void IntegrateMeasurement(const Vec3& accel, const Vec3& gyro, double dt, Preint
 
 namespace {
 
-// What the gyro-scale Jacobians need of one step's linearisation. IntegrateMeasurement spells
-// the same lines out itself: computed through this function they changed the last bits of a
-// mono-inertial run's keyframes (evaluation/studies/refactor/compare_builds.sh), and
+// What the gyro-scale and accelerometer-axis Jacobians need of one step's linearisation.
+// IntegrateMeasurement spells the same lines out itself: computed through this function they
+// changed the last bits of a mono-inertial run's keyframes
+// (evaluation/studies/refactor/compare_builds.sh), and
 // `--calibrate off` keeps its results bit for bit. GyroScaleJacobiansMatchRescaledReintegration
 // (preintegration_test.cc) checks the two agree.
 struct StepLinearisation {
   SO3d step_R;      // Exp(w dt)
   Mat3 step_Rt;     // its transpose
   Mat3 jr_dt;       // Jr(w dt) dt
+  Mat3 r_s;         // the rotation the step's sample is integrated in (mid-step for midpoint)
   Mat3 d_acc_dphi;  // d(R_s a) / d dphi
   Mat3 d_acc_dw;    // d(R_s a) / d w
 };
@@ -136,9 +138,9 @@ StepLinearisation LineariseStep(const SO3d& delta_R, const Vec3& a, const Vec3& 
   m.jr_dt = SO3d::RightJacobian(w_dt) * dt;
   const bool midpoint = scheme == ImuIntegrationScheme::kMidpoint;
   const Mat3 half_R = midpoint ? SO3d::Exp(0.5 * w_dt).Matrix() : Mat3::Identity();
-  const Mat3 r_s = delta_R.Matrix() * half_R;
-  m.d_acc_dphi = -r_s * SO3d::Hat(a) * half_R.transpose();
-  m.d_acc_dw = midpoint ? Mat3(-r_s * SO3d::Hat(a) * SO3d::RightJacobian(0.5 * w_dt) * (0.5 * dt))
+  m.r_s = delta_R.Matrix() * half_R;
+  m.d_acc_dphi = -m.r_s * SO3d::Hat(a) * half_R.transpose();
+  m.d_acc_dw = midpoint ? Mat3(-m.r_s * SO3d::Hat(a) * SO3d::RightJacobian(0.5 * w_dt) * (0.5 * dt))
                         : Mat3::Zero();
   return m;
 }
@@ -170,18 +172,14 @@ AccelAxesJacobians AccelAxesJacobiansOf(const PreintegratedImu& pim) {
   AccelAxesJacobians j;
   SO3d delta_R;
   for (const PreintegratedImu::Step& s : pim.steps) {
-    const Vec3 w_dt = (s.gyro - pim.bias.gyro) * s.dt;
-    const SO3d step_R = SO3d::Exp(w_dt);
-    const Mat3 half_R = pim.scheme == ImuIntegrationScheme::kMidpoint
-                            ? SO3d::Exp(0.5 * w_dt).Matrix()
-                            : Mat3::Identity();
-    const Mat3 r_s = delta_R.Matrix() * half_R;
+    const StepLinearisation m =
+        LineariseStep(delta_R, s.accel - pim.bias.accel, s.gyro - pim.bias.gyro, s.dt, pim.scheme);
     Eigen::Matrix<double, 3, 9> d = Eigen::Matrix<double, 3, 9>::Zero();
     for (int r = 0; r < 3; ++r) d.block<1, 3>(r, 3 * r) = -s.accel.transpose();
-    const Eigen::Matrix<double, 3, 9> d_acc = r_s * d;
+    const Eigen::Matrix<double, 3, 9> d_acc = m.r_s * d;
     j.position += j.velocity * s.dt + 0.5 * d_acc * s.dt * s.dt;
     j.velocity += d_acc * s.dt;
-    delta_R = delta_R * step_R;
+    delta_R = delta_R * m.step_R;
   }
   return j;
 }
