@@ -39,6 +39,7 @@ struct CalibrateArgs {
   bool mono_intrinsics = false;
   bool gyro_scale = true;
   bool accel_axes = true;
+  bool mono_accel_axes = false;
   bool accel_scale = false;
   bool quiet = false;
   std::string python = "/usr/bin/python3";
@@ -148,6 +149,7 @@ void RunCalibrate(const CalibrateArgs& args) {
   c.monocular_intrinsics = args.mono_intrinsics;
   c.gyro_scale = args.gyro_scale;
   c.accel_axes = args.accel_axes;
+  c.monocular_accel_axes = args.mono_accel_axes;
   c.accel_scale = args.accel_scale;
   c.final_max_observations_per_keyframe = 0;
   c.final_iterations_first = 30;
@@ -234,10 +236,12 @@ void RegisterCalibrateCommand(CLI::App& app) {
                 "default)");
   cmd->add_flag("--calibrate-hold-accel-axes{false}", args->accel_axes,
                 "inertial: hold the accelerometer's misalignment at the file's values (estimated "
-                "by default)");
+                "by default on a stereo-inertial rig)");
+  cmd->add_flag("--calibrate-mono-accel-axes", args->mono_accel_axes,
+                "mono-inertial: estimate the accelerometer's misalignment too (held by default)");
   cmd->add_flag("--calibrate-accel-scale", args->accel_scale,
                 "inertial: estimate the accelerometer's per-axis scale factors too (held by "
-                "default; its misalignment is estimated)");
+                "default)");
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
   cmd->add_option("--python", args->python, "Python with matplotlib, for the plot")
       ->capture_default_str();

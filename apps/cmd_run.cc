@@ -286,7 +286,12 @@ void AddSystemOptions(CLI::App* cmd, const std::shared_ptr<RunArgs>& args) {
   cmd->add_flag("--calibrate-hold-accel-axes{false}",
                 args->options.system.mapping.calibration.accel_axes,
                 "--calibrate online, inertial: hold the accelerometer's misalignment at the "
-                "file's values (estimated by default; docs/calibration.md)");
+                "file's values (estimated by default on a stereo-inertial rig; "
+                "docs/calibration.md)");
+  cmd->add_flag("--calibrate-mono-accel-axes",
+                args->options.system.mapping.calibration.monocular_accel_axes,
+                "--calibrate online, monocular-inertial: estimate the accelerometer's misalignment "
+                "too (held at the file's values by default; docs/calibration.md)");
   cmd->add_flag("--calibrate-accel-scale", args->options.system.mapping.calibration.accel_scale,
                 "--calibrate online, inertial: estimate the accelerometer's per-axis scale "
                 "factors too (held by default; docs/calibration.md)");

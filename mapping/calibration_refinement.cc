@@ -155,6 +155,10 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
   // turning gives (a body that never tilts sees gravity along one axis only).
   if (!options.accel_axes) {
     g.frozen["accel_axes"] = "held at the file's value (--calibrate-hold-accel-axes)";
+  } else if (IsMonocular(sensor) && !options.monocular_accel_axes) {
+    g.frozen["accel_axes"] =
+        "held at the file's value for a monocular rig (it trades against the map's scale; "
+        "--calibrate-mono-accel-axes estimates it)";
   } else if (g.second_axis_rate >= options.min_rotation_rate) {
     g.free.accel_axes = true;
   } else {

@@ -103,6 +103,21 @@ TEST(DecideFreedomTest, AStillRigKeepsTheTimeOffset) {
   EXPECT_FALSE(m.free.intrinsics[1]);  // no second camera
 }
 
+TEST(DecideFreedomTest, AMonocularInertialRigHoldsTheAccelerometerAxesUnlessAsked) {
+  const auto p = Problem(20, {{0.3, 0.0, 0.1}, {0.0, 0.4, -0.1}, {-0.2, 0.1, 0.5}}, 0.5, false);
+  const CalibrationGates g = DecideFreedom(p, Sensor::kMonocularInertial, {});
+  EXPECT_TRUE(g.free.imu_rotation);  // the turning would free them on a stereo rig
+  EXPECT_TRUE(g.free.gyro_scale);
+  EXPECT_FALSE(g.free.accel_axes);
+  EXPECT_NE(g.frozen.at("accel_axes").find("--calibrate-mono-accel-axes"), std::string::npos);
+  EXPECT_FALSE(g.free.accel_scale);
+  OnlineCalibrationOptions mono;
+  mono.monocular_accel_axes = true;
+  EXPECT_TRUE(DecideFreedom(p, Sensor::kMonocularInertial, mono).free.accel_axes);
+  // The stereo rig's default is unchanged by the monocular option.
+  EXPECT_TRUE(DecideFreedom(p, Sensor::kStereoInertial, {}).free.accel_axes);
+}
+
 TEST(DecideFreedomTest, SensorsWithoutScaleOrWithDepthFreezeEverything) {
   const auto p = Problem(20, {}, 0.5, false);
   for (Sensor s : {Sensor::kMonocular, Sensor::kRgbd}) {

@@ -1,0 +1,64 @@
+"""Tests of scale_offset.py on a hand-made bench: a run whose estimate leaves cam1's cx 0.2 px
+large has a +0.2 px offset, a run with the true rig none; runs without OUT/calibration/ and failed
+runs are left out; the sign count reads the trajectories' Sim(3) scales."""
+import os
+import tempfile
+import unittest
+
+import scale_offset
+import stereo_depth_error_test as sde_test
+
+HEADER = 'index,run_id,dataset,status,ate_m,sim3_scale\n'
+
+
+def write(path, text):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, 'w') as f:
+        f.write(text)
+
+
+class ScaleOffsetTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        root = self.tmp.name
+        self.bench, self.renders = os.path.join(root, 'bench'), os.path.join(root, 'renders')
+        truth = os.path.join(self.renders, 'R', 'truth')
+        self.cam(truth, 'cam0_sensor.yaml', 0.0, 0.0)
+        self.cam(truth, 'cam1_sensor.yaml', 0.11, 0.0)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def cam(self, folder, name, x_m, dcx):
+        intrinsics = list(sde_test.INTRINSICS)
+        intrinsics[2] += dcx
+        write(os.path.join(folder, name), sde_test.camera_yaml(x_m, intrinsics))
+
+    def add_run(self, config, seed, status, sim3_scale, dcx1=None):
+        run = os.path.join(self.bench, 'runs', 'R', 'stereo-inertial', config, f'seed{seed}')
+        write(os.path.join(run, 'result.csv'), HEADER + f'0,x,R,{status},0.005,{sim3_scale}\n')
+        if dcx1 is not None:
+            self.cam(os.path.join(run, 'calibration', 'cam0'), 'sensor.yaml', 0.0, 0.0)
+            self.cam(os.path.join(run, 'calibration', 'cam1'), 'sensor.yaml', 0.11, dcx1)
+
+    def test_offsets_signs_and_what_is_left_out(self):
+        self.add_run('online', 1, 'ok', 1.002, dcx1=0.2)   # too near, map too small: agrees
+        self.add_run('online', 2, 'ok', 0.998, dcx1=0.2)   # disagrees
+        self.add_run('online', 3, 'ok', 1.0001, dcx1=0.0)  # both below the floors
+        self.add_run('online', 4, 'failed', 1.002, dcx1=0.2)
+        self.add_run('off', 1, 'ok', 1.01)
+        rows = scale_offset.run_rows(self.bench, self.renders)
+        self.assertEqual([r['run'] for r in rows],
+                         [f'R/stereo-inertial/online/seed{s}' for s in (1, 2, 3)])
+        self.assertAlmostEqual(rows[0]['offset_px'], 0.2, delta=0.01)
+        self.assertAlmostEqual(rows[0]['map_small_pct'], 0.2, delta=1e-9)
+        self.assertLess(abs(rows[2]['offset_px']), 1e-6)
+        self.assertEqual(scale_offset.sign_agreement(rows), (1, 2))
+
+    def test_an_empty_bench_is_an_error(self):
+        self.add_run('off', 1, 'ok', 1.01)
+        self.assertEqual(scale_offset.main(['scale_offset.py', self.bench, self.renders]), 1)
+
+
+if __name__ == '__main__':
+    unittest.main()
