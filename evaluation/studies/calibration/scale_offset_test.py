@@ -7,14 +7,9 @@ import unittest
 
 import scale_offset
 import stereo_depth_error_test as sde_test
+from residual_sources_test import write
 
 HEADER = 'index,run_id,dataset,status,ate_m,sim3_scale\n'
-
-
-def write(path, text):
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(path, 'w') as f:
-        f.write(text)
 
 
 class ScaleOffsetTest(unittest.TestCase):
