@@ -53,11 +53,13 @@ void OnlineCalibrationOptions::Check() const {
 CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor sensor,
                                const OnlineCalibrationOptions& options) {
   CalibrationGates g;
+  // The groups only an initialised IMU can free; a group added here is frozen with the rest.
+  constexpr std::array<const char*, 6> kInertialGroups = {
+      "imu_rotation", "imu_translation", "time_offset", "gyro_scale", "accel_axes", "accel_scale"};
   const auto freeze_all = [&](const std::string& reason) {
-    for (const char* group : {"intrinsics", "stereo", "imu_rotation", "imu_translation",
-                              "time_offset", "gyro_scale", "accel_axes", "accel_scale"}) {
-      g.frozen[group] = reason;
-    }
+    g.frozen["intrinsics"] = reason;
+    g.frozen["stereo"] = reason;
+    for (const char* group : kInertialGroups) g.frozen[group] = reason;
     g.free = {};
   };
   if (IsRgbd(sensor)) {
@@ -108,10 +110,8 @@ CalibrationGates DecideFreedom(const CalibrationBundleProblem& problem, Sensor s
 
   if (!IsInertial(sensor) || !problem.inertial) {
     if (IsInertial(sensor)) {
-      for (const char* group : {"imu_rotation", "imu_translation", "time_offset", "gyro_scale",
-                                "accel_axes", "accel_scale"}) {
+      for (const char* group : kInertialGroups)
         g.frozen[group] = "the map's IMU is not initialised";
-      }
     }
     return g;
   }
