@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "apps/calibration_flags.h"
 #include "apps/cli_errors.h"
 #include "apps/commands.h"
 #include "bench/process.h"
@@ -35,12 +36,8 @@ struct CalibrateArgs {
   std::uint64_t seed = 0;
   bool deterministic = false;
   bool no_verify = false;
-  bool lever_arm = false;
-  bool mono_intrinsics = false;
-  bool gyro_scale = true;
-  bool accel_axes = true;
-  bool mono_accel_axes = false;
-  bool accel_scale = false;
+  // What the calibration run estimates beyond the defaults (AddCalibrationFreedomFlags).
+  OnlineCalibrationOptions calibration;
   bool quiet = false;
   std::string python = "/usr/bin/python3";
 };
@@ -144,13 +141,8 @@ void RunCalibrate(const CalibrateArgs& args) {
   RunOptions calibrate = base;
   calibrate.out = out / "run";
   OnlineCalibrationOptions& c = calibrate.system.mapping.calibration;
+  c = args.calibration;
   c.enabled = true;
-  c.imu_translation = args.lever_arm;
-  c.monocular_intrinsics = args.mono_intrinsics;
-  c.gyro_scale = args.gyro_scale;
-  c.accel_axes = args.accel_axes;
-  c.monocular_accel_axes = args.mono_accel_axes;
-  c.accel_scale = args.accel_scale;
   c.final_max_observations_per_keyframe = 0;
   c.final_iterations_first = 30;
   c.final_iterations_second = 15;
@@ -227,21 +219,7 @@ void RegisterCalibrateCommand(CLI::App& app) {
                 "Local mapping in lock-step: identical output run to run");
   cmd->add_flag("--no-verify", args->no_verify,
                 "Skip the two runs that measure ATE with the file's and the refined calibration");
-  cmd->add_flag("--calibrate-lever-arm", args->lever_arm,
-                "Estimate the camera-IMU translation too (held at the file's value by default)");
-  cmd->add_flag("--calibrate-mono-intrinsics", args->mono_intrinsics,
-                "mono-inertial: estimate the camera's intrinsics too (held by default)");
-  cmd->add_flag("--calibrate-hold-gyro-scale{false}", args->gyro_scale,
-                "inertial: hold the gyroscope's scale factors at the file's values (estimated by "
-                "default)");
-  cmd->add_flag("--calibrate-hold-accel-axes{false}", args->accel_axes,
-                "inertial: hold the accelerometer's misalignment at the file's values (estimated "
-                "by default on a stereo-inertial rig)");
-  cmd->add_flag("--calibrate-mono-accel-axes", args->mono_accel_axes,
-                "mono-inertial: estimate the accelerometer's misalignment too (held by default)");
-  cmd->add_flag("--calibrate-accel-scale", args->accel_scale,
-                "inertial: estimate the accelerometer's per-axis scale factors too (held by "
-                "default)");
+  AddCalibrationFreedomFlags(cmd, &args->calibration, "");
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
   cmd->add_option("--python", args->python, "Python with matplotlib, for the plot")
       ->capture_default_str();

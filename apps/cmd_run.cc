@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 
+#include "apps/calibration_flags.h"
 #include "apps/cli_errors.h"
 #include "apps/commands.h"
 #include "apps/live_view.h"
@@ -272,29 +273,7 @@ void AddSystemOptions(CLI::App* cmd, const std::shared_ptr<RunArgs>& args) {
          "calibration as exact")
       ->check(OneOf({"online", "off"}))
       ->default_str("off");
-  cmd->add_flag("--calibrate-lever-arm", args->options.system.mapping.calibration.imu_translation,
-                "--calibrate online: estimate the camera-IMU translation too (held at the file's "
-                "value by default; docs/calibration.md)");
-  cmd->add_flag("--calibrate-mono-intrinsics",
-                args->options.system.mapping.calibration.monocular_intrinsics,
-                "--calibrate online, monocular-inertial: estimate the camera's intrinsics too "
-                "(held at the file's values by default; docs/calibration.md)");
-  cmd->add_flag("--calibrate-hold-gyro-scale{false}",
-                args->options.system.mapping.calibration.gyro_scale,
-                "--calibrate online, inertial: hold the gyroscope's scale factors at the file's "
-                "values (estimated by default; docs/calibration.md)");
-  cmd->add_flag("--calibrate-hold-accel-axes{false}",
-                args->options.system.mapping.calibration.accel_axes,
-                "--calibrate online, inertial: hold the accelerometer's misalignment at the "
-                "file's values (estimated by default on a stereo-inertial rig; "
-                "docs/calibration.md)");
-  cmd->add_flag("--calibrate-mono-accel-axes",
-                args->options.system.mapping.calibration.monocular_accel_axes,
-                "--calibrate online, monocular-inertial: estimate the accelerometer's misalignment "
-                "too (held at the file's values by default; docs/calibration.md)");
-  cmd->add_flag("--calibrate-accel-scale", args->options.system.mapping.calibration.accel_scale,
-                "--calibrate online, inertial: estimate the accelerometer's per-axis scale "
-                "factors too (held by default; docs/calibration.md)");
+  AddCalibrationFreedomFlags(cmd, &args->options.system.mapping.calibration, "--calibrate online");
   cmd->add_option("--calibrate-thread", args->options.system.calibration_thread,
                   "--calibrate online: where each adjustment solves: thread (beside local "
                   "mapping, which goes on meanwhile), step (inside local mapping's keyframe step, "
