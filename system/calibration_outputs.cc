@@ -21,6 +21,32 @@ const std::string& SourceOf(const std::string& name, const CalibrationSources& s
   return s.cam0;
 }
 
+// The free parameters' joint covariance, by name (report units): what a derived quantity's
+// uncertainty needs. The stereo rig's depth, for one, depends on a combination of both cameras'
+// principal points, focal lengths and the stereo rotation whose errors largely cancel, so the
+// sigmas alone overstate it (evaluation/studies/calibration/scale_offset.py).
+void WriteCovarianceMatrix(const CalibrationReport& report, JsonWriter* json) {
+  std::vector<int> rows;
+  const int n = static_cast<int>(report.parameters.size());
+  if (report.parameter_covariance.rows() == n && report.parameter_covariance.cols() == n) {
+    for (int i = 0; i < n; ++i) {
+      if (report.parameters[static_cast<std::size_t>(i)].free) rows.push_back(i);
+    }
+  }
+  json->Key("covariance_matrix").BeginObject();
+  json->Key("names").BeginArray();
+  for (int i : rows) json->Value(report.parameters[static_cast<std::size_t>(i)].name);
+  json->EndArray();
+  json->Key("matrix").BeginArray();
+  for (int i : rows) {
+    json->BeginArray();
+    for (int j : rows) json->Value(report.parameter_covariance(i, j));
+    json->EndArray();
+  }
+  json->EndArray();
+  json->EndObject();
+}
+
 }  // namespace
 
 CalibrationSources SourcesFromSettingsFile(const std::filesystem::path& settings) {
@@ -99,6 +125,7 @@ void WriteCalibrationJson(const CalibrationReport& report,
     json->EndObject();
   }
   json->EndArray();
+  WriteCovarianceMatrix(report, json);
   json->Key("frozen").BeginObject();
   for (const auto& [group, reason] : report.frozen) json->Member(group, reason);
   json->EndObject();

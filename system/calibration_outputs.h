@@ -5,6 +5,7 @@
 // ORB-SLAM3 settings file, to feed back to pkslam or to another system.
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -25,6 +26,9 @@ struct CalibrationReport {
   // adjustment (empty without one).
   std::vector<CalibrationParameter> parameters;
   bool covariance_ok = false;
+  // The parameters' joint covariance (CalibrationBundleResult::parameter_covariance; empty
+  // without one).
+  Eigen::MatrixXd parameter_covariance;
   std::map<std::string, std::string> frozen;
   std::vector<CalibrationRefinementStat> history;
   std::string note;  // why the final adjustment was not applied ("" when it was, or off)

@@ -204,6 +204,7 @@ CalibrationReport SlamSystem::calibration_report() const {
   if (final_calibration_) {
     report.parameters = final_calibration_->parameters;
     report.covariance_ok = final_calibration_->covariance_ok;
+    report.parameter_covariance = final_calibration_->parameter_covariance;
     report.frozen = final_gates_.frozen;
   } else {
     CalibrationFreedom none;

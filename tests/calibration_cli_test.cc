@@ -154,6 +154,18 @@ TEST_F(CalibrationCli, OnlineRunReportsAndWritesTheEstimate) {
   EXPECT_GT(sigma_ms, 0.0);
   EXPECT_LT(std::abs(estimate_ms - 1.0), 0.5) << estimate_ms;
   EXPECT_GT(estimate_ms, 3 * sigma_ms);
+  // The free parameters' joint covariance, by name: its diagonal is their sigmas squared.
+  const YAML::Node m = c["covariance_matrix"];
+  ASSERT_GT(m["names"].size(), 1u);
+  ASSERT_EQ(m["matrix"].size(), m["names"].size());
+  for (std::size_t i = 0; i < m["names"].size(); ++i) {
+    YAML::Node p;
+    ASSERT_NE(FindParameter(c["parameters"], m["names"][i].as<std::string>(), &p), nullptr);
+    EXPECT_TRUE(p["free"].as<bool>());
+    ASSERT_EQ(m["matrix"][i].size(), m["names"].size());
+    const double sigma = p["sigma"].as<double>();
+    EXPECT_NEAR(std::sqrt(m["matrix"][i][i].as<double>()), sigma, 1e-6 * (1 + sigma));
+  }
   // The estimate's files read back as EuRoC sensor files and as settings, with the same values.
   const EurocCameraSensor cam0 = ReadEurocCameraSensor(out / "calibration/cam0/sensor.yaml");
   EXPECT_NEAR(cam0.timeshift_cam_imu * 1e3, estimate_ms, 1e-9);

@@ -179,6 +179,9 @@ struct CalibrationBundleResult {
   RigCalibration estimate;
   std::vector<CalibrationParameter> parameters;
   bool covariance_ok = false;
+  // The joint covariance of `parameters` (same order, report units; the rows and columns of
+  // frozen parameters 0); empty unless covariance_ok. The sigmas are its diagonal's roots.
+  Eigen::MatrixXd parameter_covariance;
   int outliers = 0;
   // Wall time of the whole solve and of its covariance (0 when not computed), for the reports.
   double solve_ms = 0.0;

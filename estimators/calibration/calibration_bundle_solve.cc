@@ -459,9 +459,9 @@ class CalibrationSolve {
     }
     RemoveNuisanceNullDirections(rows_left, point_added_, &ceres_problem_, &s_);
     const auto start = std::chrono::steady_clock::now();
-    result_.covariance_ok =
-        FillSigmas(&ceres_problem_, &s_, problem_, options_.num_threads, manifolds_.imu.Expansion(),
-                   manifolds_.stereo.Expansion(), &result_.parameters);
+    result_.covariance_ok = FillSigmas(&ceres_problem_, &s_, problem_, options_.num_threads,
+                                       manifolds_.imu.Expansion(), manifolds_.stereo.Expansion(),
+                                       &result_.parameters, &result_.parameter_covariance);
     result_.covariance_ms = WallMsSince(start);
     PKSLAM_LOG_DEBUG("calibration bundle adjustment: covariance {} in {:.0f} ms",
                      result_.covariance_ok ? "computed" : "not computable", result_.covariance_ms);

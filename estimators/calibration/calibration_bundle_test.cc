@@ -208,6 +208,31 @@ double StereoDepthError(const RigCalibration& calibration, const RigCalibration&
   return sum / n;
 }
 
+int IndexOf(const CalibrationBundleResult& result, const std::string& name) {
+  for (std::size_t i = 0; i < result.parameters.size(); ++i) {
+    if (result.parameters[i].name == name) return static_cast<int>(i);
+  }
+  ADD_FAILURE() << "no parameter " << name;
+  return 0;
+}
+
+// The joint covariance is symmetric, its diagonal the sigmas squared, and frozen parameters
+// have no rows or columns in it.
+void ExpectCovarianceMatrixOfTheSigmas(const CalibrationBundleResult& result) {
+  const Eigen::MatrixXd& c = result.parameter_covariance;
+  const int n = static_cast<int>(result.parameters.size());
+  ASSERT_EQ(c.rows(), n);
+  ASSERT_EQ(c.cols(), n);
+  EXPECT_LT((c - c.transpose()).cwiseAbs().maxCoeff(), 1e-12 * c.cwiseAbs().maxCoeff());
+  for (int i = 0; i < n; ++i) {
+    const CalibrationParameter& p = result.parameters[static_cast<std::size_t>(i)];
+    EXPECT_NEAR(std::sqrt(std::max(0.0, c(i, i))), p.sigma, 1e-9 * (1 + p.sigma)) << p.name;
+    if (!p.free) {
+      EXPECT_EQ(c.row(i).cwiseAbs().maxCoeff(), 0.0) << p.name;
+    }
+  }
+}
+
 // Every free parameter's estimate lies within `k` posterior sigmas of the truth.
 void ExpectWithinSigmas(const CalibrationBundleResult& result, const CalibrationScene& scene,
                         double k) {
@@ -252,6 +277,22 @@ TEST(CalibrationBundleTest, StereoInertialRecoversTheRigFromAMiscalibratedFile) 
     ASSERT_EQ(p.free, !held) << p.name;
     EXPECT_LE(p.sigma, p.prior_sigma) << p.name;
   }
+  ExpectCovarianceMatrixOfTheSigmas(result);
+  // The disparity's bias, the difference of the principal points' columns plus the stereo
+  // rotation about y (fx ry), is what stereo depth observes: far better than any of its parts,
+  // whose errors offset each other. Its sigma needs the covariance's cross terms.
+  const Eigen::MatrixXd& c = result.parameter_covariance;
+  const int cx0 = IndexOf(result, "cam0.cx");
+  const int cx1 = IndexOf(result, "cam1.cx");
+  const int ry = IndexOf(result, "stereo.ry");
+  Eigen::VectorXd bias = Eigen::VectorXd::Zero(c.rows());
+  bias[cx0] = 1;
+  bias[cx1] = -1;
+  bias[ry] = result.estimate.cameras[0].fx() * M_PI / 180.0;  // stereo.ry is in deg
+  const double bias_sigma = std::sqrt(bias.dot(c * bias));
+  std::cout << "[ covariance ] sigma of cam0.cx " << std::sqrt(c(cx0, cx0)) << ", cam1.cx "
+            << std::sqrt(c(cx1, cx1)) << ", the disparity's bias " << bias_sigma << " px\n";
+  EXPECT_LT(bias_sigma, 0.2 * std::min(std::sqrt(c(cx0, cx0)), std::sqrt(c(cx1, cx1))));
   // The keyframes come back as body poses near the truth (within the 0.1% scale error of the
   // file's baseline, which is held: some 5 m from the origin).
   ASSERT_EQ(result.world_from_body.size(), scene.true_world_from_body.size());

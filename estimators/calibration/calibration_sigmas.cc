@@ -38,13 +38,16 @@ void RemoveNuisanceNullDirections(const std::vector<int>& rows_left,
 }
 
 // The marginal covariance of the free calibration blocks (tangent space), written into the
-// parameters' sigmas. False when Ceres cannot compute it (rank-deficient Jacobian).
+// parameters' sigmas and, as the joint covariance of the reported scalars, into
+// `parameter_covariance`. False when Ceres cannot compute it (rank-deficient Jacobian).
 // `imu_expansion`, `stereo_expansion`: the extrinsic blocks' free tangent axes
 // (SE3LeftSubsetManifold::Expansion).
 bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundleProblem& problem,
                 int num_threads, const Eigen::MatrixXd& imu_expansion,
                 const Eigen::MatrixXd& stereo_expansion,
-                std::vector<CalibrationParameter>* parameters) {
+                std::vector<CalibrationParameter>* parameters,
+                Eigen::MatrixXd* parameter_covariance) {
+  parameter_covariance->resize(0, 0);
   // A block's tangent covariance C maps to the reported scalars as J C J^T (report-ordered J).
   struct Entry {
     double* block;
@@ -109,6 +112,23 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
   const std::optional<MarginalCovariance> covariance =
       ComputeMarginalCovariance(ceres_problem, blocks, options);
   if (!covariance) return false;
+  // The joint covariance T C T^T, T block-diagonal: each entry's tangent -> reported map (its j,
+  // through the manifold's plus Jacobian for ambient entries). The stereo rig's depth is a
+  // combination of both cameras' intrinsics and the stereo rotation, whose errors offset each
+  // other: its uncertainty needs the cross terms, which the sigmas leave out.
+  const int n = static_cast<int>(parameters->size());
+  Eigen::MatrixXd t = Eigen::MatrixXd::Zero(n, covariance->joint.rows());
+  for (const Entry& e : entries) {
+    const MarginalBlock& b = covariance->Find(e.block);
+    const Eigen::MatrixXd map = e.ambient ? e.j * PlusJacobianOf(*ceres_problem, e.block) : e.j;
+    t.block(e.first, b.offset, map.rows(), b.size) = map;
+  }
+  *parameter_covariance = t * covariance->joint * t.transpose();
+  for (int i = 0; i < n; ++i) {
+    if ((*parameters)[static_cast<std::size_t>(i)].free) continue;
+    parameter_covariance->row(i).setZero();
+    parameter_covariance->col(i).setZero();
+  }
   for (const Entry& e : entries) {
     const Eigen::MatrixXd tangent = covariance->Block(e.block);
     const Eigen::MatrixXd m =

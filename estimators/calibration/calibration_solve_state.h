@@ -98,11 +98,14 @@ void RemoveNuisanceNullDirections(const std::vector<int>& rows_left,
 
 // The marginal covariance of the free calibration blocks (tangent space), written into the
 // parameters' sigmas. False when Ceres cannot compute it (rank-deficient Jacobian).
+// `parameter_covariance`: the joint covariance of `parameters` (report units; the rows and
+// columns of frozen parameters 0; left empty when it cannot be computed).
 // `imu_expansion`, `stereo_expansion`: the extrinsic blocks' free tangent axes
 // (SE3LeftSubsetManifold::Expansion).
 bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundleProblem& problem,
                 int num_threads, const Eigen::MatrixXd& imu_expansion,
                 const Eigen::MatrixXd& stereo_expansion,
-                std::vector<CalibrationParameter>* parameters);
+                std::vector<CalibrationParameter>* parameters,
+                Eigen::MatrixXd* parameter_covariance);
 
 }  // namespace pkslam::calibration_solve

@@ -109,13 +109,18 @@ void MarginalCovarianceOptions::Check() const {
   PKSLAM_CHECK(num_threads >= 1, "marginal covariance: num_threads {} < 1", num_threads);
 }
 
-Eigen::MatrixXd MarginalCovariance::Block(const double* block) const {
+const MarginalBlock& MarginalCovariance::Find(const double* block) const {
   for (const MarginalBlock& b : blocks) {
-    if (b.block == block) return joint.block(b.offset, b.offset, b.size, b.size);
+    if (b.block == block) return b;
   }
   PKSLAM_CHECK(false, "marginal covariance: block {} was not requested",
                static_cast<const void*>(block));
-  return {};
+  return blocks.front();
+}
+
+Eigen::MatrixXd MarginalCovariance::Block(const double* block) const {
+  const MarginalBlock& b = Find(block);
+  return joint.block(b.offset, b.offset, b.size, b.size);
 }
 
 std::optional<MarginalCovariance> ComputeMarginalCovariance(
@@ -157,14 +162,23 @@ std::optional<MarginalCovariance> ComputeMarginalCovariance(
   return out;
 }
 
-Eigen::MatrixXd AmbientCovariance(const ceres::Problem& problem, const double* block,
-                                  const Eigen::MatrixXd& tangent_covariance) {
+Eigen::MatrixXd PlusJacobianOf(const ceres::Problem& problem, const double* block) {
   const ceres::Manifold* manifold = problem.GetManifold(block);
-  if (manifold == nullptr) return tangent_covariance;
+  if (manifold == nullptr) {
+    const int size = problem.ParameterBlockSize(block);
+    return Eigen::MatrixXd::Identity(size, size);
+  }
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> plus(
       manifold->AmbientSize(), manifold->TangentSize());
   PKSLAM_CHECK(manifold->PlusJacobian(block, plus.data()),
                "marginal covariance: the manifold's plus Jacobian failed");
+  return plus;
+}
+
+Eigen::MatrixXd AmbientCovariance(const ceres::Problem& problem, const double* block,
+                                  const Eigen::MatrixXd& tangent_covariance) {
+  if (problem.GetManifold(block) == nullptr) return tangent_covariance;
+  const Eigen::MatrixXd plus = PlusJacobianOf(problem, block);
   return plus * tangent_covariance * plus.transpose();
 }
 

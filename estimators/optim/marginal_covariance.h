@@ -38,6 +38,8 @@ struct MarginalCovariance {
 
   // One block's own covariance (tangent coordinates).
   Eigen::MatrixXd Block(const double* block) const;
+  // A requested block's place in `joint`.
+  const MarginalBlock& Find(const double* block) const;
 };
 
 // nullopt when J^T J is not positive definite or its condition is below the options' bound.
@@ -47,8 +49,11 @@ std::optional<MarginalCovariance> ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<const double*>& blocks,
     const MarginalCovarianceOptions& options = {});
 
-// A block's covariance in its ambient coordinates: P C P^T with P the manifold's plus Jacobian
-// at the block's value (P = I without a manifold); as ceres::Covariance::GetCovarianceMatrix.
+// The manifold's plus Jacobian at the block's value (ambient x tangent; I without a manifold).
+Eigen::MatrixXd PlusJacobianOf(const ceres::Problem& problem, const double* block);
+
+// A block's covariance in its ambient coordinates: P C P^T with P = PlusJacobianOf(block); as
+// ceres::Covariance::GetCovarianceMatrix.
 Eigen::MatrixXd AmbientCovariance(const ceres::Problem& problem, const double* block,
                                   const Eigen::MatrixXd& tangent_covariance);
 

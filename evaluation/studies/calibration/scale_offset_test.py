@@ -1,6 +1,7 @@
 """Tests of scale_offset.py on a hand-made bench: a run whose estimate leaves cam1's cx 0.2 px
 large has a +0.2 px offset, a run with the true rig none; runs without OUT/calibration/ and failed
 runs are left out; the sign count reads the trajectories' Sim(3) scales."""
+import json
 import os
 import tempfile
 import unittest
@@ -49,6 +50,26 @@ class ScaleOffsetTest(unittest.TestCase):
         self.assertAlmostEqual(rows[0]['map_small_pct'], 0.2, delta=1e-9)
         self.assertLess(abs(rows[2]['offset_px']), 1e-6)
         self.assertEqual(scale_offset.sign_agreement(rows), (1, 2))
+
+    def add_covariance(self, seed, names, matrix):
+        run = os.path.join(self.bench, 'runs', 'R', 'stereo-inertial', 'online', f'seed{seed}')
+        units = {'cam0.cx': 'px', 'cam1.cx': 'px', 'time_offset': 'ms'}
+        stats = {'calibration': {
+            'parameters': [{'name': n, 'unit': units[n]} for n in units],
+            'covariance_matrix': {'names': names, 'matrix': matrix}}}
+        write(os.path.join(run, 'stats.json'), json.dumps(stats))
+
+    def test_the_offsets_sigma_uses_the_cross_terms(self):
+        for seed in (1, 2, 3):
+            self.add_run('online', seed, 'ok', 1.002, dcx1=0.2)
+        # cam1's cx alone with a 0.1 px sigma; the time offset does not move stereo depth.
+        self.add_covariance(1, ['cam1.cx', 'time_offset'], [[0.01, 0.0], [0.0, 4.0]])
+        # Both principal points 1 px uncertain but moving together: the offset is pinned.
+        self.add_covariance(2, ['cam0.cx', 'cam1.cx'], [[1.0, 0.999], [0.999, 1.0]])
+        rows = scale_offset.run_rows(self.bench, self.renders)
+        self.assertAlmostEqual(rows[0]['offset_sigma_px'], 0.1, delta=0.005)
+        self.assertLess(rows[1]['offset_sigma_px'], 0.06)
+        self.assertIsNone(rows[2]['offset_sigma_px'])
 
     def test_an_empty_bench_is_an_error(self):
         self.add_run('off', 1, 'ok', 1.01)
