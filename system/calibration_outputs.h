@@ -60,6 +60,10 @@ CalibrationSources SourcesFromEurocDataset(const std::filesystem::path& dataset)
 // estimate, with the sigma at least a third of the prior's (the prior's third alone when the
 // covariance failed), naming the parameter, the size and the file; one more than 5 prior sigmas
 // off says the file is wrong for the rig.
+// Stereo rigs get one more line when the disparity bias the file makes (a combination of both
+// principal points and the stereo rotation, whose sigma comes from the joint covariance, at
+// least 0.04 px) is more than `threshold` sigmas from the estimate's, with the depth error it
+// means.
 std::vector<std::string> CalibrationWarnings(const CalibrationReport& report,
                                              const CalibrationSources& sources,
                                              double threshold = 3.0);

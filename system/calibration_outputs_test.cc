@@ -1,5 +1,6 @@
 #include "system/calibration_outputs.h"
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -41,6 +42,76 @@ CalibrationReport Report() {
                   // The accelerometer's x-y misalignment 1.5 deg at 0.05 (prior 0.2: 22 sigma).
                   {"accel.mxy", "deg", 0.0, 1.5, 0.05, 0.2, true}};
   return r;
+}
+
+// The stereo parameters alone: cam0's and cam1's cx moved by the given shifts (estimate - file),
+// each with a 0.5 px sigma, correlated so that their difference, the disparity bias (the stereo
+// rotation held), has the sigma `bias_sigma` (px).
+CalibrationReport StereoBiasReport(double cx0_shift, double cx1_shift, double bias_sigma = 0.05) {
+  CalibrationReport r;
+  r.online = true;
+  r.covariance_ok = true;
+  r.sensor = Sensor::kStereo;
+  r.file = testing::EurocRigCalibration();
+  r.estimate = r.file;
+  r.parameters = {{"cam0.fx", "px", 458.654, 458.654, 0.3, 2.0, true},
+                  {"cam0.cx", "px", 367.215, 367.215 + cx0_shift, 0.5, 2.0, true},
+                  {"cam1.cx", "px", 379.999, 379.999 + cx1_shift, 0.5, 2.0, true},
+                  {"stereo.ry", "deg", 0.0, 0.0, 0.0, 0.1, false}};
+  const double rho = 1.0 - bias_sigma * bias_sigma / (2 * 0.25);
+  r.parameter_covariance = Eigen::MatrixXd::Zero(4, 4);
+  r.parameter_covariance(0, 0) = 0.09;
+  r.parameter_covariance.block<2, 2>(1, 1) << 0.25, rho * 0.25, rho * 0.25, 0.25;
+  return r;
+}
+
+TEST(CalibrationWarnings, NameTheStereoDisparityBiasNoParameterShowsAlone) {
+  // cam0's cx +0.15 px and cam1's -0.15 px: each within its own sigma, so no parameter's line,
+  // but the file's disparities are 0.3 px larger than the estimate's, 6 of the bias's sigmas.
+  const CalibrationReport r = StereoBiasReport(0.15, -0.15);
+  const auto w = CalibrationWarnings(r, SourcesFromEurocDataset("seq"));
+  ASSERT_THAT(w, SizeIs(1));
+  EXPECT_THAT(w[0], HasSubstr("the stereo calibration in seq/mav0/cam0/sensor.yaml and "
+                              "seq/mav0/cam1/sensor.yaml makes disparities 0.300 px larger"));
+  EXPECT_THAT(w[0], HasSubstr("(cam0.cx - cam1.cx + fx stereo.ry; 6.0 sigma)"));
+  // 0.3 px of a 458.654 px x 110.1 mm disparity is 1.78% of the depth at 3 m, 4.75% at 8 m.
+  const double b = r.estimate.cam1_from_cam0.translation().norm();
+  EXPECT_THAT(w[0],
+              HasSubstr(fmt::format("stereo depths {:.2f}% too short at 3 m, {:.2f}% at 8 m",
+                                    0.3 * 3 / (458.654 * b) * 100, 0.3 * 8 / (458.654 * b) * 100)));
+  // Both moved alike leave the disparities as they were: nothing to say.
+  EXPECT_TRUE(
+      CalibrationWarnings(StereoBiasReport(0.3, 0.3), SourcesFromEurocDataset("seq")).empty());
+  // The other way round: disparities smaller, depths long.
+  const auto lw =
+      CalibrationWarnings(StereoBiasReport(-0.15, 0.15), SourcesFromEurocDataset("seq"));
+  ASSERT_THAT(lw, SizeIs(1));
+  EXPECT_THAT(lw[0], HasSubstr("0.300 px smaller"));
+  EXPECT_THAT(lw[0], HasSubstr("too long at 3 m"));
+  // A settings file holds both cameras: named once.
+  EXPECT_THAT(CalibrationWarnings(r, SourcesFromSettingsFile("s.yaml"))[0],
+              HasSubstr("the stereo calibration in s.yaml makes"));
+}
+
+TEST(CalibrationWarnings, TheDisparityBiasSigmaIsAtLeastFourHundredthsOfAPixel) {
+  // 0.1 px against a 0.03 px posterior sigma would be 3.3 sigma; at the 0.04 px floor it is 2.5.
+  EXPECT_TRUE(
+      CalibrationWarnings(StereoBiasReport(0.05, -0.05, 0.03), SourcesFromEurocDataset("seq"))
+          .empty());
+  const auto fw =
+      CalibrationWarnings(StereoBiasReport(0.08, -0.08, 0.03), SourcesFromEurocDataset("seq"));
+  ASSERT_THAT(fw, SizeIs(1));
+  EXPECT_THAT(fw[0], HasSubstr("(cam0.cx - cam1.cx + fx stereo.ry; 4.0 sigma, 0.04 px)"));
+  // Without the covariance the floor is the sigma: 0.3 px is 7.5 of it.
+  CalibrationReport r = StereoBiasReport(0.15, -0.15);
+  r.covariance_ok = false;
+  const auto w = CalibrationWarnings(r, SourcesFromEurocDataset("seq"));
+  ASSERT_THAT(w, SizeIs(1));
+  EXPECT_THAT(w[0], HasSubstr("7.5 sigma, 0.04 px: no covariance"));
+  // Monocular-inertial reports have no cam1.cx: no line.
+  CalibrationReport mono = r;
+  mono.parameters.erase(mono.parameters.begin() + 2);
+  EXPECT_TRUE(CalibrationWarnings(mono, SourcesFromEurocDataset("seq")).empty());
 }
 
 TEST(CalibrationWarnings, NameTheParameterTheSizeAndTheFile) {

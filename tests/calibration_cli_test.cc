@@ -179,7 +179,15 @@ TEST_F(CalibrationCli, OnlineRunReportsAndWritesTheEstimate) {
   // of the prior's sigma, 3 times: 2 ms), so no line claims the file is off (the rule and its
   // wording: system/calibration_outputs_test.cc; gross errors: docs/calibration.md).
   EXPECT_THAT(OnlineOutput(), ::testing::Not(HasSubstr("calibration: time_offset in")));
-  EXPECT_EQ(c["warnings"].size(), 0u);
+  // What is named is the stereo rig's disparity bias: the render's files make disparities 0.21
+  // px too large (stereo depth 1.3% short at 3 m, evaluation/studies/calibration/
+  // stereo_depth_error.py), which no single parameter shows at 3 sigma.
+  ASSERT_EQ(c["warnings"].size(), 1u);
+  const std::string bias = c["warnings"][0].as<std::string>();
+  EXPECT_THAT(bias, HasSubstr("makes disparities"));
+  EXPECT_THAT(bias, HasSubstr("px larger than the estimate does"));
+  EXPECT_THAT(bias, HasSubstr("too short at 3 m"));
+  EXPECT_THAT(OnlineOutput(), HasSubstr(bias));
 }
 
 TEST_F(CalibrationCli, DeterministicOnlineRunsAreIdentical) {
