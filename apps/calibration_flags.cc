@@ -19,34 +19,40 @@ std::string Help(const std::string& condition, const std::string& sensors, std::
   return prefix + ": " + text;
 }
 
+// One flag: its name (CLI11's "{false}" makes a "hold" flag clear the option), the option it
+// sets, the sensors it concerns (empty: every calibrating one) and its help.
+struct FreedomFlag {
+  const char* name;
+  bool OnlineCalibrationOptions::*option;
+  const char* sensors;
+  const char* text;
+};
+
+constexpr FreedomFlag kFreedomFlags[] = {
+    {"--calibrate-lever-arm", &OnlineCalibrationOptions::imu_translation, "",
+     "estimate the camera-IMU translation too (held at the file's value by default)"},
+    {"--calibrate-mono-intrinsics", &OnlineCalibrationOptions::monocular_intrinsics,
+     "monocular-inertial",
+     "estimate the camera's intrinsics too (held at the file's values by default)"},
+    {"--calibrate-hold-gyro-scale{false}", &OnlineCalibrationOptions::gyro_scale, "inertial",
+     "hold the gyroscope's scale factors at the file's values (estimated by default)"},
+    {"--calibrate-hold-accel-axes{false}", &OnlineCalibrationOptions::accel_axes, "inertial",
+     "hold the accelerometer's misalignment at the file's values (estimated by default on a "
+     "stereo-inertial rig)"},
+    {"--calibrate-mono-accel-axes", &OnlineCalibrationOptions::monocular_accel_axes,
+     "monocular-inertial",
+     "estimate the accelerometer's misalignment too (held at the file's values by default)"},
+    {"--calibrate-accel-scale", &OnlineCalibrationOptions::accel_scale, "inertial",
+     "estimate the accelerometer's per-axis scale factors too (held by default)"},
+};
+
 }  // namespace
 
 void AddCalibrationFreedomFlags(CLI::App* cmd, OnlineCalibrationOptions* options,
                                 const std::string& condition) {
-  cmd->add_flag("--calibrate-lever-arm", options->imu_translation,
-                Help(condition, "",
-                     "estimate the camera-IMU translation too (held at the file's value by "
-                     "default)"));
-  cmd->add_flag("--calibrate-mono-intrinsics", options->monocular_intrinsics,
-                Help(condition, "monocular-inertial",
-                     "estimate the camera's intrinsics too (held at the file's values by "
-                     "default)"));
-  cmd->add_flag("--calibrate-hold-gyro-scale{false}", options->gyro_scale,
-                Help(condition, "inertial",
-                     "hold the gyroscope's scale factors at the file's values (estimated by "
-                     "default)"));
-  cmd->add_flag("--calibrate-hold-accel-axes{false}", options->accel_axes,
-                Help(condition, "inertial",
-                     "hold the accelerometer's misalignment at the file's values (estimated by "
-                     "default on a stereo-inertial rig)"));
-  cmd->add_flag("--calibrate-mono-accel-axes", options->monocular_accel_axes,
-                Help(condition, "monocular-inertial",
-                     "estimate the accelerometer's misalignment too (held at the file's values "
-                     "by default)"));
-  cmd->add_flag("--calibrate-accel-scale", options->accel_scale,
-                Help(condition, "inertial",
-                     "estimate the accelerometer's per-axis scale factors too (held by "
-                     "default)"));
+  for (const FreedomFlag& flag : kFreedomFlags) {
+    cmd->add_flag(flag.name, options->*flag.option, Help(condition, flag.sensors, flag.text));
+  }
 }
 
 }  // namespace pkslam::apps

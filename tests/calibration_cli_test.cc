@@ -34,10 +34,10 @@ constexpr const char* kSharedDirVariable = "PKSLAM_CALIBRATION_CLI_DIR";
 // `pkslam run` stereo-inertial of DIR/seq into OUT.
 testing::CommandResult RunReplay(const fs::path& dir, const fs::path& out,
                                  const std::string& extra) {
-  return RunPkslam(fmt::format(
-      "--log-level info run --dataset '{}' --sensor stereo-inertial --out '{}' --quiet "
-      "--deterministic {}",
-      (dir / "seq").string(), out.string(), extra));
+  return RunPkslam(
+      fmt::format("--log-level info run --dataset '{}' --sensor stereo-inertial --out '{}' --quiet "
+                  "--deterministic {}",
+                  (dir / "seq").string(), out.string(), extra));
 }
 
 // The online run's arguments (its map goes to DIR/online.map).
@@ -203,10 +203,10 @@ TEST_F(CalibrationCli, DeterministicOnlineRunsAreIdentical) {
 TEST_F(CalibrationCli, AdjustmentsInTheirOwnThreadAreAppliedAndReported) {
   // Without --deterministic, which keeps them in local mapping's step: an offline run's default
   // is the thread, paced by the live emulation (its results applied by local mapping).
-  const auto run = RunPkslam(fmt::format(
-      "--log-level info run --dataset '{}' --sensor stereo-inertial --out '{}' --quiet "
-      "--calibrate online",
-      Seq().string(), (Dir() / "thread").string()));
+  const auto run = RunPkslam(
+      fmt::format("--log-level info run --dataset '{}' --sensor stereo-inertial --out '{}' --quiet "
+                  "--calibrate online",
+                  Seq().string(), (Dir() / "thread").string()));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const YAML::Node c = ReadJsonFile(Dir() / "thread/stats.json")["calibration"];
   EXPECT_EQ(c["solved_in"].as<std::string>(), "thread");
@@ -230,20 +230,39 @@ TEST_F(CalibrationCli, OffReportsTheFileAndWritesItBack) {
         << p["name"].as<std::string>();
   }
   // The written file is the dataset's calibration.
-  const EurocCameraSensor written = ReadEurocCameraSensor(Dir() / "off/calibration/cam1/sensor.yaml");
+  const EurocCameraSensor written =
+      ReadEurocCameraSensor(Dir() / "off/calibration/cam1/sensor.yaml");
   const EurocCameraSensor dataset = ReadEurocCameraSensor(Seq() / "mav0/cam1/sensor.yaml");
   EXPECT_EQ(written.intrinsics, dataset.intrinsics);
   EXPECT_EQ(written.distortion_coefficients, dataset.distortion_coefficients);
   EXPECT_LT((written.body_from_camera.Inverse() * dataset.body_from_camera).Log().norm(), 1e-12);
 }
 
+TEST_F(CalibrationCli, FreedomFlagsReachTheAdjustment) {
+  // One flag that frees a group held by default and one that holds a group freed by default
+  // (apps/calibration_flags.cc registers both from one table).
+  const auto run =
+      Run("freedom", "--calibrate online --calibrate-lever-arm --calibrate-hold-gyro-scale");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const YAML::Node c = ReadJsonFile(Dir() / "freedom/stats.json")["calibration"];
+  YAML::Node p;
+  ASSERT_NE(FindParameter(c["parameters"], "imu.tx", &p), nullptr);
+  EXPECT_TRUE(p["free"].as<bool>());
+  EXPECT_FALSE(c["frozen"]["imu_translation"].IsDefined());
+  ASSERT_NE(FindParameter(c["parameters"], "gyro.sy", &p), nullptr);
+  EXPECT_FALSE(p["free"].as<bool>());
+  EXPECT_THAT(c["frozen"]["gyro_scale"].as<std::string>(),
+              HasSubstr("--calibrate-hold-gyro-scale"));
+}
+
 TEST_F(CalibrationCli, TheEstimateFedBackRunsAndAMapCarriesItsCalibration) {
-  const auto fed_back = Run("fed_back", fmt::format("--settings '{}'",
-                                                    (Online() / "calibration/settings.yaml").string()));
+  const auto fed_back =
+      Run("fed_back",
+          fmt::format("--settings '{}'", (Online() / "calibration/settings.yaml").string()));
   EXPECT_EQ(fed_back.exit_code, 0) << fed_back.output;
   // A later session with the file's calibration loads the map and continues in its estimate.
-  const auto loaded = Run("loaded", fmt::format("--load-map '{}' --max-frames 60",
-                                                OnlineMap().string()));
+  const auto loaded =
+      Run("loaded", fmt::format("--load-map '{}' --max-frames 60", OnlineMap().string()));
   ASSERT_EQ(loaded.exit_code, 0) << loaded.output;
   const YAML::Node c = ReadJsonFile(Dir() / "loaded/stats.json")["calibration"];
   YAML::Node offset;
