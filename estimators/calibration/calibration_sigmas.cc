@@ -124,19 +124,14 @@ bool FillSigmas(ceres::Problem* ceres_problem, State* s, const CalibrationBundle
     t.block(e.first, b.offset, map.rows(), b.size) = map;
   }
   *parameter_covariance = t * covariance->joint * t.transpose();
+  // The sigmas are its diagonal (a block's own J P C P^T J^T).
   for (int i = 0; i < n; ++i) {
-    if ((*parameters)[static_cast<std::size_t>(i)].free) continue;
-    parameter_covariance->row(i).setZero();
-    parameter_covariance->col(i).setZero();
-  }
-  for (const Entry& e : entries) {
-    const Eigen::MatrixXd tangent = covariance->Block(e.block);
-    const Eigen::MatrixXd m =
-        e.ambient ? AmbientCovariance(*ceres_problem, e.block, tangent) : tangent;
-    const Eigen::MatrixXd reported = e.j * m * e.j.transpose();
-    for (int i = 0; i < reported.rows(); ++i) {
-      CalibrationParameter& p = (*parameters)[static_cast<std::size_t>(e.first + i)];
-      if (p.free) p.sigma = std::sqrt(std::max(0.0, reported(i, i)));
+    CalibrationParameter& p = (*parameters)[static_cast<std::size_t>(i)];
+    if (p.free) {
+      p.sigma = std::sqrt(std::max(0.0, (*parameter_covariance)(i, i)));
+    } else {
+      parameter_covariance->row(i).setZero();
+      parameter_covariance->col(i).setZero();
     }
   }
   return true;
